@@ -1,0 +1,43 @@
+//! Command-line glue: parse flags, set up logging, call into the library, pick the exit code.
+//! Each subcommand lives in a file of its own beside this one.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// skycast: a cloud and weather sky for flight simulators.
+#[derive(Debug, Parser)]
+#[command(name = "skycast", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Lists the cloud types skycast draws, by the names config files and themes use.
+    Types,
+}
+
+/// Runs the command line and maps errors to a message on standard error and exit status 2.
+pub fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+        .format_timestamp(None)
+        .init();
+    let cli = Cli::parse();
+    let result: anyhow::Result<()> = match cli.command {
+        Command::Types => {
+            for cloud_type in skycast::weather::CloudType::ALL {
+                println!("{cloud_type}");
+            }
+            Ok(())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("skycast: error: {err:#}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,12 @@
+//! The weather stage: weather files in, the weather of any 4 km x 4 km block out.
+//!
+//! `metar` decodes reports; `files` reads bulk files (the aviation weather service's
+//! `metars.cache.csv`, NOAA cycle files, plain METAR lines) and places them with `stations`;
+//! `field` triangulates the placed reports (spade, Delaunay) and interpolates by natural
+//! neighbours; `block` holds the per-block result the clouds stage consumes.
+
+pub mod block;
+pub mod cloud_type;
+
+pub use block::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, TypeSource, Wind};
+pub use cloud_type::CloudType;
