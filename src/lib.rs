@@ -5,4 +5,5 @@
 //! one module per stage: [`weather`] -> `clouds` -> `shading` -> `render` -> `flight`.
 //! Only `render` knows wgpu; every stage before it is plain data, testable without a device.
 
+pub mod config;
 pub mod weather;

@@ -1,0 +1,154 @@
+//! Loading TOML files (config, themes, flight paths) with errors a user can act on: every error
+//! names the file, the line and the field. Each stage deserialises its own types with serde; this
+//! module only turns text into them and turns failures into [`ConfigError`].
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use serde::de::DeserializeOwned;
+
+/// A TOML file that could not be read, parsed or validated.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{}{}: {}{message}", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default(),
+        field.as_ref().map(|f| format!("field `{f}`: ")).unwrap_or_default())]
+pub struct ConfigError {
+    /// The file.
+    pub path: PathBuf,
+    /// 1-based line of the offending text, when known.
+    pub line: Option<usize>,
+    /// The key at fault, when known.
+    pub field: Option<String>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl ConfigError {
+    /// An error about the text at `span` of `text` (a field's `toml::Spanned` span, say).
+    pub fn at(
+        path: &Path,
+        text: &str,
+        span: Range<usize>,
+        field: &str,
+        message: impl Into<String>,
+    ) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            line: Some(line_of(text, span.start)),
+            field: Some(field.to_string()),
+            message: message.into(),
+        }
+    }
+
+    /// An error about the whole file (it cannot be read, or a rule spans several fields).
+    pub fn whole_file(path: &Path, message: impl Into<String>) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            line: None,
+            field: None,
+            message: message.into(),
+        }
+    }
+}
+
+/// Reads and parses a TOML file.
+pub fn load_toml<T: DeserializeOwned>(path: &Path) -> Result<T, ConfigError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
+    parse_toml(&text, path)
+}
+
+/// Parses TOML text that came from `path` (used in messages only).
+pub fn parse_toml<T: DeserializeOwned>(text: &str, path: &Path) -> Result<T, ConfigError> {
+    toml::from_str(text).map_err(|err| {
+        let line = err.span().map(|span| line_of(text, span.start));
+        let message = err.message().trim_end().to_string();
+        // serde names the field in "missing field `x`" and "unknown field `x`"; otherwise the
+        // span points at a value, and the key on that line is the field.
+        let field = backticked(&message).or_else(|| {
+            let span = err.span()?;
+            key_on_line(text, span.start)
+        });
+        ConfigError {
+            path: path.to_path_buf(),
+            line,
+            field,
+            message,
+        }
+    })
+}
+
+/// 1-based line number of a byte offset.
+pub fn line_of(text: &str, offset: usize) -> usize {
+    let offset = offset.min(text.len());
+    text.as_bytes()[..offset]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+fn backticked(message: &str) -> Option<String> {
+    let start = message.find('`')? + 1;
+    let len = message[start..].find('`')?;
+    Some(message[start..start + len].to_string())
+}
+
+fn key_on_line(text: &str, offset: usize) -> Option<String> {
+    let offset = offset.min(text.len());
+    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    let line = text[line_start..].lines().next()?;
+    let (key, _) = line.split_once('=')?;
+    let key = key.trim().trim_start_matches('{').trim();
+    (!key.is_empty()).then(|| key.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::Deserialize;
+
+    #[derive(Debug, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Sample {
+        name: String,
+        size_m: f32,
+    }
+
+    fn error_of(text: &str) -> ConfigError {
+        parse_toml::<Sample>(text, Path::new("config/sample.toml")).unwrap_err()
+    }
+
+    #[test]
+    fn wrong_type_names_line_and_field() {
+        let err = error_of("name = \"a\"\nsize_m = \"big\"\n");
+        assert_eq!((err.line, err.field.as_deref()), (Some(2), Some("size_m")));
+        assert!(
+            err.to_string()
+                .starts_with("config/sample.toml:2: field `size_m`: "),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn missing_and_unknown_fields_are_named() {
+        assert_eq!(error_of("name = \"a\"\n").field.as_deref(), Some("size_m"));
+        let err = error_of("name = \"a\"\nsize_m = 1.0\ncolour = 3\n");
+        assert_eq!((err.line, err.field.as_deref()), (Some(3), Some("colour")));
+    }
+
+    #[test]
+    fn syntax_error_has_a_line() {
+        assert_eq!(error_of("name = \"a\"\nsize_m = \n").line, Some(2));
+    }
+
+    #[test]
+    fn unreadable_file_names_the_file() {
+        let err = load_toml::<Sample>(Path::new("/nonexistent/skycast.toml")).unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("/nonexistent/skycast.toml: cannot read"),
+            "{err}"
+        );
+    }
+}
