@@ -1,0 +1,238 @@
+//! The artist's time-of-day tables of Wang 2003 sections 5.1 (ambient percentage) and 5.2
+//! (maximum directional colour), plus the sky gradient colours, indexed by sun elevation in
+//! degrees and read from `config/time_of_day.toml`. Interpolation between samples is linear,
+//! the `A_T` of equations (1) and (2).
+
+use std::path::Path;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use super::{DirectionalMapping, ShadingError};
+use crate::config::{ConfigError, line_of, parse_toml};
+
+/// The built-in table, `config/time_of_day.toml`.
+pub const DEFAULT_TIME_OF_DAY_TOML: &str = include_str!("../../config/time_of_day.toml");
+
+/// One row of the table: the light at one sun elevation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeOfDaySample {
+    /// Sun elevation this row applies at, degrees (-90..=90).
+    pub sun_elevation_deg: f32,
+    /// Factor for the ambient colour levels, 0..=1.
+    pub ambient_percent: f32,
+    /// Maximum directional (sun) colour, linear RGB.
+    pub directional_rgb: [f32; 3],
+    /// Sky colour straight up, linear RGB.
+    pub sky_zenith_rgb: [f32; 3],
+    /// Sky colour at the horizon, linear RGB.
+    pub sky_horizon_rgb: [f32; 3],
+}
+
+/// The whole table as configured.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeOfDayTable {
+    /// Wang's Cmin / Cmedian / Cmax.
+    pub directional_mapping: DirectionalMapping,
+    /// Rows in increasing sun elevation.
+    #[serde(rename = "sample")]
+    pub samples: Vec<TimeOfDaySample>,
+}
+
+/// The light at one moment, interpolated from the table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeOfDay {
+    /// Factor for the ambient colour levels.
+    pub ambient_percent: f32,
+    /// Maximum directional colour.
+    pub directional_rgb: Vec3,
+    /// Sky colour straight up.
+    pub sky_zenith_rgb: Vec3,
+    /// Sky colour at the horizon.
+    pub sky_horizon_rgb: Vec3,
+}
+
+impl Default for TimeOfDayTable {
+    fn default() -> Self {
+        // The built-in text is tested below to parse.
+        Self::from_toml_str(
+            DEFAULT_TIME_OF_DAY_TOML,
+            "config/time_of_day.toml (built in)",
+        )
+        .unwrap_or_else(|_| Self {
+            directional_mapping: DirectionalMapping::default(),
+            samples: vec![TimeOfDaySample {
+                sun_elevation_deg: 0.0,
+                ambient_percent: 1.0,
+                directional_rgb: [1.0; 3],
+                sky_zenith_rgb: [0.1, 0.25, 0.6],
+                sky_horizon_rgb: [0.5, 0.6, 0.8],
+            }],
+        })
+    }
+}
+
+impl TimeOfDayTable {
+    /// Parses and checks a table; `source_name` names the file in errors.
+    pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self, ShadingError> {
+        let path = Path::new(source_name);
+        let table: Self = parse_toml(text, path)?;
+        // Rows are checked after parsing; the line is that of the row's elevation key.
+        let row_line = |row: usize| {
+            text.match_indices("[[sample]]")
+                .nth(row)
+                .map(|(offset, _)| line_of(text, offset))
+        };
+        let invalid = |row: usize, field: &str, message: String| {
+            ShadingError::Config(ConfigError {
+                path: path.to_path_buf(),
+                line: row_line(row),
+                field: Some(field.to_owned()),
+                message,
+            })
+        };
+        if table.samples.is_empty() {
+            return Err(ConfigError::whole_file(path, "needs at least one [[sample]]").into());
+        }
+        for (i, pair) in table.samples.windows(2).enumerate() {
+            if pair[1].sun_elevation_deg <= pair[0].sun_elevation_deg {
+                return Err(invalid(
+                    i + 1,
+                    "sun_elevation_deg",
+                    format!(
+                        "sample {}: {} must be greater than the previous sample's {}",
+                        i + 2,
+                        pair[1].sun_elevation_deg,
+                        pair[0].sun_elevation_deg
+                    ),
+                ));
+            }
+        }
+        for (i, s) in table.samples.iter().enumerate() {
+            if !(0.0..=4.0).contains(&s.ambient_percent) {
+                return Err(invalid(
+                    i,
+                    "ambient_percent",
+                    format!("sample {}: {} is outside 0..=4", i + 1, s.ambient_percent),
+                ));
+            }
+        }
+        Ok(table)
+    }
+
+    /// Reads and checks a table file.
+    pub fn from_path(path: &Path) -> Result<Self, ShadingError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
+        Self::from_toml_str(&text, &path.display().to_string())
+    }
+
+    /// The light when the sun stands at `sun_elevation_deg`.
+    pub fn at(&self, sun_elevation_deg: f32) -> TimeOfDay {
+        let s = &self.samples;
+        let (a, b, t) = match s
+            .iter()
+            .position(|x| x.sun_elevation_deg >= sun_elevation_deg)
+        {
+            None => (s[s.len() - 1], s[s.len() - 1], 0.0),
+            Some(0) => (s[0], s[0], 0.0),
+            Some(i) => {
+                let (lo, hi) = (s[i - 1], s[i]);
+                let t = (sun_elevation_deg - lo.sun_elevation_deg)
+                    / (hi.sun_elevation_deg - lo.sun_elevation_deg);
+                (lo, hi, t)
+            }
+        };
+        let mix3 = |x: [f32; 3], y: [f32; 3]| Vec3::from_array(x).lerp(Vec3::from_array(y), t);
+        TimeOfDay {
+            ambient_percent: a.ambient_percent + (b.ambient_percent - a.ambient_percent) * t,
+            directional_rgb: mix3(a.directional_rgb, b.directional_rgb),
+            sky_zenith_rgb: mix3(a.sky_zenith_rgb, b.sky_zenith_rgb),
+            sky_horizon_rgb: mix3(a.sky_horizon_rgb, b.sky_horizon_rgb),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn built_in_table_parses_with_more_samples_around_dawn() {
+        let t = TimeOfDayTable::from_toml_str(DEFAULT_TIME_OF_DAY_TOML, "built in").unwrap();
+        let near_horizon = t
+            .samples
+            .iter()
+            .filter(|s| (-6.0..=10.0).contains(&s.sun_elevation_deg))
+            .count();
+        let high = t
+            .samples
+            .iter()
+            .filter(|s| s.sun_elevation_deg > 10.0)
+            .count();
+        assert!(
+            near_horizon >= 5 && near_horizon > high,
+            "{near_horizon} vs {high}"
+        );
+        assert_eq!(TimeOfDayTable::default(), t);
+    }
+
+    #[test]
+    fn light_fades_towards_night_and_reddens_at_dawn() {
+        let t = TimeOfDayTable::default();
+        let noon = t.at(60.0);
+        let dawn = t.at(1.0);
+        let night = t.at(-30.0);
+        assert!(noon.ambient_percent > dawn.ambient_percent);
+        assert!(dawn.ambient_percent > night.ambient_percent);
+        assert_eq!(night.directional_rgb, Vec3::ZERO);
+        assert!(dawn.directional_rgb.x > 1.5 * dawn.directional_rgb.z);
+    }
+
+    #[test]
+    fn interpolates_linearly_between_samples_and_clamps_at_the_ends() {
+        let t = TimeOfDayTable::from_toml_str(
+            "[directional_mapping]\nc_min = 0.1\nc_median = 0.5\nc_max = 1.0\n\
+             [[sample]]\nsun_elevation_deg = 0.0\nambient_percent = 0.2\ndirectional_rgb = [0,0,0]\n\
+             sky_zenith_rgb = [0,0,0]\nsky_horizon_rgb = [0,0,0]\n\
+             [[sample]]\nsun_elevation_deg = 10.0\nambient_percent = 0.6\ndirectional_rgb = [1,1,1]\n\
+             sky_zenith_rgb = [1,1,1]\nsky_horizon_rgb = [1,1,1]\n",
+            "t.toml",
+        )
+        .unwrap();
+        assert!((t.at(2.5).ambient_percent - 0.3).abs() < 1e-6);
+        assert_eq!(t.at(2.5).directional_rgb, Vec3::splat(0.25));
+        assert_eq!(t.at(-50.0).ambient_percent, 0.2);
+        assert_eq!(t.at(50.0).ambient_percent, 0.6);
+    }
+
+    #[test]
+    fn bad_tables_name_file_line_and_field() {
+        let text = DEFAULT_TIME_OF_DAY_TOML.replacen(
+            "ambient_percent = 0.04",
+            "ambient_percent = \"x\"",
+            1,
+        );
+        let err = TimeOfDayTable::from_toml_str(&text, "my_tod.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("my_tod.toml:16: field `ambient_percent`"),
+            "{err}"
+        );
+        let text = DEFAULT_TIME_OF_DAY_TOML.replacen(
+            "sun_elevation_deg = -12.0",
+            "sun_elevation_deg = -40.0",
+            1,
+        );
+        let err = TimeOfDayTable::from_toml_str(&text, "my_tod.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("sample 3") && err.contains("sun_elevation_deg"),
+            "{err}"
+        );
+    }
+}
