@@ -64,10 +64,15 @@ pub fn parse_toml<T: DeserializeOwned>(text: &str, path: &Path) -> Result<T, Con
         let message = err.message().trim_end().to_string();
         // serde names the field in "missing field `x`" and "unknown field `x`"; otherwise the
         // span points at a value, and the key on that line is the field.
-        let field = backticked(&message).or_else(|| {
-            let span = err.span()?;
-            key_on_line(text, span.start)
-        });
+        let names_field =
+            message.starts_with("missing field") || message.starts_with("unknown field");
+        let field = names_field
+            .then(|| backticked(&message))
+            .flatten()
+            .or_else(|| {
+                let span = err.span()?;
+                key_on_line(text, span.start)
+            });
         ConfigError {
             path: path.to_path_buf(),
             line,

@@ -9,6 +9,7 @@ pub mod block;
 pub mod cloud_type;
 pub mod metar;
 pub mod remarks;
+pub mod theme;
 
 pub use block::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, TypeSource, Wind};
 pub use cloud_type::CloudType;
