@@ -7,9 +7,17 @@
 
 pub mod block;
 pub mod cloud_type;
+pub mod error;
+pub mod files;
+pub mod frame;
 pub mod metar;
 pub mod remarks;
 pub mod theme;
+pub mod stations;
 
 pub use block::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, TypeSource, Wind};
 pub use cloud_type::CloudType;
+pub use error::{LineWarning, WeatherError};
+pub use files::{FileFormat, PlacedReport, Position, WeatherFile};
+pub use frame::LocalFrame;
+pub use stations::{Station, StationTable};
