@@ -45,18 +45,10 @@ pub enum WeatherError {
         /// What was found instead.
         reason: String,
     },
-    /// A TOML configuration file is wrong at one line and field.
-    #[error("{path}:{line}: {field}: {message}")]
-    Config {
-        /// The file.
-        path: PathBuf,
-        /// 1-based line (0 when the problem is the file as a whole).
-        line: usize,
-        /// The field (TOML key path) at fault.
-        field: String,
-        /// What is wrong.
-        message: String,
-    },
+    /// A TOML configuration file (the cloud-type rule, the field settings) is wrong; the error
+    /// names file, line and field.
+    #[error(transparent)]
+    Config(#[from] crate::config::ConfigError),
 }
 
 /// A problem with one line of an input file that did not stop the file.
@@ -72,14 +64,4 @@ impl std::fmt::Display for LineWarning {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "line {}: {}", self.line, self.message)
     }
-}
-
-/// 1-based line of a byte offset into `text`.
-pub(crate) fn line_of_offset(text: &str, offset: usize) -> usize {
-    let end = offset.min(text.len());
-    text.as_bytes()[..end]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
 }

@@ -12,8 +12,8 @@ pub mod files;
 pub mod frame;
 pub mod metar;
 pub mod remarks;
-pub mod theme;
 pub mod stations;
+pub mod theme;
 
 pub use block::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, TypeSource, Wind};
 pub use cloud_type::CloudType;

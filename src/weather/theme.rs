@@ -450,7 +450,10 @@ top_ft = 5000
         for entry in std::fs::read_dir(dir).unwrap() {
             let path = entry.unwrap().path();
             let theme = load_theme(&path).unwrap_or_else(|err| panic!("{err}"));
-            assert!(!theme.everywhere.layers.is_empty() || !theme.points.is_empty(), "{path:?}");
+            assert!(
+                !theme.everywhere.layers.is_empty() || !theme.points.is_empty(),
+                "{path:?}"
+            );
             count += 1;
         }
         assert!(count >= 5, "{count} themes shipped");
