@@ -6,5 +6,6 @@
 //! Only `render` knows wgpu; every stage before it is plain data, testable without a device.
 
 pub mod config;
+pub mod flight;
 pub mod shading;
 pub mod weather;
