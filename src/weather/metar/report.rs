@@ -152,3 +152,66 @@ pub struct Report {
     /// Groups that could not be decoded, each with the group and why.
     pub warnings: Vec<String>,
 }
+
+impl std::fmt::Display for ReportTime {
+    /// `DDHHMMZ`, as the report writes it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:02}{:02}{:02}Z", self.day, self.hour, self.minute)
+    }
+}
+
+impl std::fmt::Display for PresentWeather {
+    /// The group as the report writes it (`-SHRA`, `VCTS`, `+TSRAGR`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let prefix = match self.intensity {
+            Intensity::Light => "-",
+            Intensity::Moderate => "",
+            Intensity::Heavy => "+",
+            Intensity::Vicinity => "VC",
+        };
+        f.write_str(prefix)?;
+        if let Some(descriptor) = &self.descriptor {
+            f.write_str(descriptor)?;
+        }
+        for phenomenon in &self.phenomena {
+            f.write_str(phenomenon)?;
+        }
+        Ok(())
+    }
+}
+
+impl Cover {
+    /// The code as the report writes it: FEW, SCT, BKN, OVC, VV.
+    pub fn code(self) -> &'static str {
+        match self {
+            Cover::Few => "FEW",
+            Cover::Sct => "SCT",
+            Cover::Bkn => "BKN",
+            Cover::Ovc => "OVC",
+            Cover::Vv => "VV",
+        }
+    }
+}
+
+impl ConvectiveKind {
+    /// The code as the report writes it: CB, TCU.
+    pub fn code(self) -> &'static str {
+        match self {
+            ConvectiveKind::Cb => "CB",
+            ConvectiveKind::Tcu => "TCU",
+        }
+    }
+}
+
+impl SkyCode {
+    /// The code as the report writes it: CLR, SKC, NSC, NCD, NIL.
+    pub fn code(self) -> &'static str {
+        match self {
+            SkyCode::Clr => "CLR",
+            SkyCode::Skc => "SKC",
+            SkyCode::Nsc => "NSC",
+            SkyCode::Ncd => "NCD",
+            SkyCode::Nil => "NIL",
+        }
+    }
+}
