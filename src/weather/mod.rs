@@ -8,6 +8,7 @@
 pub mod block;
 pub mod cloud_type;
 pub mod error;
+pub mod field;
 pub mod files;
 pub mod frame;
 pub mod metar;

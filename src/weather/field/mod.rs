@@ -1,0 +1,296 @@
+//! The weather field: placed reports in, the weather at any point (and so of any 4 km block) out.
+//!
+//! The stations are projected into a [`LocalFrame`] and triangulated (spade's Delaunay
+//! triangulation; stations at identical positions are merged, the latest report wins). Values are
+//! interpolated by Sibson's natural-neighbour interpolation (spade's `natural_neighbor`), which is
+//! exact at the stations and smooth between them; a point outside the convex hull of the stations
+//! takes its nearest station's values.
+//!
+//! Two triangulations: the cloud field holds the stations that say something about the sky
+//! (layers, CAVOK/NSC/NCD/SKC/CLR as zero coverage, VV, FG); the surface field holds every station
+//! (visibility, wind as a vector, temperature, dewpoint, precipitation, ground elevation). A value
+//! some neighbours do not report is interpolated over the neighbours that do (weights
+//! renormalised); with none, the configured default.
+//!
+//! Per band (fog, low < 6,500 ft, middle, high > 20,000 ft AGL) coverage is interpolated over all
+//! cloud stations (clear ones pull it down); base and thickness are weighted by weight x coverage,
+//! so clear stations do not drag bases. A reported CB (TCU) survives where the stations reporting
+//! it carry at least `convective.weight_min` of the natural-neighbour weight: near a CB station the
+//! layer stays a cumulonimbus instead of fading into its neighbours' stratocumulus. Layer types
+//! come from [`CloudTypeRule`]. Settings: `config/weather_field.toml`.
+
+mod rule;
+mod sample;
+mod settings;
+#[cfg(test)]
+mod tests;
+
+pub use rule::{Band, CloudTypeRule, LayerFacts, Reported, Rule};
+pub use sample::{BandSample, StationSample};
+pub use settings::FieldSettings;
+
+use std::collections::HashMap;
+
+use glam::DVec2;
+use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
+
+use super::block::{BlockIndex, BlockLayer, BlockWeather, TypeSource, Wind};
+use super::files::PlacedReport;
+use super::frame::LocalFrame;
+
+/// A triangulation vertex: a station's local position and its index in the sample list.
+#[derive(Debug, Clone, Copy)]
+struct Site {
+    position: Point2<f64>,
+    index: usize,
+}
+
+impl HasPosition for Site {
+    type Scalar = f64;
+    fn position(&self) -> Point2<f64> {
+        self.position
+    }
+}
+
+type Tri = DelaunayTriangulation<Site>;
+
+/// The weather everywhere, from placed reports.
+#[derive(Debug)]
+pub struct WeatherField {
+    frame: LocalFrame,
+    settings: FieldSettings,
+    rule: CloudTypeRule,
+    samples: Vec<StationSample>,
+    surface: Tri,
+    clouds: Tri,
+}
+
+/// Natural-neighbour weights of a point: (sample index, weight), weights summing to 1.
+type Weights = Vec<(usize, f64)>;
+
+impl WeatherField {
+    /// Builds the field of `reports` in `frame`.
+    pub fn build(
+        frame: LocalFrame,
+        reports: &[PlacedReport],
+        settings: &FieldSettings,
+        rule: &CloudTypeRule,
+    ) -> Self {
+        // Latest report per position (bit-identical latitude/longitude): by report time, then by
+        // file order.
+        let mut latest: HashMap<(u64, u64), &PlacedReport> = HashMap::new();
+        for p in reports {
+            let key = (
+                p.position.latitude_deg.to_bits(),
+                p.position.longitude_deg.to_bits(),
+            );
+            let time = |p: &PlacedReport| p.report.time.map(|t| (t.day, t.hour, t.minute));
+            latest
+                .entry(key)
+                .and_modify(|old| {
+                    if (time(p), p.line) >= (time(old), old.line) {
+                        *old = p;
+                    }
+                })
+                .or_insert(p);
+        }
+        let mut kept: Vec<&PlacedReport> = latest.into_values().collect();
+        kept.sort_by_key(|p| p.line);
+        let mut samples = Vec::with_capacity(kept.len());
+        let mut surface_sites = Vec::with_capacity(kept.len());
+        let mut cloud_sites = Vec::new();
+        for p in kept {
+            let Some(sample) = StationSample::of(p, settings) else {
+                continue;
+            };
+            let local = frame.to_local_m(p.position.latitude_deg, p.position.longitude_deg);
+            if !local.is_finite() {
+                continue;
+            }
+            let site = Site {
+                position: Point2::new(local.x, local.y),
+                index: samples.len(),
+            };
+            if sample.bands.is_some() {
+                cloud_sites.push(site);
+            }
+            surface_sites.push(site);
+            samples.push(sample);
+        }
+        Self {
+            frame,
+            settings: settings.clone(),
+            rule: rule.clone(),
+            samples,
+            surface: triangulate(surface_sites),
+            clouds: triangulate(cloud_sites),
+        }
+    }
+
+    /// The frame the field lives in.
+    pub fn frame(&self) -> &LocalFrame {
+        &self.frame
+    }
+
+    /// Stations in the field (after merging identical positions, NIL reports left out).
+    pub fn station_count(&self) -> usize {
+        self.surface.num_vertices()
+    }
+
+    /// Stations that say something about the sky.
+    pub fn cloud_station_count(&self) -> usize {
+        self.clouds.num_vertices()
+    }
+
+    /// The weather of a block, queried at its centre.
+    pub fn block_weather(&self, block: BlockIndex) -> BlockWeather {
+        self.weather_at(block.centre_m())
+    }
+
+    /// The weather at a latitude/longitude.
+    pub fn weather_at_lat_lon(&self, lat_deg: f64, lon_deg: f64) -> BlockWeather {
+        self.weather_at(self.frame.to_local_m(lat_deg, lon_deg))
+    }
+
+    /// The weather at a local point (metres east/north).
+    pub fn weather_at(&self, point_m: DVec2) -> BlockWeather {
+        let d = &self.settings.defaults;
+        let w = weights(&self.surface, point_m);
+        let value = |f: &dyn Fn(&StationSample) -> Option<f64>, default: f64| {
+            weighted(&w, &self.samples, f).unwrap_or(default)
+        };
+        let temperature_c = value(&|s| s.temperature_c, d.temperature_c);
+        let dewpoint_c = value(&|s| s.dewpoint_c, d.dewpoint_c);
+        let precipitation = value(&|s| Some(s.precipitation), 0.0);
+        let east = value(&|s| s.wind_kt.map(|v| v[0]), 0.0);
+        let north = value(&|s| s.wind_kt.map(|v| v[1]), 0.0);
+        let wind = wind_from_velocity_kt(east, north);
+        let layers = self.layers_at(point_m, precipitation, temperature_c - dewpoint_c);
+        BlockWeather {
+            layers,
+            visibility_m: value(&|s| s.visibility_m, d.visibility_m) as f32,
+            wind,
+            temperature_c: temperature_c as f32,
+            dewpoint_c: dewpoint_c as f32,
+            precipitation: precipitation as f32,
+            ground_elevation_m: value(&|s| s.elevation_m, d.ground_elevation_m) as f32,
+        }
+    }
+
+    fn layers_at(&self, point_m: DVec2, precipitation: f64, spread_c: f64) -> Vec<BlockLayer> {
+        let w = weights(&self.clouds, point_m);
+        let mut layers = Vec::new();
+        for (i, band) in Band::ALL.into_iter().enumerate() {
+            let bands = |s: &StationSample| s.bands.map(|b| b[i]);
+            let mut coverage = 0.0;
+            let mut weighted_base = 0.0;
+            let mut weighted_thickness = 0.0;
+            let mut cb = 0.0;
+            let mut tower = 0.0;
+            for &(index, weight) in &w {
+                let Some(b) = bands(&self.samples[index]) else {
+                    continue;
+                };
+                coverage += weight * b.coverage_oktas;
+                weighted_base += weight * b.coverage_oktas * b.base_ft;
+                weighted_thickness += weight * b.coverage_oktas * b.thickness_ft;
+                if b.cb {
+                    cb += weight;
+                }
+                if b.cb || b.tcu {
+                    tower += weight;
+                }
+            }
+            let min = self.settings.convective.weight_min;
+            let (reported_cb, reported_tcu) = (cb > 0.0 && cb >= min, tower > 0.0 && tower >= min);
+            if coverage < self.settings.layers.min_coverage_oktas || coverage <= 0.0 {
+                continue;
+            }
+            let (cloud_type, type_source) = if band != Band::Fog && reported_cb {
+                (self.rule.reported.cb, TypeSource::Reported)
+            } else if band != Band::Fog && reported_tcu {
+                (self.rule.reported.tcu, TypeSource::Reported)
+            } else {
+                let facts = LayerFacts {
+                    band,
+                    coverage_oktas: coverage,
+                    precipitation,
+                    spread_c,
+                };
+                (self.rule.height_rule_type(&facts), TypeSource::HeightRule)
+            };
+            layers.push(BlockLayer {
+                cloud_type,
+                type_source,
+                coverage_oktas: coverage.min(8.0) as f32,
+                base_ft_agl: (weighted_base / coverage) as f32,
+                thickness_ft: (weighted_thickness / coverage) as f32,
+            });
+        }
+        layers.sort_by(|a, b| a.base_ft_agl.total_cmp(&b.base_ft_agl));
+        layers
+    }
+}
+
+/// The triangulation of the sites (bulk loaded; a site spade rejects is left out).
+fn triangulate(sites: Vec<Site>) -> Tri {
+    match Tri::bulk_load(sites.clone()) {
+        Ok(tri) => tri,
+        Err(_) => {
+            let mut tri = Tri::new();
+            for site in sites {
+                let _ = tri.insert(site);
+            }
+            tri
+        }
+    }
+}
+
+/// Natural-neighbour weights at a point; the nearest station alone outside the hull.
+fn weights(tri: &Tri, point_m: DVec2) -> Weights {
+    let p = Point2::new(point_m.x, point_m.y);
+    let mut out = Vec::new();
+    if tri.num_inner_faces() > 0 {
+        let mut raw = Vec::new();
+        tri.natural_neighbor().get_weights(p, &mut raw);
+        out.extend(
+            raw.into_iter()
+                .map(|(h, w)| (tri.vertex(h).data().index, w)),
+        );
+    }
+    if out.is_empty()
+        && let Some(v) = tri.nearest_neighbor(p)
+    {
+        out.push((v.data().index, 1.0));
+    }
+    out
+}
+
+/// Weighted mean over the neighbours that report a value; `None` when none does.
+fn weighted(
+    w: &Weights,
+    samples: &[StationSample],
+    f: &dyn Fn(&StationSample) -> Option<f64>,
+) -> Option<f64> {
+    let (mut sum, mut total) = (0.0, 0.0);
+    for &(index, weight) in w {
+        if let Some(v) = f(&samples[index]) {
+            sum += weight * v;
+            total += weight;
+        }
+    }
+    (total > 0.0).then(|| sum / total)
+}
+
+/// The wind blowing with this velocity (knots east/north).
+fn wind_from_velocity_kt(east: f64, north: f64) -> Wind {
+    let speed_kt = east.hypot(north);
+    if speed_kt < 1e-9 {
+        return Wind::default();
+    }
+    let from_deg = (east.atan2(north).to_degrees() + 180.0).rem_euclid(360.0);
+    Wind {
+        from_deg: from_deg as f32,
+        speed_kt: speed_kt as f32,
+    }
+}

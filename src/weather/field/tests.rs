@@ -1,0 +1,253 @@
+//! Interpolation properties of the field, on hand-built reports.
+
+use super::*;
+use crate::weather::cloud_type::CloudType;
+use crate::weather::files::Position;
+use crate::weather::metar::{CloudGroup, ConvectiveKind, Cover, Report, ReportTime, WindGroup};
+
+const LAT0: f64 = 50.0;
+const LON0: f64 = 8.0;
+
+fn station(lat: f64, lon: f64, line: usize, report: Report) -> PlacedReport {
+    PlacedReport {
+        report,
+        position: Position {
+            latitude_deg: lat,
+            longitude_deg: lon,
+            elevation_m: Some(100.0 * line as f64),
+        },
+        line,
+    }
+}
+
+fn layer(cover: Cover, base_ft: u32, kind: Option<ConvectiveKind>) -> CloudGroup {
+    CloudGroup {
+        cover: Some(cover),
+        base_ft: Some(base_ft),
+        kind,
+    }
+}
+
+fn report(clouds: Vec<CloudGroup>, temperature_c: f32, wind_from: u16) -> Report {
+    Report {
+        station: "TEST".to_string(),
+        clouds,
+        temperature_c: Some(temperature_c),
+        dewpoint_c: Some(temperature_c - 2.0),
+        wind: Some(WindGroup {
+            dir_deg: Some(wind_from),
+            speed_kt: Some(10.0),
+            ..WindGroup::default()
+        }),
+        visibility_m: Some(8000.0),
+        ..Report::default()
+    }
+}
+
+fn cavok(temperature_c: f32) -> Report {
+    Report {
+        cavok: true,
+        ..report(vec![], temperature_c, 270)
+    }
+}
+
+/// Four stations on a square about 1 degree across, and one in the middle.
+fn square() -> Vec<PlacedReport> {
+    vec![
+        station(
+            49.5,
+            7.3,
+            1,
+            report(vec![layer(Cover::Ovc, 1000, None)], 4.0, 270),
+        ),
+        station(49.5, 8.7, 2, cavok(8.0)),
+        station(
+            50.5,
+            8.7,
+            3,
+            report(vec![layer(Cover::Bkn, 3000, None)], 6.0, 90),
+        ),
+        station(
+            50.5,
+            7.3,
+            4,
+            report(vec![layer(Cover::Few, 25000, None)], 2.0, 270),
+        ),
+        station(
+            50.0,
+            8.0,
+            5,
+            report(
+                vec![layer(Cover::Sct, 2500, Some(ConvectiveKind::Cb))],
+                5.0,
+                270,
+            ),
+        ),
+    ]
+}
+
+fn field(reports: &[PlacedReport]) -> WeatherField {
+    WeatherField::build(
+        LocalFrame::new(LAT0, LON0),
+        reports,
+        &FieldSettings::default(),
+        &CloudTypeRule::default(),
+    )
+}
+
+#[test]
+fn exact_at_the_stations() {
+    let f = field(&square());
+    let w = f.weather_at_lat_lon(49.5, 7.3);
+    assert_eq!(w.temperature_c, 4.0);
+    assert_eq!(w.ground_elevation_m, 100.0);
+    assert_eq!(w.layers.len(), 1);
+    assert_eq!(w.layers[0].coverage_oktas, 8.0);
+    assert_eq!(w.layers[0].base_ft_agl, 1000.0);
+    assert_eq!(w.layers[0].cloud_type, CloudType::Stratus);
+    assert_eq!(w.layers[0].type_source, TypeSource::HeightRule);
+    // The CAVOK station is clear.
+    let w = f.weather_at_lat_lon(49.5, 8.7);
+    assert!(w.layers.is_empty(), "{:?}", w.layers);
+    assert_eq!(w.visibility_m, 10000.0);
+    // The CB station keeps its CB, reported.
+    let w = f.weather_at_lat_lon(50.0, 8.0);
+    assert_eq!(w.layers[0].cloud_type, CloudType::Cumulonimbus);
+    assert_eq!(w.layers[0].type_source, TypeSource::Reported);
+    assert_eq!(w.layers[0].coverage_oktas, 4.0);
+    let w = f.weather_at_lat_lon(50.5, 7.3);
+    assert_eq!(w.layers[0].cloud_type, CloudType::Cirrus);
+}
+
+#[test]
+fn outside_the_hull_takes_the_nearest_station() {
+    let f = field(&square());
+    let far_south_west = f.weather_at_lat_lon(47.0, 5.0);
+    let station = f.weather_at_lat_lon(49.5, 7.3);
+    assert_eq!(far_south_west, station);
+    let far_north_east = f.weather_at_lat_lon(53.0, 11.0);
+    assert_eq!(far_north_east, f.weather_at_lat_lon(50.5, 8.7));
+}
+
+#[test]
+fn between_stations_values_blend_and_clear_stations_pull_coverage_down() {
+    let f = field(&square());
+    // Halfway between the OVC010 station and the CAVOK one, just inside the hull (the parallel
+    // 49.5 N bows south of the straight hull edge in the frame).
+    let w = f.weather_at_lat_lon(49.6, 8.0);
+    assert!(
+        w.temperature_c > 4.0 && w.temperature_c < 8.0,
+        "{}",
+        w.temperature_c
+    );
+    let low = w.layers.iter().find(|l| l.base_ft_agl < 6500.0).unwrap();
+    assert!(
+        low.coverage_oktas > 0.5 && low.coverage_oktas < 8.0,
+        "{}",
+        low.coverage_oktas
+    );
+    // The clear station does not drag the base down to 0: it stays between the reported bases.
+    assert!(
+        low.base_ft_agl >= 1000.0 && low.base_ft_agl <= 3000.0,
+        "{}",
+        low.base_ft_agl
+    );
+    assert!(w.ground_elevation_m > 100.0 && w.ground_elevation_m < 500.0);
+}
+
+#[test]
+fn cb_survives_near_its_station_only() {
+    let f = field(&square());
+    let near = f.weather_at_lat_lon(50.05, 8.05);
+    assert!(
+        near.layers
+            .iter()
+            .any(|l| l.cloud_type == CloudType::Cumulonimbus
+                && l.type_source == TypeSource::Reported),
+        "{:?}",
+        near.layers
+    );
+    let far = f.weather_at_lat_lon(49.55, 7.35);
+    assert!(
+        far.layers
+            .iter()
+            .all(|l| l.cloud_type != CloudType::Cumulonimbus)
+    );
+}
+
+#[test]
+fn opposite_winds_cancel() {
+    // Station 3 blows from 090, the others from 270: between 3 and its westerly neighbours the
+    // vector mean is weaker than either, never a 180-degree average pointing north or south.
+    let f = field(&square());
+    let w = f.weather_at_lat_lon(50.25, 8.35).wind;
+    assert!(w.speed_kt < 10.0, "{w:?}");
+    let at3 = f.weather_at_lat_lon(50.5, 8.7).wind;
+    assert!((at3.from_deg - 90.0).abs() < 1e-3 && (at3.speed_kt - 10.0).abs() < 1e-3);
+}
+
+#[test]
+fn stations_without_sky_are_left_out_of_the_clouds_only() {
+    let mut reports = square();
+    // A sixth station, no sky group, very warm, right next to the OVC one.
+    let mut no_sky = report(vec![], 30.0, 270);
+    no_sky.station = "NOSK".to_string();
+    reports.push(station(49.6, 7.4, 6, no_sky));
+    let f = field(&reports);
+    assert_eq!(f.station_count(), 6);
+    assert_eq!(f.cloud_station_count(), 5);
+    let w = f.weather_at_lat_lon(49.6, 7.4);
+    assert_eq!(w.temperature_c, 30.0);
+    // The clouds there are still interpolated from the five sky stations, not cleared.
+    assert!(!w.layers.is_empty());
+}
+
+#[test]
+fn identical_positions_keep_the_latest_report() {
+    let mut reports = square();
+    let mut later = report(vec![layer(Cover::Bkn, 800, None)], 12.0, 270);
+    later.time = Some(ReportTime {
+        day: 27,
+        hour: 22,
+        minute: 50,
+    });
+    let mut earlier = reports[0].report.clone();
+    earlier.time = Some(ReportTime {
+        day: 27,
+        hour: 22,
+        minute: 20,
+    });
+    reports[0].report = earlier;
+    // The later report comes first in the file: time decides, not order.
+    reports.insert(0, station(49.5, 7.3, 9, later));
+    let f = field(&reports);
+    assert_eq!(f.station_count(), 5);
+    let w = f.weather_at_lat_lon(49.5, 7.3);
+    assert_eq!(w.temperature_c, 12.0);
+    assert_eq!(w.layers[0].base_ft_agl, 800.0);
+    assert_eq!(w.layers[0].cloud_type, CloudType::Stratocumulus);
+}
+
+#[test]
+fn block_weather_is_the_weather_at_the_block_centre() {
+    let f = field(&square());
+    let block = f.frame().block_of(50.2, 8.1);
+    assert_eq!(f.block_weather(block), f.weather_at(block.centre_m()));
+}
+
+#[test]
+fn one_station_and_none() {
+    let one = field(&square()[..1]);
+    assert_eq!(one.weather_at_lat_lon(0.0, 0.0).temperature_c, 4.0);
+    let none = field(&[]);
+    let w = none.weather_at_lat_lon(50.0, 8.0);
+    assert!(w.layers.is_empty());
+    assert_eq!(w.temperature_c, 15.0);
+    assert_eq!(w.visibility_m, 10000.0);
+}
+
+#[test]
+fn the_field_can_be_shared_between_threads() {
+    fn sync<T: Send + Sync>() {}
+    sync::<WeatherField>();
+}
