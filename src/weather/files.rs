@@ -109,6 +109,33 @@ pub struct WeatherFile {
 /// Lines searched for the CSV header.
 const CSV_HEADER_SEARCH_LINES: usize = 10;
 
+/// Reads a weather file from disk, decodes its reports with the METAR decoder and places them
+/// (with `stations` where the file gives no position).
+pub fn load(path: &Path, stations: Option<&StationTable>) -> Result<WeatherFile, WeatherError> {
+    let bytes = std::fs::read(path).map_err(|source| WeatherError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(path, &bytes, stations)
+}
+
+/// [`load`] on bytes already in memory; `path` names the file in errors and the result.
+pub fn parse(
+    path: &Path,
+    bytes: &[u8],
+    stations: Option<&StationTable>,
+) -> Result<WeatherFile, WeatherError> {
+    let raw = read_raw(path, bytes)?;
+    let (reports, warnings) = place(&raw, stations, super::metar::decode);
+    Ok(WeatherFile {
+        path: path.to_path_buf(),
+        format: raw.format,
+        reports_found: raw.reports.len(),
+        reports,
+        warnings,
+    })
+}
+
 /// Finds the report texts of a file. `path` only names the file in errors.
 pub fn read_raw(path: &Path, bytes: &[u8]) -> Result<RawFile, WeatherError> {
     let not_weather = |reason: &str| WeatherError::NotWeather {
@@ -577,5 +604,38 @@ ZZZZ 272200Z 00000KT CAVOK 10/04 Q1004\r\n";
             33
         );
         assert_eq!(raw.reports.last().unwrap().line, 4915);
+    }
+
+    #[test]
+    fn the_real_bulk_file_places_nearly_every_report() {
+        let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/weather"));
+        let stations = StationTable::load(&dir.join("nsd_cccc.txt")).unwrap();
+        let path = dir.join("awc-metars-2025-01-27T22Z.cache.csv");
+        let file = load(&path, Some(&stations)).unwrap();
+        assert_eq!(file.reports_found, 4909);
+        let unplaced: Vec<&LineWarning> = file
+            .warnings
+            .iter()
+            .filter(|w| w.message.contains("station not in the station table"))
+            .collect();
+        // Of the 33 rows without a position the table knows only LFBT; the 32 others (US
+        // military KQ.. sites and a few more) are warnings, not failures.
+        assert_eq!(
+            file.reports.len() + unplaced.len(),
+            4909,
+            "{:?}",
+            file.warnings
+        );
+        assert_eq!(file.reports.len(), 4877);
+        assert!(file.reports.iter().any(|r| r.report.station == "LFBT"));
+        let egll = file
+            .reports
+            .iter()
+            .find(|r| r.report.station == "EGLL")
+            .unwrap();
+        assert_eq!(egll.line, 192);
+        assert_eq!(egll.report.clouds.len(), 2);
+        // The file's own elevation (the station table says 24 m).
+        assert_eq!(egll.position.elevation_m, Some(26.0));
     }
 }

@@ -19,6 +19,7 @@ pub mod theme;
 pub use block::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, TypeSource, Wind};
 pub use cloud_type::CloudType;
 pub use error::{LineWarning, WeatherError};
+pub use field::{CloudTypeRule, FieldSettings, WeatherField};
 pub use files::{FileFormat, PlacedReport, Position, WeatherFile};
 pub use frame::LocalFrame;
 pub use stations::{Station, StationTable};
