@@ -5,6 +5,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod metar;
+
 /// skycast: a cloud and weather sky for flight simulators.
 #[derive(Debug, Parser)]
 #[command(name = "skycast", version, about, long_about = None)]
@@ -17,6 +19,9 @@ struct Cli {
 enum Command {
     /// Lists the cloud types skycast draws, by the names config files and themes use.
     Types,
+    /// Decodes METAR/SPECI reports: station, time, wind, visibility, weather, clouds,
+    /// temperature, altimeter.
+    Metar(metar::MetarArgs),
 }
 
 /// Runs the command line and maps errors to a message on standard error and exit status 2.
@@ -32,6 +37,7 @@ pub fn main() -> ExitCode {
             }
             Ok(())
         }
+        Command::Metar(args) => metar::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

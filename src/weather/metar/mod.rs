@@ -47,10 +47,11 @@ fn is_trend_start(token: &str) -> bool {
 }
 
 /// Groups recognised and skipped quietly: military colour states, no significant weather,
-/// the words of a wind shear group.
-const QUIET: [&str; 14] = [
+/// the words of a wind shear group, US `M` (a missing field), missing groups written with
+/// slashes (`////SM`, `///V///`, `RE//`).
+const QUIET: [&str; 18] = [
     "BLU", "BLU+", "WHT", "GRN", "YLO", "YLO1", "YLO2", "AMB", "RED", "BLACK", "NSW", "WS", "ALL",
-    "RWY",
+    "RWY", "M", "////SM", "///V///", "RE//",
 ];
 
 /// Decodes one METAR or SPECI. Fails only when the text has no station; every other problem is a
@@ -268,18 +269,24 @@ fn parse_time(token: &str) -> Option<ReportTime> {
     ((1..=31).contains(&time.day) && time.hour <= 24 && time.minute <= 59).then_some(time)
 }
 
-/// Runway visual range (`R26/0550N`, `R16/P2000N`) and runway state (`R24///////`,
-/// `R05/CLRD70`, old eight-digit `88290195`).
+/// Runway visual range (`R26/0550N`, `R16/P2000N`), runway state (`R24///////`,
+/// `R05/CLRD70`, old eight-digit `88290195`), the runway of a wind shear group (`WS R35`).
 fn is_runway_group(token: &str) -> bool {
     let b = token.as_bytes();
-    (b.len() >= 4 && b[0] == b'R' && b[1].is_ascii_digit() && token.contains('/'))
+    let runway = b.len() >= 3 && b[0] == b'R' && b[1].is_ascii_digit() && b[2].is_ascii_digit();
+    (runway && (token.contains('/') || matches!(&b[3..], [] | [b'L' | b'C' | b'R'])))
         || (b.len() == 8 && b.iter().all(u8::is_ascii_digit))
 }
 
-/// Sea surface temperature and state: `W12/S2`, `W15/H7`.
+/// Sea surface temperature and state: `W12/S2`, `W15/H7`, `WM01/S3`, `W/////`.
 fn is_sea_state(token: &str) -> bool {
     let b = token.as_bytes();
-    b.len() >= 6 && b[0] == b'W' && b[3] == b'/' && matches!(b[4], b'S' | b'H')
+    b.len() >= 4
+        && b[0] == b'W'
+        && token.contains('/')
+        && b[1..]
+            .iter()
+            .all(|c| c.is_ascii_digit() || matches!(c, b'/' | b'S' | b'H' | b'M'))
 }
 
 #[cfg(test)]

@@ -176,3 +176,25 @@ fn not_a_report() {
         Err(MetarError::NoStation(_))
     ));
 }
+
+#[test]
+fn groups_skipped_quietly() {
+    let quiet = [
+        "EHJR 272155Z AUTO 19030KT //// // ///////// 09/06 Q0985 RE// W07/H26",
+        "EDAC 272150Z AUTO /////KT ///V/// 9999 // OVC180/// 10/04 Q0999",
+        "KVGN 272155Z AUTO 32010KT 10SM M 16/05 A3012 RMK AO2",
+        "SKBG 272200Z 32005KT 9999 SCT015 SCT070 26/21 Q1011 RESH WS R35",
+        "KXXX 272155Z AUTO 32010KT ////SM CLR 16/05 A3012",
+        "LFXX 272155Z 32010KT 9999 FEW030 16/05 Q1012 W/////",
+        "EGXX 272155Z 32010KT 9999 FEW030 16/05 Q1012 BLU",
+        "ESDF 272220Z AUTO 16004KT 0750 0600// R01/1700D R19/1400VP2000N FG FEW005/// 04/04 Q0996",
+    ];
+    for text in quiet {
+        let r = ok(text);
+        assert!(r.warnings.is_empty(), "{text}: {:?}", r.warnings);
+    }
+    let r = ok(quiet[1]);
+    assert_eq!(r.wind, None);
+    assert_eq!(r.clouds, [layer(Some(Cover::Ovc), Some(18_000), None)]);
+    assert_eq!(ok(quiet[7]).visibility_m, Some(750.0));
+}

@@ -57,12 +57,13 @@ pub(super) fn parse_weather(token: &str) -> Option<PresentWeather> {
     })
 }
 
-/// Recent weather (`RERA`, `RETSRA`, `RESN`): `RE` and a present-weather group.
+/// Recent weather (`RERA`, `RETSRA`, `RESN`, `RESH`): `RE` and a present-weather group or a
+/// lone descriptor.
 pub(super) fn is_recent_weather(token: &str) -> bool {
-    token
-        .strip_prefix("RE")
-        .and_then(parse_weather)
-        .is_some_and(|w| w.intensity == Intensity::Moderate)
+    token.strip_prefix("RE").is_some_and(|rest| {
+        DESCRIPTORS.contains(&rest)
+            || parse_weather(rest).is_some_and(|w| w.intensity == Intensity::Moderate)
+    })
 }
 
 #[cfg(test)]
@@ -124,6 +125,7 @@ mod tests {
     fn recent_weather() {
         assert!(is_recent_weather("RERA"));
         assert!(is_recent_weather("RETSRA"));
+        assert!(is_recent_weather("RESH"));
         assert!(!is_recent_weather("RE"));
         assert!(!is_recent_weather("RE-RA"));
         assert!(!is_recent_weather("RMK"));

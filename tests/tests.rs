@@ -1,0 +1,4 @@
+//! Integration tests, one module per stage, each run against the library or the built binary:
+//! - `weather`: the METAR decoder on the real bulk file, the `skycast metar` command.
+
+mod weather;
