@@ -5,7 +5,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod demo;
 mod metar;
+mod weather;
 
 /// skycast: a cloud and weather sky for flight simulators.
 #[derive(Debug, Parser)]
@@ -22,6 +24,10 @@ enum Command {
     /// Decodes METAR/SPECI reports: station, time, wind, visibility, weather, clouds,
     /// temperature, altimeter.
     Metar(metar::MetarArgs),
+    /// What a weather file holds and, with --at, the interpolated weather of the block there.
+    Weather(weather::WeatherArgs),
+    /// The demo: the weather of the default flight area on the shipped bulk weather file.
+    Demo(demo::DemoArgs),
 }
 
 /// Runs the command line and maps errors to a message on standard error and exit status 2.
@@ -38,6 +44,8 @@ pub fn main() -> ExitCode {
             Ok(())
         }
         Command::Metar(args) => metar::run(&args),
+        Command::Weather(args) => weather::run(&args),
+        Command::Demo(args) => demo::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -83,6 +83,9 @@ impl LocalFrame {
 
 /// Longitude wrapped into [-180, 180).
 fn wrap_lon_deg(lon_deg: f64) -> f64 {
+    if (-180.0..180.0).contains(&lon_deg) {
+        return lon_deg;
+    }
     (lon_deg + 180.0).rem_euclid(360.0) - 180.0
 }
 

@@ -1,0 +1,290 @@
+//! `skycast weather FILE [--stations FILE] [--at LAT,LON] [--json]`: what a weather file holds
+//! and, with `--at`, the interpolated weather of the 4 km block there.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::Args;
+use serde::Serialize;
+use skycast::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
+use skycast::weather::files::{self, WeatherFile};
+use skycast::weather::metar::{ConvectiveKind, Cover, SkyCode};
+use skycast::weather::{BlockIndex, BlockWeather, LineWarning, LocalFrame, StationTable};
+
+/// The station table used when `--stations` is not given.
+pub const DEFAULT_STATIONS: &str = "weather/nsd_cccc.txt";
+
+/// Flags of `skycast weather`.
+#[derive(Debug, Args)]
+pub struct WeatherArgs {
+    /// The weather file: metars.cache.csv, a NOAA cycle file, or one METAR a line.
+    pub file: PathBuf,
+    /// Station table (NOAA nsd_cccc.txt format) placing reports the file does not place.
+    #[arg(long, default_value = DEFAULT_STATIONS)]
+    pub stations: PathBuf,
+    /// Also print the interpolated weather of the block at this latitude,longitude (degrees).
+    #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
+    pub at: Option<(f64, f64)>,
+    /// Cloud-type rule (default: the shipped config/cloud_type_rule.toml).
+    #[arg(long)]
+    pub rule: Option<PathBuf>,
+    /// Field settings (default: the shipped config/weather_field.toml).
+    #[arg(long)]
+    pub field_settings: Option<PathBuf>,
+    /// One JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `LAT,LON` in degrees.
+pub fn parse_lat_lon(text: &str) -> Result<(f64, f64), String> {
+    let (lat, lon) = text
+        .split_once(',')
+        .ok_or_else(|| format!("`{text}` is not LAT,LON (for example 51.85,-8.48)"))?;
+    let lat: f64 = lat
+        .trim()
+        .parse()
+        .map_err(|_| format!("latitude `{lat}` is not a number"))?;
+    let lon: f64 = lon
+        .trim()
+        .parse()
+        .map_err(|_| format!("longitude `{lon}` is not a number"))?;
+    if !(-90.0..=90.0).contains(&lat) || !(-180.0..=180.0).contains(&lon) {
+        return Err(format!("{lat},{lon} is not on Earth (latitude -90..90, longitude -180..180)"));
+    }
+    Ok((lat, lon))
+}
+
+/// Counts over the located reports of a file.
+#[derive(Debug, Default, Serialize)]
+pub struct Summary {
+    /// Cloud groups by cover (FEW, SCT, BKN, OVC, VV, and `///` for a missing cover).
+    pub layers_by_cover: BTreeMap<&'static str, usize>,
+    /// Cloud groups with CB.
+    pub cb: usize,
+    /// Cloud groups with TCU.
+    pub tcu: usize,
+    /// Reports with CAVOK.
+    pub cavok: usize,
+    /// Reports with a no-cloud code (CLR, SKC, NSC, NCD).
+    pub clear_code: usize,
+    /// Reports with no sky group at all.
+    pub no_sky_group: usize,
+}
+
+impl Summary {
+    /// Counts the located reports of `file`.
+    pub fn of(file: &WeatherFile) -> Self {
+        let mut s = Summary::default();
+        for p in &file.reports {
+            let r = &p.report;
+            for g in &r.clouds {
+                let cover = match g.cover {
+                    Some(Cover::Few) => "FEW",
+                    Some(Cover::Sct) => "SCT",
+                    Some(Cover::Bkn) => "BKN",
+                    Some(Cover::Ovc) => "OVC",
+                    Some(Cover::Vv) => "VV",
+                    None => "///",
+                };
+                *s.layers_by_cover.entry(cover).or_default() += 1;
+                match g.kind {
+                    Some(ConvectiveKind::Cb) => s.cb += 1,
+                    Some(ConvectiveKind::Tcu) => s.tcu += 1,
+                    None => {}
+                }
+            }
+            if r.cavok {
+                s.cavok += 1;
+            } else if matches!(
+                r.sky,
+                Some(SkyCode::Clr | SkyCode::Skc | SkyCode::Nsc | SkyCode::Ncd)
+            ) {
+                s.clear_code += 1;
+            } else if r.clouds.is_empty() && r.sky.is_none() {
+                s.no_sky_group += 1;
+            }
+        }
+        s
+    }
+}
+
+/// The weather of one block, for printing.
+#[derive(Debug, Serialize)]
+pub struct AtBlock {
+    /// Latitude asked for, degrees.
+    pub lat_deg: f64,
+    /// Longitude asked for, degrees.
+    pub lon_deg: f64,
+    /// The block (of a frame whose origin is the point asked for).
+    pub block: BlockIndex,
+    /// Its interpolated weather.
+    pub weather: BlockWeather,
+}
+
+#[derive(Serialize)]
+struct JsonOut<'a> {
+    file: &'a Path,
+    format: skycast::weather::FileFormat,
+    reports: usize,
+    located: usize,
+    warnings: &'a [LineWarning],
+    #[serde(flatten)]
+    summary: &'a Summary,
+    at: Option<&'a AtBlock>,
+}
+
+/// Everything `skycast weather` needs, loaded: the file, the rule and the settings.
+pub struct Loaded {
+    /// The file, decoded and placed.
+    pub file: WeatherFile,
+    /// Field settings.
+    pub settings: FieldSettings,
+    /// Cloud-type rule.
+    pub rule: CloudTypeRule,
+}
+
+/// Loads the file (with the station table), the rule and the settings.
+pub fn load(
+    file: &Path,
+    stations: &Path,
+    rule: Option<&Path>,
+    field_settings: Option<&Path>,
+) -> anyhow::Result<Loaded> {
+    let table = StationTable::load(stations)
+        .with_context(|| format!("station table (choose one with --stations)"))?;
+    let file = files::load(file, Some(&table))?;
+    let rule = match rule {
+        Some(path) => CloudTypeRule::load(path)?,
+        None => CloudTypeRule::default(),
+    };
+    let settings = match field_settings {
+        Some(path) => FieldSettings::load(path)?,
+        None => FieldSettings::default(),
+    };
+    Ok(Loaded {
+        file,
+        settings,
+        rule,
+    })
+}
+
+/// The weather of the block at a point: a frame with its origin there, so block (0, 0), whose
+/// centre lies 2 km east and 2 km north of the point.
+pub fn at_block(loaded: &Loaded, lat_deg: f64, lon_deg: f64) -> AtBlock {
+    let frame = LocalFrame::new(lat_deg, lon_deg);
+    let field = WeatherField::build(frame, &loaded.file.reports, &loaded.settings, &loaded.rule);
+    let block = BlockIndex::new(0, 0);
+    AtBlock {
+        lat_deg,
+        lon_deg,
+        block,
+        weather: field.block_weather(block),
+    }
+}
+
+/// Runs `skycast weather`.
+pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
+    let loaded = load(
+        &args.file,
+        &args.stations,
+        args.rule.as_deref(),
+        args.field_settings.as_deref(),
+    )?;
+    let summary = Summary::of(&loaded.file);
+    let at = args.at.map(|(lat, lon)| at_block(&loaded, lat, lon));
+    if args.json {
+        let out = JsonOut {
+            file: &loaded.file.path,
+            format: loaded.file.format,
+            reports: loaded.file.reports_found,
+            located: loaded.file.reports.len(),
+            warnings: &loaded.file.warnings,
+            summary: &summary,
+            at: at.as_ref(),
+        };
+        println!("{}", serde_json::to_string(&out)?);
+        return Ok(());
+    }
+    print!("{}", describe_file(&loaded.file, &summary, true));
+    if let Some(at) = &at {
+        print!("{}", describe_block(at));
+    }
+    Ok(())
+}
+
+/// The text summary of a file; `all_warnings` lists every warning, else only their count.
+pub fn describe_file(file: &WeatherFile, summary: &Summary, all_warnings: bool) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    let f = file;
+    let _ = writeln!(out, "{}: {}", f.path.display(), f.format.describe());
+    let _ = writeln!(
+        out,
+        "  reports {}, located {}, warnings {}",
+        f.reports_found,
+        f.reports.len(),
+        f.warnings.len()
+    );
+    let covers: Vec<String> = summary
+        .layers_by_cover
+        .iter()
+        .map(|(k, v)| format!("{k} {v}"))
+        .collect();
+    let _ = writeln!(out, "  layers by cover: {}", covers.join(", "));
+    let _ = writeln!(out, "  CB {}, TCU {}", summary.cb, summary.tcu);
+    let _ = writeln!(
+        out,
+        "  CAVOK {}, no-cloud code {}, no sky group {}",
+        summary.cavok, summary.clear_code, summary.no_sky_group
+    );
+    if all_warnings {
+        for w in &f.warnings {
+            let _ = writeln!(out, "  warning: line {}: {}", w.line, w.message);
+        }
+    }
+    out
+}
+
+/// The text description of one block's weather.
+pub fn describe_block(at: &AtBlock) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    let w = &at.weather;
+    let _ = writeln!(
+        out,
+        "block ({}, {}) at {:.4},{:.4}: visibility {:.0} m, wind {:03.0}/{:.0} kt, \
+         temperature {:.1} C, dewpoint {:.1} C, precipitation {:.2}, ground {:.0} m",
+        at.block.i,
+        at.block.j,
+        at.lat_deg,
+        at.lon_deg,
+        w.visibility_m,
+        w.wind.from_deg,
+        w.wind.speed_kt,
+        w.temperature_c,
+        w.dewpoint_c,
+        w.precipitation,
+        w.ground_elevation_m
+    );
+    if w.layers.is_empty() {
+        let _ = writeln!(out, "  no cloud");
+    }
+    for l in &w.layers {
+        let source = serde_json::to_value(l.type_source)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default();
+        let _ = writeln!(
+            out,
+            "  {:<18} {:<11} {:.1} oktas, base {:.0} ft AGL, {:.0} ft thick",
+            l.cloud_type.name(),
+            source,
+            l.coverage_oktas,
+            l.base_ft_agl,
+            l.thickness_ft
+        );
+    }
+    out
+}
