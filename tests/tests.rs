@@ -1,4 +1,5 @@
 //! Integration tests, one module per stage, each run against the library or the built binary:
-//! - `weather`: the METAR decoder on the real bulk file, the `skycast metar` command.
+//! - `weather`: the METAR decoder on the real bulk file, the `skycast metar` and
+//!   `skycast weather` commands.
 
 mod weather;

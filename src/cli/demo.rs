@@ -33,8 +33,13 @@ pub struct DemoArgs {
 /// Runs `skycast demo`.
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     let loaded = load(&args.weather, &args.stations, None, None)?;
-    print!("{}", describe_file(&loaded.file, &Summary::of(&loaded.file), false));
-    println!("\nThe default flight area, south-west Ireland (showers and a CB line off the Atlantic):");
+    print!(
+        "{}",
+        describe_file(&loaded.file, &Summary::of(&loaded.file), false)
+    );
+    println!(
+        "\nThe default flight area, south-west Ireland (showers and a CB line off the Atlantic):"
+    );
     for (name, lat, lon) in AREA {
         println!("\n{name}");
         print!("{}", describe_block(&at_block(&loaded, lat, lon)));

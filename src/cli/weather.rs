@@ -51,7 +51,9 @@ pub fn parse_lat_lon(text: &str) -> Result<(f64, f64), String> {
         .parse()
         .map_err(|_| format!("longitude `{lon}` is not a number"))?;
     if !(-90.0..=90.0).contains(&lat) || !(-180.0..=180.0).contains(&lon) {
-        return Err(format!("{lat},{lon} is not on Earth (latitude -90..90, longitude -180..180)"));
+        return Err(format!(
+            "{lat},{lon} is not on Earth (latitude -90..90, longitude -180..180)"
+        ));
     }
     Ok((lat, lon))
 }
@@ -152,8 +154,8 @@ pub fn load(
     rule: Option<&Path>,
     field_settings: Option<&Path>,
 ) -> anyhow::Result<Loaded> {
-    let table = StationTable::load(stations)
-        .with_context(|| format!("station table (choose one with --stations)"))?;
+    let table =
+        StationTable::load(stations).context("station table (choose one with --stations)")?;
     let file = files::load(file, Some(&table))?;
     let rule = match rule {
         Some(path) => CloudTypeRule::load(path)?,

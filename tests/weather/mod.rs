@@ -1,5 +1,7 @@
 //! The weather stage from outside: `metar_bulk` decodes every report of the real bulk file and
-//! compares its cloud layers with the service's own decode; `metar_cli` runs `skycast metar`.
+//! compares its cloud layers with the service's own decode; `metar_cli` runs `skycast metar`;
+//! `weather_cli` runs `skycast weather` on bulk, plain and cycle files and on bad input.
 
 mod metar_bulk;
 mod metar_cli;
+mod weather_cli;

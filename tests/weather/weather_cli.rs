@@ -1,0 +1,170 @@
+//! `skycast weather` run as a user runs it: the summary of the real bulk file, the block at a
+//! place (text and JSON), plain and NOAA cycle files placed by the station table, and the errors:
+//! exit status 2 with one message naming the file.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+const BULK: &str = "weather/awc-metars-2025-01-27T22Z.cache.csv";
+
+fn skycast(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_skycast"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the skycast binary runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A file in a fresh directory under the system temp dir.
+fn temp_file(name: &str, contents: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("skycast-weather-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(name);
+    std::fs::write(&path, contents).expect("temp file");
+    path
+}
+
+#[test]
+fn summarises_the_real_bulk_file() {
+    let o = skycast(&["weather", BULK]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(
+        text.contains("aviation weather service metars.cache.csv"),
+        "{text}"
+    );
+    assert!(text.contains("reports 4909, located 4877"), "{text}");
+    assert!(text.contains("VV 33"), "{text}");
+    // Reports the table cannot place are warnings with their line.
+    assert!(
+        text.contains("warning: line 72: KQFX: station not in the station table"),
+        "{text}"
+    );
+}
+
+#[test]
+fn the_block_at_cork_is_a_reported_cumulonimbus() {
+    let o = skycast(&["weather", BULK, "--at", "51.848,-8.479", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("one JSON object");
+    assert_eq!(v["format"], "awc_csv");
+    assert_eq!(v["reports"], 4909);
+    assert_eq!(v["located"], 4877);
+    assert_eq!(v["layers_by_cover"]["VV"], 33);
+    let warnings = v["warnings"].as_array().expect("warnings");
+    assert!(warnings.iter().all(|w| w["line"].as_u64().unwrap_or(0) > 6));
+    let at = &v["at"];
+    assert_eq!(at["block"]["i"], 0);
+    let layers = at["weather"]["layers"].as_array().expect("layers");
+    // EICK: FEW006 SCT018CB BKN035, 6/5 C.
+    assert_eq!(layers[0]["cloud_type"], "cumulonimbus", "{at}");
+    assert_eq!(layers[0]["type_source"], "reported", "{at}");
+    let t = at["weather"]["temperature_c"]
+        .as_f64()
+        .expect("temperature");
+    assert!((t - 6.0).abs() < 1.0, "{t}");
+}
+
+#[test]
+fn text_at_a_place_lists_layers_with_their_type_source() {
+    // San Antonio (KSAT) reports OVC020.
+    let o = skycast(&["weather", BULK, "--at", "29.533,-98.47"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    let block = text
+        .lines()
+        .skip_while(|l| !l.starts_with("block (0, 0) at 29.5330,-98.4700"))
+        .collect::<Vec<_>>();
+    assert!(!block.is_empty(), "{text}");
+    assert!(
+        block
+            .iter()
+            .any(|l| l.contains("stratus") && l.contains("height_rule")),
+        "{text}"
+    );
+}
+
+#[test]
+fn plain_and_cycle_files_are_placed_by_the_station_table() {
+    let plain = temp_file(
+        "plain.txt",
+        "EGLL 272220Z AUTO 19015KT 9999 BKN027 BKN046 08/04 Q0981 NOSIG\n\
+         not a report\n\
+         LFPG 272200Z 20020KT 9999 BKN025 09/04 Q0993 NOSIG\n",
+    );
+    let o = skycast(&[
+        "weather",
+        plain.to_str().unwrap(),
+        "--at",
+        "51.4775,-0.4614",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("plain METAR lines"), "{text}");
+    assert!(text.contains("reports 2, located 2, warnings 1"), "{text}");
+    assert!(
+        text.contains("warning: line 2: not a METAR report"),
+        "{text}"
+    );
+    assert!(text.contains("stratocumulus"), "{text}");
+    let cycle = temp_file(
+        "22Z.TXT",
+        "2025/01/27 22:20\nEGLL 272220Z AUTO 19015KT 9999 BKN027\n  BKN046 08/04 Q0981 NOSIG\n\n",
+    );
+    let o = skycast(&["weather", cycle.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("JSON");
+    assert_eq!(v["format"], "noaa_cycle");
+    assert_eq!(v["located"], 1);
+    assert_eq!(v["layers_by_cover"]["BKN"], 2);
+}
+
+#[test]
+fn a_file_that_is_not_weather_exits_2_with_one_message_naming_it() {
+    let o = skycast(&["weather", "Cargo.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("Cargo.toml: not a weather file"), "{err}");
+    assert!(stdout(&o).is_empty());
+}
+
+#[test]
+fn missing_files_and_bad_config_exit_2_naming_them() {
+    let o = skycast(&["weather", "weather/no-such-file.csv"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("weather/no-such-file.csv: cannot read"),
+        "{}",
+        stderr(&o)
+    );
+
+    let o = skycast(&["weather", BULK, "--stations", "Cargo.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("Cargo.toml: not a station table"),
+        "{}",
+        stderr(&o)
+    );
+
+    let rule = temp_file(
+        "rule.toml",
+        "[reported]\ncb = \"cumulonimbus\"\ntcu = \"towering\"\n",
+    );
+    let o = skycast(&["weather", BULK, "--rule", rule.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert!(err.contains("rule.toml:3: field `tcu`"), "{err}");
+
+    let o = skycast(&["weather", BULK, "--at", "95,10"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("not on Earth"), "{}", stderr(&o));
+}
