@@ -7,5 +7,6 @@
 
 pub mod config;
 pub mod flight;
+pub mod render;
 pub mod shading;
 pub mod weather;

@@ -1,0 +1,23 @@
+// Pass `sky.in_cloud`: inside a cloud, density fog over everything (Wang 7.1's proposed fix), so
+// the inside is as opaque as the outside suggests. Opacity grows with the host's depth at each
+// pixel; the sky (far plane) is fully covered. Shared structs: shared/frame.wgsl.
+
+struct FogOut {
+    @builtin(position) position: vec4<f32>,
+};
+
+@vertex
+fn vs_in_cloud(@builtin(vertex_index) vi: u32) -> FogOut {
+    var o: FogOut;
+    o.position = fullscreen_position(vi);
+    return o;
+}
+
+@fragment
+fn fs_in_cloud(i: FogOut) -> @location(0) vec4<f32> {
+    let d = scene_depth_at(i.position.xy);
+    let dist_m = select(linear_depth_m(d), 1.0e9, d >= 1.0);
+    let density = 1.0 - exp(-dist_m / frame.params.w);
+    let alpha = clamp(density * frame.in_cloud_rgba.a, 0.0, 1.0);
+    return vec4<f32>(frame.in_cloud_rgba.rgb * alpha, alpha);
+}

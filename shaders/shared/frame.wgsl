@@ -1,0 +1,47 @@
+// Shared by the sky passes. Keep in sync with `GpuFrame` in src/render/gpu_types.rs.
+struct Frame {
+    view_proj: mat4x4<f32>,
+    inv_view_proj: mat4x4<f32>,
+    sun_dir: vec4<f32>,
+    sun_rgb: vec4<f32>,
+    sky_zenith_rgb: vec4<f32>,
+    sky_horizon_rgb: vec4<f32>,
+    in_cloud_rgba: vec4<f32>,
+    // near_m, far_m, soft_depth_fade_m, in_cloud_visibility_m
+    params: vec4<f32>,
+};
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+// The host's depth, read only. Bound as an unfilterable float texture (works on Vulkan and GL).
+@group(0) @binding(1) var scene_depth: texture_2d<f32>;
+
+// Metres from the camera plane of a [0, 1] perspective depth value.
+fn linear_depth_m(d: f32) -> f32 {
+    let near = frame.params.x;
+    let far = frame.params.y;
+    return near * far / (far - d * (far - near));
+}
+
+fn scene_depth_at(frag_xy: vec2<f32>) -> f32 {
+    return textureLoad(scene_depth, vec2<i32>(frag_xy), 0).r;
+}
+
+// Full-screen triangle.
+fn fullscreen_position(vi: u32) -> vec4<f32> {
+    let x = f32((vi << 1u) & 2u) * 2.0 - 1.0;
+    let y = f32(vi & 2u) * 2.0 - 1.0;
+    return vec4<f32>(x, y, 0.0, 1.0);
+}
+
+// Sky colour seen along a unit direction (east, north, up); also the horizon haze for fog.
+fn sky_colour(dir: vec3<f32>) -> vec3<f32> {
+    let up = clamp(dir.z, -1.0, 1.0);
+    let t = pow(clamp(up, 0.0, 1.0), 0.45);
+    var c = mix(frame.sky_horizon_rgb.rgb, frame.sky_zenith_rgb.rgb, t);
+    // Below the horizon: the haze darkens a little towards the ground.
+    c = select(c, frame.sky_horizon_rgb.rgb * (1.0 + 0.6 * up), up < 0.0);
+    let cos_sun = dot(dir, frame.sun_dir.xyz);
+    let glow = smoothstep(frame.sun_rgb.w, 1.0, cos_sun);
+    c += frame.sun_rgb.rgb * glow * glow * 0.35;
+    return c;
+}

@@ -1,0 +1,40 @@
+// Pass `sky.sprites`: cloud sprites, back to front, premultiplied alpha. Vertices come from the
+// CPU (facing, locking and Wang shading happen there, cached). The fragment multiplies in the
+// sheet texture (Wang eq. 3) and fades against the host's depth over soft_depth_fade_m
+// (Bahnassi) instead of cutting hard. Shared structs: shared/frame.wgsl.
+
+@group(1) @binding(0) var sheet: texture_2d<f32>;
+@group(1) @binding(1) var sheet_sampler: sampler;
+
+// Keep in sync with `GpuSpriteVertex` in src/render/gpu_types.rs.
+struct VertexIn {
+    @location(0) position_m: vec3<f32>,
+    @location(1) uv: vec2<f32>,
+    @location(2) colour: vec4<f32>,
+};
+
+struct VertexOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) colour: vec4<f32>,
+    @location(2) view_depth_m: f32,
+};
+
+@vertex
+fn vs_sprite(v: VertexIn) -> VertexOut {
+    var o: VertexOut;
+    o.position = frame.view_proj * vec4<f32>(v.position_m, 1.0);
+    o.uv = v.uv;
+    o.colour = v.colour;
+    o.view_depth_m = o.position.w;
+    return o;
+}
+
+@fragment
+fn fs_sprite(i: VertexOut) -> @location(0) vec4<f32> {
+    let texel = textureSample(sheet, sheet_sampler, i.uv);
+    let scene_m = linear_depth_m(scene_depth_at(i.position.xy));
+    let soft = clamp((scene_m - i.view_depth_m) / frame.params.z, 0.0, 1.0);
+    let alpha = texel.a * i.colour.a * soft;
+    return vec4<f32>(i.colour.rgb * texel.rgb * alpha, alpha);
+}

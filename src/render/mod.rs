@@ -1,0 +1,68 @@
+//! The renderer: the only stage that uses wgpu. A host simulator creates a [`Sky`] with its own
+//! device and queue, gives it clouds ([`SkyBlock`]s), and each frame calls [`Sky::prepare`]
+//! (camera, sun, dt: CPU work and uploads, returns [`FrameStats`]) and [`Sky::record`] (its
+//! passes into the host's encoder, reading the host's depth, never writing it).
+//!
+//! - `vertices`: sort (blocks, clouds, sprites back to front), facing and its lock (Wang 2003
+//!   3.3), Wang 5 shading per corner, the vertex cache (Wang 6.1). Plain CPU data.
+//! - `sky`: pipelines and passes: sky gradient and sun, sprites with soft depth fades (Bahnassi),
+//!   in-cloud fog (Wang 7.1). Shaders in `shaders/*.wgsl`, structs with twins in `gpu_types`.
+//! - `terrain`, `headless`, `output`: the demo host (height-field ground with fog, an offscreen
+//!   device and target on any adapter, lavapipe included) and PNG / EXR output.
+//!
+//! Positions are f64 on the CPU and camera-relative f32 on the GPU. Units: metres, degrees,
+//! linear RGB.
+
+pub mod camera;
+pub mod gpu_types;
+pub mod headless;
+pub mod output;
+pub mod scene;
+pub mod settings;
+pub mod sky;
+pub mod terrain;
+pub mod vertices;
+
+pub use camera::Camera;
+pub use headless::{Frame, HeadlessGpu, OffscreenTarget};
+pub use scene::{SkyBlock, SkyCloud, SkySprite};
+pub use settings::RenderSettings;
+pub use sky::{Sky, SkyConfig, SpriteSheet};
+pub use terrain::{HeightField, Terrain, TerrainLight};
+pub use vertices::{FrameStats, Lighting};
+
+/// Errors of the renderer.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RenderError {
+    /// No graphics adapter at all (no GPU and no software driver).
+    #[error(
+        "no graphics adapter found ({0}); skycast renders on any GPU or on Mesa's software Vulkan driver, install it with: {hint}",
+        hint = headless::INSTALL_HINT
+    )]
+    NoAdapter(String),
+    /// The adapter refused a device, or a device operation failed.
+    #[error("graphics device: {0}")]
+    Device(String),
+    /// The requested image size is zero or beyond the device's limit.
+    #[error("image size {width}x{height} is not drawable (each side 1..={max})")]
+    Size {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+        /// The device's largest texture side.
+        max: u32,
+    },
+    /// The sprite sheet's pixel data does not match its size.
+    #[error("sprite sheet: {0}")]
+    Sheet(String),
+    /// An output file could not be written.
+    #[error("{path}: {message}")]
+    Output {
+        /// The file.
+        path: String,
+        /// Why.
+        message: String,
+    },
+}

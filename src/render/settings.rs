@@ -1,0 +1,202 @@
+//! Renderer settings, read from `config/render.toml` (built in as the default).
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::config::{ConfigError, parse_toml};
+
+/// The built-in settings, `config/render.toml`.
+pub const DEFAULT_RENDER_TOML: &str = include_str!("../../config/render.toml");
+
+/// Camera projection settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSettings {
+    /// Vertical field of view, degrees.
+    pub fov_y_deg: f32,
+    /// Near clip plane, metres.
+    pub near_m: f32,
+    /// Far clip plane, metres.
+    pub far_m: f32,
+}
+
+/// Cloud sprite settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CloudSettings {
+    /// Depth difference over which a sprite fades out against the scene (Bahnassi), metres.
+    pub soft_depth_fade_m: f32,
+    /// Facing locks within this fraction of the sprite radius (Wang 3.3).
+    pub lock_radius_fraction: f32,
+    /// Locked sprites stay opaque up to this angle to the camera, degrees.
+    pub lock_fade_start_deg: f32,
+    /// Locked sprites are fully transparent beyond this angle, degrees.
+    pub lock_fade_end_deg: f32,
+    /// Sprites farther than this from the camera are not drawn, metres.
+    pub draw_distance_m: f32,
+}
+
+/// In-cloud fog settings (Wang 7.1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InCloudSettings {
+    /// Visibility inside a cloud, metres.
+    pub visibility_m: f32,
+    /// Fog ramps in over this fraction of the cloud half-extent inside its boundary.
+    pub ramp_fraction: f32,
+}
+
+/// Sun disc settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunSettings {
+    /// Apparent radius of the disc, degrees.
+    pub disc_radius_deg: f32,
+    /// Radius of the glow around it, degrees.
+    pub glow_radius_deg: f32,
+}
+
+/// Vertex cache thresholds (Wang 6.1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VertexCacheSettings {
+    /// When false every cloud is recomputed every frame (for comparisons).
+    pub enabled: bool,
+    /// Recompute after the camera moves this fraction of its distance to the cloud.
+    pub move_fraction: f32,
+    /// ... plus this many metres.
+    pub min_move_m: f32,
+    /// Recompute after `max_age_s * (1 + distance / time_distance_m)` seconds.
+    pub max_age_s: f32,
+    /// Distance scale of the age threshold, metres.
+    pub time_distance_m: f32,
+    /// Age threshold while a cloud forms or dissipates, seconds.
+    pub fading_max_age_s: f32,
+}
+
+/// All renderer settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderSettings {
+    /// Projection.
+    pub camera: CameraSettings,
+    /// Cloud sprites.
+    pub clouds: CloudSettings,
+    /// In-cloud fog.
+    pub in_cloud: InCloudSettings,
+    /// Sun disc.
+    pub sun: SunSettings,
+    /// Vertex cache.
+    pub vertex_cache: VertexCacheSettings,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        // The built-in text is tested to parse; the fallback is never reached in practice.
+        Self::from_toml_str(DEFAULT_RENDER_TOML, "config/render.toml (built in)").unwrap_or(Self {
+            camera: CameraSettings {
+                fov_y_deg: 60.0,
+                near_m: 2.0,
+                far_m: 160_000.0,
+            },
+            clouds: CloudSettings {
+                soft_depth_fade_m: 120.0,
+                lock_radius_fraction: 0.5,
+                lock_fade_start_deg: 20.0,
+                lock_fade_end_deg: 70.0,
+                draw_distance_m: 60_000.0,
+            },
+            in_cloud: InCloudSettings {
+                visibility_m: 70.0,
+                ramp_fraction: 0.35,
+            },
+            sun: SunSettings {
+                disc_radius_deg: 0.8,
+                glow_radius_deg: 12.0,
+            },
+            vertex_cache: VertexCacheSettings {
+                enabled: true,
+                move_fraction: 0.02,
+                min_move_m: 5.0,
+                max_age_s: 2.0,
+                time_distance_m: 2000.0,
+                fading_max_age_s: 0.25,
+            },
+        })
+    }
+}
+
+impl RenderSettings {
+    /// Parses and checks settings; `source_name` names the file in errors.
+    pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self, ConfigError> {
+        let path = Path::new(source_name);
+        let s: Self = parse_toml(text, path)?;
+        let positive = [
+            ("camera.near_m", s.camera.near_m),
+            ("camera.fov_y_deg", s.camera.fov_y_deg),
+            ("clouds.soft_depth_fade_m", s.clouds.soft_depth_fade_m),
+            ("in_cloud.visibility_m", s.in_cloud.visibility_m),
+            (
+                "vertex_cache.time_distance_m",
+                s.vertex_cache.time_distance_m,
+            ),
+        ];
+        for (field, value) in positive {
+            if value.is_nan() || value <= 0.0 {
+                return Err(ConfigError {
+                    path: path.to_path_buf(),
+                    line: None,
+                    field: Some(field.into()),
+                    message: format!("must be greater than 0, is {value}"),
+                });
+            }
+        }
+        if s.camera.far_m <= s.camera.near_m {
+            return Err(ConfigError {
+                path: path.to_path_buf(),
+                line: None,
+                field: Some("camera.far_m".into()),
+                message: "must be greater than camera.near_m".into(),
+            });
+        }
+        Ok(s)
+    }
+
+    /// Reads and checks a settings file.
+    pub fn from_path(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
+        Self::from_toml_str(&text, &path.display().to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn built_in_settings_parse() {
+        let s = RenderSettings::from_toml_str(DEFAULT_RENDER_TOML, "render.toml").unwrap();
+        assert_eq!(s, RenderSettings::default());
+        assert_eq!(s.clouds.lock_radius_fraction, 0.5);
+    }
+
+    #[test]
+    fn bad_values_name_the_field() {
+        let text =
+            DEFAULT_RENDER_TOML.replace("soft_depth_fade_m = 120.0", "soft_depth_fade_m = -1.0");
+        let err = RenderSettings::from_toml_str(&text, "r.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("r.toml") && err.contains("clouds.soft_depth_fade_m"),
+            "{err}"
+        );
+        let text = DEFAULT_RENDER_TOML.replace("near_m = 2.0", "near_m = \"near\"");
+        let err = RenderSettings::from_toml_str(&text, "r.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("r.toml:7: field `near_m`"), "{err}");
+    }
+}

@@ -1,0 +1,360 @@
+//! Real headless renders on whatever adapter there is (lavapipe on machines without a GPU),
+//! checking pixels. Few, small (320 x 180) and batched in this one binary. A missing adapter
+//! FAILS these tests: every machine that runs the suite has the software driver (`make vulkan`).
+//! Frames are written to `target/render-tests/` to look at.
+
+use std::path::PathBuf;
+
+use glam::{DVec2, DVec3, Vec3};
+use skycast::render::terrain::{HeightField, TerrainLight};
+use skycast::render::vertices::square_sprite;
+use skycast::render::{
+    Camera, Frame, HeadlessGpu, OffscreenTarget, RenderSettings, Sky, SkyBlock, SkyCloud,
+    SkyConfig, SpriteSheet, Terrain, headless,
+};
+use skycast::shading::{ColourLevels, SunPosition, TimeOfDayTable};
+
+const W: u32 = 320;
+const H: u32 = 180;
+
+/// A soft round puff in every cell, with mips (test stand-in for the clouds stage's sheet).
+fn puff_sheet() -> SpriteSheet {
+    let mut mips = Vec::new();
+    let mut size = 256u32;
+    while size >= 16 {
+        let cell = size / 4;
+        let mut px = Vec::with_capacity((size * size * 4) as usize);
+        for y in 0..size {
+            for x in 0..size {
+                let fx = ((x % cell) as f32 + 0.5) / cell as f32 * 2.0 - 1.0;
+                let fy = ((y % cell) as f32 + 0.5) / cell as f32 * 2.0 - 1.0;
+                let r = (fx * fx + fy * fy).sqrt();
+                let a = (1.0 - r).clamp(0.0, 1.0).powf(0.8);
+                px.extend_from_slice(&[255, 255, 255, (a * 255.0) as u8]);
+            }
+        }
+        mips.push(px);
+        size /= 2;
+    }
+    SpriteSheet { size_px: 256, mips }
+}
+
+fn levels(base: f32, top: f32) -> ColourLevels {
+    ColourLevels::even(
+        base,
+        top,
+        [
+            [0.55, 0.57, 0.62, 1.0],
+            [0.68, 0.7, 0.74, 1.0],
+            [0.8, 0.81, 0.84, 1.0],
+            [0.9, 0.9, 0.92, 1.0],
+            [0.95, 0.95, 0.96, 1.0],
+        ],
+    )
+}
+
+/// A flat-bottomed cumulus of puffs around `centre` (radius about 600 m).
+fn cumulus(centre: DVec3) -> SkyCloud {
+    let mut sprites = Vec::new();
+    let mut seed = 7u32;
+    let mut rnd = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed as f32 / u32::MAX as f32
+    };
+    for k in 0..60 {
+        let (a, r, z) = (rnd() * std::f32::consts::TAU, rnd().sqrt() * 550.0, rnd());
+        let z = z * (1.0 - r / 700.0) * 500.0;
+        sprites.push(square_sprite(
+            Vec3::new(a.cos() * r, a.sin() * r, z),
+            260.0 + rnd() * 120.0,
+            (k % 16) as u8,
+            (k % 4) as u16,
+        ));
+    }
+    SkyCloud {
+        centre_m: centre,
+        sprites,
+        group_centres_m: vec![
+            Vec3::new(-250.0, 0.0, 150.0),
+            Vec3::new(250.0, 0.0, 150.0),
+            Vec3::new(0.0, 250.0, 300.0),
+            Vec3::new(0.0, -250.0, 100.0),
+        ],
+        colour_levels: levels(centre.z as f32, centre.z as f32 + 500.0),
+    }
+}
+
+/// An overcast deck: a grid of wide sprites from `base` to `base + 300`, 12 km square.
+fn overcast(centre: DVec2, base: f64) -> SkyCloud {
+    let mut sprites = Vec::new();
+    for i in -15..=15 {
+        for j in -15..=15 {
+            for k in 0..2 {
+                let o = Vec3::new(i as f32 * 400.0, j as f32 * 400.0, 100.0 + k as f32 * 150.0);
+                sprites.push(square_sprite(o, 700.0, ((i + j + k) & 15) as u8, 0));
+            }
+        }
+    }
+    SkyCloud {
+        centre_m: DVec3::new(centre.x, centre.y, base),
+        sprites,
+        group_centres_m: vec![Vec3::new(0.0, 0.0, 150.0)],
+        colour_levels: levels(base as f32, base as f32 + 300.0),
+    }
+}
+
+struct Rig {
+    gpu: HeadlessGpu,
+    target: OffscreenTarget,
+    sky: Sky,
+    terrain: Terrain,
+    settings: RenderSettings,
+}
+
+fn sun() -> SunPosition {
+    SunPosition {
+        elevation_deg: 35.0,
+        azimuth_deg: 200.0,
+        declination_deg: 0.0,
+    }
+}
+
+impl Rig {
+    fn new(ground: HeightField) -> Rig {
+        let gpu =
+            HeadlessGpu::new().unwrap_or_else(|e| panic!("render tests need an adapter: {e}"));
+        let target = OffscreenTarget::new(&gpu, W, H).unwrap();
+        let settings = RenderSettings::default();
+        let sky = Sky::new(
+            &gpu.device,
+            &gpu.queue,
+            SkyConfig {
+                colour_format: headless::COLOUR_FORMAT,
+                settings,
+                time_of_day: TimeOfDayTable::default(),
+                sheet: puff_sheet(),
+            },
+        )
+        .unwrap();
+        let terrain = Terrain::new(&gpu.device, headless::COLOUR_FORMAT, &ground);
+        Rig {
+            gpu,
+            target,
+            sky,
+            terrain,
+            settings,
+        }
+    }
+
+    fn camera(&self, position: DVec3, heading: f64, pitch: f64) -> Camera {
+        Camera {
+            position_m: position,
+            heading_deg: heading,
+            pitch_deg: pitch,
+            fov_y_deg: self.settings.camera.fov_y_deg,
+            aspect: W as f32 / H as f32,
+            near_m: self.settings.camera.near_m,
+            far_m: self.settings.camera.far_m,
+        }
+    }
+
+    fn frame(&mut self, name: &str, camera: &Camera) -> (Frame, skycast::render::FrameStats) {
+        let stats = self.sky.prepare(&self.gpu.queue, camera, &sun(), 0.0);
+        let light = self.sky.light();
+        self.terrain.prepare(
+            &self.gpu.queue,
+            camera,
+            &TerrainLight {
+                sun_dir: sun().direction_enu().as_vec3(),
+                sun_rgb: light.directional_rgb,
+                ambient: light.ambient_percent * 0.35,
+                fog_rgb: self.sky.horizon_rgb(),
+                visibility_m: 40_000.0,
+            },
+        );
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        self.terrain
+            .record(&mut enc, &self.target.colour_view, &self.target.depth_view);
+        self.sky
+            .record(&mut enc, &self.target.colour_view, &self.target.depth_view);
+        self.gpu.queue.submit([enc.finish()]);
+        let frame = self.target.read_back(&self.gpu).unwrap();
+        let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
+        std::fs::create_dir_all(&dir).unwrap();
+        frame.write_png(&dir.join(format!("{name}.png"))).unwrap();
+        (frame, stats)
+    }
+}
+
+fn flat_ground(height: f64) -> HeightField {
+    HeightField::from_fn(DVec2::ZERO, 80_000.0, 64, |_| height)
+}
+
+/// Grey or white (low saturation), not the blue sky or green ground.
+fn cloud_like(p: [f32; 4]) -> bool {
+    let max = p[0].max(p[1]).max(p[2]);
+    let min = p[0].min(p[1]).min(p[2]);
+    max > 0.15 && (max - min) / max < 0.18
+}
+
+fn fraction(frame: &Frame, pred: impl Fn(usize) -> bool) -> f32 {
+    (0..frame.rgba.len()).filter(|&i| pred(i)).count() as f32 / frame.rgba.len() as f32
+}
+
+fn luminance(p: [f32; 4]) -> f32 {
+    0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+}
+
+/// Clear sky: nothing cloud-like anywhere; an overcast deck overhead: the sky is covered; inside
+/// the deck: every pixel is cloud, opaque.
+#[test]
+fn clear_overcast_and_in_cloud_frames() {
+    let mut rig = Rig::new(flat_ground(0.0));
+    let up = rig.camera(DVec3::new(0.0, 0.0, 300.0), 0.0, 55.0);
+    rig.sky.set_clouds(Vec::new());
+    let (clear, stats) = rig.frame("clear_sky", &up);
+    assert_eq!(stats.sprites_drawn, 0);
+    assert_eq!(
+        fraction(&clear, |i| cloud_like(clear.rgba[i])),
+        0.0,
+        "clear sky has cloud-like pixels"
+    );
+    let sky_share = fraction(&clear, |i| clear.depth[i] >= 1.0);
+    assert!(
+        sky_share > 0.95,
+        "looking up, the frame is sky: {sky_share}"
+    );
+
+    rig.sky.set_clouds(vec![SkyBlock {
+        centre_m: DVec3::new(0.0, 0.0, 1500.0),
+        clouds: vec![overcast(DVec2::ZERO, 1500.0)],
+    }]);
+    let (deck, stats) = rig.frame("overcast_overhead", &up);
+    assert!(
+        stats.sprites_drawn > 1000 && stats.in_cloud == 0.0,
+        "{stats:?}"
+    );
+    let covered = fraction(&deck, |i| deck.depth[i] >= 1.0 && cloud_like(deck.rgba[i]));
+    assert!(
+        covered > 0.97 * sky_share,
+        "overcast covers {covered} of {sky_share} sky"
+    );
+
+    let inside = rig.camera(DVec3::new(0.0, 0.0, 1680.0), 90.0, -10.0);
+    let (fog, stats) = rig.frame("in_cloud", &inside);
+    assert!(stats.in_cloud > 0.99, "{stats:?}");
+    let grey = fraction(&fog, |i| cloud_like(fog.rgba[i]));
+    assert_eq!(
+        grey, 1.0,
+        "in-cloud frame shows something that is not cloud"
+    );
+    let lum: Vec<f32> = fog.rgba.iter().map(|&p| luminance(p)).collect();
+    let (lo, hi) = lum
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(a, b), &l| (a.min(l), b.max(l)));
+    assert!(
+        hi - lo < 0.05,
+        "in-cloud frame is not uniformly opaque: luminance {lo}..{hi}"
+    );
+}
+
+/// A ridge between the camera and a cloud hides the cloud exactly where the ridge is drawn.
+#[test]
+fn terrain_in_front_hides_the_cloud() {
+    // A 1,000 m ridge 3 km north of the camera; the cloud 6 km north at 1,000 m.
+    let ridge = HeightField::from_fn(DVec2::ZERO, 40_000.0, 200, |p| {
+        1000.0 * (-((p.y - 3000.0) / 600.0).powi(2)).exp()
+    });
+    let mut rig = Rig::new(ridge);
+    let cam = rig.camera(DVec3::new(0.0, 0.0, 800.0), 0.0, 4.0);
+    rig.sky.set_clouds(Vec::new());
+    let (bare, _) = rig.frame("ridge_bare", &cam);
+    rig.sky.set_clouds(vec![SkyBlock {
+        centre_m: DVec3::new(0.0, 6000.0, 1300.0),
+        clouds: vec![cumulus(DVec3::new(0.0, 6000.0, 1000.0))],
+    }]);
+    let (cloudy, stats) = rig.frame("ridge_cloud", &cam);
+    assert_eq!(stats.sprites_drawn, 60);
+    let changed = |i: usize| (luminance(cloudy.rgba[i]) - luminance(bare.rgba[i])).abs() > 0.004;
+    let on_ground = fraction(&bare, |i| bare.depth[i] < 1.0 && changed(i));
+    let in_sky = fraction(&bare, |i| bare.depth[i] >= 1.0 && changed(i));
+    let in_sky_px = in_sky * (W * H) as f32;
+    assert!(
+        in_sky_px > 100.0,
+        "the cloud shows above the ridge: {in_sky_px} pixels"
+    );
+    assert_eq!(on_ground, 0.0, "cloud drawn over the ridge in front of it");
+}
+
+/// Where a cloud sprite cuts into a hillside, it fades over soft_depth_fade_m: a ramp of pixels,
+/// not a step. The same scene with a 0.5 m fade shows the step, so the test can tell them apart.
+#[test]
+fn cloud_terrain_edge_is_a_ramp() {
+    // A 45 degree slope rising northwards from y = 900 m; a 600 m sprite 1 km north at 130 m,
+    // cut by the slope 30 m below its centre.
+    let slope = HeightField::from_fn(DVec2::new(0.0, 2000.0), 8000.0, 400, |p| {
+        (p.y - 900.0).max(0.0)
+    });
+    let sprite_cloud = SkyCloud {
+        centre_m: DVec3::new(0.0, 1000.0, 130.0),
+        sprites: vec![square_sprite(Vec3::ZERO, 600.0, 5, 0)],
+        group_centres_m: vec![Vec3::ZERO],
+        colour_levels: levels(0.0, 600.0),
+    };
+    let mut jumps = Vec::new();
+    for (name, fade_m) in [("edge_soft", None), ("edge_hard", Some(0.5))] {
+        let mut rig = Rig::new(slope.clone());
+        if let Some(f) = fade_m {
+            rig.settings.clouds.soft_depth_fade_m = f;
+            rig.sky = Sky::new(
+                &rig.gpu.device,
+                &rig.gpu.queue,
+                SkyConfig {
+                    colour_format: headless::COLOUR_FORMAT,
+                    settings: rig.settings,
+                    time_of_day: TimeOfDayTable::default(),
+                    sheet: puff_sheet(),
+                },
+            )
+            .unwrap();
+        }
+        let cam = rig.camera(DVec3::new(0.0, 0.0, 130.0), 0.0, 0.0);
+        rig.sky.set_clouds(Vec::new());
+        let (bare, _) = rig.frame(&format!("{name}_bare"), &cam);
+        rig.sky.set_clouds(vec![SkyBlock {
+            centre_m: sprite_cloud.centre_m,
+            clouds: vec![sprite_cloud.clone()],
+        }]);
+        let (cloudy, _) = rig.frame(name, &cam);
+        // Cloud contribution down the centre column, on ground pixels only.
+        let x = (W / 2) as usize;
+        let contribution: Vec<f32> = (0..H as usize)
+            .map(|y| y * W as usize + x)
+            .filter(|&i| bare.depth[i] < 1.0)
+            .map(|i| luminance(cloudy.rgba[i]) - luminance(bare.rgba[i]))
+            .collect();
+        let peak = contribution.iter().cloned().fold(0.0, f32::max);
+        assert!(
+            peak > 0.1,
+            "{name}: the sprite shows over the slope ({peak})"
+        );
+        let max_jump = contribution
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f32::max);
+        let ramp_rows = contribution
+            .iter()
+            .filter(|&&c| c > 0.1 * peak && c < 0.9 * peak)
+            .count();
+        eprintln!("{name}: peak {peak:.3}, largest row step {max_jump:.3}, ramp rows {ramp_rows}");
+        jumps.push((max_jump / peak, ramp_rows));
+    }
+    let (soft, hard) = (jumps[0], jumps[1]);
+    assert!(soft.0 < 0.2 && soft.1 >= 5, "soft edge is a step: {soft:?}");
+    assert!(
+        hard.0 > 0.45,
+        "with a 0.5 m fade the edge should be a step: {hard:?}"
+    );
+}
