@@ -10,13 +10,23 @@ use super::weather::{DEFAULT_STATIONS, Summary, at_block, describe_block, descri
 /// The shipped bulk weather file.
 pub const DEFAULT_WEATHER: &str = "weather/awc-metars-2025-01-27T22Z.cache.csv";
 
-/// Places across the default area: name, latitude, longitude (degrees).
-const AREA: [(&str, f64, f64); 5] = [
-    ("Cork (EICK, reports SCT018CB)", 51.848, -8.479),
-    ("between Cork and Shannon", 52.27, -8.7),
-    ("Shannon (EINN)", 52.702, -8.925),
-    ("Kerry (EIKY)", 52.181, -9.524),
-    ("Waterford coast", 52.0, -7.3),
+/// Places across the default area, the Irish Sea (24 stations within 250 km in the shipped file):
+/// name, latitude, longitude (degrees).
+const AREA: [(&str, f64, f64); 6] = [
+    (
+        "Belfast Aldergrove (EGAC: RA FEW007 OVC042 //////CB)",
+        54.614,
+        -5.873,
+    ),
+    ("Isle of Man (EGNS: FEW006 BKN011)", 54.085, -4.632),
+    ("the middle of the Irish Sea", 53.8, -5.2),
+    ("Dublin (EIDW: -RA FEW008 SCT026 BKN045)", 53.422, -6.298),
+    ("Anglesey (EGOV: RA FEW018 BKN045)", 53.252, -4.536),
+    (
+        "Manchester (EGCC: BKN015 BKN026 OVC031 //////TCU)",
+        53.354,
+        -2.275,
+    ),
 ];
 
 /// Flags of `skycast demo`.
@@ -38,7 +48,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         describe_file(&loaded.file, &Summary::of(&loaded.file), false)
     );
     println!(
-        "\nThe default flight area, south-west Ireland (showers and a CB line off the Atlantic):"
+        "\nThe default flight area, the Irish Sea: rain, low broken cloud, a CB over Belfast:"
     );
     for (name, lat, lon) in AREA {
         println!("\n{name}");

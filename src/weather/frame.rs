@@ -51,7 +51,12 @@ impl LocalFrame {
         let cos_c = self.sin_lat0 * sin_lat + self.cos_lat0 * cos_lat * cos_dlon;
         let sin_c = east.hypot(north);
         if sin_c == 0.0 {
-            return DVec2::ZERO;
+            // The reference itself, or its antipode (every direction at once: put it due south).
+            return if cos_c > 0.0 {
+                DVec2::ZERO
+            } else {
+                DVec2::new(0.0, -std::f64::consts::PI * EARTH_MEAN_RADIUS_M)
+            };
         }
         let c = sin_c.atan2(cos_c);
         DVec2::new(east, north) * (EARTH_MEAN_RADIUS_M * c / sin_c)
@@ -142,6 +147,9 @@ mod tests {
             assert!((lat - lat2).abs() < 1e-9, "{lat} {lat2}");
             assert!((wrap_lon_deg(lon - lon2)).abs() < 1e-9, "{lon} {lon2}");
         }
+        // The antipode is pi R away, not at the origin.
+        let antipode = LocalFrame::new(10.0, 20.0).to_local_m(-10.0, -160.0);
+        assert!((antipode.length() - std::f64::consts::PI * EARTH_MEAN_RADIUS_M).abs() < 1.0);
         // Across the date line 1 degree of longitude east is about 76 km east, not 40,000 km west.
         let p = f.to_local_m(47.0, -179.5);
         assert!(p.x > 75_000.0 && p.x < 77_000.0, "{p}");

@@ -3,7 +3,8 @@
 //!
 //! Per band, the band's layers merge into one: coverage is the largest of its groups (METAR
 //! covers are cumulative, each group counts all cloud at and below it), the base is the lowest
-//! base, the top the highest base plus that group's default thickness. VV is a fog layer as deep
+//! base (or the base of the band's lowest CB/TCU group, the cloud that will be drawn), the top the
+//! highest base plus that group's default thickness. VV is a fog layer as deep
 //! as the vertical visibility; FG in present weather a fog layer of the configured depth.
 //! CAVOK/NSC/NCD/SKC/CLR stations have zero coverage in every band; a station with no sky group at
 //! all has no cloud sample (it is left out of the cloud field).
@@ -131,6 +132,7 @@ fn sky_bands(r: &Report, settings: &FieldSettings) -> Option<[BandSample; 4]> {
     }
     let mut bands = [BandSample::default(); 4];
     let mut top_ft = [0.0f64; 4];
+    let mut convective_base_ft: [Option<f64>; 4] = [None; 4];
     if fog {
         let f = &mut bands[index(Band::Fog)];
         f.coverage_oktas = 8.0;
@@ -159,11 +161,20 @@ fn sky_bands(r: &Report, settings: &FieldSettings) -> Option<[BandSample; 4]> {
             continue;
         };
         let base = f64::from(base);
+        if g.kind.is_some() {
+            convective_base_ft[i] = Some(convective_base_ft[i].map_or(base, |c| c.min(base)));
+        }
         let first = b.coverage_oktas == 0.0;
         b.coverage_oktas = b.coverage_oktas.max(settings.oktas.get(cover));
         b.base_ft = if first { base } else { b.base_ft.min(base) };
         top_ft[i] = top_ft[i].max(base + settings.thickness_ft.get(cover));
         b.thickness_ft = top_ft[i] - b.base_ft;
+    }
+    for (b, (base, top)) in bands.iter_mut().zip(convective_base_ft.iter().zip(top_ft)) {
+        if let Some(base) = *base {
+            b.base_ft = base;
+            b.thickness_ft = top - base;
+        }
     }
     // A reported CB/TCU without cover or base (`//////CB`) still gets a layer to be drawn in.
     for b in &mut bands[1..] {
@@ -222,13 +233,33 @@ mod tests {
         let bands = StationSample::of(&placed(r), &s).unwrap().bands.unwrap();
         let low = bands[1];
         assert_eq!(low.coverage_oktas, 8.0);
-        assert_eq!(low.base_ft, 2800.0);
-        assert_eq!(low.thickness_ft, 5000.0 + 1500.0 - 2800.0);
+        // The TCU group's base, not the SCT028 below it.
+        assert_eq!(low.base_ft, 3300.0);
+        assert_eq!(low.thickness_ft, 5000.0 + 1500.0 - 3300.0);
         assert!(low.tcu && !low.cb);
         assert_eq!(bands[2].coverage_oktas, 0.0);
         assert_eq!(bands[3].coverage_oktas, 2.0);
         assert_eq!(bands[3].base_ft, 25000.0);
         assert_eq!(bands[0].coverage_oktas, 0.0);
+    }
+
+    #[test]
+    fn a_convective_group_sets_its_band_base() {
+        let s = FieldSettings::default();
+        // EICK: FEW006 SCT018CB BKN035.
+        let r = Report {
+            clouds: vec![
+                group(Some(Cover::Few), Some(600), None),
+                group(Some(Cover::Sct), Some(1800), Some(ConvectiveKind::Cb)),
+                group(Some(Cover::Bkn), Some(3500), None),
+            ],
+            ..Report::default()
+        };
+        let low = StationSample::of(&placed(r), &s).unwrap().bands.unwrap()[1];
+        assert!(low.cb);
+        assert_eq!(low.coverage_oktas, 6.0);
+        assert_eq!(low.base_ft, 1800.0);
+        assert_eq!(low.thickness_ft, 3500.0 + 1500.0 - 1800.0);
     }
 
     #[test]
