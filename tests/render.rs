@@ -1,16 +1,15 @@
 //! Real headless renders on whatever adapter there is (lavapipe on machines without a GPU),
 //! checking pixels. Few, small (320 x 180) and batched in this one binary. A missing adapter
 //! FAILS these tests: every machine that runs the suite has the software driver (`make vulkan`).
-//! Frames are written to `target/render-tests/` to look at.
+//! Frames are written to `target/tmp/render-tests/` to look at.
 
 use std::path::PathBuf;
 
 use glam::{DVec2, DVec3, Vec3};
-use skycast::render::terrain::{HeightField, TerrainLight};
+use skycast::render::terrain::HeightField;
 use skycast::render::vertices::square_sprite;
 use skycast::render::{
-    Camera, Frame, HeadlessGpu, OffscreenTarget, RenderSettings, Sky, SkyBlock, SkyCloud,
-    SkyConfig, SpriteSheet, Terrain, headless,
+    Camera, DemoHost, Frame, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteSheet, headless,
 };
 use skycast::shading::{ColourLevels, SunPosition, TimeOfDayTable};
 
@@ -83,6 +82,7 @@ fn cumulus(centre: DVec3) -> SkyCloud {
             Vec3::new(0.0, -250.0, 100.0),
         ],
         colour_levels: levels(centre.z as f32, centre.z as f32 + 500.0),
+        flat: false,
     }
 }
 
@@ -102,15 +102,12 @@ fn overcast(centre: DVec2, base: f64) -> SkyCloud {
         sprites,
         group_centres_m: vec![Vec3::new(0.0, 0.0, 150.0)],
         colour_levels: levels(base as f32, base as f32 + 300.0),
+        flat: false,
     }
 }
 
 struct Rig {
-    gpu: HeadlessGpu,
-    target: OffscreenTarget,
-    sky: Sky,
-    terrain: Terrain,
-    settings: RenderSettings,
+    host: DemoHost,
 }
 
 fn sun() -> SunPosition {
@@ -121,66 +118,36 @@ fn sun() -> SunPosition {
     }
 }
 
+fn sky_config(settings: RenderSettings) -> SkyConfig {
+    SkyConfig {
+        colour_format: headless::COLOUR_FORMAT,
+        settings,
+        time_of_day: TimeOfDayTable::default(),
+        sheet: puff_sheet(),
+    }
+}
+
 impl Rig {
     fn new(ground: HeightField) -> Rig {
-        let gpu =
-            HeadlessGpu::new().unwrap_or_else(|e| panic!("render tests need an adapter: {e}"));
-        let target = OffscreenTarget::new(&gpu, W, H).unwrap();
-        let settings = RenderSettings::default();
-        let sky = Sky::new(
-            &gpu.device,
-            &gpu.queue,
-            SkyConfig {
-                colour_format: headless::COLOUR_FORMAT,
-                settings,
-                time_of_day: TimeOfDayTable::default(),
-                sheet: puff_sheet(),
-            },
-        )
-        .unwrap();
-        let terrain = Terrain::new(&gpu.device, headless::COLOUR_FORMAT, &ground);
-        Rig {
-            gpu,
-            target,
-            sky,
-            terrain,
-            settings,
-        }
+        Rig::with_settings(ground, RenderSettings::default())
+    }
+
+    fn with_settings(ground: HeightField, settings: RenderSettings) -> Rig {
+        let host = DemoHost::new(W, H, &ground, sky_config(settings))
+            .unwrap_or_else(|e| panic!("render tests need an adapter: {e}"));
+        Rig { host }
     }
 
     fn camera(&self, position: DVec3, heading: f64, pitch: f64) -> Camera {
-        Camera {
-            position_m: position,
-            heading_deg: heading,
-            pitch_deg: pitch,
-            fov_y_deg: self.settings.camera.fov_y_deg,
-            aspect: W as f32 / H as f32,
-            near_m: self.settings.camera.near_m,
-            far_m: self.settings.camera.far_m,
-        }
+        self.host.camera(position, heading, pitch)
+    }
+
+    fn set_clouds(&mut self, blocks: Vec<SkyBlock>) {
+        self.host.sky.set_clouds(blocks);
     }
 
     fn frame(&mut self, name: &str, camera: &Camera) -> (Frame, skycast::render::FrameStats) {
-        let stats = self.sky.prepare(&self.gpu.queue, camera, &sun(), 0.0);
-        let light = self.sky.light();
-        self.terrain.prepare(
-            &self.gpu.queue,
-            camera,
-            &TerrainLight {
-                sun_dir: sun().direction_enu().as_vec3(),
-                sun_rgb: light.directional_rgb,
-                ambient: light.ambient_percent * 0.35,
-                fog_rgb: self.sky.horizon_rgb(),
-                visibility_m: 40_000.0,
-            },
-        );
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        self.terrain
-            .record(&mut enc, &self.target.colour_view, &self.target.depth_view);
-        self.sky
-            .record(&mut enc, &self.target.colour_view, &self.target.depth_view);
-        self.gpu.queue.submit([enc.finish()]);
-        let frame = self.target.read_back(&self.gpu).unwrap();
+        let (frame, stats) = self.host.frame(camera, &sun(), 0.0, 40_000.0).unwrap();
         let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
         std::fs::create_dir_all(&dir).unwrap();
         frame.write_png(&dir.join(format!("{name}.png"))).unwrap();
@@ -213,7 +180,7 @@ fn luminance(p: [f32; 4]) -> f32 {
 fn clear_overcast_and_in_cloud_frames() {
     let mut rig = Rig::new(flat_ground(0.0));
     let up = rig.camera(DVec3::new(0.0, 0.0, 300.0), 0.0, 55.0);
-    rig.sky.set_clouds(Vec::new());
+    rig.set_clouds(Vec::new());
     let (clear, stats) = rig.frame("clear_sky", &up);
     assert_eq!(stats.sprites_drawn, 0);
     assert_eq!(
@@ -227,7 +194,7 @@ fn clear_overcast_and_in_cloud_frames() {
         "looking up, the frame is sky: {sky_share}"
     );
 
-    rig.sky.set_clouds(vec![SkyBlock {
+    rig.set_clouds(vec![SkyBlock {
         centre_m: DVec3::new(0.0, 0.0, 1500.0),
         clouds: vec![overcast(DVec2::ZERO, 1500.0)],
     }]);
@@ -269,9 +236,9 @@ fn terrain_in_front_hides_the_cloud() {
     });
     let mut rig = Rig::new(ridge);
     let cam = rig.camera(DVec3::new(0.0, 0.0, 800.0), 0.0, 4.0);
-    rig.sky.set_clouds(Vec::new());
+    rig.set_clouds(Vec::new());
     let (bare, _) = rig.frame("ridge_bare", &cam);
-    rig.sky.set_clouds(vec![SkyBlock {
+    rig.set_clouds(vec![SkyBlock {
         centre_m: DVec3::new(0.0, 6000.0, 1300.0),
         clouds: vec![cumulus(DVec3::new(0.0, 6000.0, 1000.0))],
     }]);
@@ -302,28 +269,19 @@ fn cloud_terrain_edge_is_a_ramp() {
         sprites: vec![square_sprite(Vec3::ZERO, 600.0, 5, 0)],
         group_centres_m: vec![Vec3::ZERO],
         colour_levels: levels(0.0, 600.0),
+        flat: false,
     };
     let mut jumps = Vec::new();
     for (name, fade_m) in [("edge_soft", None), ("edge_hard", Some(0.5))] {
-        let mut rig = Rig::new(slope.clone());
+        let mut settings = RenderSettings::default();
         if let Some(f) = fade_m {
-            rig.settings.clouds.soft_depth_fade_m = f;
-            rig.sky = Sky::new(
-                &rig.gpu.device,
-                &rig.gpu.queue,
-                SkyConfig {
-                    colour_format: headless::COLOUR_FORMAT,
-                    settings: rig.settings,
-                    time_of_day: TimeOfDayTable::default(),
-                    sheet: puff_sheet(),
-                },
-            )
-            .unwrap();
+            settings.clouds.soft_depth_fade_m = f;
         }
+        let mut rig = Rig::with_settings(slope.clone(), settings);
         let cam = rig.camera(DVec3::new(0.0, 0.0, 130.0), 0.0, 0.0);
-        rig.sky.set_clouds(Vec::new());
+        rig.set_clouds(Vec::new());
         let (bare, _) = rig.frame(&format!("{name}_bare"), &cam);
-        rig.sky.set_clouds(vec![SkyBlock {
+        rig.set_clouds(vec![SkyBlock {
             centre_m: sprite_cloud.centre_m,
             clouds: vec![sprite_cloud.clone()],
         }]);

@@ -14,6 +14,7 @@
 //! linear RGB.
 
 pub mod camera;
+pub mod demo_host;
 pub mod gpu_types;
 pub mod headless;
 pub mod output;
@@ -24,6 +25,7 @@ pub mod terrain;
 pub mod vertices;
 
 pub use camera::Camera;
+pub use demo_host::{DemoHost, ground_from_field};
 pub use headless::{Frame, HeadlessGpu, OffscreenTarget};
 pub use scene::{SkyBlock, SkyCloud, SkySprite};
 pub use settings::RenderSettings;

@@ -39,6 +39,9 @@ pub struct SkyCloud {
     pub group_centres_m: Vec<Vec3>,
     /// The five ambient colour levels; heights in metres above mean sea level (Wang 5.1).
     pub colour_levels: ColourLevels,
+    /// Drawn as flat horizontal rectangles instead of camera-facing sprites (cirrus, Wang 7.1);
+    /// a flat sprite's height is its north-south extent.
+    pub flat: bool,
 }
 
 /// A 4 km x 4 km block of clouds.

@@ -297,7 +297,16 @@ fn build_cloud(
         let radius = 0.5 * s.width_m.max(s.height_m);
         let lock_key = (key.0, key.1, i as u32);
         // Wang 3.3: lock the facing inside half the radius; fade with the angle to the camera.
-        let (facing, lock_alpha) = if dist2.sqrt() < settings.lock_radius_fraction * radius {
+        let (facing, lock_alpha) = if cloud.flat {
+            (
+                Facing {
+                    right: Vec3::X,
+                    up: Vec3::Y,
+                    normal: Vec3::Z,
+                },
+                1.0,
+            )
+        } else if dist2.sqrt() < settings.lock_radius_fraction * radius {
             let f = *locks
                 .entry(lock_key)
                 .or_insert_with(|| facing_towards(to_cam.normalize_or(Vec3::Y)));
@@ -383,6 +392,7 @@ mod tests {
                 .collect(),
             group_centres_m: vec![Vec3::new(200.0, 0.0, 100.0)],
             colour_levels: ColourLevels::even(1500.0, 1800.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+            flat: false,
         };
         vec![SkyBlock {
             centre_m: DVec3::new(0.0, 5000.0, 1500.0),
@@ -475,6 +485,7 @@ mod tests {
             sprites: vec![square_sprite(Vec3::ZERO, 200.0, 0, 0)],
             group_centres_m: vec![Vec3::ZERO],
             colour_levels: ColourLevels::even(900.0, 1100.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+            flat: false,
         };
         let b = vec![SkyBlock {
             centre_m: cloud.centre_m,

@@ -1,0 +1,145 @@
+//! The demo host: what a flight simulator would do around a [`Sky`], packaged for the CLI, the
+//! render tests and the benchmarks. It owns a headless device, an offscreen colour + depth
+//! target and the demo [`Terrain`]; each frame it draws the ground first (colour and depth), then
+//! lets the sky record its passes reading that depth, then reads the frame back.
+//!
+//! [`ground_from_field`] builds the ground so it agrees with the weather: the field's ground
+//! elevation (interpolated from station elevations) plus gentle procedural relief, so a METAR
+//! base above ground lands above this ground.
+
+use glam::DVec2;
+
+use super::RenderError;
+use super::camera::Camera;
+use super::headless::{self, Frame, HeadlessGpu, OffscreenTarget};
+use super::sky::{Sky, SkyConfig};
+use super::terrain::{HeightField, Terrain, TerrainLight, procedural_relief_m};
+use super::vertices::FrameStats;
+use crate::shading::SunPosition;
+use crate::weather::field::WeatherField;
+
+/// A headless device, target, ground and sky.
+pub struct DemoHost {
+    /// The device.
+    pub gpu: HeadlessGpu,
+    /// The offscreen target.
+    pub target: OffscreenTarget,
+    /// The ground.
+    pub terrain: Terrain,
+    /// The sky.
+    pub sky: Sky,
+}
+
+impl DemoHost {
+    /// Creates the device (any adapter), a `width` x `height` target, the ground and the sky.
+    pub fn new(
+        width: u32,
+        height: u32,
+        ground: &HeightField,
+        sky: SkyConfig,
+    ) -> Result<Self, RenderError> {
+        let gpu = HeadlessGpu::new()?;
+        let target = OffscreenTarget::new(&gpu, width, height)?;
+        let terrain = Terrain::new(&gpu.device, headless::COLOUR_FORMAT, ground);
+        let sky = Sky::new(
+            &gpu.device,
+            &gpu.queue,
+            SkyConfig {
+                colour_format: headless::COLOUR_FORMAT,
+                ..sky
+            },
+        )?;
+        Ok(Self {
+            gpu,
+            target,
+            terrain,
+            sky,
+        })
+    }
+
+    /// A camera with the sky's projection settings and this target's aspect.
+    pub fn camera(&self, position_m: glam::DVec3, heading_deg: f64, pitch_deg: f64) -> Camera {
+        let c = &self.sky.settings().camera;
+        Camera {
+            position_m,
+            heading_deg,
+            pitch_deg,
+            fov_y_deg: c.fov_y_deg,
+            aspect: self.target.width as f32 / self.target.height as f32,
+            near_m: c.near_m,
+            far_m: c.far_m,
+        }
+    }
+
+    /// Draws one frame (ground, then sky) without reading it back; returns the sky's stats.
+    pub fn draw(
+        &mut self,
+        camera: &Camera,
+        sun: &SunPosition,
+        dt_s: f64,
+        visibility_m: f32,
+    ) -> FrameStats {
+        let stats = self.sky.prepare(&self.gpu.queue, camera, sun, dt_s);
+        let light = self.sky.light();
+        self.terrain.prepare(
+            &self.gpu.queue,
+            camera,
+            &TerrainLight {
+                sun_dir: sun.direction_enu().as_vec3(),
+                sun_rgb: light.directional_rgb,
+                ambient: light.ambient_percent * 0.35,
+                fog_rgb: self.sky.horizon_rgb(),
+                visibility_m,
+            },
+        );
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("host.frame"),
+            });
+        self.terrain.record(
+            &mut encoder,
+            &self.target.colour_view,
+            &self.target.depth_view,
+        );
+        self.sky.record(
+            &mut encoder,
+            &self.target.colour_view,
+            &self.target.depth_view,
+        );
+        self.gpu.queue.submit([encoder.finish()]);
+        stats
+    }
+
+    /// Draws one frame and reads it back.
+    pub fn frame(
+        &mut self,
+        camera: &Camera,
+        sun: &SunPosition,
+        dt_s: f64,
+        visibility_m: f32,
+    ) -> Result<(Frame, FrameStats), RenderError> {
+        let stats = self.draw(camera, sun, dt_s, visibility_m);
+        Ok((self.target.read_back(&self.gpu)?, stats))
+    }
+}
+
+/// Ground around `centre_m` (`size_m` square, `samples` per side) at the field's interpolated
+/// station elevations plus `relief_m` of procedural relief. The field is sampled on a coarser
+/// grid (every 4th sample) and interpolated; it changes slowly.
+pub fn ground_from_field(
+    field: &WeatherField,
+    centre_m: DVec2,
+    size_m: f64,
+    samples: u32,
+    relief_m: f64,
+) -> HeightField {
+    let coarse_samples = (samples / 4).max(2);
+    let coarse = HeightField::from_fn(centre_m, size_m, coarse_samples, |p| {
+        field.weather_at(p).ground_elevation_m as f64
+    });
+    HeightField::from_fn(centre_m, size_m, samples, |p| {
+        coarse.height_at_m(p) + procedural_relief_m(p, relief_m, 11)
+    })
+}
