@@ -195,6 +195,7 @@ fn clear_overcast_and_in_cloud_frames() {
     );
 
     rig.set_clouds(vec![SkyBlock {
+        id: 7,
         centre_m: DVec3::new(0.0, 0.0, 1500.0),
         clouds: vec![overcast(DVec2::ZERO, 1500.0)],
     }]);
@@ -239,6 +240,7 @@ fn terrain_in_front_hides_the_cloud() {
     rig.set_clouds(Vec::new());
     let (bare, _) = rig.frame("ridge_bare", &cam);
     rig.set_clouds(vec![SkyBlock {
+        id: 7,
         centre_m: DVec3::new(0.0, 6000.0, 1300.0),
         clouds: vec![cumulus(DVec3::new(0.0, 6000.0, 1000.0))],
     }]);
@@ -282,6 +284,7 @@ fn cloud_terrain_edge_is_a_ramp() {
         rig.set_clouds(Vec::new());
         let (bare, _) = rig.frame(&format!("{name}_bare"), &cam);
         rig.set_clouds(vec![SkyBlock {
+            id: 7,
             centre_m: sprite_cloud.centre_m,
             clouds: vec![sprite_cloud.clone()],
         }]);

@@ -47,6 +47,8 @@ pub struct SkyCloud {
 /// A 4 km x 4 km block of clouds.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SkyBlock {
+    /// Identifies the block across frames for the vertex cache (e.g. a hash of its index).
+    pub id: u64,
     /// Centre of the block, metres (the sort key of the block pass).
     pub centre_m: DVec3,
     /// The clouds.

@@ -303,9 +303,9 @@ impl Sky {
         })
     }
 
-    /// Replaces the clouds (the vertex cache starts over).
+    /// Replaces the clouds. Cached vertices of blocks that stay (same id) are kept.
     pub fn set_clouds(&mut self, blocks: Vec<SkyBlock>) {
-        self.builder.reset(&blocks);
+        self.builder.retain(&blocks);
         self.blocks = blocks;
     }
 

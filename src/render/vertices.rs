@@ -66,14 +66,16 @@ struct CacheEntry {
     camera_m: DVec3,
     time_s: f64,
     sun_dir: Vec3,
+    /// Which cloud this was computed for: centre and sprite count (a changed cloud recomputes).
+    fingerprint: (DVec3, usize),
     valid: bool,
 }
 
 /// Builds sprite vertices and keeps the per-cloud cache and locked facings.
 #[derive(Debug, Default)]
 pub struct SpriteVertexBuilder {
-    entries: Vec<Vec<CacheEntry>>,
-    locks: HashMap<(u32, u32, u32), Facing>,
+    entries: HashMap<(u64, u32), CacheEntry>,
+    locks: HashMap<(u64, u32, u32), Facing>,
     vertices: Vec<GpuSpriteVertex>,
     in_cloud_rgb: Vec3,
 }
@@ -110,13 +112,12 @@ impl SpriteVertexBuilder {
         Self::default()
     }
 
-    /// Forgets every cached cloud (call when the clouds change).
-    pub fn reset(&mut self, blocks: &[SkyBlock]) {
-        self.entries = blocks
-            .iter()
-            .map(|b| vec![CacheEntry::default(); b.clouds.len()])
-            .collect();
-        self.locks.clear();
+    /// Forgets the cached clouds of blocks that are no longer in `blocks` (call when the set
+    /// of blocks changes; clouds whose centre or sprite count changed recompute by themselves).
+    pub fn retain(&mut self, blocks: &[SkyBlock]) {
+        let ids: std::collections::HashSet<u64> = blocks.iter().map(|b| b.id).collect();
+        self.entries.retain(|k, _| ids.contains(&k.0));
+        self.locks.retain(|k, _| ids.contains(&k.0));
     }
 
     /// The vertices of the last [`Self::update`], four per sprite, back to front.
@@ -140,15 +141,6 @@ impl SpriteVertexBuilder {
     ) -> FrameStats {
         let start = Instant::now();
         let (clouds, cache) = (&settings.clouds, &settings.vertex_cache);
-        if self.entries.len() != blocks.len()
-            || self
-                .entries
-                .iter()
-                .zip(blocks)
-                .any(|(e, b)| e.len() != b.clouds.len())
-        {
-            self.reset(blocks);
-        }
         let mut stats = FrameStats::default();
         let draw_m = clouds.draw_distance_m as f64;
 
@@ -176,14 +168,20 @@ impl SpriteVertexBuilder {
             cloud_order.sort_by(|a, b| b.1.total_cmp(&a.1));
             for (ci, _, near_edge_m) in cloud_order {
                 let cloud = &block.clouds[ci];
-                stats.in_cloud = stats.in_cloud.max(in_cloud_factor(
-                    cloud,
-                    camera_m,
-                    settings.in_cloud.ramp_fraction,
-                ));
-                let entry = &mut self.entries[bi][ci];
+                let inside = in_cloud_factor(cloud, camera_m, settings.in_cloud.ramp_fraction);
+                if inside > stats.in_cloud {
+                    stats.in_cloud = inside;
+                    // Fog colour: the cloud's ambient at the camera's height plus the median sun.
+                    let tod = &lighting.time_of_day;
+                    self.in_cloud_rgb = cloud.colour_levels.at(camera_m.z as f32).truncate()
+                        * tod.ambient_percent
+                        + tod.directional_rgb * lighting.mapping.c_median;
+                }
+                let fingerprint = (cloud.centre_m, cloud.sprites.len());
+                let entry = self.entries.entry((block.id, ci as u32)).or_default();
                 let stale = !cache.enabled
                     || !entry.valid
+                    || entry.fingerprint != fingerprint
                     || needs_recompute(
                         entry,
                         cloud,
@@ -198,7 +196,7 @@ impl SpriteVertexBuilder {
                     entry.vertices.clear();
                     build_cloud(
                         cloud,
-                        (bi as u32, ci as u32),
+                        (block.id, ci as u32),
                         camera_m,
                         lighting,
                         clouds,
@@ -208,6 +206,7 @@ impl SpriteVertexBuilder {
                     entry.camera_m = camera_m;
                     entry.time_s = time_s;
                     entry.sun_dir = lighting.sun_dir;
+                    entry.fingerprint = fingerprint;
                     entry.valid = true;
                     stats.clouds_recomputed += 1;
                 }
@@ -273,11 +272,11 @@ pub fn in_cloud_factor(cloud: &SkyCloud, camera_m: DVec3, ramp: f32) -> f32 {
 /// Faces, shades and sorts one cloud's sprites into `out` (positions relative to the centre).
 fn build_cloud(
     cloud: &SkyCloud,
-    key: (u32, u32),
+    key: (u64, u32),
     camera_m: DVec3,
     lighting: &Lighting,
     settings: &CloudSettings,
-    locks: &mut HashMap<(u32, u32, u32), Facing>,
+    locks: &mut HashMap<(u64, u32, u32), Facing>,
     out: &mut Vec<LocalVertex>,
 ) {
     let cam_local = (camera_m - cloud.centre_m).as_vec3();
@@ -395,6 +394,7 @@ mod tests {
             flat: false,
         };
         vec![SkyBlock {
+            id: 1,
             centre_m: DVec3::new(0.0, 5000.0, 1500.0),
             clouds: (0..10).map(|i| cloud(i as f64 * 1500.0)).collect(),
         }]
@@ -430,6 +430,9 @@ mod tests {
             assert_eq!(still.cache_hit_rate, 1.0);
         }
         assert_eq!(builder.vertices(), &first_vertices[..]);
+        // Handing the same blocks again (as a host does when the block set changes) keeps them.
+        builder.retain(&b);
+        assert_eq!(builder.update(&b, cam, 1.0, &l, &s).clouds_recomputed, 0);
         // 300 m is past the threshold of every cloud (at most 5 m + 2% of ~19 km).
         let moved = builder.update(&b, cam + DVec3::new(0.0, 300.0, 0.0), 1.0, &l, &s);
         assert_eq!(moved.clouds_recomputed, 10);
@@ -488,6 +491,7 @@ mod tests {
             flat: false,
         };
         let b = vec![SkyBlock {
+            id: 1,
             centre_m: cloud.centre_m,
             clouds: vec![cloud],
         }];
