@@ -25,6 +25,8 @@ pub struct FrameStats {
     pub clouds_drawn: u32,
     /// Clouds whose vertices were recomputed this frame.
     pub clouds_recomputed: u32,
+    /// Sprites of those clouds (the vertex work of the frame).
+    pub sprites_recomputed: u32,
     /// Fraction of drawn clouds served from the cache, 0..=1 (1 when nothing was drawn).
     pub cache_hit_rate: f32,
     /// CPU time of the update, microseconds.
@@ -68,6 +70,7 @@ struct CacheEntry {
     sun_dir: Vec3,
     /// Which cloud this was computed for: centre and sprite count (a changed cloud recomputes).
     fingerprint: (DVec3, usize),
+    info: Option<CloudInfo>,
     valid: bool,
 }
 
@@ -155,20 +158,31 @@ impl SpriteVertexBuilder {
         self.vertices.clear();
         for (bi, _) in block_order {
             let block = &blocks[bi];
-            let mut cloud_order: Vec<(usize, f64, f64)> = block
-                .clouds
-                .iter()
-                .enumerate()
-                .filter_map(|(ci, c)| {
-                    let d = (c.centre_m - camera_m).length();
-                    let near_edge = (d - c.radius_m() as f64).max(0.0);
-                    (near_edge <= draw_m).then_some((ci, d, near_edge))
-                })
-                .collect();
+            // Per-cloud bounds are computed once per cloud (and on each recompute), not per frame.
+            let mut cloud_order: Vec<(usize, f64, f64)> = Vec::with_capacity(block.clouds.len());
+            for (ci, cloud) in block.clouds.iter().enumerate() {
+                let fingerprint = (cloud.centre_m, cloud.sprites.len());
+                let entry = self.entries.entry((block.id, ci as u32)).or_default();
+                if entry.fingerprint != fingerprint || entry.info.is_none() {
+                    entry.info = Some(CloudInfo::of(cloud));
+                    entry.fingerprint = fingerprint;
+                    entry.valid = false;
+                }
+                let info = entry.info.unwrap_or_default();
+                let d = (cloud.centre_m - camera_m).length();
+                let near_edge = (d - info.radius_m as f64).max(0.0);
+                if near_edge <= draw_m {
+                    cloud_order.push((ci, d, near_edge));
+                }
+            }
             cloud_order.sort_by(|a, b| b.1.total_cmp(&a.1));
             for (ci, _, near_edge_m) in cloud_order {
                 let cloud = &block.clouds[ci];
-                let inside = in_cloud_factor(cloud, camera_m, settings.in_cloud.ramp_fraction);
+                let Some(entry) = self.entries.get_mut(&(block.id, ci as u32)) else {
+                    continue;
+                };
+                let info = entry.info.unwrap_or_default();
+                let inside = info.in_cloud_factor(cloud, camera_m, settings.in_cloud.ramp_fraction);
                 if inside > stats.in_cloud {
                     stats.in_cloud = inside;
                     // Fog colour: the cloud's ambient at the camera's height plus the median sun.
@@ -177,14 +191,11 @@ impl SpriteVertexBuilder {
                         * tod.ambient_percent
                         + tod.directional_rgb * lighting.mapping.c_median;
                 }
-                let fingerprint = (cloud.centre_m, cloud.sprites.len());
-                let entry = self.entries.entry((block.id, ci as u32)).or_default();
                 let stale = !cache.enabled
                     || !entry.valid
-                    || entry.fingerprint != fingerprint
                     || needs_recompute(
                         entry,
-                        cloud,
+                        info.fading,
                         camera_m,
                         time_s,
                         lighting.sun_dir,
@@ -206,9 +217,10 @@ impl SpriteVertexBuilder {
                     entry.camera_m = camera_m;
                     entry.time_s = time_s;
                     entry.sun_dir = lighting.sun_dir;
-                    entry.fingerprint = fingerprint;
+                    entry.info = Some(CloudInfo::of(cloud));
                     entry.valid = true;
                     stats.clouds_recomputed += 1;
+                    stats.sprites_recomputed += cloud.sprites.len() as u32;
                 }
                 stats.clouds_drawn += 1;
                 let offset = (cloud.centre_m - camera_m).as_vec3();
@@ -236,7 +248,7 @@ impl SpriteVertexBuilder {
 /// Wang 6.1: thresholds grow with the cloud's distance; fading clouds age out sooner.
 fn needs_recompute(
     entry: &CacheEntry,
-    cloud: &SkyCloud,
+    fading: bool,
     camera_m: DVec3,
     time_s: f64,
     sun_dir: Vec3,
@@ -245,7 +257,7 @@ fn needs_recompute(
 ) -> bool {
     let moved_m = (camera_m - entry.camera_m).length();
     let move_limit_m = cache.min_move_m as f64 + cache.move_fraction as f64 * near_edge_m;
-    let max_age_s = if cloud.is_fading() {
+    let max_age_s = if fading {
         cache.fading_max_age_s as f64
     } else {
         cache.max_age_s as f64 * (1.0 + near_edge_m / cache.time_distance_m as f64)
@@ -256,17 +268,37 @@ fn needs_recompute(
         || sun_dir.dot(entry.sun_dir) < 0.999_96 // about half a degree
 }
 
-/// How far inside a cloud's core box the camera is: 0 outside, rising to 1 over `ramp` of the
-/// half-extent inside the boundary.
-pub fn in_cloud_factor(cloud: &SkyCloud, camera_m: DVec3, ramp: f32) -> f32 {
-    let (half, centre) = cloud.core_box_m();
-    if half.min_element() <= 0.0 {
-        return 0.0;
+/// A cloud's bounds and state, computed when its vertices are.
+#[derive(Debug, Clone, Copy, Default)]
+struct CloudInfo {
+    radius_m: f32,
+    core_half_m: Vec3,
+    core_centre_m: Vec3,
+    fading: bool,
+}
+
+impl CloudInfo {
+    fn of(cloud: &SkyCloud) -> Self {
+        let (core_half_m, core_centre_m) = cloud.core_box_m();
+        Self {
+            radius_m: cloud.radius_m(),
+            core_half_m,
+            core_centre_m,
+            fading: cloud.is_fading(),
+        }
     }
-    let rel = (camera_m - cloud.centre_m).as_vec3() - centre;
-    // Depth inside the box as a fraction of the half extent, along the tightest axis.
-    let inside = (Vec3::ONE - rel.abs() / half).min_element();
-    (inside / ramp.max(1e-3)).clamp(0.0, 1.0)
+
+    /// How far inside the cloud's core box the camera is: 0 outside, rising to 1 over `ramp`
+    /// of the half-extent inside the boundary.
+    fn in_cloud_factor(&self, cloud: &SkyCloud, camera_m: DVec3, ramp: f32) -> f32 {
+        if self.core_half_m.min_element() <= 0.0 {
+            return 0.0;
+        }
+        let rel = (camera_m - cloud.centre_m).as_vec3() - self.core_centre_m;
+        // Depth inside the box as a fraction of the half extent, along the tightest axis.
+        let inside = (Vec3::ONE - rel.abs() / self.core_half_m).min_element();
+        (inside / ramp.max(1e-3)).clamp(0.0, 1.0)
+    }
 }
 
 /// Faces, shades and sorts one cloud's sprites into `out` (positions relative to the centre).
