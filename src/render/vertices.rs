@@ -570,4 +570,28 @@ mod tests {
                 .all(|v| (v.position_m[0] + 300.0).abs() < 1e-3)
         );
     }
+
+    #[test]
+    fn far_from_the_origin_the_vertices_are_as_precise_as_near_it() {
+        let (l, s) = (lighting(), RenderSettings::default());
+        let shifted = |offset: DVec3| -> Vec<GpuSpriteVertex> {
+            let mut b = blocks();
+            for block in &mut b {
+                block.centre_m += offset;
+                for c in &mut block.clouds {
+                    c.centre_m += offset;
+                }
+            }
+            let mut builder = SpriteVertexBuilder::new();
+            builder.update(&b, DVec3::new(0.0, 0.0, 1000.0) + offset, 0.0, &l, &s);
+            builder.vertices().to_vec()
+        };
+        let near = shifted(DVec3::ZERO);
+        let far = shifted(DVec3::new(250_000.0, -180_000.0, 0.0));
+        assert_eq!(near.len(), far.len());
+        for (a, b) in near.iter().zip(&far) {
+            let d = Vec3::from_array(a.position_m) - Vec3::from_array(b.position_m);
+            assert!(d.length() < 1e-3, "jitter of {} m 300 km out", d.length());
+        }
+    }
 }
