@@ -1,7 +1,7 @@
 // Pass `sky.sprites`: cloud sprites, back to front, premultiplied alpha. Vertices come from the
 // CPU (facing, locking and Wang shading happen there, cached). The fragment multiplies in the
 // sheet texture (Wang eq. 3) and fades against the host's depth over soft_depth_fade_m
-// (Bahnassi) instead of cutting hard. Shared structs: shared/frame.wgsl.
+// (Bahnassi) instead of cutting hard, and fades distant sprites into the horizon haze. Shared structs: shared/frame.wgsl.
 
 @group(1) @binding(0) var sheet: texture_2d<f32>;
 @group(1) @binding(1) var sheet_sampler: sampler;
@@ -36,5 +36,8 @@ fn fs_sprite(i: VertexOut) -> @location(0) vec4<f32> {
     let scene_m = linear_depth_m(scene_depth_at(i.position.xy));
     let soft = clamp((scene_m - i.view_depth_m) / frame.params.z, 0.0, 1.0);
     let alpha = texel.a * i.colour.a * soft;
-    return vec4<f32>(i.colour.rgb * texel.rgb * alpha, alpha);
+    // Aerial perspective: distant clouds fade into the horizon haze.
+    let haze = 1.0 - exp(-i.view_depth_m / frame.haze.x);
+    let rgb = mix(i.colour.rgb * texel.rgb, frame.sky_horizon_rgb.rgb, haze);
+    return vec4<f32>(rgb * alpha, alpha);
 }

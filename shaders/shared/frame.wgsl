@@ -9,6 +9,8 @@ struct Frame {
     in_cloud_rgba: vec4<f32>,
     // near_m, far_m, soft_depth_fade_m, in_cloud_visibility_m
     params: vec4<f32>,
+    // x: haze distance, metres
+    haze: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> frame: Frame;

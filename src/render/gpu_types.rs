@@ -24,8 +24,10 @@ pub struct GpuFrame {
     pub in_cloud_rgba: [f32; 4],
     /// near_m, far_m, soft_depth_fade_m, in_cloud_visibility_m.
     pub params: [f32; 4],
+    /// x: distance at which sprites have faded 63% into the horizon haze, metres; yzw unused.
+    pub haze: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuFrame>() == 224);
+const _: () = assert!(std::mem::size_of::<GpuFrame>() == 240);
 
 /// One corner of a cloud sprite, camera-relative. Keep in sync with `VertexIn` in
 /// `shaders/sprites.wgsl`.

@@ -35,6 +35,8 @@ pub struct CloudSettings {
     pub lock_fade_end_deg: f32,
     /// Sprites farther than this from the camera are not drawn, metres.
     pub draw_distance_m: f32,
+    /// Distant sprites fade into the horizon haze: 63% at this distance, metres.
+    pub haze_distance_m: f32,
 }
 
 /// In-cloud fog settings (Wang 7.1).
@@ -106,6 +108,7 @@ impl Default for RenderSettings {
                 lock_fade_start_deg: 20.0,
                 lock_fade_end_deg: 70.0,
                 draw_distance_m: 60_000.0,
+                haze_distance_m: 50_000.0,
             },
             in_cloud: InCloudSettings {
                 visibility_m: 70.0,
@@ -136,6 +139,7 @@ impl RenderSettings {
             ("camera.near_m", s.camera.near_m),
             ("camera.fov_y_deg", s.camera.fov_y_deg),
             ("clouds.soft_depth_fade_m", s.clouds.soft_depth_fade_m),
+            ("clouds.haze_distance_m", s.clouds.haze_distance_m),
             ("in_cloud.visibility_m", s.in_cloud.visibility_m),
             (
                 "vertex_cache.time_distance_m",

@@ -403,6 +403,7 @@ impl Sky {
                 self.settings.clouds.soft_depth_fade_m,
                 self.settings.in_cloud.visibility_m,
             ],
+            haze: [self.settings.clouds.haze_distance_m, 0.0, 0.0, 0.0],
         };
         queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&frame));
         stats.cpu_update_us += upload_start.elapsed().as_micros() as u64;
