@@ -5,7 +5,11 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::weather::{DEFAULT_STATIONS, Summary, at_block, describe_block, describe_file, load};
+use skycast::weather::WeatherInput;
+
+use super::weather::{
+    DEFAULT_STATIONS, Summary, at_block, describe_block, describe_file, describe_theme, load,
+};
 
 /// The shipped bulk weather file.
 pub const DEFAULT_WEATHER: &str = "weather/awc-metars-2025-01-27T22Z.cache.csv";
@@ -43,10 +47,10 @@ pub struct DemoArgs {
 /// Runs `skycast demo`.
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     let loaded = load(&args.weather, &args.stations, None, None)?;
-    print!(
-        "{}",
-        describe_file(&loaded.file, &Summary::of(&loaded.file), false)
-    );
+    match &loaded.input {
+        WeatherInput::Reports(file) => print!("{}", describe_file(file, &Summary::of(file), false)),
+        WeatherInput::Theme(theme) => print!("{}", describe_theme(&args.weather, theme)),
+    }
     println!(
         "\nThe default flight area, the Irish Sea: rain, low broken cloud, a CB over Belfast:"
     );

@@ -7,10 +7,13 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use serde::Serialize;
-use skycast::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
-use skycast::weather::files::{self, WeatherFile};
+use skycast::weather::field::{CloudTypeRule, FieldSettings};
+use skycast::weather::files::WeatherFile;
 use skycast::weather::metar::{ConvectiveKind, Cover, SkyCode};
-use skycast::weather::{BlockIndex, BlockWeather, LineWarning, LocalFrame, StationTable};
+use skycast::weather::theme::{self, Theme};
+use skycast::weather::{
+    BlockIndex, BlockWeather, LineWarning, LocalFrame, StationTable, WeatherInput,
+};
 
 /// The station table used when `--stations` is not given.
 pub const DEFAULT_STATIONS: &str = "weather/nsd_cccc.txt";
@@ -18,7 +21,8 @@ pub const DEFAULT_STATIONS: &str = "weather/nsd_cccc.txt";
 /// Flags of `skycast weather`.
 #[derive(Debug, Args)]
 pub struct WeatherArgs {
-    /// The weather file: metars.cache.csv, a NOAA cycle file, or one METAR a line.
+    /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, or a weather
+    /// theme (`.toml`, see weather/themes/).
     pub file: PathBuf,
     /// Station table (NOAA nsd_cccc.txt format) placing reports the file does not place.
     #[arg(long, default_value = DEFAULT_STATIONS)]
@@ -56,6 +60,16 @@ pub fn parse_lat_lon(text: &str) -> Result<(f64, f64), String> {
         ));
     }
     Ok((lat, lon))
+}
+
+#[derive(Serialize)]
+struct ThemeJsonOut<'a> {
+    file: &'a Path,
+    format: &'static str,
+    name: &'a str,
+    description: &'a str,
+    points: usize,
+    at: Option<&'a AtBlock>,
 }
 
 /// Counts over the located reports of a file.
@@ -137,10 +151,10 @@ struct JsonOut<'a> {
     at: Option<&'a AtBlock>,
 }
 
-/// Everything `skycast weather` needs, loaded: the file, the rule and the settings.
+/// Everything `skycast weather` needs, loaded: the weather, the rule and the settings.
 pub struct Loaded {
-    /// The file, decoded and placed.
-    pub file: WeatherFile,
+    /// The report file (decoded and placed) or the theme.
+    pub input: WeatherInput,
     /// Field settings.
     pub settings: FieldSettings,
     /// Cloud-type rule.
@@ -154,9 +168,13 @@ pub fn load(
     rule: Option<&Path>,
     field_settings: Option<&Path>,
 ) -> anyhow::Result<Loaded> {
-    let table =
-        StationTable::load(stations).context("station table (choose one with --stations)")?;
-    let file = files::load(file, Some(&table))?;
+    // A theme places itself; only report files need the station table.
+    let table = if theme::is_theme_path(file) {
+        None
+    } else {
+        Some(StationTable::load(stations).context("station table (choose one with --stations)")?)
+    };
+    let input = WeatherInput::load(file, table.as_ref())?;
     let rule = match rule {
         Some(path) => CloudTypeRule::load(path)?,
         None => CloudTypeRule::default(),
@@ -166,7 +184,7 @@ pub fn load(
         None => FieldSettings::default(),
     };
     Ok(Loaded {
-        file,
+        input,
         settings,
         rule,
     })
@@ -176,7 +194,7 @@ pub fn load(
 /// centre lies 2 km east and 2 km north of the point.
 pub fn at_block(loaded: &Loaded, lat_deg: f64, lon_deg: f64) -> AtBlock {
     let frame = LocalFrame::new(lat_deg, lon_deg);
-    let field = WeatherField::build(frame, &loaded.file.reports, &loaded.settings, &loaded.rule);
+    let field = loaded.input.field(frame, &loaded.settings, &loaded.rule);
     let block = BlockIndex::new(0, 0);
     AtBlock {
         lat_deg,
@@ -194,26 +212,62 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
         args.rule.as_deref(),
         args.field_settings.as_deref(),
     )?;
-    let summary = Summary::of(&loaded.file);
     let at = args.at.map(|(lat, lon)| at_block(&loaded, lat, lon));
+    let file = match &loaded.input {
+        WeatherInput::Reports(file) => file,
+        WeatherInput::Theme(theme) => {
+            if args.json {
+                let out = ThemeJsonOut {
+                    file: &args.file,
+                    format: "theme",
+                    name: &theme.name,
+                    description: &theme.description,
+                    points: theme.points.len(),
+                    at: at.as_ref(),
+                };
+                println!("{}", serde_json::to_string(&out)?);
+            } else {
+                print!("{}", describe_theme(&args.file, theme));
+                if let Some(at) = &at {
+                    print!("{}", describe_block(at));
+                }
+            }
+            return Ok(());
+        }
+    };
+    let summary = Summary::of(file);
     if args.json {
         let out = JsonOut {
-            file: &loaded.file.path,
-            format: loaded.file.format,
-            reports: loaded.file.reports_found,
-            located: loaded.file.reports.len(),
-            warnings: &loaded.file.warnings,
+            file: &file.path,
+            format: file.format,
+            reports: file.reports_found,
+            located: file.reports.len(),
+            warnings: &file.warnings,
             summary: &summary,
             at: at.as_ref(),
         };
         println!("{}", serde_json::to_string(&out)?);
         return Ok(());
     }
-    print!("{}", describe_file(&loaded.file, &summary, true));
+    print!("{}", describe_file(file, &summary, true));
     if let Some(at) = &at {
         print!("{}", describe_block(at));
     }
     Ok(())
+}
+
+/// The text summary of a theme.
+pub fn describe_theme(path: &Path, theme: &Theme) -> String {
+    let place = match theme.points.len() {
+        0 => "the same everywhere".to_string(),
+        n => format!("pinned to {n} points, interpolated between them"),
+    };
+    format!(
+        "{}: weather theme \"{}\", {place}\n  {}\n",
+        path.display(),
+        theme.name,
+        theme.description
+    )
 }
 
 /// The text summary of a file; `all_warnings` lists every warning, else only their count.

@@ -210,3 +210,97 @@ mod tests {
         assert_eq!(remark_types(&clouds, "SC2AS5CS1"), [None, None]);
     }
 }
+
+#[cfg(test)]
+mod bulk_file_tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
+    use crate::weather::files::{self, PlacedReport};
+    use crate::weather::{LocalFrame, TypeSource};
+
+    fn bulk_file() -> Vec<PlacedReport> {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("weather/awc-metars-2025-01-27T22Z.cache.csv");
+        files::load(&path, None).unwrap().reports
+    }
+
+    fn types_of(reports: &[PlacedReport], station: &str) -> Vec<Option<CloudType>> {
+        let r = &reports
+            .iter()
+            .find(|p| p.report.station == station)
+            .unwrap()
+            .report;
+        remark_types(&r.clouds, &r.remarks)
+    }
+
+    #[test]
+    fn real_reports_get_their_remark_types() {
+        use CloudType::*;
+        let reports = bulk_file();
+        // CYHY: BKN098 BKN110 BKN240 RMK AC5AC1CI1
+        assert_eq!(
+            types_of(&reports, "CYHY"),
+            [Some(Altocumulus), Some(Altocumulus), Some(Cirrus)]
+        );
+        // CYAM: FEW007 SCT014 OVC022 RMK SN2SF1SC2NS4
+        assert_eq!(
+            types_of(&reports, "CYAM"),
+            [Some(Stratus), Some(Stratocumulus), Some(Nimbostratus)]
+        );
+        // CYCO: FEW020 BKN140 OVC260 RMK SC2AS5CS1
+        assert_eq!(
+            types_of(&reports, "CYCO"),
+            [Some(Stratocumulus), Some(Altostratus), Some(Cirrostratus)]
+        );
+        // CYVO: VV010 RMK SN8 (snow hides the sky: drawn as fog)
+        assert_eq!(types_of(&reports, "CYVO"), [Some(Fog)]);
+        // KLAX has no cloud-type remark.
+        assert!(types_of(&reports, "KLAX").iter().all(Option::is_none));
+        // The figures quoted in the README. The one remark that types no layer is CYRT's
+        // `BLSN2`: blowing snow over a sky with no cloud group.
+        let typed = reports
+            .iter()
+            .filter(|p| {
+                remark_types(&p.report.clouds, &p.report.remarks)
+                    .iter()
+                    .any(Option::is_some)
+            })
+            .count();
+        let with_remark = reports
+            .iter()
+            .filter(|p| !remark_layers(&p.report.remarks).is_empty())
+            .count();
+        assert_eq!(
+            (with_remark, typed),
+            (141, 140),
+            "reports with a cloud-type remark, and typed by it"
+        );
+    }
+
+    #[test]
+    fn the_field_draws_remark_types_at_their_station() {
+        let reports = bulk_file();
+        let cyhy = reports.iter().find(|p| p.report.station == "CYHY").unwrap();
+        let frame = LocalFrame::new(cyhy.position.latitude_deg, cyhy.position.longitude_deg);
+        let field = WeatherField::build(
+            frame,
+            &reports,
+            &FieldSettings::default(),
+            &CloudTypeRule::default(),
+        );
+        let layers = field.weather_at(glam::DVec2::ZERO).layers;
+        let types: Vec<_> = layers
+            .iter()
+            .map(|l| (l.cloud_type, l.type_source))
+            .collect();
+        assert_eq!(
+            types,
+            [
+                (CloudType::Altocumulus, TypeSource::Remark),
+                (CloudType::Cirrus, TypeSource::Remark)
+            ]
+        );
+    }
+}

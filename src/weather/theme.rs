@@ -11,7 +11,7 @@ use std::path::Path;
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::block::{BlockLayer, BlockWeather, TypeSource, Wind};
+use super::block::{BlockLayer, TypeSource, Wind};
 use super::cloud_type::CloudType;
 use crate::config::{ConfigError, parse_toml};
 
@@ -25,7 +25,7 @@ pub struct Theme {
     /// What the theme shows.
     pub description: String,
     /// The theme's own conditions: the weather everywhere when `points` is empty.
-    pub everywhere: BlockWeather,
+    pub everywhere: ThemeWeather,
     /// Places the weather is pinned to, each with its weather; empty when it applies everywhere.
     pub points: Vec<ThemePoint>,
 }
@@ -38,7 +38,26 @@ pub struct ThemePoint {
     /// Longitude, degrees east.
     pub lon_deg: f64,
     /// The weather there.
-    pub weather: BlockWeather,
+    pub weather: ThemeWeather,
+}
+
+/// The weather a theme gives one place: surface conditions and cloud layers with named types.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThemeWeather {
+    /// Cloud layers, lowest base first, heights above ground, `TypeSource::Theme`.
+    pub layers: Vec<BlockLayer>,
+    /// Visibility, metres.
+    pub visibility_m: f32,
+    /// Surface wind.
+    pub wind: Wind,
+    /// Temperature, degrees C.
+    pub temperature_c: f32,
+    /// Dewpoint, degrees C.
+    pub dewpoint_c: f32,
+    /// Precipitation, as a METAR intensity (the field settings turn it into 0..=1).
+    pub precipitation: Precipitation,
+    /// Ground elevation, metres above mean sea level.
+    pub ground_elevation_m: f32,
 }
 
 #[derive(Debug, Deserialize)]
@@ -90,25 +109,18 @@ impl Default for SurfaceFile {
     }
 }
 
-#[derive(Debug, Clone, Copy, Deserialize)]
+/// Precipitation a theme asks for, as METAR grades it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
-enum Precipitation {
+pub enum Precipitation {
+    /// None.
     None,
+    /// Light (`-RA`).
     Light,
+    /// Moderate (`RA`).
     Moderate,
+    /// Heavy (`+RA`).
     Heavy,
-}
-
-impl Precipitation {
-    /// Intensity 0..=1, as the weather field reads present weather.
-    fn intensity(self) -> f32 {
-        match self {
-            Precipitation::None => 0.0,
-            Precipitation::Light => 0.3,
-            Precipitation::Moderate => 0.6,
-            Precipitation::Heavy => 1.0,
-        }
-    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -206,7 +218,7 @@ impl Ctx<'_> {
         &self,
         surface: &SurfaceFile,
         layers: &[LayerFile],
-    ) -> Result<BlockWeather, ConfigError> {
+    ) -> Result<ThemeWeather, ConfigError> {
         let mut out: Vec<(BlockLayer, &LayerFile)> = Vec::with_capacity(layers.len());
         for layer in layers {
             out.push((self.layer(layer, surface.ground_elevation_m)?, layer));
@@ -223,7 +235,7 @@ impl Ctx<'_> {
                 return Err(self.error(&above.1.base_ft, "base_ft", message));
             }
         }
-        Ok(BlockWeather {
+        Ok(ThemeWeather {
             layers: out.into_iter().map(|(layer, _)| layer).collect(),
             visibility_m: surface.visibility_m,
             wind: Wind {
@@ -232,7 +244,7 @@ impl Ctx<'_> {
             },
             temperature_c: surface.temperature_c,
             dewpoint_c: surface.dewpoint_c,
-            precipitation: surface.precipitation.intensity(),
+            precipitation: surface.precipitation,
             ground_elevation_m: surface.ground_elevation_m,
         })
     }

@@ -168,3 +168,28 @@ fn missing_files_and_bad_config_exit_2_naming_them() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("not on Earth"), "{}", stderr(&o));
 }
+
+#[test]
+fn themes_and_remarks_show_where_each_type_came_from() {
+    let o = skycast(&[
+        "weather",
+        "weather/themes/building_cumulus_cb_line.toml",
+        "--at",
+        "28.5,-81.3",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(
+        text.contains("weather theme \"Building cumulus with a Cb line\", pinned to 9 points"),
+        "{text}"
+    );
+    assert!(text.contains("cumulonimbus       theme"), "{text}");
+    // CYHY reports BKN098 BKN110 BKN240 RMK AC5AC1CI1: the remark types its layers.
+    let o = skycast(&["weather", BULK, "--at", "60.84,-115.78"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("altocumulus        remark"), "{text}");
+    let o = skycast(&["weather", "config/flights/cumulonimbus_circle.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("not a weather theme"), "{}", stderr(&o));
+}

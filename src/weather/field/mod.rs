@@ -35,8 +35,10 @@ use glam::DVec2;
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 
 use super::block::{BlockIndex, BlockLayer, BlockWeather, TypeSource, Wind};
+use super::cloud_type::CloudType;
 use super::files::PlacedReport;
 use super::frame::LocalFrame;
+use super::theme::Theme;
 
 /// A triangulation vertex: a station's local position and its index in the sample list.
 #[derive(Debug, Clone, Copy)]
@@ -96,14 +98,52 @@ impl WeatherField {
         }
         let mut kept: Vec<&PlacedReport> = latest.into_values().collect();
         kept.sort_by_key(|p| p.line);
-        let mut samples = Vec::with_capacity(kept.len());
-        let mut surface_sites = Vec::with_capacity(kept.len());
-        let mut cloud_sites = Vec::new();
-        for p in kept {
-            let Some(sample) = StationSample::of(p, settings) else {
-                continue;
-            };
+        let placed = kept.into_iter().filter_map(|p| {
+            let sample = StationSample::of(p, settings)?;
             let local = frame.to_local_m(p.position.latitude_deg, p.position.longitude_deg);
+            Some((local, sample))
+        });
+        Self::from_samples(frame, placed, settings, rule)
+    }
+
+    /// Builds the field of a weather theme in `frame`: its points, or, for a theme without
+    /// points, one place at the frame origin (so the same weather everywhere).
+    pub fn from_theme(
+        frame: LocalFrame,
+        theme: &Theme,
+        settings: &FieldSettings,
+        rule: &CloudTypeRule,
+    ) -> Self {
+        let places: Vec<(DVec2, StationSample)> = if theme.points.is_empty() {
+            vec![(
+                DVec2::ZERO,
+                StationSample::of_theme(&theme.everywhere, settings),
+            )]
+        } else {
+            theme
+                .points
+                .iter()
+                .map(|p| {
+                    let local = frame.to_local_m(p.lat_deg, p.lon_deg);
+                    (local, StationSample::of_theme(&p.weather, settings))
+                })
+                .collect()
+        };
+        Self::from_samples(frame, places, settings, rule)
+    }
+
+    /// Triangulates station samples at local positions (non-finite positions are left out).
+    fn from_samples(
+        frame: LocalFrame,
+        places: impl IntoIterator<Item = (DVec2, StationSample)>,
+        settings: &FieldSettings,
+        rule: &CloudTypeRule,
+    ) -> Self {
+        let places = places.into_iter();
+        let mut samples = Vec::with_capacity(places.size_hint().0);
+        let mut surface_sites = Vec::with_capacity(places.size_hint().0);
+        let mut cloud_sites = Vec::new();
+        for (local, sample) in places {
             if !local.is_finite() {
                 continue;
             }
@@ -187,6 +227,8 @@ impl WeatherField {
             let mut weighted_thickness = 0.0;
             let mut cb = 0.0;
             let mut tower = 0.0;
+            let mut named: Vec<((CloudType, TypeSource), f64)> = Vec::new();
+            let mut unnamed_cloud_weight = 0.0;
             for &(index, weight) in &w {
                 let Some(b) = bands(&self.samples[index]) else {
                     continue;
@@ -200,7 +242,27 @@ impl WeatherField {
                 if b.cb || b.tcu {
                     tower += weight;
                 }
+                match b.named {
+                    Some(t) => match named.iter_mut().find(|(n, _)| *n == t) {
+                        Some((_, total)) => *total += weight,
+                        None => named.push((t, weight)),
+                    },
+                    None if b.coverage_oktas > 0.0 => unnamed_cloud_weight += weight,
+                    None => {}
+                }
             }
+            // The named type carrying the most weight (the first named on ties). Where some
+            // cloudy neighbours name no type, a named type needs the same weight share as a CB.
+            let named_min = if unnamed_cloud_weight > 0.0 {
+                self.settings.convective.weight_min
+            } else {
+                0.0
+            };
+            let named = named
+                .into_iter()
+                .rev()
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .filter(|(_, weight)| *weight > 0.0 && *weight >= named_min);
             let min = self.settings.convective.weight_min;
             let (reported_cb, reported_tcu) = (cb > 0.0 && cb >= min, tower > 0.0 && tower >= min);
             if coverage < self.settings.layers.min_coverage_oktas || coverage <= 0.0 {
@@ -210,6 +272,8 @@ impl WeatherField {
                 (self.rule.reported.cb, TypeSource::Reported)
             } else if band != Band::Fog && reported_tcu {
                 (self.rule.reported.tcu, TypeSource::Reported)
+            } else if let Some((named, _)) = named {
+                named
             } else {
                 let facts = LayerFacts {
                     band,

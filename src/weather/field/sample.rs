@@ -8,9 +8,16 @@
 //! as the vertical visibility; FG in present weather a fog layer of the configured depth.
 //! CAVOK/NSC/NCD/SKC/CLR stations have zero coverage in every band; a station with no sky group at
 //! all has no cloud sample (it is left out of the cloud field).
+//!
+//! A band may also carry a named cloud type: from a cloud-type remark (`RMK SC4AC2`, the type of
+//! the band's lowest group the remark names) or from a weather theme, whose layers name theirs.
 
+use crate::weather::block::TypeSource;
+use crate::weather::cloud_type::CloudType;
 use crate::weather::files::PlacedReport;
 use crate::weather::metar::{ConvectiveKind, Cover, Intensity, Report, SkyCode};
+use crate::weather::remarks::remark_types;
+use crate::weather::theme::{Precipitation as ThemePrecipitation, ThemeWeather};
 
 use super::rule::Band;
 use super::settings::FieldSettings;
@@ -31,6 +38,8 @@ pub struct BandSample {
     pub cb: bool,
     /// A TCU was reported in the band.
     pub tcu: bool,
+    /// The cloud type a remark or a theme names for the band, and which of the two.
+    pub named: Option<(CloudType, TypeSource)>,
 }
 
 /// One station's values.
@@ -80,8 +89,7 @@ impl StationSample {
             let Some(dir) = w.dir_deg else {
                 return Some([0.0, 0.0]);
             };
-            let to = (dir as f64 + 180.0).to_radians();
-            Some([to.sin() * speed, to.cos() * speed])
+            Some(wind_velocity_kt(f64::from(dir), speed))
         });
         let visibility_m = if r.cavok {
             Some(settings.defaults.cavok_visibility_m)
@@ -98,6 +106,56 @@ impl StationSample {
             elevation_m: placed.position.elevation_m,
         })
     }
+
+    /// The sample of one place of a weather theme: its layers keep the types they name.
+    pub fn of_theme(weather: &ThemeWeather, settings: &FieldSettings) -> Self {
+        let mut bands = [BandSample::default(); 4];
+        for layer in &weather.layers {
+            let band = if layer.cloud_type == CloudType::Fog {
+                Band::Fog
+            } else {
+                band_of(f64::from(layer.base_ft_agl), settings)
+            };
+            let b = &mut bands[index(band)];
+            let coverage = f64::from(layer.coverage_oktas);
+            // Two theme layers in one band: the band is drawn as the one covering more sky.
+            if coverage > b.coverage_oktas {
+                *b = BandSample {
+                    coverage_oktas: coverage,
+                    base_ft: f64::from(layer.base_ft_agl),
+                    thickness_ft: f64::from(layer.thickness_ft),
+                    cb: false,
+                    tcu: false,
+                    named: Some((layer.cloud_type, TypeSource::Theme)),
+                };
+            }
+        }
+        let p = &settings.precipitation;
+        let wind = weather.wind;
+        Self {
+            bands: Some(bands),
+            visibility_m: Some(f64::from(weather.visibility_m)),
+            wind_kt: Some(wind_velocity_kt(
+                f64::from(wind.from_deg),
+                f64::from(wind.speed_kt),
+            )),
+            temperature_c: Some(f64::from(weather.temperature_c)),
+            dewpoint_c: Some(f64::from(weather.dewpoint_c)),
+            precipitation: match weather.precipitation {
+                ThemePrecipitation::None => 0.0,
+                ThemePrecipitation::Light => p.light,
+                ThemePrecipitation::Moderate => p.moderate,
+                ThemePrecipitation::Heavy => p.heavy,
+            },
+            elevation_m: Some(f64::from(weather.ground_elevation_m)),
+        }
+    }
+}
+
+/// The velocity (knots east, north) of a wind blowing from `from_deg`.
+fn wind_velocity_kt(from_deg: f64, speed_kt: f64) -> [f64; 2] {
+    let to = (from_deg + 180.0).to_radians();
+    [to.sin() * speed_kt, to.cos() * speed_kt]
 }
 
 /// The heaviest precipitation of the report's present weather, 0..=1.
@@ -138,8 +196,12 @@ fn sky_bands(r: &Report, settings: &FieldSettings) -> Option<[BandSample; 4]> {
         f.coverage_oktas = 8.0;
         f.thickness_ft = settings.fog.thickness_ft;
     }
-    for g in &r.clouds {
+    let named = remark_types(&r.clouds, &r.remarks);
+    for (g, named) in r.clouds.iter().zip(named) {
         if g.cover == Some(Cover::Vv) {
+            if let Some(t) = named {
+                bands[index(Band::Fog)].named = Some((t, TypeSource::Remark));
+            }
             let f = &mut bands[index(Band::Fog)];
             f.coverage_oktas = 8.0;
             f.base_ft = 0.0;
@@ -152,6 +214,9 @@ fn sky_bands(r: &Report, settings: &FieldSettings) -> Option<[BandSample; 4]> {
             .map_or(Band::Low, |b| band_of(f64::from(b), settings));
         let i = index(band);
         let b = &mut bands[i];
+        if let (None, Some(t)) = (b.named, named) {
+            b.named = Some((t, TypeSource::Remark));
+        }
         match g.kind {
             Some(ConvectiveKind::Cb) => b.cb = true,
             Some(ConvectiveKind::Tcu) => b.tcu = true,

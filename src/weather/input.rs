@@ -1,0 +1,139 @@
+//! Any weather input a command takes with `--weather FILE`: a bulk report file (METAR in any of
+//! the formats of [`files`](super::files)) or a weather theme (`.toml`, see
+//! [`theme`](super::theme)). Both become the same [`WeatherField`].
+
+use std::path::Path;
+
+use super::error::WeatherError;
+use super::field::{CloudTypeRule, FieldSettings, WeatherField};
+use super::files::{self, WeatherFile};
+use super::frame::LocalFrame;
+use super::stations::StationTable;
+use super::theme::{self, Theme};
+
+/// A loaded weather input.
+#[derive(Debug, Clone, PartialEq)]
+pub enum WeatherInput {
+    /// Reports from a bulk weather file, decoded and placed.
+    Reports(WeatherFile),
+    /// A weather theme.
+    Theme(Theme),
+}
+
+impl WeatherInput {
+    /// Loads a theme (a `.toml` file) or a report file (anything else; placed with `stations`
+    /// where the file gives no positions).
+    pub fn load(path: &Path, stations: Option<&StationTable>) -> Result<Self, WeatherError> {
+        if theme::is_theme_path(path) {
+            let text = std::fs::read_to_string(path).map_err(|source| WeatherError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            // Another TOML file (a config, a flight path) is not weather at all; a theme with a
+            // mistake in it gets the theme's own error naming line and field.
+            let table: Option<toml::Table> = toml::from_str(&text).ok();
+            if table.is_some_and(|t| !t.contains_key("layers") && !t.contains_key("points")) {
+                return Err(WeatherError::NotWeather {
+                    path: path.to_path_buf(),
+                    reason:
+                        "a TOML file, but not a weather theme (it has no [[layers]] or [[points]])"
+                            .to_string(),
+                });
+            }
+            Ok(Self::Theme(theme::parse_theme(&text, path)?))
+        } else {
+            Ok(Self::Reports(files::load(path, stations)?))
+        }
+    }
+
+    /// The weather field of this input in `frame`.
+    pub fn field(
+        &self,
+        frame: LocalFrame,
+        settings: &FieldSettings,
+        rule: &CloudTypeRule,
+    ) -> WeatherField {
+        match self {
+            Self::Reports(file) => WeatherField::build(frame, &file.reports, settings, rule),
+            Self::Theme(theme) => WeatherField::from_theme(frame, theme, settings, rule),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::weather::{BlockIndex, CloudType, TypeSource};
+
+    fn shipped(name: &str) -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(name)
+    }
+
+    fn field_at(input: &WeatherInput, lat: f64, lon: f64) -> WeatherField {
+        let frame = LocalFrame::new(lat, lon);
+        input.field(frame, &FieldSettings::default(), &CloudTypeRule::default())
+    }
+
+    #[test]
+    fn a_theme_without_points_is_the_same_everywhere() {
+        let input =
+            WeatherInput::load(&shipped("weather/themes/frontal_nimbostratus.toml"), None).unwrap();
+        let field = field_at(&input, 47.0, 11.0);
+        let here = field.block_weather(BlockIndex::new(0, 0));
+        let far = field.block_weather(BlockIndex::new(40, -25));
+        assert_eq!(here, far);
+        let types: Vec<_> = here
+            .layers
+            .iter()
+            .map(|l| (l.cloud_type, l.type_source))
+            .collect();
+        assert_eq!(
+            types,
+            [
+                (CloudType::Nimbostratus, TypeSource::Theme),
+                (CloudType::Altostratus, TypeSource::Theme)
+            ]
+        );
+        assert_eq!(
+            (here.layers[0].base_ft_agl, here.layers[0].thickness_ft),
+            (1500.0, 7500.0)
+        );
+        assert!(
+            (here.precipitation - 0.67).abs() < 1e-6,
+            "{}",
+            here.precipitation
+        );
+    }
+
+    #[test]
+    fn a_pinned_theme_interpolates_between_its_points() {
+        let input = WeatherInput::load(
+            &shipped("weather/themes/building_cumulus_cb_line.toml"),
+            None,
+        )
+        .unwrap();
+        let on_line = field_at(&input, 28.5, -81.3).weather_at(glam::DVec2::ZERO);
+        assert_eq!(on_line.layers[0].cloud_type, CloudType::Cumulonimbus);
+        assert_eq!(on_line.layers[0].type_source, TypeSource::Theme);
+        let out_west = field_at(&input, 28.5, -81.8).weather_at(glam::DVec2::ZERO);
+        assert_eq!(out_west.layers[0].cloud_type, CloudType::CumulusMediocris);
+        let between = field_at(&input, 28.5, -81.4).weather_at(glam::DVec2::ZERO);
+        assert!(
+            between.wind.speed_kt < on_line.wind.speed_kt
+                && between.wind.speed_kt > out_west.wind.speed_kt
+        );
+    }
+
+    #[test]
+    fn a_broken_theme_is_an_error_naming_file_and_line() {
+        let dir = std::env::temp_dir().join(format!("skycast-input-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("bad.toml");
+        std::fs::write(&path, "name = \"x\"\n[[layers]]\ncloud_type = \"cumulus\"\ncover = 2\nbase_ft = 1\ntop_ft = 2\n").unwrap();
+        let err = WeatherInput::load(&path, None).unwrap_err().to_string();
+        assert!(
+            err.contains("bad.toml:3: field `cloud_type`: unknown cloud type `cumulus`"),
+            "{err}"
+        );
+    }
+}
