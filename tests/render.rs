@@ -148,6 +148,9 @@ impl Rig {
 
     fn frame(&mut self, name: &str, camera: &Camera) -> (Frame, skycast::render::FrameStats) {
         let (frame, stats) = self.host.frame(camera, &sun(), 0.0, 40_000.0).unwrap();
+        if let Some(ms) = self.host.last_gpu_ms() {
+            eprintln!("{name}: GPU {ms:.2} ms");
+        }
         let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
         std::fs::create_dir_all(&dir).unwrap();
         frame.write_png(&dir.join(format!("{name}.png"))).unwrap();

@@ -28,6 +28,64 @@ pub struct DemoHost {
     pub terrain: Terrain,
     /// The sky.
     pub sky: Sky,
+    timer: Option<GpuTimer>,
+}
+
+/// Two timestamps around a frame's passes, where the device has timestamp queries.
+struct GpuTimer {
+    queries: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    read: wgpu::Buffer,
+    period_ns: f32,
+}
+
+impl GpuTimer {
+    fn new(gpu: &HeadlessGpu) -> Option<Self> {
+        let needed =
+            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        if !gpu.device.features().contains(needed) {
+            return None;
+        }
+        let queries = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("host.frame_time"),
+            ty: wgpu::QueryType::Timestamp,
+            count: 2,
+        });
+        let buffer = |label, usage| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 16,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Some(Self {
+            queries,
+            resolve: buffer(
+                "host.frame_time_resolve",
+                wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            ),
+            read: buffer(
+                "host.frame_time_read",
+                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            ),
+            period_ns: gpu.queue.get_timestamp_period(),
+        })
+    }
+
+    /// Milliseconds between the two timestamps of the last submitted frame (waits for it).
+    fn read_ms(&self, gpu: &HeadlessGpu) -> Option<f64> {
+        self.read.map_async(wgpu::MapMode::Read, .., |_| {});
+        gpu.device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
+        let ticks: [u64; 2] = {
+            let view = self.read.get_mapped_range(..).ok()?;
+            let t =
+                |i: usize| u64::from_le_bytes(view[i * 8..i * 8 + 8].try_into().unwrap_or([0; 8]));
+            [t(0), t(1)]
+        };
+        self.read.unmap();
+        Some(ticks[1].saturating_sub(ticks[0]) as f64 * self.period_ns as f64 / 1.0e6)
+    }
 }
 
 impl DemoHost {
@@ -49,11 +107,13 @@ impl DemoHost {
                 ..sky
             },
         )?;
+        let timer = GpuTimer::new(&gpu);
         Ok(Self {
             gpu,
             target,
             terrain,
             sky,
+            timer,
         })
     }
 
@@ -98,6 +158,9 @@ impl DemoHost {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("host.frame"),
             });
+        if let Some(t) = &self.timer {
+            encoder.write_timestamp(&t.queries, 0);
+        }
         self.terrain.record(
             &mut encoder,
             &self.target.colour_view,
@@ -108,8 +171,19 @@ impl DemoHost {
             &self.target.colour_view,
             &self.target.depth_view,
         );
+        if let Some(t) = &self.timer {
+            encoder.write_timestamp(&t.queries, 1);
+            encoder.resolve_query_set(&t.queries, 0..2, &t.resolve, 0);
+            encoder.copy_buffer_to_buffer(&t.resolve, 0, &t.read, 0, 16);
+        }
         self.gpu.queue.submit([encoder.finish()]);
         stats
+    }
+
+    /// GPU time of the last drawn frame (ground and sky passes), milliseconds, where the device
+    /// has timestamp queries. Waits for the frame.
+    pub fn last_gpu_ms(&self) -> Option<f64> {
+        self.timer.as_ref()?.read_ms(&self.gpu)
     }
 
     /// Draws one frame and reads it back.

@@ -37,9 +37,17 @@ impl HeadlessGpu {
         }))
         .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
         let adapter_info = adapter.get_info();
+        // GPU frame times where the adapter can measure them.
+        let timing =
+            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let required_features = if adapter.features().contains(timing) {
+            timing
+        } else {
+            wgpu::Features::empty()
+        };
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("skycast.headless"),
-            required_features: wgpu::Features::empty(),
+            required_features,
             required_limits: wgpu::Limits::downlevel_defaults(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
