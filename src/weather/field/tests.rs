@@ -251,3 +251,57 @@ fn the_field_can_be_shared_between_threads() {
     fn sync<T: Send + Sync>() {}
     sync::<WeatherField>();
 }
+
+#[test]
+fn on_the_real_bulk_file_every_cb_station_keeps_its_cb() {
+    use crate::weather::stations::StationTable;
+    use std::path::Path;
+    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/weather"));
+    let stations = StationTable::load(&dir.join("nsd_cccc.txt")).unwrap();
+    let file = crate::weather::files::load(
+        &dir.join("awc-metars-2025-01-27T22Z.cache.csv"),
+        Some(&stations),
+    )
+    .unwrap();
+    let f = WeatherField::build(
+        LocalFrame::new(51.848, -8.479),
+        &file.reports,
+        &FieldSettings::default(),
+        &CloudTypeRule::default(),
+    );
+    // 4,877 placed reports; some share coordinates and some are NIL: 4,856 stations, 4,497 of
+    // them with something to say about the sky.
+    assert_eq!(f.station_count(), 4_856);
+    assert_eq!(f.cloud_station_count(), 4_497);
+    let mut checked = 0;
+    for p in &file.reports {
+        let has_cb = p
+            .report
+            .clouds
+            .iter()
+            .any(|g| g.kind == Some(ConvectiveKind::Cb));
+        let shares_position = file
+            .reports
+            .iter()
+            .filter(|q| q.position.latitude_deg == p.position.latitude_deg)
+            .filter(|q| q.position.longitude_deg == p.position.longitude_deg)
+            .count()
+            > 1;
+        if !has_cb || shares_position {
+            continue;
+        }
+        let w = f.weather_at_lat_lon(p.position.latitude_deg, p.position.longitude_deg);
+        assert!(
+            w.layers
+                .iter()
+                .any(|l| l.cloud_type == CloudType::Cumulonimbus
+                    && l.type_source == TypeSource::Reported),
+            "{} line {}: {:?}",
+            p.report.station,
+            p.line,
+            w.layers
+        );
+        checked += 1;
+    }
+    assert!(checked >= 50, "{checked}");
+}
