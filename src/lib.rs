@@ -5,6 +5,7 @@
 //! one module per stage: [`weather`] -> `clouds` -> [`shading`] -> `render` -> `flight`.
 //! Only `render` knows wgpu; every stage before it is plain data, testable without a device.
 
+pub mod clouds;
 pub mod config;
 pub mod flight;
 pub mod render;

@@ -7,6 +7,7 @@ use clap::{Parser, Subcommand};
 
 mod demo;
 mod metar;
+mod sheet;
 mod weather;
 
 /// skycast: a cloud and weather sky for flight simulators.
@@ -28,6 +29,8 @@ enum Command {
     Weather(weather::WeatherArgs),
     /// The demo: the weather of the default flight area on the shipped bulk weather file.
     Demo(demo::DemoArgs),
+    /// Writes the 16-texture cloud sheet (512 x 512 RGBA PNG, Wang 2003 figure 6).
+    Sheet(sheet::SheetArgs),
 }
 
 /// Runs the command line and maps errors to a message on standard error and exit status 2.
@@ -46,6 +49,7 @@ pub fn main() -> ExitCode {
         Command::Metar(args) => metar::run(&args),
         Command::Weather(args) => weather::run(&args),
         Command::Demo(args) => demo::run(&args),
+        Command::Sheet(args) => sheet::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,845 @@
+//! Cloud-type and lifecycle settings, loaded from TOML (`config/cloud_types.toml`,
+//! `config/clouds.toml`) with serde; every fault names the file, line and field.
+//!
+//! The defaults are Wang 2003's numbers (§3.1: 20 to 200 boxes per 16 km2 block, 1 to 100 sprites
+//! per box, cull radius 1/3 of the sprite height for typical clouds and 1/5 to 1/6 for dense
+//! ones; §3.2: cumulus bottoms rotated -5..5 degrees, others 0..360, non-square sprites not at all;
+//! §5.1: five colour levels per cloud; §5.2: shading groups of 1 to 30 sprites). Heights inside a
+//! cloud (texture bands, colour levels) are fractions 0 (base) ..= 1 (top) of the cloud thickness.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::CloudsError;
+use crate::weather::CloudType;
+
+/// The texture categories of the sheet (Wang 2003 §3.2, figure 6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TextureCategory {
+    /// Soft, low-contrast, subtly blue-grey: stratus and fog (cells 0..3).
+    Foggy,
+    /// A puff with a flat underside: cumulus bases (cell 3).
+    FlatBottom,
+    /// Streaks and curls, used by every type (cells 4..10).
+    Wispy,
+    /// Heaped cauliflower puffs: cumulus (cells 10..16).
+    Puffy,
+}
+
+impl TextureCategory {
+    /// Every category, in sheet order.
+    pub const ALL: [TextureCategory; 4] = [
+        TextureCategory::Foggy,
+        TextureCategory::FlatBottom,
+        TextureCategory::Wispy,
+        TextureCategory::Puffy,
+    ];
+
+    /// The sheet cells (row-major, 0..16) holding this category.
+    pub fn cells(self) -> std::ops::Range<u8> {
+        match self {
+            TextureCategory::Foggy => 0..3,
+            TextureCategory::FlatBottom => 3..4,
+            TextureCategory::Wispy => 4..10,
+            TextureCategory::Puffy => 10..16,
+        }
+    }
+
+    /// The category of a sheet cell.
+    pub fn of_cell(cell: u8) -> TextureCategory {
+        TextureCategory::ALL
+            .into_iter()
+            .find(|c| c.cells().contains(&cell))
+            .unwrap_or(TextureCategory::Puffy)
+    }
+}
+
+/// Boxes per block by METAR cover (Wang 2003 §3.1: 20 to 200 per 16 km2): the most boxes a layer
+/// of this type may spend in one block.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxesByCover {
+    /// FEW, 1-2 oktas.
+    pub few: u32,
+    /// SCT, 3-4 oktas.
+    pub sct: u32,
+    /// BKN, 5-7 oktas.
+    pub bkn: u32,
+    /// OVC, 8 oktas.
+    pub ovc: u32,
+}
+
+impl BoxesByCover {
+    /// The budget for a coverage in oktas.
+    pub fn for_oktas(&self, oktas: f32) -> u32 {
+        if oktas <= 2.0 {
+            self.few
+        } else if oktas <= 4.0 {
+            self.sct
+        } else if oktas < 8.0 {
+            self.bkn
+        } else {
+            self.ovc
+        }
+    }
+}
+
+/// Which textures and rotations go at which height in a cloud.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureBand {
+    /// The band covers heights from the previous band's `up_to` to this, fraction of thickness.
+    pub up_to: f32,
+    /// Categories to choose from, at random.
+    pub textures: Vec<TextureCategory>,
+    /// Rotation range for square sprites, degrees.
+    pub rotation_deg: [f32; 2],
+}
+
+/// A colour level as configured: height as a fraction of the cloud thickness.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColourLevelConfig {
+    /// Height, fraction 0 (base) ..= 1 (top).
+    pub height: f32,
+    /// Colour and alpha, linear 0..=1.
+    pub rgba: [f32; 4],
+}
+
+/// The anvil of a cumulonimbus: boxes above `from` spread out wide and flat.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnvilConfig {
+    /// Height where the anvil starts, fraction of the thickness, 0..1.
+    pub from: f32,
+    /// Anvil width over the tower's base width, >= 1.
+    pub width_scale: f32,
+}
+
+/// The shape of one cloud type (one `[section]` of `config/cloud_types.toml`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CloudTypeConfig {
+    /// Placed on a world-aligned lattice so that layers run on across block borders (stratus,
+    /// overcast decks, fog) instead of as separate clouds.
+    pub continuous: bool,
+    /// Lattice spacing for continuous types, metres (ignored otherwise).
+    pub lattice_spacing_m: f32,
+    /// Drawn as flat horizontal rectangles (cirrus, Wang 2003 §7.1).
+    pub flat: bool,
+    /// Cloud thickness range, metres; the layer's reported thickness is clamped into it.
+    pub thickness_m: [f32; 2],
+    /// Horizontal cloud diameter range, metres.
+    pub cloud_size_m: [f32; 2],
+    /// Boxes per cloud.
+    pub boxes_per_cloud: [u32; 2],
+    /// How much narrower the top box is than the bottom one, 0 (column) ..= 1 (cone).
+    pub taper: f32,
+    /// The anvil, for cumulonimbus.
+    #[serde(default)]
+    pub anvil: Option<AnvilConfig>,
+    /// Most boxes per block, by cover.
+    pub boxes_per_block: BoxesByCover,
+    /// Sprites per box before the cull, 1..=100.
+    pub sprites_per_box: [u32; 2],
+    /// Sprite width range, metres.
+    pub sprite_width_m: [f32; 2],
+    /// Sprite height over width; 1 is square, below 1 the wide short sprites of haze (§3.1).
+    pub sprite_height_ratio: [f32; 2],
+    /// Cull radius as a fraction of the sprite height (1/3 typical, 1/5..1/6 dense).
+    pub cull_radius_fraction: f32,
+    /// Sprites per shading group, 1..=30.
+    pub shading_group_size: [u32; 2],
+    /// Texture categories and rotations by height in the cloud, lowest band first.
+    pub texture_bands: Vec<TextureBand>,
+    /// Five ambient colour levels, lowest first.
+    pub colour_levels: [ColourLevelConfig; 5],
+}
+
+impl CloudTypeConfig {
+    /// The texture band holding a height fraction.
+    pub fn band_at(&self, height_fraction: f32) -> &TextureBand {
+        self.texture_bands
+            .iter()
+            .find(|b| height_fraction <= b.up_to)
+            .or(self.texture_bands.last())
+            .expect("validated: texture_bands is not empty")
+    }
+}
+
+/// All cloud types, validated: one config per [`CloudType`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CloudTypes {
+    types: Vec<CloudTypeConfig>,
+}
+
+/// The shipped `config/cloud_types.toml`.
+pub const BUILTIN_CLOUD_TYPES: &str = include_str!("../../config/cloud_types.toml");
+/// The shipped `config/clouds.toml`.
+pub const BUILTIN_CLOUDS: &str = include_str!("../../config/clouds.toml");
+
+impl CloudTypes {
+    /// Reads and validates a cloud-types file.
+    pub fn load(path: &Path) -> Result<Self, CloudsError> {
+        let text = read(path)?;
+        Self::parse(&text, path)
+    }
+
+    /// The shipped defaults (`config/cloud_types.toml`, compiled in).
+    pub fn builtin() -> Self {
+        Self::parse(BUILTIN_CLOUD_TYPES, Path::new("config/cloud_types.toml"))
+            .expect("the shipped config/cloud_types.toml is valid (tested)")
+    }
+
+    /// Parses and validates cloud-types TOML; `path` names the file in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, CloudsError> {
+        // First pass: section names only, so a misspelt type is named before its fields are.
+        let sections: std::collections::BTreeMap<String, toml::Spanned<toml::Value>> =
+            toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        for (name, spanned) in &sections {
+            if CloudType::from_name(name).is_none() {
+                return Err(CloudsError::Parse {
+                    path: path.to_owned(),
+                    line: line_of_offset(text, spanned.span().start),
+                    field: name.clone(),
+                    message: format!(
+                        "unknown cloud type; expected one of: {}",
+                        CloudType::ALL.map(CloudType::name).join(", ")
+                    ),
+                });
+            }
+        }
+        let table: std::collections::BTreeMap<String, CloudTypeConfig> =
+            toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        let mut types = Vec::with_capacity(CloudType::ALL.len());
+        for cloud_type in CloudType::ALL {
+            let Some(config) = table.get(cloud_type.name()) else {
+                return Err(CloudsError::MissingType {
+                    path: path.to_owned(),
+                    cloud_type,
+                });
+            };
+            validate(config, cloud_type.name(), text, path)?;
+            types.push(config.clone());
+        }
+        Ok(Self { types })
+    }
+
+    /// The config of a type.
+    pub fn get(&self, cloud_type: CloudType) -> &CloudTypeConfig {
+        let i = CloudType::ALL
+            .iter()
+            .position(|&t| t == cloud_type)
+            .unwrap_or(0);
+        &self.types[i]
+    }
+}
+
+/// Formation and dissipation timings (Wang 2003 §4).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LifecycleConfig {
+    /// Time for a cloud to form completely, seconds.
+    pub formation_s: f32,
+    /// Time for a cloud to dissipate completely, seconds.
+    pub dissipation_s: f32,
+    /// Sprites nearer the centre than this fraction of the cloud radius form first (paper: 0.5).
+    pub inner_radius_fraction: f32,
+    /// Opacity the inner sprites reach before the outer ones start to fade in, 0..1.
+    pub outer_start_opacity: f32,
+}
+
+/// Settings of the field of blocks around the camera.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FieldConfig {
+    /// Blocks whose centre lies within this distance of the field centre exist, metres.
+    pub radius_m: f64,
+    /// World seed; block content is a pure function of it, the block index and the weather.
+    pub seed: u64,
+    /// Layer wind over surface wind (clouds drift faster than the surface wind), >= 0.
+    pub wind_factor: f64,
+}
+
+/// `config/clouds.toml`: lifecycle and field settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CloudsConfig {
+    /// Formation and dissipation.
+    pub lifecycle: LifecycleConfig,
+    /// The field of blocks.
+    pub field: FieldConfig,
+}
+
+impl CloudsConfig {
+    /// Reads and validates `config/clouds.toml`.
+    pub fn load(path: &Path) -> Result<Self, CloudsError> {
+        let text = read(path)?;
+        Self::parse(&text, path)
+    }
+
+    /// The shipped defaults (`config/clouds.toml`, compiled in).
+    pub fn builtin() -> Self {
+        Self::parse(BUILTIN_CLOUDS, Path::new("config/clouds.toml"))
+            .expect("the shipped config/clouds.toml is valid (tested)")
+    }
+
+    /// Parses and validates; `path` names the file in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, CloudsError> {
+        let config: CloudsConfig = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        let v = Validator {
+            text,
+            path,
+            section: "lifecycle",
+        };
+        let l = &config.lifecycle;
+        v.check(l.formation_s > 0.0, "formation_s", "must be > 0 seconds")?;
+        v.check(
+            l.dissipation_s > 0.0,
+            "dissipation_s",
+            "must be > 0 seconds",
+        )?;
+        v.check(
+            l.inner_radius_fraction > 0.0 && l.inner_radius_fraction < 1.0,
+            "inner_radius_fraction",
+            "must be between 0 and 1 (exclusive)",
+        )?;
+        v.check(
+            l.outer_start_opacity > 0.0 && l.outer_start_opacity < 1.0,
+            "outer_start_opacity",
+            "must be between 0 and 1 (exclusive)",
+        )?;
+        let v = Validator {
+            section: "field",
+            ..v
+        };
+        let f = &config.field;
+        v.check(f.radius_m > 0.0, "radius_m", "must be > 0 metres")?;
+        v.check(f.wind_factor >= 0.0, "wind_factor", "must be >= 0")?;
+        Ok(config)
+    }
+}
+
+fn read(path: &Path) -> Result<String, CloudsError> {
+    std::fs::read_to_string(path).map_err(|source| CloudsError::Read {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+/// 1-based line of a byte offset.
+fn line_of_offset(text: &str, offset: usize) -> usize {
+    text.get(..offset.min(text.len()))
+        .map_or(1, |head| head.matches('\n').count() + 1)
+}
+
+/// The `[section]` header before a byte offset, if any.
+fn section_before(text: &str, offset: usize) -> Option<String> {
+    let head = text.get(..offset.min(text.len()))?;
+    head.lines().rev().find_map(|l| {
+        let t = l.trim();
+        (t.starts_with('[') && !t.starts_with("[[") && t.ends_with(']'))
+            .then(|| t.trim_matches(|c| c == '[' || c == ']').trim().to_owned())
+    })
+}
+
+/// Turns a toml error into one naming the line and the field.
+fn toml_error(path: &Path, text: &str, err: &toml::de::Error) -> CloudsError {
+    let offset = err.span().map_or(0, |s| s.start);
+    let line = line_of_offset(text, offset);
+    let message = err.message().trim().to_owned();
+    // serde names the field in backticks ("missing field `x`", "unknown field `y`").
+    let named = message.split('`').nth(1).map(str::to_owned);
+    let key_on_line = text
+        .lines()
+        .nth(line.saturating_sub(1))
+        .and_then(|l| l.split_once('='))
+        .map(|(k, _)| k.trim().to_owned())
+        .filter(|k| !k.is_empty() && !k.starts_with('['));
+    let key = named.or(key_on_line).unwrap_or_else(|| "?".to_owned());
+    let field = match section_before(text, offset + 1) {
+        Some(section) if section != key => format!("{section}.{key}"),
+        _ => key,
+    };
+    CloudsError::Parse {
+        path: path.to_owned(),
+        line,
+        field,
+        message,
+    }
+}
+
+struct Validator<'a> {
+    text: &'a str,
+    path: &'a Path,
+    section: &'a str,
+}
+
+impl Validator<'_> {
+    /// Line of `key = ...` inside `[section]` (the header line when not found).
+    fn line(&self, key: &str) -> usize {
+        let header = format!("[{}]", self.section);
+        let lines: Vec<&str> = self.text.lines().collect();
+        let Some(start) = lines.iter().position(|l| l.trim() == header) else {
+            return 1;
+        };
+        for (n, l) in lines.iter().enumerate().skip(start + 1) {
+            let t = l.trim_start();
+            if t.starts_with('[') && !t.starts_with("[[") {
+                break;
+            }
+            if let Some(rest) = t.strip_prefix(key)
+                && rest.trim_start().starts_with('=')
+            {
+                return n + 1;
+            }
+        }
+        start + 1
+    }
+
+    fn check(&self, ok: bool, key: &str, message: &str) -> Result<(), CloudsError> {
+        if ok {
+            return Ok(());
+        }
+        Err(CloudsError::Invalid {
+            path: self.path.to_owned(),
+            line: self.line(key),
+            field: format!("{}.{key}", self.section),
+            message: message.to_owned(),
+        })
+    }
+
+    fn range_f32(&self, r: [f32; 2], key: &str, lo: f32, hi: f32) -> Result<(), CloudsError> {
+        self.check(
+            r[0] >= lo && r[0] <= r[1] && r[1] <= hi,
+            key,
+            &format!("must be [min, max] with {lo} <= min <= max <= {hi}"),
+        )
+    }
+
+    fn range_u32(&self, r: [u32; 2], key: &str, lo: u32, hi: u32) -> Result<(), CloudsError> {
+        self.check(
+            r[0] >= lo && r[0] <= r[1] && r[1] <= hi,
+            key,
+            &format!("must be [min, max] with {lo} <= min <= max <= {hi}"),
+        )
+    }
+}
+
+fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<(), CloudsError> {
+    let v = Validator {
+        text,
+        path,
+        section: name,
+    };
+    v.range_f32(c.thickness_m, "thickness_m", 1.0, 20_000.0)?;
+    v.range_f32(c.cloud_size_m, "cloud_size_m", 10.0, 20_000.0)?;
+    v.check(
+        !c.continuous || (100.0..=4_000.0).contains(&c.lattice_spacing_m),
+        "lattice_spacing_m",
+        "must be 100..=4000 metres for a continuous type",
+    )?;
+    v.range_u32(c.boxes_per_cloud, "boxes_per_cloud", 1, 50)?;
+    v.check(
+        (0.0..=1.0).contains(&c.taper),
+        "taper",
+        "must be 0..=1 (0 column, 1 cone)",
+    )?;
+    if let Some(anvil) = c.anvil {
+        v.check(
+            anvil.from > 0.0 && anvil.from < 1.0 && anvil.width_scale >= 1.0,
+            "anvil",
+            "needs 0 < from < 1 and width_scale >= 1",
+        )?;
+    }
+    let b = c.boxes_per_block;
+    v.check(
+        [b.few, b.sct, b.bkn, b.ovc]
+            .iter()
+            .all(|n| (20..=200).contains(n))
+            && b.few <= b.sct
+            && b.sct <= b.bkn
+            && b.bkn <= b.ovc,
+        "boxes_per_block",
+        "each of few, sct, bkn, ovc must be 20..=200 boxes per block, not decreasing",
+    )?;
+    v.range_u32(c.sprites_per_box, "sprites_per_box", 1, 100)?;
+    v.range_f32(c.sprite_width_m, "sprite_width_m", 1.0, 10_000.0)?;
+    v.range_f32(c.sprite_height_ratio, "sprite_height_ratio", 0.05, 1.0)?;
+    v.check(
+        (0.0..=1.0).contains(&c.cull_radius_fraction),
+        "cull_radius_fraction",
+        "must be 0..=1 (1/3 typical, 1/5..1/6 dense)",
+    )?;
+    v.range_u32(c.shading_group_size, "shading_group_size", 1, 30)?;
+    let bands = &c.texture_bands;
+    v.check(
+        !bands.is_empty(),
+        "texture_bands",
+        "needs at least one band",
+    )?;
+    let mut last = 0.0;
+    for band in bands {
+        v.check(
+            band.up_to > last && band.up_to <= 1.0,
+            "texture_bands",
+            "up_to must rise from band to band within (0, 1]",
+        )?;
+        v.check(
+            !band.textures.is_empty(),
+            "texture_bands",
+            "every band needs at least one texture category",
+        )?;
+        v.check(
+            band.rotation_deg[0] <= band.rotation_deg[1],
+            "texture_bands",
+            "rotation_deg must be [min, max] with min <= max",
+        )?;
+        last = band.up_to;
+    }
+    v.check(
+        last == 1.0,
+        "texture_bands",
+        "the last band must reach up_to = 1.0",
+    )?;
+    let mut last = 0.0;
+    for level in &c.colour_levels {
+        v.check(
+            level.height >= last && level.height <= 1.0,
+            "colour_levels",
+            "heights must rise within 0..=1",
+        )?;
+        v.check(
+            level.rgba.iter().all(|x| (0.0..=1.0).contains(x)),
+            "colour_levels",
+            "rgba components must be 0..=1",
+        )?;
+        last = level.height;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FILE: &str = "cloud_types.toml";
+
+    /// The shipped file with the first occurrence of `from` (after `[section]`) replaced.
+    fn edited(section: &str, from: &str, to: &str) -> String {
+        let text = BUILTIN_CLOUD_TYPES;
+        let start = text.find(&format!("[{section}]")).expect("section exists");
+        let at = start + text[start..].find(from).expect("text exists in section");
+        format!("{}{}{}", &text[..at], to, &text[at + from.len()..])
+    }
+
+    fn error_of(text: &str) -> (usize, String, String) {
+        match CloudTypes::parse(text, Path::new(FILE)) {
+            Err(CloudsError::Parse {
+                line,
+                field,
+                message,
+                ..
+            })
+            | Err(CloudsError::Invalid {
+                line,
+                field,
+                message,
+                ..
+            }) => (line, field, message),
+            other => panic!("expected a parse or invalid error, got {other:?}"),
+        }
+    }
+
+    fn line_containing(text: &str, section: &str, needle: &str) -> usize {
+        let start = text.find(&format!("[{section}]")).unwrap();
+        let at = start + text[start..].find(needle).unwrap();
+        text[..at].matches('\n').count() + 1
+    }
+
+    #[test]
+    fn the_shipped_files_are_valid_and_cover_every_type() {
+        let types = CloudTypes::builtin();
+        for t in CloudType::ALL {
+            assert!(!types.get(t).texture_bands.is_empty());
+        }
+        assert!(types.get(CloudType::Cirrus).flat);
+        assert!(types.get(CloudType::Stratus).continuous);
+        assert!(types.get(CloudType::Cumulonimbus).anvil.is_some());
+        let c = CloudsConfig::builtin();
+        assert_eq!(c.lifecycle.inner_radius_fraction, 0.5);
+    }
+
+    #[test]
+    fn every_out_of_range_field_is_named_with_its_line() {
+        // (section, text to replace, replacement, field named in the error)
+        let cases = [
+            (
+                "stratus",
+                "thickness_m = [150.0, 600.0]",
+                "thickness_m = [600.0, 150.0]",
+                "thickness_m",
+            ),
+            (
+                "stratus",
+                "cloud_size_m = [1500.0, 1800.0]",
+                "cloud_size_m = [0.0, 1800.0]",
+                "cloud_size_m",
+            ),
+            (
+                "stratus",
+                "lattice_spacing_m = 1000.0",
+                "lattice_spacing_m = 5.0",
+                "lattice_spacing_m",
+            ),
+            (
+                "cumulus_humilis",
+                "boxes_per_cloud = [2, 3]",
+                "boxes_per_cloud = [0, 3]",
+                "boxes_per_cloud",
+            ),
+            ("cumulus_humilis", "taper = 0.45", "taper = 1.5", "taper"),
+            (
+                "cumulonimbus",
+                "anvil = { from = 0.8,",
+                "anvil = { from = 1.2,",
+                "anvil",
+            ),
+            ("cumulus_humilis", "few = 40", "few = 10", "boxes_per_block"),
+            (
+                "cumulus_humilis",
+                "ovc = 200",
+                "ovc = 201",
+                "boxes_per_block",
+            ),
+            (
+                "cumulus_humilis",
+                "sprites_per_box = [10, 18]",
+                "sprites_per_box = [10, 101]",
+                "sprites_per_box",
+            ),
+            (
+                "cumulus_humilis",
+                "sprite_width_m = [160.0, 300.0]",
+                "sprite_width_m = [300.0, 160.0]",
+                "sprite_width_m",
+            ),
+            (
+                "stratus",
+                "sprite_height_ratio = [0.35, 0.6]",
+                "sprite_height_ratio = [0.35, 1.6]",
+                "sprite_height_ratio",
+            ),
+            (
+                "cumulus_humilis",
+                "cull_radius_fraction = 0.333",
+                "cull_radius_fraction = -0.1",
+                "cull_radius_fraction",
+            ),
+            (
+                "cumulus_humilis",
+                "shading_group_size = [3, 10]",
+                "shading_group_size = [3, 31]",
+                "shading_group_size",
+            ),
+            (
+                "cumulus_humilis",
+                "{ up_to = 0.2,",
+                "{ up_to = 1.2,",
+                "texture_bands",
+            ),
+            (
+                "cumulus_humilis",
+                "{ up_to = 1.0, textures = [\"puffy\", \"puffy\", \"wispy\"]",
+                "{ up_to = 0.9, textures = [\"puffy\", \"puffy\", \"wispy\"]",
+                "texture_bands",
+            ),
+            (
+                "cumulus_humilis",
+                "textures = [\"flat_bottom\"]",
+                "textures = []",
+                "texture_bands",
+            ),
+            (
+                "cumulus_humilis",
+                "rotation_deg = [-5.0, 5.0]",
+                "rotation_deg = [5.0, -5.0]",
+                "texture_bands",
+            ),
+            (
+                "cumulus_humilis",
+                "{ height = 0.25,",
+                "{ height = 1.25,",
+                "colour_levels",
+            ),
+            (
+                "cumulus_humilis",
+                "rgba = [0.86, 0.87, 0.90, 1.0]",
+                "rgba = [0.86, 0.87, 0.90, 2.0]",
+                "colour_levels",
+            ),
+        ];
+        for (section, from, to, field) in cases {
+            let text = edited(section, from, to);
+            let (line, named, message) = error_of(&text);
+            let key = from.split([' ', '=']).next().unwrap();
+            let expected_line = if named.ends_with("colour_levels") {
+                line_containing(&text, section, "colour_levels")
+            } else if ["few", "ovc"].contains(&key) {
+                line_containing(&text, section, "boxes_per_block")
+            } else if key == "{" || key == "textures" || key == "rotation_deg" {
+                line_containing(&text, section, "texture_bands")
+            } else {
+                line_containing(&text, section, key)
+            };
+            assert_eq!(
+                named,
+                format!("{section}.{field}"),
+                "{from} -> {to}: {message}"
+            );
+            assert_eq!(line, expected_line, "{from} -> {to}: {message}");
+            let shown = CloudTypes::parse(&text, Path::new(FILE))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                shown.starts_with(&format!("{FILE}:{line}: field `{section}.{field}`")),
+                "{shown}"
+            );
+        }
+    }
+
+    #[test]
+    fn toml_faults_name_line_and_field() {
+        // Missing field: the error points at the section and names the field.
+        let text = edited("fog", "taper = 0.0\n", "");
+        let (line, field, message) = error_of(&text);
+        assert!(
+            field.ends_with("taper") && message.contains("missing"),
+            "{field}: {message}"
+        );
+        assert!(
+            line >= line_containing(&text, "fog", "[fog]"),
+            "line {line}"
+        );
+        // Unknown field.
+        let text = edited("fog", "taper = 0.0", "taper = 0.0\nwobble = 1");
+        let (line, field, message) = error_of(&text);
+        assert_eq!(
+            (line, field.as_str()),
+            (line_containing(&text, "fog", "wobble"), "fog.wobble"),
+            "{message}"
+        );
+        // Wrong type.
+        let text = edited("fog", "taper = 0.0", "taper = \"steep\"");
+        let (line, field, _) = error_of(&text);
+        assert_eq!(
+            (line, field.as_str()),
+            (line_containing(&text, "fog", "taper"), "fog.taper")
+        );
+        // Wrong number of colour levels.
+        let text = edited(
+            "fog",
+            "  { height = 1.0, rgba = [0.88, 0.89, 0.91, 0.4] },\n",
+            "",
+        );
+        let (line, field, _) = error_of(&text);
+        assert_eq!(
+            (line, field.as_str()),
+            (
+                line_containing(&text, "fog", "colour_levels"),
+                "fog.colour_levels"
+            )
+        );
+        // Unknown texture category.
+        let text = edited("fog", "textures = [\"foggy\"]", "textures = [\"smoky\"]");
+        let (line, _, message) = error_of(&text);
+        assert_eq!(line, line_containing(&text, "fog", "smoky"), "{message}");
+        // Not TOML at all.
+        let (line, _, _) = error_of("[fog]\ncontinuous = = true\n");
+        assert_eq!(line, 2);
+        // A section for a type that does not exist.
+        let text = format!("{BUILTIN_CLOUD_TYPES}\n[cumulus_giganticus]\n");
+        let (line, field, _) = error_of(&text);
+        assert_eq!(field, "cumulus_giganticus");
+        assert_eq!(line, text.lines().count());
+    }
+
+    #[test]
+    fn a_missing_type_section_or_file_is_an_error() {
+        let start = BUILTIN_CLOUD_TYPES.find("[fog]").unwrap();
+        let text = &BUILTIN_CLOUD_TYPES[..start];
+        match CloudTypes::parse(text, Path::new(FILE)) {
+            Err(e @ CloudsError::MissingType { .. }) => {
+                assert_eq!(
+                    e.to_string(),
+                    "cloud_types.toml: no section `[fog]`: every cloud type needs one"
+                )
+            }
+            other => panic!("{other:?}"),
+        }
+        let missing = Path::new("/nonexistent/cloud_types.toml");
+        assert!(matches!(
+            CloudTypes::load(missing),
+            Err(CloudsError::Read { .. })
+        ));
+        assert!(matches!(
+            CloudsConfig::load(missing),
+            Err(CloudsError::Read { .. })
+        ));
+    }
+
+    #[test]
+    fn clouds_toml_faults_name_line_and_field() {
+        let cases = [
+            (
+                "formation_s = 600.0",
+                "formation_s = 0.0",
+                "lifecycle.formation_s",
+            ),
+            (
+                "dissipation_s = 480.0",
+                "dissipation_s = -1.0",
+                "lifecycle.dissipation_s",
+            ),
+            (
+                "inner_radius_fraction = 0.5",
+                "inner_radius_fraction = 1.0",
+                "lifecycle.inner_radius_fraction",
+            ),
+            (
+                "outer_start_opacity = 0.6",
+                "outer_start_opacity = 0.0",
+                "lifecycle.outer_start_opacity",
+            ),
+            ("radius_m = 100000.0", "radius_m = 0.0", "field.radius_m"),
+            (
+                "wind_factor = 1.5",
+                "wind_factor = -2.0",
+                "field.wind_factor",
+            ),
+            ("seed = 2003", "seed = \"x\"", "field.seed"),
+            (
+                "wind_factor = 1.5",
+                "wind_factor = 1.5\ngust = 3",
+                "field.gust",
+            ),
+        ];
+        for (from, to, field) in cases {
+            let text = BUILTIN_CLOUDS.replacen(from, to, 1);
+            let key = field.split('.').nth(1).unwrap();
+            let expected = text[..text.find(&format!("{key} =")).unwrap()]
+                .matches('\n')
+                .count()
+                + 1;
+            match CloudsConfig::parse(&text, Path::new("clouds.toml")) {
+                Err(CloudsError::Invalid { line, field: f, .. })
+                | Err(CloudsError::Parse { line, field: f, .. }) => {
+                    assert_eq!((line, f.as_str()), (expected, field), "{to}");
+                }
+                other => panic!("{to}: {other:?}"),
+            }
+        }
+    }
+}

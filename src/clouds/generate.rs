@@ -1,0 +1,729 @@
+//! Block generation (Wang 2003 §3.1): a pure function of (block index, block weather, seed).
+//!
+//! Per weather layer: clouds are placed until the layer's coverage is met, each cloud a stack of
+//! boxes filled with random sprite centres; then the cull pass drops every sprite closer than the
+//! cull radius (a fraction of its height) to one already kept; then each sprite gets a texture
+//! and rotation from the band of its height in the cloud, and sprites are grouped into shading
+//! groups; each cloud gets its type's five colour levels.
+//!
+//! Two placements:
+//! - scattered: random cloud centres in the block; a 100 m coverage grid tracks the fraction of
+//!   the block under the clouds' footprint discs, and placement stops at oktas / 8;
+//! - lattice (continuous types, and every overcast layer): one cloud per cell of a world-aligned
+//!   lattice, seeded by the world cell, so neighbouring blocks agree and the layer runs on across
+//!   borders without a gap (clouds overhang their cell and block).
+//!
+//! Heights: base = ground elevation + base ft AGL x 0.3048; the thickness is the layer's, clamped
+//! into the type's range. Randomness: [`SplitMix64`] keyed by seed, block and layer (or world
+//! cell), with no trigonometry, so the block is the same bytes on every machine.
+
+use glam::{DVec2, DVec3};
+
+use super::block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};
+use super::config::{CloudTypeConfig, CloudTypes};
+use super::rng::{SplitMix64, hash_keys};
+use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, CloudType};
+
+/// Feet to metres.
+const M_PER_FT: f64 = 0.3048;
+/// Cells per side of the coverage grid.
+const GRID: usize = 40;
+/// Layers at or above this coverage are placed on the lattice, whatever their type.
+const OVERCAST_OKTAS: f32 = 7.5;
+
+/// Generates the clouds of one block. Pure: equal inputs give byte-identical blocks.
+pub fn generate_block(
+    index: BlockIndex,
+    weather: &BlockWeather,
+    seed: u64,
+    types: &CloudTypes,
+) -> CloudBlock {
+    let mut block = CloudBlock {
+        index,
+        seed,
+        layers: Vec::with_capacity(weather.layers.len()),
+        clouds: Vec::new(),
+    };
+    for (li, layer) in weather.layers.iter().enumerate() {
+        let config = types.get(layer.cloud_type);
+        let frame = LayerFrame::new(layer, config, weather.ground_elevation_m as f64);
+        let first = block.clouds.len();
+        let (covered, boxes) = if layer.coverage_oktas <= 0.0 {
+            (0.0, 0)
+        } else if config.continuous || layer.coverage_oktas >= OVERCAST_OKTAS {
+            lattice_layer(index, layer, li, config, &frame, seed, &mut block.clouds)
+        } else {
+            scattered_layer(index, layer, li, config, &frame, seed, &mut block.clouds)
+        };
+        let clouds = &block.clouds[first..];
+        let area: f64 = clouds.iter().map(Cloud::sprite_area_m2).sum();
+        block.layers.push(LayerSummary {
+            cloud_type: layer.cloud_type,
+            coverage_oktas: layer.coverage_oktas,
+            covered_fraction: covered as f32,
+            base_m: frame.base_m as f32,
+            top_m: (frame.base_m + frame.thickness_m) as f32,
+            clouds: clouds.len() as u32,
+            boxes,
+            sprites: clouds.iter().map(|c| c.sprites.len() as u32).sum(),
+            overdraw: (area / (BLOCK_SIZE_M * BLOCK_SIZE_M)) as f32,
+        });
+    }
+    block
+}
+
+/// Vertical placement of one layer, metres above mean sea level.
+struct LayerFrame {
+    base_m: f64,
+    thickness_m: f64,
+}
+
+impl LayerFrame {
+    fn new(layer: &BlockLayer, config: &CloudTypeConfig, ground_m: f64) -> Self {
+        let [lo, hi] = config.thickness_m.map(f64::from);
+        let reported = layer.thickness_ft.max(0.0) as f64 * M_PER_FT;
+        Self {
+            base_m: ground_m + layer.base_ft_agl.max(0.0) as f64 * M_PER_FT,
+            thickness_m: reported.clamp(lo, hi),
+        }
+    }
+}
+
+fn type_key(t: CloudType) -> u64 {
+    CloudType::ALL.iter().position(|&x| x == t).unwrap_or(0) as u64
+}
+
+/// Random clouds until the coverage grid reaches oktas / 8 (or the box budget runs out).
+fn scattered_layer(
+    index: BlockIndex,
+    layer: &BlockLayer,
+    li: usize,
+    config: &CloudTypeConfig,
+    frame: &LayerFrame,
+    seed: u64,
+    out: &mut Vec<Cloud>,
+) -> (f64, u32) {
+    let mut rng = SplitMix64::from_keys(&[
+        seed,
+        index.i as u64,
+        index.j as u64,
+        li as u64,
+        type_key(layer.cloud_type),
+    ]);
+    let target = (layer.coverage_oktas as f64 / 8.0).clamp(0.0, 1.0);
+    let budget = config.boxes_per_block.for_oktas(layer.coverage_oktas);
+    let corner = index.min_corner_m();
+    let mut grid = vec![false; GRID * GRID];
+    let mut covered = 0usize;
+    let mut boxes = 0u32;
+    let [dmin, dmax] = config.cloud_size_m.map(f64::from);
+    // Denser skies tolerate overlap; sparse ones keep clouds apart.
+    let min_new_share = if target > 0.6 { 0.15 } else { 0.5 };
+    for _attempt in 0..2000 {
+        let frac = covered as f64 / (GRID * GRID) as f64;
+        if frac >= target || boxes >= budget {
+            break;
+        }
+        // Denser skies merge into bigger patches (and keep to the box budget).
+        let mut d = rng.range_f64(dmin, dmax) * (1.0 + target);
+        // Near the target, shrink the last clouds so they do not overshoot it.
+        let remaining_m2 = (target - frac) * BLOCK_SIZE_M * BLOCK_SIZE_M;
+        let disc_m2 = std::f64::consts::FRAC_PI_4 * d * d;
+        if disc_m2 > remaining_m2 * 1.3 {
+            d = (remaining_m2 * 1.3 / std::f64::consts::FRAC_PI_4)
+                .sqrt()
+                .max(dmin * 0.5);
+        }
+        let margin = (d / 4.0).min(BLOCK_SIZE_M / 2.0);
+        let centre = corner
+            + DVec2::new(
+                rng.range_f64(margin, BLOCK_SIZE_M - margin),
+                rng.range_f64(margin, BLOCK_SIZE_M - margin),
+            );
+        let cloud_seed = rng.next_u64();
+        let (cloud, n_boxes) = build_cloud(
+            &LayerCtx {
+                config,
+                layer,
+                li,
+                frame,
+            },
+            centre,
+            d,
+            None,
+            cloud_seed,
+        );
+        let cells = cloud_cells(&cloud, corner);
+        let new = cells.iter().filter(|&&c| !grid[c]).count();
+        if cells.is_empty() || (new as f64) < min_new_share * cells.len() as f64 {
+            continue;
+        }
+        for c in cells {
+            if !grid[c] {
+                grid[c] = true;
+                covered += 1;
+            }
+        }
+        boxes += n_boxes;
+        out.push(cloud);
+    }
+    (covered as f64 / (GRID * GRID) as f64, boxes)
+}
+
+/// Coverage-grid cells (of the block, 100 m) under a cloud: those whose centre lies within
+/// 0.6 half-widths of a sprite centre horizontally (the sprite's dense core).
+fn cloud_cells(cloud: &Cloud, corner: DVec2) -> Vec<usize> {
+    let cell = BLOCK_SIZE_M / GRID as f64;
+    let mut cells = Vec::new();
+    for s in &cloud.sprites {
+        let p = DVec2::new(
+            cloud.centre_m.x + s.offset_m[0] as f64,
+            cloud.centre_m.y + s.offset_m[1] as f64,
+        ) - corner;
+        let r = 0.3 * s.width_m as f64;
+        let lo_x = ((p.x - r) / cell).floor().max(0.0) as usize;
+        let hi_x = ((p.x + r) / cell).ceil().clamp(0.0, GRID as f64) as usize;
+        let lo_y = ((p.y - r) / cell).floor().max(0.0) as usize;
+        let hi_y = ((p.y + r) / cell).ceil().clamp(0.0, GRID as f64) as usize;
+        for y in lo_y..hi_y {
+            for x in lo_x..hi_x {
+                let q = DVec2::new((x as f64 + 0.5) * cell, (y as f64 + 0.5) * cell);
+                if q.distance_squared(p) <= r * r {
+                    cells.push(y * GRID + x);
+                }
+            }
+        }
+    }
+    cells.sort_unstable();
+    cells.dedup();
+    cells
+}
+
+/// One cloud per world lattice cell whose origin lies in the block; below 8 oktas only the
+/// coverage share of them (those with the lowest per-cell random key).
+fn lattice_layer(
+    index: BlockIndex,
+    layer: &BlockLayer,
+    li: usize,
+    config: &CloudTypeConfig,
+    frame: &LayerFrame,
+    seed: u64,
+    out: &mut Vec<Cloud>,
+) -> (f64, u32) {
+    let s = config.lattice_spacing_m as f64;
+    let lo = index.min_corner_m();
+    let hi = lo + DVec2::splat(BLOCK_SIZE_M);
+    let (ci0, ci1) = ((lo.x / s).ceil() as i64, (hi.x / s).ceil() as i64);
+    let (cj0, cj1) = ((lo.y / s).ceil() as i64, (hi.y / s).ceil() as i64);
+    // Two decks of one type in a block are told apart by their layer index.
+    let rank = li as u64;
+    let cell_key = |ci: i64, cj: i64| {
+        hash_keys(&[seed, type_key(layer.cloud_type), rank, ci as u64, cj as u64])
+    };
+    let mut cells: Vec<(u64, i64, i64)> = Vec::new();
+    for cj in cj0..cj1 {
+        for ci in ci0..ci1 {
+            cells.push((cell_key(ci, cj), ci, cj));
+        }
+    }
+    let fraction = (layer.coverage_oktas as f64 / 8.0).clamp(0.0, 1.0);
+    let keep = if layer.coverage_oktas >= OVERCAST_OKTAS {
+        cells.len()
+    } else {
+        (fraction * cells.len() as f64).round() as usize
+    };
+    let mut chosen = cells.clone();
+    chosen.sort_unstable();
+    chosen.truncate(keep);
+    let mut boxes = 0;
+    for &(key, ci, cj) in cells.iter().filter(|c| chosen.contains(c)) {
+        let mut rng = SplitMix64::new(key);
+        let jitter = DVec2::new(rng.range_f64(-0.1, 0.1), rng.range_f64(-0.1, 0.1)) * s;
+        let centre = DVec2::new((ci as f64 + 0.5) * s, (cj as f64 + 0.5) * s) + jitter;
+        let [dmin, dmax] = config.cloud_size_m.map(f64::from);
+        // Wide enough to cover the cell's corners: diagonal plus the jitter.
+        let d = rng.range_f64(dmin, dmax).max(s * 1.5);
+        let (cloud, n) = build_cloud(
+            &LayerCtx {
+                config,
+                layer,
+                li,
+                frame,
+            },
+            centre,
+            d,
+            Some(s),
+            rng.next_u64(),
+        );
+        boxes += n;
+        out.push(cloud);
+    }
+    (keep as f64 / cells.len().max(1) as f64, boxes)
+}
+
+/// A sprite before texture, rotation and grouping.
+struct Raw {
+    pos: DVec3,
+    width: f64,
+    height: f64,
+    group: u32,
+}
+
+/// Builds one cloud of `d` metres diameter centred (horizontally) at `centre`; returns the cloud
+/// and the number of boxes it used.
+/// What every cloud of one layer shares.
+struct LayerCtx<'a> {
+    config: &'a CloudTypeConfig,
+    layer: &'a BlockLayer,
+    li: usize,
+    frame: &'a LayerFrame,
+}
+
+fn build_cloud(
+    ctx: &LayerCtx,
+    centre: DVec2,
+    d: f64,
+    lattice_cell_m: Option<f64>,
+    cloud_seed: u64,
+) -> (Cloud, u32) {
+    let LayerCtx { config, frame, .. } = *ctx;
+    let mut rng = SplitMix64::new(cloud_seed);
+    let n_boxes = rng.range_u32(config.boxes_per_cloud[0], config.boxes_per_cloud[1]);
+    let thickness = frame.thickness_m;
+    let [wmin, wmax] = config.sprite_width_m.map(f64::from);
+    let [rmin, rmax] = config.sprite_height_ratio.map(f64::from);
+    let mut raws: Vec<Raw> = Vec::new();
+    let mut group = 0u32;
+    // Continuous decks lay their boxes side by side; heaped clouds stack them.
+    let stacked = lattice_cell_m.is_none() && !config.continuous && !config.flat;
+    for k in 0..n_boxes {
+        let t = (k as f64 + 0.5) / n_boxes as f64;
+        let (mut half_w, z0, z1, offset) = if stacked {
+            let lo = thickness * k as f64 / n_boxes as f64;
+            let hi = thickness * (k as f64 + 1.3) / n_boxes as f64;
+            let wander = d * 0.12 * t;
+            let off = DVec2::new(
+                rng.range_f64(-wander, wander),
+                rng.range_f64(-wander, wander),
+            );
+            (
+                d / 2.0 * (1.0 - config.taper as f64 * t),
+                lo,
+                hi.min(thickness),
+                off,
+            )
+        } else if let Some(cell) = lattice_cell_m {
+            // A lattice cell: every box spans the cell and a little of its neighbours.
+            (cell * 0.55, 0.0, thickness, DVec2::ZERO)
+        } else {
+            let off = DVec2::new(rng.range_f64(-0.15, 0.15), rng.range_f64(-0.15, 0.15)) * d;
+            (
+                d / 2.0 * if n_boxes > 1 { 0.75 } else { 1.0 },
+                0.0,
+                thickness,
+                off,
+            )
+        };
+        let mut z_range = (z0, z1);
+        if let Some(anvil) = config.anvil
+            && t >= anvil.from as f64
+        {
+            half_w = d / 2.0 * anvil.width_scale as f64;
+            z_range = (thickness * anvil.from as f64, thickness);
+        }
+        let n = rng.range_u32(config.sprites_per_box[0], config.sprites_per_box[1]);
+        // Sprites in proportion to the box area against the type's mean cloud size (bigger
+        // patches and anvils get more), at most 100 per box (Wang 2003 §3.1).
+        let mean_d = (config.cloud_size_m[0] + config.cloud_size_m[1]) as f64 / 2.0;
+        let area_ratio = if lattice_cell_m.is_some() {
+            1.0
+        } else {
+            (half_w * 2.0 / mean_d).max(1.0).powi(2)
+        };
+        let mut n = ((n as f64 * area_ratio).round() as u32).min(100);
+        // On the lattice, enough sprites that the jittered grid leaves no hole (at most 100).
+        let grid_side = lattice_cell_m.map(|_| {
+            let cover = (2.0 * half_w / (0.5 * (wmin + wmax) / 2.0)).ceil();
+            (n as f64).sqrt().ceil().max(cover).clamp(1.0, 10.0) as u32
+        });
+        if let Some(m) = grid_side {
+            n = m * m;
+        }
+        let group_size = rng.range_u32(config.shading_group_size[0], config.shading_group_size[1]);
+        for s in 0..n {
+            if s % group_size == 0 {
+                group += 1;
+            }
+            let width = rng.range_f64(wmin, wmax);
+            let height = width * rng.range_f64(rmin, rmax);
+            let (x, y) = if let Some(m) = grid_side {
+                // Continuous decks: a jittered grid over the square cell, so no holes.
+                let (gx, gy) = ((s % m) as f64, ((s / m) % m) as f64);
+                let cell = 2.0 / m as f64;
+                (
+                    -1.0 + cell * (gx + 0.5 + rng.range_f64(-0.2, 0.2)),
+                    -1.0 + cell * (gy + 0.5 + rng.range_f64(-0.2, 0.2)),
+                )
+            } else {
+                // A random point in the box's elliptic footprint (rejection, no trigonometry).
+                loop {
+                    let x = rng.range_f64(-1.0, 1.0);
+                    let y = rng.range_f64(-1.0, 1.0);
+                    if x * x + y * y <= 1.0 {
+                        break (x, y);
+                    }
+                }
+            };
+            let spread = if grid_side.is_some() {
+                half_w
+            } else {
+                (half_w - width * 0.25).max(half_w * 0.3)
+            };
+            // Sprites keep their full height inside the cloud: flat bottoms sit on the base.
+            let half_h = height / 2.0;
+            let (mut zlo, mut zhi) = (z_range.0 + half_h, z_range.1 - half_h);
+            if zhi < zlo {
+                zlo = (z_range.0 + z_range.1) / 2.0;
+                zhi = zlo;
+            }
+            let z = if config.flat {
+                rng.range_f64(0.0, thickness)
+            } else {
+                rng.range_f64(zlo, zhi)
+            };
+            raws.push(Raw {
+                pos: DVec3::new(offset.x + x * spread, offset.y + y * spread, z),
+                width,
+                height,
+                group: group - 1,
+            });
+        }
+    }
+    let kept = cull(raws, config.cull_radius_fraction as f64);
+    let cloud = finish_cloud(ctx, centre, kept, &mut rng);
+    (cloud, n_boxes)
+}
+
+/// Wang 2003 §3.1: traverse the list, drop a sprite closer than the cull radius to a kept one.
+fn cull(raws: Vec<Raw>, fraction: f64) -> Vec<Raw> {
+    let mut kept: Vec<Raw> = Vec::with_capacity(raws.len());
+    for r in raws {
+        let radius = fraction * r.height;
+        let r2 = radius * radius;
+        if kept.iter().all(|k| k.pos.distance_squared(r.pos) >= r2) {
+            kept.push(r);
+        }
+    }
+    kept
+}
+
+/// Textures, rotations, shading groups and colour levels; positions made relative to the centre.
+fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMix64) -> Cloud {
+    let LayerCtx {
+        config,
+        layer,
+        li,
+        frame,
+    } = *ctx;
+    let thickness = frame.thickness_m;
+    let centre_z = frame.base_m + thickness / 2.0;
+    let origin = DVec3::new(0.0, 0.0, thickness / 2.0);
+    // Renumber the surviving groups densely and find their centres.
+    let mut group_ids: Vec<u32> = kept.iter().map(|r| r.group).collect();
+    group_ids.dedup();
+    let mut sums: Vec<(DVec3, u32)> = vec![(DVec3::ZERO, 0); group_ids.len()];
+    let mut sprite_groups = Vec::with_capacity(kept.len());
+    for r in &kept {
+        let g = group_ids.iter().position(|&x| x == r.group).unwrap_or(0);
+        sums[g].0 += r.pos - origin;
+        sums[g].1 += 1;
+        sprite_groups.push(g as u16);
+    }
+    let radius = kept
+        .iter()
+        .map(|r| (r.pos - origin).length())
+        .fold(1.0f64, f64::max);
+    let mut sprites = Vec::with_capacity(kept.len());
+    for (r, &g) in kept.iter().zip(&sprite_groups) {
+        let fraction = (r.pos.z / thickness).clamp(0.0, 1.0) as f32;
+        let band = config.band_at(fraction);
+        let category = band.textures[rng.range_u32(0, band.textures.len() as u32 - 1) as usize];
+        let cells = category.cells();
+        let texture = rng.range_u32(cells.start as u32, cells.end as u32 - 1) as u8;
+        let square = (r.height - r.width).abs() < 1e-6 * r.width.max(1.0);
+        let rotation_deg = if square {
+            rng.range_f32(band.rotation_deg[0], band.rotation_deg[1])
+        } else {
+            0.0
+        };
+        let offset = r.pos - origin;
+        sprites.push(Sprite {
+            offset_m: offset.as_vec3().to_array(),
+            width_m: r.width as f32,
+            height_m: r.height as f32,
+            rotation_deg,
+            texture,
+            shading_group: g,
+            radius_fraction: (offset.length() / radius).min(1.0) as f32,
+            alpha_morph: 1.0,
+        });
+    }
+    let shading_groups = sums
+        .iter()
+        .map(|&(sum, n)| ShadingGroup {
+            centre_m: (sum / n.max(1) as f64).as_vec3().to_array(),
+        })
+        .collect();
+    let colour_levels = config.colour_levels.map(|l| ColourLevel {
+        height_m: ((l.height as f64 - 0.5) * thickness) as f32,
+        rgba: l.rgba,
+    });
+    Cloud {
+        centre_m: DVec3::new(centre.x, centre.y, centre_z),
+        cloud_type: layer.cloud_type,
+        layer: li.min(u8::MAX as usize) as u8,
+        radius_m: radius as f32,
+        flat: config.flat,
+        colour_levels,
+        shading_groups,
+        sprites,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::weather::{TypeSource, Wind};
+
+    fn weather(cloud_type: CloudType, oktas: f32, base_ft: f32, thickness_ft: f32) -> BlockWeather {
+        BlockWeather {
+            layers: vec![BlockLayer {
+                cloud_type,
+                type_source: TypeSource::HeightRule,
+                coverage_oktas: oktas,
+                base_ft_agl: base_ft,
+                thickness_ft,
+            }],
+            visibility_m: 9999.0,
+            wind: Wind::default(),
+            temperature_c: 10.0,
+            dewpoint_c: 5.0,
+            precipitation: 0.0,
+            ground_elevation_m: 250.0,
+        }
+    }
+
+    fn types() -> &'static CloudTypes {
+        static TYPES: std::sync::OnceLock<CloudTypes> = std::sync::OnceLock::new();
+        TYPES.get_or_init(CloudTypes::builtin)
+    }
+
+    /// Fraction of a 50 m grid over the block within 0.7 sprite half-widths (horizontally) of a
+    /// sprite centre: the coverage a person looking up would see, measured from the sprites.
+    fn sprite_coverage(blocks: &[&CloudBlock], index: BlockIndex) -> f64 {
+        let step = 50.0;
+        let n = (BLOCK_SIZE_M / step) as usize;
+        let corner = index.min_corner_m();
+        let mut grid = vec![false; n * n];
+        for block in blocks {
+            for c in &block.clouds {
+                for s in &c.sprites {
+                    let p = DVec2::new(
+                        c.centre_m.x + s.offset_m[0] as f64,
+                        c.centre_m.y + s.offset_m[1] as f64,
+                    ) - corner;
+                    let r = 0.7 * s.width_m as f64 / 2.0;
+                    let (x0, x1) = (
+                        ((p.x - r) / step).floor().max(0.0) as usize,
+                        (((p.x + r) / step).ceil().max(0.0) as usize).min(n),
+                    );
+                    let (y0, y1) = (
+                        ((p.y - r) / step).floor().max(0.0) as usize,
+                        (((p.y + r) / step).ceil().max(0.0) as usize).min(n),
+                    );
+                    for y in y0..y1 {
+                        for x in x0..x1 {
+                            let q = DVec2::new((x as f64 + 0.5) * step, (y as f64 + 0.5) * step);
+                            if q.distance_squared(p) <= r * r {
+                                grid[y * n + x] = true;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        grid.iter().filter(|&&g| g).count() as f64 / (n * n) as f64
+    }
+
+    #[test]
+    fn generation_is_pure_and_seeded() {
+        let w = weather(CloudType::CumulusMediocris, 4.0, 3000.0, 2000.0);
+        let a = generate_block(BlockIndex::new(3, -2), &w, 7, types());
+        let b = generate_block(BlockIndex::new(3, -2), &w, 7, types());
+        assert_eq!(a, b);
+        assert_eq!(a.content_hash(), b.content_hash());
+        assert_ne!(
+            a.content_hash(),
+            generate_block(BlockIndex::new(3, -2), &w, 8, types()).content_hash()
+        );
+        assert_ne!(
+            a.content_hash(),
+            generate_block(BlockIndex::new(4, -2), &w, 7, types()).content_hash()
+        );
+        assert!(a.sprite_count() > 50);
+    }
+
+    #[test]
+    fn sprites_follow_the_paper_and_the_config() {
+        for t in CloudType::ALL {
+            let w = weather(t, 5.0, 3000.0, 1500.0);
+            let block = generate_block(BlockIndex::new(0, 0), &w, 1, types());
+            let config = types().get(t);
+            assert!(!block.clouds.is_empty(), "{t}: no clouds");
+            let l = block.layers[0];
+            assert!(
+                (l.base_m - (250.0 + 3000.0 * 0.3048)).abs() < 0.01,
+                "{t}: base {}",
+                l.base_m
+            );
+            for c in &block.clouds {
+                assert_eq!(c.flat, config.flat);
+                assert!(
+                    c.sprites.len() <= 800,
+                    "{t}: {} sprites in a cloud",
+                    c.sprites.len()
+                );
+                for s in &c.sprites {
+                    assert!(s.texture < 16);
+                    assert!((s.shading_group as usize) < c.shading_groups.len());
+                    let z = c.centre_m.z + s.offset_m[2] as f64;
+                    assert!(
+                        z >= l.base_m as f64 - 0.5 && z <= l.top_m as f64 + 0.5,
+                        "{t}: z {z}"
+                    );
+                    let fraction = ((z - l.base_m as f64) / (l.top_m - l.base_m) as f64) as f32;
+                    let band = config.band_at(fraction.clamp(0.0, 1.0));
+                    let cat = crate::clouds::TextureCategory::of_cell(s.texture);
+                    assert!(band.textures.contains(&cat), "{t}: {cat:?} at {fraction}");
+                    if s.width_m != s.height_m {
+                        assert_eq!(s.rotation_deg, 0.0, "{t}: non-square sprite rotated");
+                    } else {
+                        assert!(
+                            s.rotation_deg >= band.rotation_deg[0]
+                                && s.rotation_deg <= band.rotation_deg[1]
+                        );
+                    }
+                }
+                // The cull pass: no two sprites closer than the cull radius of the later one.
+                for (k, s) in c.sprites.iter().enumerate() {
+                    for o in &c.sprites[..k] {
+                        let d2: f32 = (0..3)
+                            .map(|a| (s.offset_m[a] - o.offset_m[a]).powi(2))
+                            .sum();
+                        let r = config.cull_radius_fraction * s.height_m;
+                        assert!(d2 >= r * r * 0.999, "{t}: sprites {d2} apart");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn coverage_is_honoured_for_every_cover_code() {
+        // FEW 1-2, SCT 3-4, BKN 5-7, OVC 8 oktas, for heaped and layered types.
+        for t in [
+            CloudType::CumulusHumilis,
+            CloudType::CumulusMediocris,
+            CloudType::Stratocumulus,
+            CloudType::Altocumulus,
+            CloudType::Stratus,
+        ] {
+            for oktas in [1.5f32, 3.5, 6.0, 8.0] {
+                let mut sum = 0.0;
+                let blocks = 6;
+                for i in 0..blocks {
+                    let index = BlockIndex::new(i, 1);
+                    let block =
+                        generate_block(index, &weather(t, oktas, 3000.0, 1500.0), 11, types());
+                    sum += sprite_coverage(&[&block], index);
+                }
+                let got = sum / blocks as f64;
+                let want = oktas as f64 / 8.0;
+                assert!(
+                    (got - want).abs() <= 0.15,
+                    "{t} {oktas} oktas: covered {got:.2}, want {want:.2}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn overcast_neighbours_meet_without_a_gap() {
+        for t in [
+            CloudType::Stratus,
+            CloudType::Nimbostratus,
+            CloudType::Stratocumulus,
+            CloudType::Fog,
+        ] {
+            let w = weather(
+                t,
+                8.0,
+                if t == CloudType::Fog { 0.0 } else { 1200.0 },
+                800.0,
+            );
+            let a = generate_block(BlockIndex::new(0, 0), &w, 5, types());
+            let b = generate_block(BlockIndex::new(1, 0), &w, 5, types());
+            // Points along the shared border x = 4000 m, every 20 m: each lies under some sprite's
+            // disc (half its width), from one block or the other.
+            for k in 0..200 {
+                let p = DVec2::new(BLOCK_SIZE_M, 10.0 + 20.0 * k as f64);
+                let covered = [&a, &b].iter().any(|blk| {
+                    blk.clouds.iter().any(|c| {
+                        c.sprites.iter().any(|s| {
+                            let q = DVec2::new(
+                                c.centre_m.x + s.offset_m[0] as f64,
+                                c.centre_m.y + s.offset_m[1] as f64,
+                            );
+                            q.distance(p) < s.width_m as f64 * 0.5
+                        })
+                    })
+                });
+                assert!(covered, "{t}: gap at the border, y = {} m", p.y);
+            }
+        }
+    }
+
+    #[test]
+    fn a_block_with_no_cloud_is_empty_and_cb_has_an_anvil() {
+        let block = generate_block(
+            BlockIndex::new(0, 0),
+            &weather(CloudType::Stratus, 0.0, 1000.0, 500.0),
+            1,
+            types(),
+        );
+        assert_eq!(block.sprite_count(), 0);
+        assert_eq!(block.overdraw(), 0.0);
+        let cb = generate_block(
+            BlockIndex::new(0, 0),
+            &weather(CloudType::Cumulonimbus, 3.0, 2500.0, 3000.0),
+            1,
+            types(),
+        );
+        let c = &cb.clouds[0];
+        let half_h = (cb.layers[0].top_m - cb.layers[0].base_m) / 2.0;
+        let spread = |lo: f32, hi: f32| {
+            c.sprites
+                .iter()
+                .filter(|s| s.offset_m[2] / half_h >= lo && s.offset_m[2] / half_h < hi)
+                .map(|s| s.offset_m[0].abs().max(s.offset_m[1].abs()))
+                .fold(0.0f32, f32::max)
+        };
+        // The anvil (top tenth) spreads wider than the tower's middle.
+        assert!(
+            spread(0.7, 1.01) > 1.5 * spread(-0.2, 0.2),
+            "anvil {} tower {}",
+            spread(0.7, 1.01),
+            spread(-0.2, 0.2)
+        );
+    }
+}

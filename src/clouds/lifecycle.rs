@@ -1,0 +1,142 @@
+//! Formation and dissipation (Wang 2003 §4) as a transparency factor per sprite, `alpha_morph`,
+//! which the renderer multiplies into the shaded colour (§5.3, eq. 3).
+//!
+//! Formation, progress p = elapsed / formation_s in 0..=1: sprites within
+//! `inner_radius_fraction` of the cloud radius fade in first, reaching full opacity at p = 0.5;
+//! once they pass `outer_start_opacity` the outer sprites start, reaching full opacity at p = 1.
+//! Dissipation, progress q = elapsed / dissipation_s: the outer sprites fade out over the first
+//! half; then the inner ones, those nearer the edge faster (the ones at the inner radius are gone
+//! at q = 0.75, the centre at q = 1). Both are monotonic in time and complete at their end.
+
+use serde::{Deserialize, Serialize};
+
+use super::block::Cloud;
+use super::config::LifecycleConfig;
+
+/// Where a cloud is in its life.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Phase {
+    /// Forming since `since_s` (field time, seconds).
+    Forming {
+        /// Start time, seconds.
+        since_s: f64,
+    },
+    /// Fully formed.
+    Steady,
+    /// Dissipating since `since_s` (field time, seconds).
+    Dissipating {
+        /// Start time, seconds.
+        since_s: f64,
+    },
+    /// Dissipated completely: nothing left to draw.
+    Gone,
+}
+
+/// Opacity factor of a sprite at formation progress `p` (0..=1).
+pub fn formation_alpha(p: f32, radius_fraction: f32, config: &LifecycleConfig) -> f32 {
+    let p = p.clamp(0.0, 1.0);
+    let inner = (p / 0.5).min(1.0);
+    if radius_fraction <= config.inner_radius_fraction {
+        return inner;
+    }
+    let start = 0.5 * config.outer_start_opacity;
+    ((p - start) / (1.0 - start)).clamp(0.0, 1.0)
+}
+
+/// Opacity factor of a sprite at dissipation progress `q` (0..=1).
+pub fn dissipation_alpha(q: f32, radius_fraction: f32, config: &LifecycleConfig) -> f32 {
+    let q = q.clamp(0.0, 1.0);
+    if radius_fraction > config.inner_radius_fraction {
+        return 1.0 - (q / 0.5).min(1.0);
+    }
+    let s = ((q - 0.5) / 0.5).max(0.0);
+    let edge = radius_fraction / config.inner_radius_fraction;
+    1.0 - (s * (1.0 + edge)).min(1.0)
+}
+
+/// Sets every sprite's `alpha_morph` for a phase at field time `now_s`; returns the phase after
+/// (Forming becomes Steady once complete, Dissipating becomes Gone).
+pub fn apply(cloud: &mut Cloud, phase: Phase, now_s: f64, config: &LifecycleConfig) -> Phase {
+    match phase {
+        Phase::Steady => {
+            cloud.sprites.iter_mut().for_each(|s| s.alpha_morph = 1.0);
+            Phase::Steady
+        }
+        Phase::Gone => {
+            cloud.sprites.iter_mut().for_each(|s| s.alpha_morph = 0.0);
+            Phase::Gone
+        }
+        Phase::Forming { since_s } => {
+            let p = ((now_s - since_s) / config.formation_s as f64).clamp(0.0, 1.0) as f32;
+            for s in &mut cloud.sprites {
+                s.alpha_morph = formation_alpha(p, s.radius_fraction, config);
+            }
+            if p >= 1.0 { Phase::Steady } else { phase }
+        }
+        Phase::Dissipating { since_s } => {
+            let q = ((now_s - since_s) / config.dissipation_s as f64).clamp(0.0, 1.0) as f32;
+            for s in &mut cloud.sprites {
+                s.alpha_morph = dissipation_alpha(q, s.radius_fraction, config);
+            }
+            if q >= 1.0 { Phase::Gone } else { phase }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::clouds::CloudsConfig;
+
+    fn config() -> LifecycleConfig {
+        CloudsConfig::builtin().lifecycle
+    }
+
+    const FRACTIONS: [f32; 6] = [0.0, 0.2, 0.5, 0.51, 0.8, 1.0];
+
+    #[test]
+    fn formation_is_monotonic_complete_and_inner_first() {
+        let c = config();
+        for rf in FRACTIONS {
+            let mut last = 0.0;
+            assert_eq!(formation_alpha(0.0, rf, &c), 0.0);
+            for k in 0..=200 {
+                let a = formation_alpha(k as f32 / 200.0, rf, &c);
+                assert!(a >= last && (0.0..=1.0).contains(&a), "rf {rf} step {k}");
+                last = a;
+            }
+            assert_eq!(last, 1.0, "rf {rf} does not finish");
+        }
+        // Outer sprites stay invisible until the inner ones reach the threshold opacity.
+        for k in 0..=200 {
+            let p = k as f32 / 200.0;
+            if formation_alpha(p, 0.9, &c) > 0.0 {
+                assert!(formation_alpha(p, 0.1, &c) >= c.outer_start_opacity);
+            }
+        }
+    }
+
+    #[test]
+    fn dissipation_is_monotonic_complete_outer_first_and_edges_faster() {
+        let c = config();
+        for rf in FRACTIONS {
+            let mut last = 1.0;
+            assert_eq!(dissipation_alpha(0.0, rf, &c), 1.0);
+            for k in 0..=200 {
+                let a = dissipation_alpha(k as f32 / 200.0, rf, &c);
+                assert!(a <= last && (0.0..=1.0).contains(&a), "rf {rf} step {k}");
+                last = a;
+            }
+            assert_eq!(last, 0.0, "rf {rf} does not finish");
+        }
+        for k in 0..=200 {
+            let q = k as f32 / 200.0;
+            // Inner sprites only start once the outer ones are gone.
+            if dissipation_alpha(q, 0.2, &c) < 1.0 {
+                assert_eq!(dissipation_alpha(q, 0.9, &c), 0.0);
+            }
+            // Nearer the edge, more transparent.
+            assert!(dissipation_alpha(q, 0.4, &c) <= dissipation_alpha(q, 0.1, &c));
+        }
+    }
+}
