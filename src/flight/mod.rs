@@ -11,4 +11,4 @@
 mod path;
 mod spline;
 
-pub use path::{CameraPose, FlightPath, FlightPlan, View, Waypoint};
+pub use path::{CameraPose, FlightPath, FlightPlan, View, Waypoint, WeatherEvent};

@@ -1,6 +1,6 @@
 //! Flight-path files and the camera pose along them.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::{DVec2, DVec3};
 use serde::Deserialize;
@@ -59,7 +59,18 @@ pub struct FlightPlan {
     pub description: String,
     /// Latitude/longitude of the frame origin the flight is meant for.
     pub origin_lat_lon_deg: (f64, f64),
+    /// Weather files that replace the sky at given times (a front passing), in time order.
+    pub weather_events: Vec<WeatherEvent>,
     waypoints: Vec<WaypointFile>,
+}
+
+/// A timed weather change of a scripted flight.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WeatherEvent {
+    /// Seconds from the start of the flight.
+    pub time_s: f64,
+    /// The weather file (reports or a theme), resolved against the flight file's folder.
+    pub weather: PathBuf,
 }
 
 /// A flight placed in a local frame: sample it with [`FlightPath::pose_at`].
@@ -77,6 +88,15 @@ struct FlightFile {
     description: String,
     origin: Option<LatLonFile>,
     waypoints: Spanned<Vec<WaypointFile>>,
+    #[serde(default)]
+    weather_events: Vec<WeatherEventFile>,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WeatherEventFile {
+    time_s: Spanned<f64>,
+    weather: Spanned<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
@@ -171,10 +191,29 @@ impl FlightPlan {
                     "waypoints in local metres need an `origin = { lat, lon }`".to_string();
                 at(waypoints_span, "origin", message)
             })?;
+        let folder = path.parent().unwrap_or(Path::new("."));
+        let mut weather_events = Vec::with_capacity(file.weather_events.len());
+        for (k, event) in file.weather_events.iter().enumerate() {
+            let t = *event.time_s.get_ref();
+            if !t.is_finite() || (k > 0 && t <= *file.weather_events[k - 1].time_s.get_ref()) {
+                let message = format!("{t} s must come after the previous event's time");
+                return Err(at(event.time_s.span(), "time_s", message));
+            }
+            let weather = folder.join(event.weather.get_ref());
+            if !weather.is_file() {
+                let message = format!(
+                    "no such file {} (paths are relative to the flight file)",
+                    weather.display()
+                );
+                return Err(at(event.weather.span(), "weather", message));
+            }
+            weather_events.push(WeatherEvent { time_s: t, weather });
+        }
         Ok(Self {
             name: file.name,
             description: file.description,
             origin_lat_lon_deg: origin,
+            weather_events,
             waypoints,
         })
     }
@@ -419,5 +458,26 @@ mod tests {
             count += 1;
         }
         assert!(count >= 3);
+    }
+
+    #[test]
+    fn weather_events_resolve_against_the_flight_file() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/flights/front_passing.toml");
+        let plan = FlightPlan::load(&path).unwrap();
+        let times: Vec<_> = plan.weather_events.iter().map(|e| e.time_s).collect();
+        assert_eq!(times, [0.0, 120.0, 240.0]);
+        assert!(plan.weather_events.iter().all(|e| e.weather.is_file()));
+
+        let flights = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/flights/t.toml");
+        let with = |events: &str| FlightPlan::parse(&format!("{LOCAL}{events}"), &flights);
+        let err = with("[[weather_events]]\ntime_s = 5\nweather = \"../../weather/none.txt\"\n")
+            .unwrap_err();
+        assert_eq!(
+            (err.line, err.field.as_deref()),
+            (Some(17), Some("weather"))
+        );
+        let ok = "[[weather_events]]\ntime_s = 5\nweather = \"../../weather/front/1_clear.txt\"\n";
+        let err = with(&format!("{ok}{ok}")).unwrap_err();
+        assert_eq!((err.line, err.field.as_deref()), (Some(19), Some("time_s")));
     }
 }

@@ -107,7 +107,7 @@ pub struct WeatherFile {
 }
 
 /// Lines searched for the CSV header.
-const CSV_HEADER_SEARCH_LINES: usize = 10;
+pub(crate) const CSV_HEADER_SEARCH_LINES: usize = 10;
 
 /// Reads a weather file from disk, decodes its reports with the METAR decoder and places them
 /// (with `stations` where the file gives no position).

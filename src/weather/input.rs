@@ -24,26 +24,35 @@ impl WeatherInput {
     /// Loads a theme (a `.toml` file) or a report file (anything else; placed with `stations`
     /// where the file gives no positions).
     pub fn load(path: &Path, stations: Option<&StationTable>) -> Result<Self, WeatherError> {
-        if theme::is_theme_path(path) {
-            let text = std::fs::read_to_string(path).map_err(|source| WeatherError::Io {
-                path: path.to_path_buf(),
-                source,
-            })?;
-            // Another TOML file (a config, a flight path) is not weather at all; a theme with a
-            // mistake in it gets the theme's own error naming line and field.
-            let table: Option<toml::Table> = toml::from_str(&text).ok();
-            if table.is_some_and(|t| !t.contains_key("layers") && !t.contains_key("points")) {
-                return Err(WeatherError::NotWeather {
-                    path: path.to_path_buf(),
-                    reason:
-                        "a TOML file, but not a weather theme (it has no [[layers]] or [[points]])"
-                            .to_string(),
-                });
-            }
-            Ok(Self::Theme(theme::parse_theme(&text, path)?))
-        } else {
-            Ok(Self::Reports(files::load(path, stations)?))
+        let bytes = std::fs::read(path).map_err(|source| WeatherError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(path, &bytes, stations)
+    }
+
+    /// [`load`](Self::load) on bytes already read; `path` tells a theme by its extension and
+    /// names the file in errors.
+    pub fn parse(
+        path: &Path,
+        bytes: &[u8],
+        stations: Option<&StationTable>,
+    ) -> Result<Self, WeatherError> {
+        if !theme::is_theme_path(path) {
+            return Ok(Self::Reports(files::parse(path, bytes, stations)?));
         }
+        let text = String::from_utf8_lossy(bytes);
+        // Another TOML file (a config, a flight path) is not weather at all; a theme with a
+        // mistake in it gets the theme's own error naming line and field.
+        let table: Option<toml::Table> = toml::from_str(&text).ok();
+        if table.is_some_and(|t| !t.contains_key("layers") && !t.contains_key("points")) {
+            return Err(WeatherError::NotWeather {
+                path: path.to_path_buf(),
+                reason: "a TOML file, but not a weather theme (it has no [[layers]] or [[points]])"
+                    .to_string(),
+            });
+        }
+        Ok(Self::Theme(theme::parse_theme(&text, path)?))
     }
 
     /// The weather field of this input in `frame`.

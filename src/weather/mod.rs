@@ -16,6 +16,7 @@ pub mod metar;
 pub mod remarks;
 pub mod stations;
 pub mod theme;
+pub mod watch;
 
 pub use block::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, TypeSource, Wind};
 pub use cloud_type::CloudType;
