@@ -18,6 +18,18 @@ test: vulkan
 	cargo test --all-targets
 	cargo test --doc
 
+# Runs every cargo-fuzz target for FUZZ_SECONDS each (see fuzz/README.md); needs cargo-fuzz.
+FUZZ_SECONDS ?= 120
+fuzz:
+	@command -v cargo-fuzz >/dev/null || { echo "make fuzz needs cargo-fuzz: cargo install cargo-fuzz"; exit 1; }
+	cd fuzz && for target in $$(RUSTC_BOOTSTRAP=1 cargo fuzz list); do \
+		mkdir -p corpus/$$target; \
+		seeds=$$([ -d seeds/$$target ] && echo seeds/$$target); \
+		dict=$$([ -f dicts/$$target.dict ] && echo -dict=dicts/$$target.dict); \
+		RUSTC_BOOTSTRAP=1 cargo fuzz run $$target --sanitizer none corpus/$$target $$seeds -- \
+			$$dict -max_total_time=$(FUZZ_SECONDS) || exit 1; \
+	done
+
 # Installs lavapipe where missing: as root directly, else with sudo, else says the one line to run.
 vulkan:
 	@if ls /usr/share/vulkan/icd.d/lvp_icd.*.json >/dev/null 2>&1 && /sbin/ldconfig -p | grep -q 'libvulkan.so.1 '; then \
