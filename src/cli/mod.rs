@@ -6,7 +6,9 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod demo;
+mod fly;
 mod metar;
+mod render;
 mod sheet;
 mod weather;
 
@@ -31,6 +33,10 @@ enum Command {
     Demo(demo::DemoArgs),
     /// Writes the 16-texture cloud sheet (512 x 512 RGBA PNG, Wang 2003 figure 6).
     Sheet(sheet::SheetArgs),
+    /// Renders one frame of real weather over the demo ground (PNG, optionally EXR with depth).
+    Render(render::RenderArgs),
+    /// Flies a scripted path through real weather: frames, frames.csv and a progress bar.
+    Fly(fly::FlyArgs),
 }
 
 /// Runs the command line and maps errors to a message on standard error and exit status 2.
@@ -49,6 +55,8 @@ pub fn main() -> ExitCode {
         Command::Metar(args) => metar::run(&args),
         Command::Weather(args) => weather::run(&args),
         Command::Demo(args) => demo::run(&args),
+        Command::Render(args) => render::run(&args),
+        Command::Fly(args) => fly::run(&args),
         Command::Sheet(args) => sheet::run(&args),
     };
     match result {

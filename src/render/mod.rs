@@ -23,6 +23,7 @@ pub mod settings;
 pub mod sky;
 pub mod terrain;
 pub mod vertices;
+pub mod world;
 
 pub use camera::Camera;
 pub use demo_host::{DemoHost, ground_from_field};

@@ -211,7 +211,7 @@ mod tests {
     #[test]
     fn bad_tables_name_file_line_and_field() {
         let text = DEFAULT_TIME_OF_DAY_TOML.replacen(
-            "ambient_percent = 0.04",
+            "ambient_percent = 0.0248",
             "ambient_percent = \"x\"",
             1,
         );
@@ -219,7 +219,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            err.starts_with("my_tod.toml:16: field `ambient_percent`"),
+            err.starts_with("my_tod.toml:17: field `ambient_percent`"),
             "{err}"
         );
         let text = DEFAULT_TIME_OF_DAY_TOML.replacen(

@@ -1,0 +1,174 @@
+//! `skycast fly --weather FILE --path FLIGHT.toml --out DIR [--size WxH] [--every N]`: flies a
+//! scripted path through the real weather. Every simulated frame runs the sky's CPU update (so
+//! the vertex cache sees the real frame rate); every Nth frame is drawn and written as PNG.
+//! `frames.csv` has one row per simulated frame.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use skycast::flight::FlightPlan;
+use skycast::render::world::{World, WorldSettings};
+use skycast::render::{DemoHost, SkyConfig};
+use skycast::shading::sun_position;
+use skycast::weather::LocalFrame;
+
+use super::render::{DEFAULT_TIME, load_look, parse_size, parse_time};
+use super::weather::{DEFAULT_STATIONS, load};
+
+/// Flags of `skycast fly`.
+#[derive(Debug, Args)]
+pub struct FlyArgs {
+    /// The weather file.
+    #[arg(long)]
+    pub weather: PathBuf,
+    /// Station table placing reports the file does not place.
+    #[arg(long, default_value = DEFAULT_STATIONS)]
+    pub stations: PathBuf,
+    /// The flight path (TOML, see config/flights/).
+    #[arg(long)]
+    pub path: PathBuf,
+    /// Directory for the frames and frames.csv (created).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Image size, WIDTHxHEIGHT pixels.
+    #[arg(long, default_value = "960x540", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Simulated frames per second of flight time.
+    #[arg(long, default_value_t = 10.0)]
+    pub fps: f64,
+    /// Draw and write every Nth simulated frame.
+    #[arg(long, default_value_t = 50)]
+    pub every: u32,
+    /// UTC time at the start of the flight, RFC 3339 (default: the shipped weather file's time).
+    #[arg(long, value_parser = parse_time)]
+    pub time: Option<f64>,
+    /// Renderer settings (default: the shipped config/render.toml).
+    #[arg(long)]
+    pub render_settings: Option<PathBuf>,
+    /// Time-of-day table (default: the shipped config/time_of_day.toml).
+    #[arg(long)]
+    pub time_of_day: Option<PathBuf>,
+}
+
+/// Runs `skycast fly`.
+pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
+    if !(args.fps > 0.0 && args.fps <= 240.0) {
+        anyhow::bail!("--fps {} is outside (0, 240]", args.fps);
+    }
+    if args.every == 0 {
+        anyhow::bail!("--every must be at least 1");
+    }
+    let plan = FlightPlan::load(&args.path)?;
+    let (lat, lon) = plan.origin_lat_lon_deg;
+    let flight = plan.place(&LocalFrame::new(lat, lon));
+    let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
+    let loaded = load(&args.weather, &args.stations, None, None)?;
+    let start_unix_s = match args.time {
+        Some(t) => t,
+        None => parse_time(DEFAULT_TIME).map_err(anyhow::Error::msg)?,
+    };
+    let mut world = World::new(
+        loaded
+            .input
+            .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule),
+        &WorldSettings::default(),
+    );
+    let mut host = DemoHost::new(
+        args.size.0,
+        args.size.1,
+        world.ground(),
+        SkyConfig {
+            colour_format: skycast::render::headless::COLOUR_FORMAT,
+            settings,
+            time_of_day: table,
+            sheet: world.sheet(),
+        },
+    )?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let csv_path = args.out.join("frames.csv");
+    let mut csv = csv::Writer::from_path(&csv_path)
+        .with_context(|| format!("cannot write {}", csv_path.display()))?;
+    csv.write_record([
+        "frame",
+        "time_s",
+        "east_m",
+        "north_m",
+        "alt_m",
+        "heading_deg",
+        "pitch_deg",
+        "sprites_drawn",
+        "clouds_drawn",
+        "clouds_recomputed",
+        "cache_hit_rate",
+        "cpu_update_us",
+        "written",
+    ])?;
+    let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
+    let dt_s = 1.0 / args.fps;
+    let mut block_set = Vec::new();
+    let mut written = 0u32;
+    for k in 0..frames {
+        let time_s = flight.start_s() + k as f64 * dt_s;
+        let pose = flight.pose_at(time_s);
+        let indices = world.block_indices(pose.position_m);
+        if indices != block_set {
+            host.sky.set_clouds(world.sky_blocks(&indices));
+            block_set = indices;
+        }
+        let camera = host.camera(pose.position_m, pose.heading_deg, pose.pitch_deg);
+        let sun = sun_position(start_unix_s + time_s, lat, lon);
+        let write = k % args.every as u64 == 0 || k + 1 == frames;
+        let stats = if write {
+            let (frame, stats) = host.frame(
+                &camera,
+                &sun,
+                if k == 0 { 0.0 } else { dt_s },
+                world.visibility_m(),
+            )?;
+            frame.write_png(&args.out.join(format!("frame_{k:05}.png")))?;
+            written += 1;
+            stats
+        } else {
+            host.sky.prepare(&host.gpu.queue, &camera, &sun, dt_s)
+        };
+        let p = pose.position_m;
+        csv.write_record([
+            k.to_string(),
+            format!("{time_s:.2}"),
+            format!("{:.1}", p.x),
+            format!("{:.1}", p.y),
+            format!("{:.1}", p.z),
+            format!("{:.1}", pose.heading_deg),
+            format!("{:.1}", pose.pitch_deg),
+            stats.sprites_drawn.to_string(),
+            stats.clouds_drawn.to_string(),
+            stats.clouds_recomputed.to_string(),
+            format!("{:.3}", stats.cache_hit_rate),
+            stats.cpu_update_us.to_string(),
+            (write as u8).to_string(),
+        ])?;
+        // The bar moves in whole percents; redraw only when it does.
+        let percent = (k + 1) * 100 / frames;
+        if percent != k * 100 / frames || k == 0 {
+            let bar = (percent * 30 / 100) as usize;
+            eprint!(
+                "\r[{}{}] {percent:3}% {}/{frames} frames, {written} written",
+                "#".repeat(bar),
+                " ".repeat(30 - bar),
+                k + 1
+            );
+            std::io::stderr().flush().ok();
+        }
+    }
+    eprintln!();
+    csv.flush()?;
+    println!(
+        "{}: {written} frames and frames.csv ({frames} simulated at {} fps)",
+        args.out.display(),
+        args.fps
+    );
+    Ok(())
+}

@@ -1,0 +1,160 @@
+//! `skycast render --weather FILE --at LAT,LON --alt-ft FT --heading DEG [...] --out frame.png`:
+//! one frame of the real weather over the demo ground, as PNG and optionally EXR (linear RGBA
+//! half floats plus depth `Z` in metres).
+
+use std::path::PathBuf;
+
+use clap::Args;
+use skycast::render::world::{World, WorldSettings};
+use skycast::render::{DemoHost, RenderSettings, SkyConfig};
+use skycast::shading::{TimeOfDayTable, sun_position};
+use skycast::weather::LocalFrame;
+
+use super::weather::{DEFAULT_STATIONS, load, parse_lat_lon};
+
+const METRES_PER_FOOT: f64 = 0.3048;
+
+/// Flags of `skycast render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// The weather file: metars.cache.csv, a NOAA cycle file, or one METAR a line.
+    #[arg(long)]
+    pub weather: PathBuf,
+    /// Station table placing reports the file does not place.
+    #[arg(long, default_value = DEFAULT_STATIONS)]
+    pub stations: PathBuf,
+    /// Camera latitude,longitude, degrees.
+    #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
+    pub at: (f64, f64),
+    /// Camera altitude, feet above mean sea level.
+    #[arg(long, allow_hyphen_values = true)]
+    pub alt_ft: f64,
+    /// View heading, degrees clockwise from true north.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub heading: f64,
+    /// View pitch, degrees above the horizon.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub pitch: f64,
+    /// UTC time, RFC 3339 (default: 2025-01-27T22:00:00Z, the time of the shipped weather file).
+    #[arg(long, value_parser = parse_time)]
+    pub time: Option<f64>,
+    /// Image size, WIDTHxHEIGHT pixels.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Output PNG.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also write an EXR: linear RGBA half floats and depth `Z` in metres.
+    #[arg(long)]
+    pub exr: Option<PathBuf>,
+    /// Renderer settings (default: the shipped config/render.toml).
+    #[arg(long)]
+    pub render_settings: Option<PathBuf>,
+    /// Time-of-day table (default: the shipped config/time_of_day.toml).
+    #[arg(long)]
+    pub time_of_day: Option<PathBuf>,
+}
+
+/// The default time: that of the shipped weather file (afternoon in the Americas).
+pub const DEFAULT_TIME: &str = "2025-01-27T22:00:00Z";
+
+/// An RFC 3339 time as Unix seconds.
+pub fn parse_time(text: &str) -> Result<f64, String> {
+    let t: jiff::Timestamp = text.parse().map_err(|e| {
+        format!("`{text}` is not an RFC 3339 time such as 2025-01-27T13:00:00Z: {e}")
+    })?;
+    Ok(t.as_millisecond() as f64 / 1000.0)
+}
+
+/// `WIDTHxHEIGHT` in pixels, each 16..=8192.
+pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{text}` is not WIDTHxHEIGHT (for example 1280x720)"))?;
+    let side = |s: &str| -> Result<u32, String> {
+        let v: u32 = s
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{s}` in `{text}` is not a whole number"))?;
+        if (16..=8192).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!("{v} in `{text}` is outside 16..=8192"))
+        }
+    };
+    Ok((side(w)?, side(h)?))
+}
+
+/// Loads the renderer settings and time-of-day table the flags name (or the shipped ones).
+pub fn load_look(
+    render: Option<&PathBuf>,
+    time_of_day: Option<&PathBuf>,
+) -> anyhow::Result<(RenderSettings, TimeOfDayTable)> {
+    let settings = match render {
+        Some(p) => RenderSettings::from_path(p)?,
+        None => RenderSettings::default(),
+    };
+    let table = match time_of_day {
+        Some(p) => TimeOfDayTable::from_path(p)?,
+        None => TimeOfDayTable::default(),
+    };
+    Ok((settings, table))
+}
+
+/// Runs `skycast render`.
+pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
+    let (lat, lon) = args.at;
+    if !(-2_000.0..=100_000.0).contains(&args.alt_ft) {
+        anyhow::bail!("--alt-ft {} is outside -2000..=100000 feet", args.alt_ft);
+    }
+    let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
+    let loaded = load(&args.weather, &args.stations, None, None)?;
+    let unix_s = match args.time {
+        Some(t) => t,
+        None => parse_time(DEFAULT_TIME).map_err(anyhow::Error::msg)?,
+    };
+    let mut world = World::new(
+        loaded
+            .input
+            .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule),
+        &WorldSettings::default(),
+    );
+    let sheet = world.sheet();
+    let mut host = DemoHost::new(
+        args.size.0,
+        args.size.1,
+        world.ground(),
+        SkyConfig {
+            colour_format: skycast::render::headless::COLOUR_FORMAT,
+            settings,
+            time_of_day: table,
+            sheet,
+        },
+    )?;
+    let position = glam::DVec3::new(0.0, 0.0, args.alt_ft * METRES_PER_FOOT);
+    let camera = host.camera(position, args.heading, args.pitch);
+    host.sky.set_clouds(world.sky_blocks_around(position));
+    let sun = sun_position(unix_s, lat, lon);
+    let (frame, stats) = host.frame(&camera, &sun, 0.0, world.visibility_m())?;
+    frame.write_png(&args.out)?;
+    if let Some(exr) = &args.exr {
+        frame.write_exr(exr, camera.near_m, camera.far_m)?;
+    }
+    let ground_m = world.ground().height_at_m(glam::DVec2::ZERO);
+    println!(
+        "{}: {}x{} on {} ({:?}); sun elevation {:.1} deg, azimuth {:.1} deg; camera {:.0} ft MSL, {:.0} ft above the ground; {} clouds, {} sprites; CPU update {} us",
+        args.out.display(),
+        frame.width,
+        frame.height,
+        host.gpu.adapter_info.name,
+        host.gpu.adapter_info.backend,
+        sun.elevation_deg,
+        sun.azimuth_deg,
+        args.alt_ft,
+        args.alt_ft - ground_m / METRES_PER_FOOT,
+        stats.clouds_drawn,
+        stats.sprites_drawn,
+        stats.cpu_update_us,
+    );
+    Ok(())
+}

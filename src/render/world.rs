@@ -1,0 +1,194 @@
+//! The demo world: what the CLI, the flights and the benchmarks draw. Weather reports go in; the
+//! weather field, the ground that agrees with it (station elevations) and the cloud blocks around
+//! the camera come out, the blocks converted to [`SkyBlock`]s for the [`super::Sky`].
+//!
+//! Blocks are generated on demand (a pure function of block index, block weather and seed) and
+//! kept, so a flight regenerates nothing it has seen.
+
+use std::collections::HashMap;
+
+use glam::{DVec2, DVec3, Vec3};
+use serde::{Deserialize, Serialize};
+
+use super::demo_host::ground_from_field;
+use super::scene::{SkyBlock, SkyCloud, SkySprite};
+use super::sky::SpriteSheet;
+use super::terrain::HeightField;
+use crate::clouds::{Cloud, CloudTypes, TextureSheet, generate_block};
+use crate::shading::{ColourLevel, ColourLevels};
+use crate::weather::BlockIndex;
+use crate::weather::field::WeatherField;
+
+/// Settings of the demo world (`[world]` of `config/render.toml`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorldSettings {
+    /// Side of the square of ground around the origin, metres.
+    pub ground_size_m: f64,
+    /// Ground samples per side.
+    pub ground_samples: u32,
+    /// Procedural relief on top of the station elevations, metres.
+    pub relief_m: f64,
+    /// Blocks whose centre lies within this horizontal distance of the camera get clouds, metres.
+    pub cloud_radius_m: f64,
+    /// Seed of the cloud generation.
+    pub seed: u64,
+}
+
+impl Default for WorldSettings {
+    fn default() -> Self {
+        Self {
+            ground_size_m: 120_000.0,
+            ground_samples: 257,
+            relief_m: 40.0,
+            cloud_radius_m: 24_000.0,
+            seed: 2003,
+        }
+    }
+}
+
+impl From<&Cloud> for SkyCloud {
+    fn from(c: &Cloud) -> Self {
+        let z = c.centre_m.z as f32;
+        SkyCloud {
+            centre_m: c.centre_m,
+            sprites: c
+                .sprites
+                .iter()
+                .map(|s| SkySprite {
+                    offset_m: Vec3::from_array(s.offset_m),
+                    width_m: s.width_m,
+                    height_m: s.height_m,
+                    rotation_deg: s.rotation_deg,
+                    cell: s.texture,
+                    group: s.shading_group,
+                    alpha_morph: s.alpha_morph,
+                })
+                .collect(),
+            group_centres_m: c
+                .shading_groups
+                .iter()
+                .map(|g| Vec3::from_array(g.centre_m))
+                .collect(),
+            colour_levels: ColourLevels(c.colour_levels.map(|l| ColourLevel {
+                height_m: z + l.height_m,
+                rgba: l.rgba,
+            })),
+            flat: c.flat,
+        }
+    }
+}
+
+/// The clouds stage's texture sheet as the renderer's [`SpriteSheet`].
+pub fn sprite_sheet(sheet: &TextureSheet) -> SpriteSheet {
+    SpriteSheet {
+        size_px: sheet.level_size_px(0),
+        mips: (0..sheet.level_count())
+            .map(|l| sheet.level(l).to_vec())
+            .collect(),
+    }
+}
+
+/// Weather field, ground and cloud blocks around a reference point.
+pub struct World {
+    field: WeatherField,
+    ground: HeightField,
+    types: CloudTypes,
+    settings: WorldSettings,
+    blocks: HashMap<BlockIndex, SkyBlock>,
+}
+
+impl World {
+    /// Builds the ground for `field` (whose frame origin is the world's centre).
+    pub fn new(field: WeatherField, settings: &WorldSettings) -> Self {
+        let ground = ground_from_field(
+            &field,
+            DVec2::ZERO,
+            settings.ground_size_m,
+            settings.ground_samples,
+            settings.relief_m,
+        );
+        Self {
+            field,
+            ground,
+            types: CloudTypes::builtin(),
+            settings: *settings,
+            blocks: HashMap::new(),
+        }
+    }
+
+    /// The weather field.
+    pub fn field(&self) -> &WeatherField {
+        &self.field
+    }
+
+    /// The ground.
+    pub fn ground(&self) -> &HeightField {
+        &self.ground
+    }
+
+    /// The texture sheet of the clouds stage.
+    pub fn sheet(&self) -> SpriteSheet {
+        sprite_sheet(&TextureSheet::generate())
+    }
+
+    /// Horizontal visibility at the origin, metres. METAR caps visibility at 10 km (9999) or
+    /// 10 statute miles; a capped value means clear air, taken as 40 km for the ground's fog.
+    pub fn visibility_m(&self) -> f32 {
+        let v = self.field.weather_at(DVec2::ZERO).visibility_m;
+        if v >= 9_000.0 { 40_000.0 } else { v }
+    }
+
+    /// The blocks that get clouds around `camera_m`, in a fixed order.
+    pub fn block_indices(&self, camera_m: DVec3) -> Vec<BlockIndex> {
+        let r = self.settings.cloud_radius_m;
+        let at = camera_m.truncate();
+        let lo = BlockIndex::containing(at - DVec2::splat(r));
+        let hi = BlockIndex::containing(at + DVec2::splat(r));
+        (lo.j..=hi.j)
+            .flat_map(|j| (lo.i..=hi.i).map(move |i| BlockIndex::new(i, j)))
+            .filter(|b| b.centre_m().distance(at) <= r)
+            .collect()
+    }
+
+    /// The cloud blocks with these indices (generated on first use, then kept).
+    pub fn sky_blocks(&mut self, indices: &[BlockIndex]) -> Vec<SkyBlock> {
+        indices
+            .iter()
+            .map(|&index| {
+                self.blocks
+                    .entry(index)
+                    .or_insert_with(|| {
+                        let weather = self.field.block_weather(index);
+                        let generated =
+                            generate_block(index, &weather, self.settings.seed, &self.types);
+                        let clouds: Vec<SkyCloud> =
+                            generated.clouds.iter().map(SkyCloud::from).collect();
+                        let c = index.centre_m();
+                        let mean_z = if clouds.is_empty() {
+                            weather.ground_elevation_m as f64
+                        } else {
+                            clouds.iter().map(|c| c.centre_m.z).sum::<f64>() / clouds.len() as f64
+                        };
+                        SkyBlock {
+                            id: block_id(index),
+                            centre_m: DVec3::new(c.x, c.y, mean_z),
+                            clouds,
+                        }
+                    })
+                    .clone()
+            })
+            .collect()
+    }
+
+    /// The cloud blocks around `camera_m`.
+    pub fn sky_blocks_around(&mut self, camera_m: DVec3) -> Vec<SkyBlock> {
+        let indices = self.block_indices(camera_m);
+        self.sky_blocks(&indices)
+    }
+}
+
+/// A block's id for the vertex cache: its index packed into 64 bits.
+pub fn block_id(index: BlockIndex) -> u64 {
+    ((index.i as u32 as u64) << 32) | index.j as u32 as u64
+}
