@@ -5,9 +5,11 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod block;
 mod demo;
 mod fly;
 mod metar;
+mod preview;
 mod render;
 mod sheet;
 mod weather;
@@ -37,6 +39,10 @@ enum Command {
     Render(render::RenderArgs),
     /// Flies a scripted path through real weather: frames, frames.csv and a progress bar.
     Fly(fly::FlyArgs),
+    /// Draws one block of a cloud type (or of every type) to a PNG, on the CPU.
+    Preview(preview::PreviewArgs),
+    /// The cloud block at a place: its layers and types, clouds, sprites and overdraw.
+    Block(block::BlockArgs),
 }
 
 /// Runs the command line and maps errors to a message on standard error and exit status 2.
@@ -58,6 +64,8 @@ pub fn main() -> ExitCode {
         Command::Render(args) => render::run(&args),
         Command::Fly(args) => fly::run(&args),
         Command::Sheet(args) => sheet::run(&args),
+        Command::Preview(args) => preview::run(&args),
+        Command::Block(args) => block::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -86,6 +86,37 @@ impl BoxesByCover {
     }
 }
 
+/// A factor on the sprites per box, by METAR cover: the distinct, dense heaps of a sparse sky
+/// against the looser patches of a scattered one (Wang 2003 §6.3: sparse 170 % overdraw,
+/// scattered 200 %, overcast 475 %).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DensityByCover {
+    /// FEW, 1-2 oktas.
+    pub few: f32,
+    /// SCT, 3-4 oktas.
+    pub sct: f32,
+    /// BKN, 5-7 oktas.
+    pub bkn: f32,
+    /// OVC, 8 oktas.
+    pub ovc: f32,
+}
+
+impl DensityByCover {
+    /// The factor for a coverage in oktas.
+    pub fn for_oktas(&self, oktas: f32) -> f32 {
+        if oktas <= 2.0 {
+            self.few
+        } else if oktas <= 4.0 {
+            self.sct
+        } else if oktas < 8.0 {
+            self.bkn
+        } else {
+            self.ovc
+        }
+    }
+}
+
 /// Which textures and rotations go at which height in a cloud.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -144,6 +175,8 @@ pub struct CloudTypeConfig {
     pub boxes_per_block: BoxesByCover,
     /// Sprites per box before the cull, 1..=100.
     pub sprites_per_box: [u32; 2],
+    /// Factor on `sprites_per_box` by cover (the result is kept within 1..=100).
+    pub density_by_cover: DensityByCover,
     /// Sprite width range, metres.
     pub sprite_width_m: [f32; 2],
     /// Sprite height over width; 1 is square, below 1 the wide short sprites of haze (§3.1).
@@ -466,6 +499,14 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
         "each of few, sct, bkn, ovc must be 20..=200 boxes per block, not decreasing",
     )?;
     v.range_u32(c.sprites_per_box, "sprites_per_box", 1, 100)?;
+    let dc = c.density_by_cover;
+    v.check(
+        [dc.few, dc.sct, dc.bkn, dc.ovc]
+            .iter()
+            .all(|f| (0.1..=10.0).contains(f)),
+        "density_by_cover",
+        "each of few, sct, bkn, ovc must be 0.1..=10",
+    )?;
     v.range_f32(c.sprite_width_m, "sprite_width_m", 1.0, 10_000.0)?;
     v.range_f32(c.sprite_height_ratio, "sprite_height_ratio", 0.05, 1.0)?;
     v.check(
@@ -685,7 +726,9 @@ mod tests {
             let text = edited(section, from, to);
             let (line, named, message) = error_of(&text);
             let key = from.split([' ', '=']).next().unwrap();
-            let expected_line = if named.ends_with("colour_levels") {
+            let expected_line = if key == "density_by_cover" {
+                line_containing(&text, section, key)
+            } else if named.ends_with("colour_levels") {
                 line_containing(&text, section, "colour_levels")
             } else if ["few", "ovc"].contains(&key) {
                 line_containing(&text, section, "boxes_per_block")

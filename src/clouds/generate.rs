@@ -125,14 +125,20 @@ fn scattered_layer(
             break;
         }
         // Denser skies merge into bigger patches (and keep to the box budget).
-        let mut d = rng.range_f64(dmin, dmax) * (1.0 + target);
+        // (Sprites per box stay the same, so the patches of a scattered sky are looser than the
+        // distinct heaps of a sparse one: Wang 2003 §6.3 has sparse 170 %, scattered 200 %.)
+        let mut d = rng.range_f64(dmin, dmax) * (1.0 + 3.0 * target * target);
         // Near the target, shrink the last clouds so they do not overshoot it.
         let remaining_m2 = (target - frac) * BLOCK_SIZE_M * BLOCK_SIZE_M;
         let disc_m2 = std::f64::consts::FRAC_PI_4 * d * d;
         if disc_m2 > remaining_m2 * 1.3 {
             d = (remaining_m2 * 1.3 / std::f64::consts::FRAC_PI_4)
                 .sqrt()
-                .max(dmin * 0.5);
+                .max(if config.anvil.is_some() {
+                    dmin
+                } else {
+                    dmin * 0.5
+                });
         }
         let margin = (d / 4.0).min(BLOCK_SIZE_M / 2.0);
         let centre = corner
@@ -171,7 +177,7 @@ fn scattered_layer(
 }
 
 /// Coverage-grid cells (of the block, 100 m) under a cloud: those whose centre lies within
-/// 0.6 half-widths of a sprite centre horizontally (the sprite's dense core).
+/// 0.7 half-widths of a sprite centre horizontally (the sprite's dense core).
 fn cloud_cells(cloud: &Cloud, corner: DVec2) -> Vec<usize> {
     let cell = BLOCK_SIZE_M / GRID as f64;
     let mut cells = Vec::new();
@@ -180,7 +186,7 @@ fn cloud_cells(cloud: &Cloud, corner: DVec2) -> Vec<usize> {
             cloud.centre_m.x + s.offset_m[0] as f64,
             cloud.centre_m.y + s.offset_m[1] as f64,
         ) - corner;
-        let r = 0.3 * s.width_m as f64;
+        let r = 0.35 * s.width_m as f64;
         let lo_x = ((p.x - r) / cell).floor().max(0.0) as usize;
         let hi_x = ((p.x + r) / cell).ceil().clamp(0.0, GRID as f64) as usize;
         let lo_y = ((p.y - r) / cell).floor().max(0.0) as usize;
@@ -325,22 +331,22 @@ fn build_cloud(
             )
         };
         let mut z_range = (z0, z1);
+        let in_anvil = stacked && config.anvil.is_some_and(|a| t >= a.from as f64);
         if let Some(anvil) = config.anvil
-            && t >= anvil.from as f64
+            && in_anvil
         {
             half_w = d / 2.0 * anvil.width_scale as f64;
             z_range = (thickness * anvil.from as f64, thickness);
         }
         let n = rng.range_u32(config.sprites_per_box[0], config.sprites_per_box[1]);
-        // Sprites in proportion to the box area against the type's mean cloud size (bigger
-        // patches and anvils get more), at most 100 per box (Wang 2003 §3.1).
-        let mean_d = (config.cloud_size_m[0] + config.cloud_size_m[1]) as f64 / 2.0;
-        let area_ratio = if lattice_cell_m.is_some() {
-            1.0
+        // Anvils spread the tower's sprites wide: more of them, at most 100 per box (§3.1).
+        let area_ratio = if in_anvil {
+            config.anvil.map_or(1.0, |a| (a.width_scale as f64).powi(2))
         } else {
-            (half_w * 2.0 / mean_d).max(1.0).powi(2)
+            1.0
         };
-        let mut n = ((n as f64 * area_ratio).round() as u32).min(100);
+        let density = config.density_by_cover.for_oktas(ctx.layer.coverage_oktas) as f64;
+        let mut n = ((n as f64 * area_ratio * density).round() as u32).clamp(1, 100);
         // On the lattice, enough sprites that the jittered grid leaves no hole (at most 100).
         let grid_side = lattice_cell_m.map(|_| {
             let cover = (2.0 * half_w / (0.5 * (wmin + wmax) / 2.0)).ceil();
@@ -380,14 +386,25 @@ fn build_cloud(
                 (half_w - width * 0.25).max(half_w * 0.3)
             };
             // Sprites keep their full height inside the cloud: flat bottoms sit on the base.
+            // Centres anywhere in the box, but sprites stay inside the layer: flat bottoms sit
+            // on the base.
             let half_h = height / 2.0;
-            let (mut zlo, mut zhi) = (z_range.0 + half_h, z_range.1 - half_h);
-            if zhi < zlo {
-                zlo = (z_range.0 + z_range.1) / 2.0;
-                zhi = zlo;
-            }
+            let (lim_lo, lim_hi) = (
+                half_h.min(thickness / 2.0),
+                (thickness - half_h).max(thickness / 2.0),
+            );
+            let zlo = z_range.0.clamp(lim_lo, lim_hi);
+            let zhi = z_range.1.clamp(lim_lo, lim_hi).max(zlo);
             let z = if config.flat {
                 rng.range_f64(0.0, thickness)
+            } else if stacked {
+                // Heaped clouds end in a dome: the top box is lower towards its rim.
+                let dome = if k + 1 == n_boxes && !in_anvil {
+                    1.0 - 0.75 * (x * x + y * y)
+                } else {
+                    1.0
+                };
+                rng.range_f64(zlo, zlo + (zhi - zlo) * dome)
             } else {
                 rng.range_f64(zlo, zhi)
             };

@@ -18,17 +18,17 @@
 
 pub mod block;
 pub mod config;
-// pub mod field;
+pub mod field;
 pub mod generate;
 pub mod lifecycle;
 pub mod noise;
-// pub mod preview;
+pub mod preview;
 pub mod rng;
 pub mod sheet;
 
 pub use block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};
 pub use config::{CloudTypeConfig, CloudTypes, CloudsConfig, LifecycleConfig, TextureCategory};
-// pub use field::{BlockGenerator, CloudField};
+pub use field::{BlockGenerator, CloudField};
 pub use generate::generate_block;
 pub use sheet::{CELL_PX, CELLS_PER_ROW, SHEET_PX, TEXTURE_COUNT, TextureSheet};
 
@@ -78,6 +78,9 @@ pub enum CloudsError {
         /// The type without a section.
         cloud_type: crate::weather::CloudType,
     },
+    /// The generation thread pool could not be started.
+    #[error("cannot start the cloud generation threads: {0}")]
+    ThreadPool(String),
     /// An image could not be written.
     #[error("{path}: cannot write image: {source}")]
     Image {

@@ -1,0 +1,531 @@
+//! The field of cloud blocks around a point: what exists now, generated in the background,
+//! changing with the weather and drifting with the wind.
+//!
+//! - [`BlockGenerator`] runs [`generate_block`] on a rayon pool of its own and hands results back
+//!   through a channel: [`BlockGenerator::poll`] never blocks, so a caller drawing frames keeps
+//!   drawing while blocks are made. [`generate_blocks`] is the blocking, data-parallel batch form.
+//! - [`CloudField`] keeps the blocks within `radius_m` of a centre. Blocks live in the frame of the
+//!   moving air: block (i, j) of the field sits at its ground position plus the drift (layer wind
+//!   = surface wind x `wind_factor`, integrated over time), so clouds glide across block borders
+//!   and a block keeps its identity and content while it drifts (no jumps). When a block's weather
+//!   changes noticeably, its old clouds dissipate while the new ones form (Wang 2003 §4); a block
+//!   is never swapped at once. Blocks entering the field at its rim appear fully formed.
+//!
+//! Units: metres east/north in the local frame, seconds of field time.
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, Sender, channel};
+
+use glam::DVec2;
+use rayon::prelude::*;
+
+use super::CloudsError;
+use super::block::CloudBlock;
+use super::config::{CloudTypes, CloudsConfig};
+use super::generate::generate_block;
+use super::lifecycle::{Phase, apply};
+use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockWeather};
+
+/// A finished generation job.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Generated {
+    /// The block asked for.
+    pub index: BlockIndex,
+    /// The weather it was generated from.
+    pub weather: BlockWeather,
+    /// The clouds.
+    pub block: CloudBlock,
+}
+
+/// Generates blocks on a thread pool without blocking the caller.
+pub struct BlockGenerator {
+    pool: Arc<rayon::ThreadPool>,
+    types: Arc<CloudTypes>,
+    tx: Sender<Generated>,
+    rx: Receiver<Generated>,
+    pending: usize,
+}
+
+impl std::fmt::Debug for BlockGenerator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("BlockGenerator")
+            .field("threads", &self.pool.current_num_threads())
+            .field("pending", &self.pending)
+            .finish()
+    }
+}
+
+impl BlockGenerator {
+    /// A generator with a pool of `threads` worker threads (0: one per core).
+    pub fn new(types: Arc<CloudTypes>, threads: usize) -> Result<Self, CloudsError> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .thread_name(|k| format!("skycast-clouds-{k}"))
+            .build()
+            .map_err(|e| CloudsError::ThreadPool(e.to_string()))?;
+        Ok(Self::with_pool(types, Arc::new(pool)))
+    }
+
+    /// A generator running on an existing pool (shared with the host, or a test's).
+    pub fn with_pool(types: Arc<CloudTypes>, pool: Arc<rayon::ThreadPool>) -> Self {
+        let (tx, rx) = channel();
+        Self {
+            pool,
+            types,
+            tx,
+            rx,
+            pending: 0,
+        }
+    }
+
+    /// Queues one block; returns at once.
+    pub fn submit(&mut self, index: BlockIndex, weather: BlockWeather, seed: u64) {
+        let tx = self.tx.clone();
+        let types = Arc::clone(&self.types);
+        self.pending += 1;
+        self.pool.spawn(move || {
+            let block = generate_block(index, &weather, seed, &types);
+            // The receiver is gone only when the generator was dropped: nobody wants the block.
+            let _ = tx.send(Generated {
+                index,
+                weather,
+                block,
+            });
+        });
+    }
+
+    /// The blocks finished since the last call, without waiting for any.
+    pub fn poll(&mut self) -> Vec<Generated> {
+        let done: Vec<Generated> = self.rx.try_iter().collect();
+        self.pending -= done.len();
+        done
+    }
+
+    /// Waits for every queued block (for tools and tests; a frame loop uses [`Self::poll`]).
+    pub fn wait_all(&mut self) -> Vec<Generated> {
+        let mut done = Vec::with_capacity(self.pending);
+        while self.pending > 0 {
+            match self.rx.recv() {
+                Ok(g) => {
+                    self.pending -= 1;
+                    done.push(g);
+                }
+                Err(_) => break,
+            }
+        }
+        done
+    }
+
+    /// Blocks queued and not yet handed back.
+    pub fn pending(&self) -> usize {
+        self.pending
+    }
+}
+
+/// Generates many blocks in parallel on the current rayon pool, in input order (blocking).
+pub fn generate_blocks(
+    jobs: &[(BlockIndex, BlockWeather)],
+    seed: u64,
+    types: &CloudTypes,
+) -> Vec<CloudBlock> {
+    jobs.par_iter()
+        .map(|(index, weather)| generate_block(*index, weather, seed, types))
+        .collect()
+}
+
+/// The blocks whose centre lies within `radius_m` of `centre_m`, in index order.
+pub fn blocks_within(centre_m: DVec2, radius_m: f64) -> Vec<BlockIndex> {
+    let lo = BlockIndex::containing(centre_m - DVec2::splat(radius_m));
+    let hi = BlockIndex::containing(centre_m + DVec2::splat(radius_m));
+    let mut out = Vec::new();
+    for j in lo.j..=hi.j {
+        for i in lo.i..=hi.i {
+            let b = BlockIndex::new(i, j);
+            if b.centre_m().distance_squared(centre_m) <= radius_m * radius_m {
+                out.push(b);
+            }
+        }
+    }
+    out
+}
+
+/// Whether two block weathers differ enough to re-form the clouds: a layer added or removed, a
+/// type changed, coverage by an okta or more, base or thickness by 300 ft or more.
+pub fn weather_changed(a: &BlockWeather, b: &BlockWeather) -> bool {
+    a.layers.len() != b.layers.len()
+        || a.layers.iter().zip(&b.layers).any(|(x, y)| {
+            x.cloud_type != y.cloud_type
+                || (x.coverage_oktas - y.coverage_oktas).abs() >= 1.0
+                || (x.base_ft_agl - y.base_ft_agl).abs() >= 300.0
+                || (x.thickness_ft - y.thickness_ft).abs() >= 300.0
+        })
+}
+
+/// One generation of clouds in a block, with where it is in its life.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldBlock {
+    /// The clouds (sprites' `alpha_morph` set for the current time).
+    pub block: CloudBlock,
+    /// Forming, steady or dissipating.
+    pub phase: Phase,
+}
+
+#[derive(Debug)]
+struct Slot {
+    /// The weather of the newest generation asked for.
+    weather: BlockWeather,
+    /// Oldest first; during a weather change the old one dissipates while the new one forms.
+    generations: Vec<FieldBlock>,
+}
+
+/// The blocks around a point, advancing in time. See the module docs.
+#[derive(Debug)]
+pub struct CloudField {
+    config: CloudsConfig,
+    generator: BlockGenerator,
+    time_s: f64,
+    drift_m: DVec2,
+    wind_m_s: DVec2,
+    slots: BTreeMap<BlockIndex, Slot>,
+}
+
+impl CloudField {
+    /// An empty field generating on its own pool (`threads`, 0: one per core).
+    pub fn new(
+        config: CloudsConfig,
+        types: Arc<CloudTypes>,
+        threads: usize,
+    ) -> Result<Self, CloudsError> {
+        Ok(Self::with_generator(
+            config,
+            BlockGenerator::new(types, threads)?,
+        ))
+    }
+
+    /// An empty field using `generator`.
+    pub fn with_generator(config: CloudsConfig, generator: BlockGenerator) -> Self {
+        Self {
+            config,
+            generator,
+            time_s: 0.0,
+            drift_m: DVec2::ZERO,
+            wind_m_s: DVec2::ZERO,
+            slots: BTreeMap::new(),
+        }
+    }
+
+    /// Asks for the blocks around `centre_m` (ground metres), with `weather` giving the weather
+    /// of a ground block; queues what is missing or changed and takes in what has finished.
+    /// Never waits for generation.
+    pub fn update(&mut self, centre_m: DVec2, weather: &dyn Fn(BlockIndex) -> BlockWeather) {
+        let here = weather(BlockIndex::containing(centre_m));
+        self.wind_m_s = here.wind.drift_m_s() * self.config.field.wind_factor;
+        let air_centre = centre_m - self.drift_m;
+        let radius = self.config.field.radius_m;
+        let seed = self.config.field.seed;
+        let wanted = blocks_within(air_centre, radius);
+        for &index in &wanted {
+            let ground = BlockIndex::containing(index.centre_m() + self.drift_m);
+            let w = weather(ground);
+            match self.slots.get_mut(&index) {
+                None => {
+                    self.generator.submit(index, w.clone(), seed);
+                    self.slots.insert(
+                        index,
+                        Slot {
+                            weather: w,
+                            generations: Vec::new(),
+                        },
+                    );
+                }
+                Some(slot) if weather_changed(&slot.weather, &w) => {
+                    self.generator.submit(index, w.clone(), seed);
+                    slot.weather = w;
+                }
+                Some(_) => {}
+            }
+        }
+        // Blocks a block beyond the rim leave the field.
+        let keep = radius + BLOCK_SIZE_M;
+        self.slots
+            .retain(|index, _| index.centre_m().distance_squared(air_centre) <= keep * keep);
+        self.take_finished();
+    }
+
+    fn take_finished(&mut self) {
+        let done = self.generator.poll();
+        self.take_in(done);
+    }
+
+    fn take_in(&mut self, finished: Vec<Generated>) {
+        let now = self.time_s;
+        for done in finished {
+            let Some(slot) = self.slots.get_mut(&done.index) else {
+                continue;
+            };
+            if done.weather != slot.weather {
+                continue; // superseded by a newer request
+            }
+            let phase = if slot.generations.is_empty() {
+                Phase::Steady
+            } else {
+                Phase::Forming { since_s: now }
+            };
+            for g in &mut slot.generations {
+                if !matches!(g.phase, Phase::Dissipating { .. }) {
+                    g.phase = Phase::Dissipating { since_s: now };
+                }
+            }
+            let mut block = done.block;
+            for cloud in &mut block.clouds {
+                apply(cloud, phase, now, &self.config.lifecycle);
+            }
+            slot.generations.push(FieldBlock { block, phase });
+        }
+    }
+
+    /// Advances field time by `dt_s`: clouds drift, forming and dissipating ones change their
+    /// `alpha_morph`, dissipated ones go.
+    pub fn advance(&mut self, dt_s: f64) {
+        self.time_s += dt_s;
+        self.drift_m += self.wind_m_s * dt_s;
+        let now = self.time_s;
+        let lifecycle = self.config.lifecycle;
+        for slot in self.slots.values_mut() {
+            for g in &mut slot.generations {
+                if g.phase == Phase::Steady {
+                    continue;
+                }
+                let mut next = g.phase;
+                for cloud in &mut g.block.clouds {
+                    next = apply(cloud, g.phase, now, &lifecycle);
+                }
+                g.phase = next;
+            }
+            slot.generations.retain(|g| g.phase != Phase::Gone);
+        }
+        self.take_finished();
+    }
+
+    /// Waits until every queued block is generated and taken in (tools and tests).
+    pub fn wait_for_pending(&mut self) {
+        let done = self.generator.wait_all();
+        self.take_in(done);
+    }
+
+    /// Everything to draw now: each block generation with the offset to add to its cloud centres
+    /// (the drift), field-frame index first.
+    pub fn blocks(&self) -> impl Iterator<Item = (BlockIndex, &FieldBlock)> {
+        self.slots
+            .iter()
+            .flat_map(|(i, s)| s.generations.iter().map(move |g| (*i, g)))
+    }
+
+    /// The generations of one block, oldest first.
+    pub fn generations(&self, index: BlockIndex) -> &[FieldBlock] {
+        self.slots
+            .get(&index)
+            .map_or(&[][..], |s| s.generations.as_slice())
+    }
+
+    /// How far the air (and every cloud) has moved since time 0, metres east/north: add it to a
+    /// cloud's `centre_m` for its ground position now.
+    pub fn drift_m(&self) -> DVec2 {
+        self.drift_m
+    }
+
+    /// Field time, seconds.
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+
+    /// Blocks in the field (with or without clouds generated yet).
+    pub fn block_count(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// Blocks queued for generation and not yet taken in.
+    pub fn pending(&self) -> usize {
+        self.generator.pending()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::weather::{BlockLayer, CloudType, TypeSource, Wind};
+
+    fn weather(oktas: f32) -> BlockWeather {
+        BlockWeather {
+            layers: vec![BlockLayer {
+                cloud_type: CloudType::CumulusMediocris,
+                type_source: TypeSource::HeightRule,
+                coverage_oktas: oktas,
+                base_ft_agl: 3000.0,
+                thickness_ft: 2000.0,
+            }],
+            visibility_m: 9999.0,
+            wind: Wind {
+                from_deg: 270.0,
+                speed_kt: 20.0,
+            },
+            ..Default::default()
+        }
+    }
+
+    fn types() -> Arc<CloudTypes> {
+        static TYPES: std::sync::OnceLock<Arc<CloudTypes>> = std::sync::OnceLock::new();
+        Arc::clone(TYPES.get_or_init(|| Arc::new(CloudTypes::builtin())))
+    }
+
+    fn small_field() -> CloudField {
+        let mut config = CloudsConfig::builtin();
+        config.field.radius_m = 9_000.0;
+        CloudField::new(config, types(), 2).unwrap()
+    }
+
+    #[test]
+    fn polling_never_waits_for_a_busy_pool() {
+        // A one-thread pool held busy by a gate the test owns: generation cannot run.
+        let pool = Arc::new(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(1)
+                .build()
+                .unwrap(),
+        );
+        let (open_gate, gate) = channel::<()>();
+        pool.spawn(move || {
+            let _ = gate.recv();
+        });
+        let mut generator = BlockGenerator::with_pool(types(), Arc::clone(&pool));
+        for i in 0..3 {
+            generator.submit(BlockIndex::new(i, 0), weather(4.0), 9);
+        }
+        // The caller gets control back at once with nothing finished, three times over.
+        for _ in 0..3 {
+            assert!(generator.poll().is_empty());
+            assert_eq!(generator.pending(), 3);
+        }
+        open_gate.send(()).unwrap();
+        let mut done = generator.wait_all();
+        done.sort_by_key(|g| g.index);
+        assert_eq!(done.len(), 3);
+        assert_eq!(generator.pending(), 0);
+        let direct = generate_block(BlockIndex::new(1, 0), &weather(4.0), 9, &types());
+        assert_eq!(done[1].block, direct);
+    }
+
+    #[test]
+    fn batch_generation_matches_one_by_one() {
+        let jobs: Vec<_> = (0..6)
+            .map(|i| (BlockIndex::new(i, -i), weather(3.0)))
+            .collect();
+        let batch = generate_blocks(&jobs, 4, &types());
+        for ((index, w), block) in jobs.iter().zip(&batch) {
+            assert_eq!(block, &generate_block(*index, w, 4, &types()));
+        }
+    }
+
+    #[test]
+    fn the_field_fills_its_circle_and_drifts_without_jumps() {
+        let mut field = small_field();
+        field.update(DVec2::ZERO, &|_| weather(4.0));
+        field.wait_for_pending();
+        let expected = blocks_within(DVec2::ZERO, 9_000.0).len();
+        assert_eq!(field.block_count(), expected);
+        assert_eq!(field.blocks().count(), expected);
+        assert!(field.blocks().all(|(_, g)| g.phase == Phase::Steady));
+        let before: BTreeMap<BlockIndex, u64> = field
+            .blocks()
+            .map(|(i, g)| (i, g.block.content_hash()))
+            .collect();
+        // Ten minutes of a 20 kt westerly x 1.5: about 9.3 km east, in one-second steps.
+        let mut last = field.drift_m();
+        for _ in 0..600 {
+            field.advance(1.0);
+            field.update(DVec2::ZERO, &|_| weather(4.0));
+            let step = field.drift_m() - last;
+            assert!(
+                step.x > 0.0 && step.x < 16.0 && step.y.abs() < 1e-9,
+                "step {step}"
+            );
+            last = field.drift_m();
+        }
+        field.wait_for_pending();
+        assert!((field.drift_m().x - 600.0 * 20.0 * 0.514_444 * 1.5).abs() < 1.0);
+        // Blocks that stayed in the field kept their identity and content while they moved.
+        let mut kept = 0;
+        for (i, g) in field.blocks() {
+            if let Some(hash) = before.get(&i) {
+                assert_eq!(
+                    *hash,
+                    g.block.content_hash(),
+                    "block {i:?} changed while drifting"
+                );
+                kept += 1;
+            }
+        }
+        assert!(kept > expected / 2, "only {kept} of {expected} blocks kept");
+        // The field still covers the circle around the (unmoved) centre.
+        for (i, _) in field.blocks() {
+            let ground = i.centre_m() + field.drift_m();
+            assert!(ground.length() <= 9_000.0 + BLOCK_SIZE_M * 1.5);
+        }
+    }
+
+    #[test]
+    fn a_weather_change_dissipates_the_old_while_the_new_forms() {
+        let mut field = small_field();
+        field.update(DVec2::ZERO, &|_| weather(2.0));
+        field.wait_for_pending();
+        let index = BlockIndex::new(0, 0);
+        assert_eq!(field.generations(index).len(), 1);
+        // A small change (half an okta) re-forms nothing.
+        field.update(DVec2::ZERO, &|_| weather(2.5));
+        assert_eq!(field.pending(), 0);
+        field.update(DVec2::ZERO, &|_| weather(6.0));
+        field.wait_for_pending();
+        let config = CloudsConfig::builtin().lifecycle;
+        let gens = field.generations(index);
+        assert_eq!(gens.len(), 2);
+        assert!(matches!(gens[0].phase, Phase::Dissipating { .. }));
+        assert!(matches!(gens[1].phase, Phase::Forming { .. }));
+        let opacity = |g: &FieldBlock| -> f32 {
+            g.block
+                .clouds
+                .iter()
+                .flat_map(|c| &c.sprites)
+                .map(|s| s.alpha_morph)
+                .sum::<f32>()
+        };
+        let (mut old_last, mut new_last) = (f32::MAX, -1.0);
+        let total = config.formation_s.max(config.dissipation_s) as f64;
+        let mut t = 0.0;
+        while t < total {
+            field.advance(10.0);
+            t += 10.0;
+            let gens = field.generations(index);
+            // Never nothing, never a swap: the new clouds are there from the start.
+            assert!(!gens.is_empty());
+            let new = gens.last().unwrap();
+            assert!(opacity(new) >= new_last);
+            new_last = opacity(new);
+            if gens.len() == 2 {
+                assert!(opacity(&gens[0]) <= old_last);
+                old_last = opacity(&gens[0]);
+            }
+        }
+        let gens = field.generations(index);
+        assert_eq!(gens.len(), 1, "the old clouds are gone");
+        assert_eq!(gens[0].phase, Phase::Steady);
+        assert!(
+            gens[0]
+                .block
+                .clouds
+                .iter()
+                .flat_map(|c| &c.sprites)
+                .all(|s| s.alpha_morph == 1.0)
+        );
+    }
+}

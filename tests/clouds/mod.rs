@@ -1,0 +1,5 @@
+//! The clouds stage from outside: `scenarios` runs the paper's three overdraw scenarios from real
+//! METARs through the weather and clouds stages; `cli` runs `skycast sheet`, `preview` and
+//! `block`.
+
+mod scenarios;
