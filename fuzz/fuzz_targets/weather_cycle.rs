@@ -1,0 +1,13 @@
+//! Any bytes as a NOAA cycle file (a date line prepended), through the same checks as
+//! `weather_file`.
+#![no_main]
+
+mod common;
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let mut file = b"2025/01/27 22:00\n".to_vec();
+    file.extend_from_slice(data);
+    common::check_weather_file(&file);
+});
