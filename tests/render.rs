@@ -6,12 +6,15 @@
 use std::path::PathBuf;
 
 use glam::{DVec2, DVec3, Vec3};
+use skycast::clouds::{CloudTypes, generate_block};
 use skycast::render::terrain::HeightField;
 use skycast::render::vertices::square_sprite;
+use skycast::render::world::block_id;
 use skycast::render::{
     Camera, DemoHost, Frame, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteSheet, headless,
 };
 use skycast::shading::{ColourLevels, SunPosition, TimeOfDayTable};
+use skycast::weather::{BlockIndex, BlockLayer, BlockWeather, CloudType, TypeSource};
 
 const W: u32 = 320;
 const H: u32 = 180;
@@ -213,6 +216,46 @@ fn clear_overcast_and_in_cloud_frames() {
         "overcast covers {covered} of {sky_share} sky"
     );
 
+    // The clouds stage's own overcast stratus deck (OVC at 2,000 ft) over a 3 x 3 block area.
+    let weather = BlockWeather {
+        layers: vec![BlockLayer {
+            cloud_type: CloudType::Stratus,
+            type_source: TypeSource::Reported,
+            coverage_oktas: 8.0,
+            base_ft_agl: 2000.0,
+            thickness_ft: 800.0,
+        }],
+        visibility_m: 9999.0,
+        ..BlockWeather::default()
+    };
+    let types = CloudTypes::builtin();
+    let blocks: Vec<SkyBlock> = (-2..2)
+        .flat_map(|j| (-2..2).map(move |i| BlockIndex::new(i, j)))
+        .map(|index| {
+            let block = generate_block(index, &weather, 7, &types);
+            let c = index.centre_m();
+            SkyBlock {
+                id: block_id(index),
+                centre_m: DVec3::new(c.x, c.y, 700.0),
+                clouds: block.clouds.iter().map(SkyCloud::from).collect(),
+            }
+        })
+        .collect();
+    rig.set_clouds(blocks);
+    let (stratus, stats) = rig.frame("stratus_overhead", &up);
+    let covered = fraction(&stratus, |i| {
+        stratus.depth[i] >= 1.0 && cloud_like(stratus.rgba[i])
+    });
+    assert!(
+        covered > 0.97 * sky_share,
+        "the stratus deck covers {covered} of {sky_share} sky ({stats:?})"
+    );
+
+    rig.set_clouds(vec![SkyBlock {
+        id: 7,
+        centre_m: DVec3::new(0.0, 0.0, 1500.0),
+        clouds: vec![overcast(DVec2::ZERO, 1500.0)],
+    }]);
     let inside = rig.camera(DVec3::new(0.0, 0.0, 1680.0), 90.0, -10.0);
     let (fog, stats) = rig.frame("in_cloud", &inside);
     assert!(stats.in_cloud > 0.99, "{stats:?}");

@@ -1,5 +1,6 @@
-//! `skycast demo`: until the renderer lands, the weather of the default flight area on the shipped
-//! bulk weather file: the file's summary, then the interpolated weather of blocks across the area.
+//! `skycast demo`: the shipped bulk weather file's summary and the interpolated weather of blocks
+//! across the Irish Sea, then the default flight (the cruise through scattered cumulus off Los
+//! Angeles) rendered through the same real weather into `out/`.
 
 use std::path::PathBuf;
 
@@ -42,7 +43,22 @@ pub struct DemoArgs {
     /// Station table.
     #[arg(long, default_value = DEFAULT_STATIONS)]
     pub stations: PathBuf,
+    /// The flight to render.
+    #[arg(long, default_value = DEFAULT_FLIGHT)]
+    pub flight: PathBuf,
+    /// Directory for the frames and frames.csv.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// Image size, WIDTHxHEIGHT pixels.
+    #[arg(long, default_value = "960x540", value_parser = super::render::parse_size)]
+    pub size: (u32, u32),
+    /// Draw and write every Nth simulated frame (10 simulated frames a second).
+    #[arg(long, default_value_t = 300)]
+    pub every: u32,
 }
+
+/// The default flight of the demo.
+pub const DEFAULT_FLIGHT: &str = "config/flights/cruise_scattered_cumulus.toml";
 
 /// Runs `skycast demo`.
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
@@ -58,5 +74,26 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         println!("\n{name}");
         print!("{}", describe_block(&at_block(&loaded, lat, lon)));
     }
+    println!(
+        "\nRendering {} through {} ...",
+        args.flight.display(),
+        args.weather.display()
+    );
+    super::fly::run(&super::fly::FlyArgs {
+        weather: args.weather.clone(),
+        stations: args.stations.clone(),
+        path: args.flight.clone(),
+        out: args.out.clone(),
+        size: args.size,
+        fps: 10.0,
+        every: args.every,
+        time: None,
+        render_settings: None,
+        time_of_day: None,
+    })?;
+    println!(
+        "The frames are in {}/ (frame_*.png, frames.csv).",
+        args.out.display()
+    );
     Ok(())
 }
