@@ -7,7 +7,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 
 use skycast::clouds::preview::{self, PreviewSettings};
-use skycast::clouds::{CloudTypes, TextureSheet, generate_block};
+use skycast::clouds::{CloudTypes, CloudsConfig, TextureSheet, generate_block};
 use skycast::weather::{BlockIndex, CloudType};
 
 /// Flags of `skycast preview`.
@@ -25,6 +25,10 @@ pub struct PreviewArgs {
     /// Cloud types file (default: the shipped config/cloud_types.toml).
     #[arg(long)]
     pub types: Option<PathBuf>,
+    /// Draw the block's life instead: forming at 15, 40, 70 and 100 %, dissipating at 30, 60
+    /// and 85 % (config/clouds.toml timings), side by side.
+    #[arg(long)]
+    pub lifecycle: bool,
     /// World seed.
     #[arg(long, default_value_t = 2003)]
     pub seed: u64,
@@ -70,7 +74,19 @@ pub fn run(args: &PreviewArgs) -> anyhow::Result<()> {
             height_px: args.height,
             pitch_deg,
         };
-        let img = preview::render(&[&block], &sheet, &settings);
+        let img = if args.lifecycle {
+            let lifecycle = CloudsConfig::builtin().lifecycle;
+            preview::lifecycle_strip(
+                &block,
+                &sheet,
+                &settings,
+                &lifecycle,
+                &[0.15, 0.4, 0.7, 1.0],
+                &[0.3, 0.6, 0.85],
+            )
+        } else {
+            preview::render(&[&block], &sheet, &settings)
+        };
         let path = if args.all {
             args.out.join(format!("{}.png", t.name()))
         } else {

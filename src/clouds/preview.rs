@@ -10,6 +10,8 @@
 use glam::DVec3;
 
 use super::block::{Cloud, CloudBlock, Sprite};
+use super::config::LifecycleConfig;
+use super::lifecycle::{Phase, apply};
 use super::sheet::TextureSheet;
 use crate::weather::{BlockLayer, BlockWeather, CloudType, TypeSource};
 
@@ -197,14 +199,58 @@ pub fn colour_at(cloud: &Cloud, height_m: f64) -> [f32; 4] {
     levels[4].rgba
 }
 
+/// A strip of frames of one block's life side by side: formation at the progress values
+/// `forming` (0..=1), then dissipation at `dissipating`, each frame `settings`-sized, all with the
+/// same framing (the fully formed block's).
+pub fn lifecycle_strip(
+    block: &CloudBlock,
+    sheet: &TextureSheet,
+    settings: &PreviewSettings,
+    lifecycle: &LifecycleConfig,
+    forming: &[f32],
+    dissipating: &[f32],
+) -> image::RgbaImage {
+    let frames: Vec<(Phase, f64)> = forming
+        .iter()
+        .map(|&p| {
+            (
+                Phase::Forming { since_s: 0.0 },
+                p as f64 * lifecycle.formation_s as f64,
+            )
+        })
+        .chain(dissipating.iter().map(|&q| {
+            (
+                Phase::Dissipating { since_s: 0.0 },
+                q as f64 * lifecycle.dissipation_s as f64,
+            )
+        }))
+        .collect();
+    let mut strip =
+        image::RgbaImage::new(settings.width_px * frames.len() as u32, settings.height_px);
+    for (k, (phase, now_s)) in frames.into_iter().enumerate() {
+        let mut b = block.clone();
+        for cloud in &mut b.clouds {
+            apply(cloud, phase, now_s, lifecycle);
+        }
+        // Keep the framing of the whole block: an invisible copy of it fixes the bounds.
+        let mut frame_ref = block.clone();
+        for cloud in &mut frame_ref.clouds {
+            cloud.sprites.iter_mut().for_each(|s| s.alpha_morph = 0.0);
+        }
+        let img = render(&[&frame_ref, &b], sheet, settings);
+        image::imageops::replace(&mut strip, &img, (k as u32 * settings.width_px) as i64, 0);
+    }
+    strip
+}
+
 /// A typical one-layer weather for showing a cloud type: (base ft AGL, thickness ft, oktas) as a
 /// pilot would meet it, and the camera pitch that shows it best (decks from below).
 pub fn typical_weather(cloud_type: CloudType) -> (BlockWeather, f64) {
     use CloudType::*;
     let (base_ft, thickness_ft, oktas, pitch_deg) = match cloud_type {
         CumulusHumilis => (3000.0, 1500.0, 3.0, 8.0),
-        CumulusMediocris => (3500.0, 3500.0, 3.0, 8.0),
-        CumulusCongestus => (3000.0, 10000.0, 3.0, 6.0),
+        CumulusMediocris => (3500.0, 3500.0, 2.0, 8.0),
+        CumulusCongestus => (3000.0, 10000.0, 2.0, 6.0),
         Cumulonimbus => (3000.0, 30000.0, 2.0, 4.0),
         Stratocumulus => (2500.0, 2000.0, 6.0, 12.0),
         Stratus => (800.0, 1000.0, 8.0, -25.0),

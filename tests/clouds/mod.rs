@@ -2,4 +2,5 @@
 //! METARs through the weather and clouds stages; `cli` runs `skycast sheet`, `preview` and
 //! `block`.
 
+mod cli;
 mod scenarios;
