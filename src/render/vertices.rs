@@ -65,11 +65,13 @@ struct Facing {
 #[derive(Debug, Clone, Default)]
 struct CacheEntry {
     vertices: Vec<LocalVertex>,
-    camera_m: DVec3,
+    /// Camera position relative to the cloud centre when computed: a cloud drifting with the
+    /// wind and a camera moving are the same to the cache.
+    camera_rel_m: DVec3,
     time_s: f64,
     sun_dir: Vec3,
-    /// Which cloud this was computed for: centre and sprite count (a changed cloud recomputes).
-    fingerprint: (DVec3, usize),
+    /// Which cloud this was computed for: its sprite count (a regenerated cloud recomputes).
+    fingerprint: usize,
     info: Option<CloudInfo>,
     valid: bool,
 }
@@ -116,7 +118,8 @@ impl SpriteVertexBuilder {
     }
 
     /// Forgets the cached clouds of blocks that are no longer in `blocks` (call when the set
-    /// of blocks changes; clouds whose centre or sprite count changed recompute by themselves).
+    /// of blocks changes; clouds whose sprite count changed recompute by themselves, and a
+    /// drifting cloud is judged by the camera's movement relative to it).
     pub fn retain(&mut self, blocks: &[SkyBlock]) {
         let ids: std::collections::HashSet<u64> = blocks.iter().map(|b| b.id).collect();
         self.entries.retain(|k, _| ids.contains(&k.0));
@@ -161,7 +164,7 @@ impl SpriteVertexBuilder {
             // Per-cloud bounds are computed once per cloud (and on each recompute), not per frame.
             let mut cloud_order: Vec<(usize, f64, f64)> = Vec::with_capacity(block.clouds.len());
             for (ci, cloud) in block.clouds.iter().enumerate() {
-                let fingerprint = (cloud.centre_m, cloud.sprites.len());
+                let fingerprint = cloud.sprites.len();
                 let entry = self.entries.entry((block.id, ci as u32)).or_default();
                 if entry.fingerprint != fingerprint || entry.info.is_none() {
                     entry.info = Some(CloudInfo::of(cloud));
@@ -196,7 +199,7 @@ impl SpriteVertexBuilder {
                     || needs_recompute(
                         entry,
                         info.fading,
-                        camera_m,
+                        camera_m - cloud.centre_m,
                         time_s,
                         lighting.sun_dir,
                         near_edge_m,
@@ -214,7 +217,7 @@ impl SpriteVertexBuilder {
                         locks,
                         &mut entry.vertices,
                     );
-                    entry.camera_m = camera_m;
+                    entry.camera_rel_m = camera_m - cloud.centre_m;
                     entry.time_s = time_s;
                     entry.sun_dir = lighting.sun_dir;
                     entry.info = Some(CloudInfo::of(cloud));
@@ -249,13 +252,13 @@ impl SpriteVertexBuilder {
 fn needs_recompute(
     entry: &CacheEntry,
     fading: bool,
-    camera_m: DVec3,
+    camera_rel_m: DVec3,
     time_s: f64,
     sun_dir: Vec3,
     near_edge_m: f64,
     cache: &VertexCacheSettings,
 ) -> bool {
-    let moved_m = (camera_m - entry.camera_m).length();
+    let moved_m = (camera_rel_m - entry.camera_rel_m).length();
     let move_limit_m = cache.min_move_m as f64 + cache.move_fraction as f64 * near_edge_m;
     let max_age_s = if fading {
         cache.fading_max_age_s as f64
@@ -465,6 +468,19 @@ mod tests {
         // Handing the same blocks again (as a host does when the block set changes) keeps them.
         builder.retain(&b);
         assert_eq!(builder.update(&b, cam, 1.0, &l, &s).clouds_recomputed, 0);
+        // Clouds drifting with the wind and a camera flying along with them: nothing moved
+        // relative to each other, nothing recomputes.
+        let drift = DVec3::new(400.0, -250.0, 0.0);
+        let mut drifted = b.clone();
+        for c in drifted.iter_mut().flat_map(|b| b.clouds.iter_mut()) {
+            c.centre_m += drift;
+        }
+        assert_eq!(
+            builder
+                .update(&drifted, cam + drift, 1.0, &l, &s)
+                .clouds_recomputed,
+            0
+        );
         // 300 m is past the threshold of every cloud (at most 5 m + 2% of ~19 km).
         let moved = builder.update(&b, cam + DVec3::new(0.0, 300.0, 0.0), 1.0, &l, &s);
         assert_eq!(moved.clouds_recomputed, 10);
