@@ -1,7 +1,8 @@
 //! `skycast fly --weather FILE --path FLIGHT.toml --out DIR [--size WxH] [--every N]`: flies a
 //! scripted path through the real weather. Every simulated frame runs the sky's CPU update (so
 //! the vertex cache sees the real frame rate); every Nth frame is drawn and written as PNG.
-//! `frames.csv` has one row per simulated frame.
+//! `frames.csv` has one row per simulated frame. The clouds live: the clouds stage's field
+//! generates blocks in the background, drifts them with the wind and forms and dissipates them.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -108,16 +109,14 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
-    let mut block_set = Vec::new();
     let mut written = 0u32;
     for k in 0..frames {
         let time_s = flight.start_s() + k as f64 * dt_s;
         let pose = flight.pose_at(time_s);
-        let indices = world.block_indices(pose.position_m);
-        if indices != block_set {
-            host.sky.set_clouds(world.sky_blocks(&indices));
-            block_set = indices;
-        }
+        // The clouds stage's living field: drift with the wind, formation and dissipation.
+        let step_s = if k == 0 { 0.0 } else { dt_s };
+        host.sky
+            .set_clouds(world.living_blocks(pose.position_m, step_s)?);
         let camera = host.camera(pose.position_m, pose.heading_deg, pose.pitch_deg);
         let sun = sun_position(start_unix_s + time_s, lat, lon);
         let write = k % args.every as u64 == 0 || k + 1 == frames;

@@ -57,6 +57,9 @@ pub enum RenderError {
         /// The device's largest texture side.
         max: u32,
     },
+    /// The clouds stage could not start (its generation pool or config).
+    #[error("clouds: {0}")]
+    Clouds(String),
     /// The sprite sheet's pixel data does not match its size.
     #[error("sprite sheet: {0}")]
     Sheet(String),

@@ -10,14 +10,16 @@ use std::collections::HashMap;
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
+use super::RenderError;
 use super::demo_host::ground_from_field;
 use super::scene::{SkyBlock, SkyCloud, SkySprite};
 use super::sky::SpriteSheet;
 use super::terrain::HeightField;
-use crate::clouds::{Cloud, CloudTypes, TextureSheet, generate_block};
+use crate::clouds::{Cloud, CloudField, CloudTypes, CloudsConfig, TextureSheet, generate_block};
 use crate::shading::{ColourLevel, ColourLevels};
-use crate::weather::BlockIndex;
 use crate::weather::field::WeatherField;
+use crate::weather::{BlockIndex, BlockWeather};
+use std::sync::Arc;
 
 /// Settings of the demo world (`[world]` of `config/render.toml`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -89,6 +91,13 @@ pub fn sprite_sheet(sheet: &TextureSheet) -> SpriteSheet {
     }
 }
 
+/// The clouds stage's living field (background generation, drift, formation and dissipation)
+/// as a [`World`] flies through it.
+pub struct LivingClouds {
+    field: CloudField,
+    weather: HashMap<BlockIndex, BlockWeather>,
+}
+
 /// Weather field, ground and cloud blocks around a reference point.
 pub struct World {
     field: WeatherField,
@@ -96,6 +105,7 @@ pub struct World {
     types: CloudTypes,
     settings: WorldSettings,
     blocks: HashMap<BlockIndex, SkyBlock>,
+    living: Option<LivingClouds>,
 }
 
 impl World {
@@ -114,6 +124,7 @@ impl World {
             types: CloudTypes::builtin(),
             settings: *settings,
             blocks: HashMap::new(),
+            living: None,
         }
     }
 
@@ -185,6 +196,78 @@ impl World {
     pub fn sky_blocks_around(&mut self, camera_m: DVec3) -> Vec<SkyBlock> {
         let indices = self.block_indices(camera_m);
         self.sky_blocks(&indices)
+    }
+}
+
+impl World {
+    /// The clouds of the clouds stage's [`CloudField`] around `camera_m` after `dt_s` more
+    /// seconds: blocks generated in the background (the first call waits for them), drifting
+    /// with the wind, forming and dissipating when the weather changes.
+    pub fn living_blocks(
+        &mut self,
+        camera_m: DVec3,
+        dt_s: f64,
+    ) -> Result<Vec<SkyBlock>, RenderError> {
+        if self.living.is_none() {
+            let mut config = CloudsConfig::builtin();
+            config.field.radius_m = self.settings.cloud_radius_m;
+            config.field.seed = self.settings.seed;
+            let field = CloudField::new(config, Arc::new(self.types.clone()), 0)
+                .map_err(|e| RenderError::Clouds(e.to_string()))?;
+            self.living = Some(LivingClouds {
+                field,
+                weather: HashMap::new(),
+            });
+        }
+        let weather_field = &self.field;
+        let Some(living) = self.living.as_mut() else {
+            return Ok(Vec::new());
+        };
+        let first = living.field.time_s() == 0.0 && living.field.block_count() == 0;
+        let cache = std::cell::RefCell::new(std::mem::take(&mut living.weather));
+        let weather = |index: BlockIndex| {
+            cache
+                .borrow_mut()
+                .entry(index)
+                .or_insert_with(|| weather_field.block_weather(index))
+                .clone()
+        };
+        living.field.update(camera_m.truncate(), &weather);
+        living.weather = cache.into_inner();
+        if first {
+            living.field.wait_for_pending();
+        }
+        living.field.advance(dt_s);
+        let drift = living.field.drift_m();
+        let drift3 = DVec3::new(drift.x, drift.y, 0.0);
+        let mut generation = HashMap::new();
+        Ok(living
+            .field
+            .blocks()
+            .map(|(index, fb)| {
+                let g: &mut u64 = generation.entry(index).or_insert(0);
+                let id = block_id(index) ^ (*g << 62);
+                *g += 1;
+                let clouds: Vec<SkyCloud> = fb
+                    .block
+                    .clouds
+                    .iter()
+                    .map(|c| {
+                        let mut sky = SkyCloud::from(c);
+                        sky.centre_m += drift3;
+                        sky
+                    })
+                    .collect();
+                let c = index.centre_m() + drift;
+                let mean_z =
+                    clouds.iter().map(|c| c.centre_m.z).sum::<f64>() / clouds.len().max(1) as f64;
+                SkyBlock {
+                    id,
+                    centre_m: DVec3::new(c.x, c.y, mean_z),
+                    clouds,
+                }
+            })
+            .collect())
     }
 }
 
