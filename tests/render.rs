@@ -365,3 +365,81 @@ fn cloud_terrain_edge_is_a_ramp() {
         "with a 0.5 m fade the edge should be a step: {hard:?}"
     );
 }
+
+/// `skycast render` end to end on the real bulk file: under the San Antonio overcast, a PNG and
+/// an EXR with linear RGBA and depth; bad flags fail with status 2 and one message.
+#[test]
+fn render_command_writes_png_and_exr() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-command");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (png, exr) = (dir.join("ksat.png"), dir.join("ksat.exr"));
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_skycast"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .env("XDG_RUNTIME_DIR", "/tmp")
+            .args([
+                "render",
+                "--weather",
+                "weather/awc-metars-2025-01-27T22Z.cache.csv",
+            ])
+            .args(["--at", "29.48,-98.548", "--heading", "40"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run(&[
+        "--alt-ft",
+        "1500",
+        "--pitch",
+        "20",
+        "--size",
+        "160x90",
+        "--out",
+        png.to_str().unwrap(),
+        "--exr",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("above the ground") && said.contains("sprites"),
+        "{said}"
+    );
+    let img = image::open(&png).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (160, 90));
+    // Looking 20 degrees up under OVC020: the upper half is grey cloud, hardly any blue sky
+    // (clear zenith blue has blue - red of about 135 here).
+    let upper: Vec<_> = img.pixels().take(160 * 45).collect();
+    let blue = upper
+        .iter()
+        .filter(|p| p[2] as i32 - p[0] as i32 > 80)
+        .count();
+    assert!(
+        blue * 10 < upper.len(),
+        "{blue} of {} upper pixels are blue sky",
+        upper.len()
+    );
+    use exr::prelude::*;
+    let layers = read_all_flat_layers_from_file(&exr).unwrap();
+    let names: Vec<String> = layers.layer_data[0]
+        .channel_data
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    assert_eq!(names, ["A", "B", "G", "R", "Z"]);
+    let bad = run(&[
+        "--alt-ft",
+        "1500",
+        "--size",
+        "12x9000",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--size"));
+}
