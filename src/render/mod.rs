@@ -60,6 +60,14 @@ pub enum RenderError {
     /// The clouds stage could not start (its generation pool or config).
     #[error("clouds: {0}")]
     Clouds(String),
+    /// An elevation file could not be read or is not a square 16-bit greyscale PNG.
+    #[error("{path}: {message}")]
+    Elevation {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
     /// The sprite sheet's pixel data does not match its size.
     #[error("sprite sheet: {0}")]
     Sheet(String),

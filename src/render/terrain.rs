@@ -9,6 +9,7 @@
 use glam::{DVec2, DVec3, Vec3};
 use wgpu::util::DeviceExt;
 
+use super::RenderError;
 use super::camera::Camera;
 use super::gpu_types::{GpuTerrainFrame, GpuTerrainVertex};
 use super::headless::DEPTH_FORMAT;
@@ -47,6 +48,44 @@ impl HeightField {
             samples,
             heights_m,
         }
+    }
+
+    /// A square 16-bit greyscale PNG elevation file covering `size_m` around `centre_m`: the top
+    /// row is the northern edge, value 0 is `min_m` and 65535 is `max_m` metres above mean sea
+    /// level.
+    pub fn from_png16(
+        path: &std::path::Path,
+        centre_m: DVec2,
+        size_m: f64,
+        min_m: f64,
+        max_m: f64,
+    ) -> Result<Self, RenderError> {
+        let bad = |message: String| RenderError::Elevation {
+            path: path.display().to_string(),
+            message,
+        };
+        let img = image::open(path).map_err(|e| bad(e.to_string()))?;
+        let image::DynamicImage::ImageLuma16(grey) = img else {
+            return Err(bad("not a 16-bit greyscale PNG".into()));
+        };
+        let (w, h) = grey.dimensions();
+        if w != h || w < 2 {
+            return Err(bad(format!(
+                "{w} x {h} pixels; needs a square of at least 2 x 2"
+            )));
+        }
+        let scale = (max_m - min_m) / 65_535.0;
+        let heights_m = (0..h)
+            .rev()
+            .flat_map(|row| (0..w).map(move |col| (col, row)))
+            .map(|(col, row)| (min_m + grey.get_pixel(col, row)[0] as f64 * scale) as f32)
+            .collect();
+        Ok(Self {
+            centre_m,
+            size_m,
+            samples: w,
+            heights_m,
+        })
     }
 
     /// Height at a grid sample.
@@ -322,6 +361,35 @@ mod tests {
             v[4].normal[0] < 0.0,
             "slope up to the east tilts the normal west"
         );
+    }
+
+    #[test]
+    fn png16_elevation_file_reads_north_up() {
+        let dir = std::env::temp_dir().join(format!("skycast-png16-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("dem.png");
+        // 2 x 2: north row 0 and 65535, south row 32768 and 0.
+        let img = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_raw(
+            2,
+            2,
+            vec![0, 65_535, 32_768, 0],
+        )
+        .unwrap();
+        img.save(&path).unwrap();
+        let f = HeightField::from_png16(&path, DVec2::ZERO, 1000.0, 100.0, 1100.0).unwrap();
+        // South-west first: (SW, SE, NW, NE).
+        let expect = [100.0 + 32_768.0 / 65_535.0 * 1000.0, 100.0, 100.0, 1100.0];
+        for (got, want) in f.heights_m.iter().zip(expect) {
+            assert!((*got as f64 - want).abs() < 0.01, "{:?}", f.heights_m);
+        }
+        assert!((f.height_at_m(DVec2::new(500.0, 500.0)) - 1100.0).abs() < 0.01);
+        let rgb = image::RgbImage::new(2, 2);
+        rgb.save(&path).unwrap();
+        let err = HeightField::from_png16(&path, DVec2::ZERO, 1000.0, 0.0, 1.0)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("dem.png") && err.contains("16-bit"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
