@@ -192,13 +192,13 @@ pub struct CloudTypeConfig {
 }
 
 impl CloudTypeConfig {
-    /// The texture band holding a height fraction.
-    pub fn band_at(&self, height_fraction: f32) -> &TextureBand {
+    /// The texture band holding a height fraction (the last band above them all; `None` only
+    /// for a config with no bands, which [`CloudTypes`] never holds).
+    pub fn band_at(&self, height_fraction: f32) -> Option<&TextureBand> {
         self.texture_bands
             .iter()
             .find(|b| height_fraction <= b.up_to)
             .or(self.texture_bands.last())
-            .expect("validated: texture_bands is not empty")
     }
 }
 
@@ -751,6 +751,24 @@ mod tests {
                 "{shown}"
             );
         }
+    }
+
+    #[test]
+    fn a_type_without_texture_bands_is_refused() {
+        let start = BUILTIN_CLOUD_TYPES.find("[fog]").unwrap();
+        let at = start
+            + BUILTIN_CLOUD_TYPES[start..]
+                .find("texture_bands = [")
+                .unwrap();
+        let end = at + BUILTIN_CLOUD_TYPES[at..].find("\n]\n").unwrap() + 3;
+        let text = format!(
+            "{}texture_bands = []\n{}",
+            &BUILTIN_CLOUD_TYPES[..at],
+            &BUILTIN_CLOUD_TYPES[end..]
+        );
+        let (line, field, message) = error_of(&text);
+        assert_eq!(field, "fog.texture_bands", "{message}");
+        assert_eq!(line, line_containing(&text, "fog", "texture_bands"));
     }
 
     #[test]

@@ -20,7 +20,7 @@
 use glam::{DVec2, DVec3};
 
 use super::block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};
-use super::config::{CloudTypeConfig, CloudTypes};
+use super::config::{CloudTypeConfig, CloudTypes, TextureCategory};
 use super::rng::{SplitMix64, hash_keys};
 use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, CloudType};
 
@@ -341,7 +341,9 @@ fn build_cloud(
         let n = rng.range_u32(config.sprites_per_box[0], config.sprites_per_box[1]);
         // Anvils spread the tower's sprites wide: more of them, at most 100 per box (§3.1).
         let area_ratio = if in_anvil {
-            config.anvil.map_or(1.0, |a| (a.width_scale as f64).powi(2))
+            config
+                .anvil
+                .map_or(1.0, |a| a.width_scale as f64 * a.width_scale as f64)
         } else {
             1.0
         };
@@ -463,13 +465,18 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
     let mut sprites = Vec::with_capacity(kept.len());
     for (r, &g) in kept.iter().zip(&sprite_groups) {
         let fraction = (r.pos.z / thickness).clamp(0.0, 1.0) as f32;
-        let band = config.band_at(fraction);
-        let category = band.textures[rng.range_u32(0, band.textures.len() as u32 - 1) as usize];
-        let cells = category.cells();
+        let (categories, rotation) = match config.band_at(fraction) {
+            Some(band) if !band.textures.is_empty() => {
+                (band.textures.as_slice(), band.rotation_deg)
+            }
+            _ => (&[TextureCategory::Wispy][..], [0.0, 360.0]),
+        };
+        let pick = rng.range_u32(0, categories.len() as u32 - 1) as usize;
+        let cells = categories[pick].cells();
         let texture = rng.range_u32(cells.start as u32, cells.end as u32 - 1) as u8;
         let square = (r.height - r.width).abs() < 1e-6 * r.width.max(1.0);
         let rotation_deg = if square {
-            rng.range_f32(band.rotation_deg[0], band.rotation_deg[1])
+            rng.range_f32(rotation[0], rotation[1])
         } else {
             0.0
         };
@@ -619,7 +626,7 @@ mod tests {
                         "{t}: z {z}"
                     );
                     let fraction = ((z - l.base_m as f64) / (l.top_m - l.base_m) as f64) as f32;
-                    let band = config.band_at(fraction.clamp(0.0, 1.0));
+                    let band = config.band_at(fraction.clamp(0.0, 1.0)).unwrap();
                     let cat = crate::clouds::TextureCategory::of_cell(s.texture);
                     assert!(band.textures.contains(&cat), "{t}: {cat:?} at {fraction}");
                     if s.width_m != s.height_m {
@@ -741,6 +748,49 @@ mod tests {
             "anvil {} tower {}",
             spread(0.7, 1.01),
             spread(-0.2, 0.2)
+        );
+    }
+}
+
+#[cfg(test)]
+mod golden {
+    use super::*;
+    use crate::weather::TypeSource;
+
+    /// The content hash of a few pinned blocks: equal on every machine and run. A deliberate
+    /// change to the generator or to config/cloud_types.toml changes it; update it then.
+    #[test]
+    fn pinned_blocks_hash_the_same_everywhere() {
+        let types = CloudTypes::builtin();
+        let mut hashes = Vec::new();
+        for (t, oktas, base_ft, thickness_ft) in [
+            (CloudType::CumulusHumilis, 2.0, 3600.0, 1000.0),
+            (CloudType::Stratus, 8.0, 800.0, 1500.0),
+            (CloudType::Cumulonimbus, 3.0, 2500.0, 30000.0),
+            (CloudType::Cirrus, 4.0, 28000.0, 800.0),
+        ] {
+            let weather = BlockWeather {
+                layers: vec![BlockLayer {
+                    cloud_type: t,
+                    type_source: TypeSource::HeightRule,
+                    coverage_oktas: oktas,
+                    base_ft_agl: base_ft,
+                    thickness_ft,
+                }],
+                ground_elevation_m: 120.0,
+                ..Default::default()
+            };
+            let block = generate_block(BlockIndex::new(-3, 5), &weather, 2003, &types);
+            hashes.push(format!("{:016x}", block.content_hash()));
+        }
+        assert_eq!(
+            hashes,
+            [
+                "4dc331662684200d",
+                "83150a6389ef7cc7",
+                "25eda867bd8c613d",
+                "0f4dac4f3a2b26f9"
+            ]
         );
     }
 }
