@@ -157,13 +157,16 @@ impl WeatherField {
             surface_sites.push(site);
             samples.push(sample);
         }
+        // The two triangulations are independent: build them side by side.
+        let (surface, clouds) =
+            rayon::join(|| triangulate(surface_sites), || triangulate(cloud_sites));
         Self {
             frame,
             settings: settings.clone(),
             rule: rule.clone(),
             samples,
-            surface: triangulate(surface_sites),
-            clouds: triangulate(cloud_sites),
+            surface,
+            clouds,
         }
     }
 
