@@ -443,3 +443,45 @@ fn render_command_writes_png_and_exr() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--size"));
 }
+
+/// `skycast fly` end to end: the approach through the San Antonio deck, a few simulated frames,
+/// frames.csv with a row per frame and the first and last frames drawn.
+#[test]
+fn fly_command_writes_frames_and_csv() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("fly-command");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_skycast"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .args([
+            "fly",
+            "--weather",
+            "weather/awc-metars-2025-01-27T22Z.cache.csv",
+        ])
+        .args([
+            "--path",
+            "config/flights/approach_overcast.toml",
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+        .args(["--size", "64x36", "--fps", "0.02", "--every", "100"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows[0][9], "clouds_recomputed");
+    // 300 s at 0.02 frames a second: frames 0..=6, the first and the last written.
+    assert_eq!(rows.len(), 1 + 7);
+    assert_eq!((rows[1][12], rows[7][12]), ("1", "1"));
+    assert!(
+        rows[1][7].parse::<u32>().unwrap() > 1000,
+        "sprites drawn: {:?}",
+        rows[1]
+    );
+    assert!(dir.join("frame_00000.png").exists() && dir.join("frame_00006.png").exists());
+}

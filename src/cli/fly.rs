@@ -1,7 +1,8 @@
 //! `skycast fly --weather FILE --path FLIGHT.toml --out DIR [--size WxH] [--every N]`: flies a
 //! scripted path through the real weather. Every simulated frame runs the sky's CPU update (so
 //! the vertex cache sees the real frame rate); every Nth frame is drawn and written as PNG.
-//! `frames.csv` has one row per simulated frame. The clouds live: the clouds stage's field
+//! `frames.csv` has one row per simulated frame (GPU milliseconds on drawn frames where the
+//! adapter has timestamp queries). The clouds live: the clouds stage's field
 //! generates blocks in the background, drifts them with the wind and forms and dissipates them.
 
 use std::io::Write;
@@ -106,6 +107,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "cache_hit_rate",
         "cpu_update_us",
         "written",
+        "gpu_ms",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
@@ -120,6 +122,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         let camera = host.camera(pose.position_m, pose.heading_deg, pose.pitch_deg);
         let sun = sun_position(start_unix_s + time_s, lat, lon);
         let write = k % args.every as u64 == 0 || k + 1 == frames;
+        let mut gpu_ms = String::new();
         let stats = if write {
             let (frame, stats) = host.frame(
                 &camera,
@@ -128,6 +131,9 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
                 world.visibility_m(),
             )?;
             frame.write_png(&args.out.join(format!("frame_{k:05}.png")))?;
+            if let Some(ms) = host.last_gpu_ms() {
+                gpu_ms = format!("{ms:.2}");
+            }
             written += 1;
             stats
         } else {
@@ -148,6 +154,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             format!("{:.3}", stats.cache_hit_rate),
             stats.cpu_update_us.to_string(),
             (write as u8).to_string(),
+            gpu_ms,
         ])?;
         // The bar moves in whole percents; redraw only when it does.
         let percent = (k + 1) * 100 / frames;
