@@ -237,62 +237,20 @@ fn foggy(cell: u8, u: f32, v: f32) -> Rgba {
     }
 }
 
-/// Heaped cauliflower puffs: a few round lobes, billowed edges, bright tops, creased eddies inside;
+/// Heaped cauliflower puffs: a few round lobes merged into one heap with billowed edges, lit
+/// from above by the slope of their own density (bright tops, shaded creases between lobes);
 /// `flat_bottom` cuts a flat, slightly darker underside.
 fn puffy(cell: u8, u: f32, v: f32, flat_bottom: bool) -> Rgba {
-    let seed = cell as u64 * 131 + 11;
-    let mut rng = cell_rng(cell);
-    let lobes = 5 + rng.range_u32(0, 3) as usize;
-    let base_v = if flat_bottom { 0.70 } else { 0.62 };
-    // Edge billows: perturb the sample point before measuring the lobes.
-    let wu = u + 0.1 * (fbm(u * 5.0, v * 5.0, seed + 3, 4, 0.5) - 0.5);
-    let wv = v + 0.1 * (fbm(u * 5.0 + 9.1, v * 5.0, seed + 4, 4, 0.5) - 0.5);
-    let mut density: f32 = 0.0;
-    let mut height_light: f32 = 0.0;
-    for k in 0..lobes {
-        let (lu, lv, r) = if flat_bottom {
-            // Lobes sit on a dome: wide at the bottom, one or two higher in the middle.
-            let t = (k as f32 + 0.5) / lobes as f32;
-            let rise = 1.0 - (2.0 * t - 1.0).abs();
-            let r = 0.15 + 0.10 * rise + rng.range_f32(-0.02, 0.03);
-            let lu = 0.2 + 0.6 * t + rng.range_f32(-0.04, 0.04);
-            (
-                lu,
-                base_v - r * 0.5 - 0.2 * rise + rng.range_f32(-0.03, 0.03),
-                r,
-            )
-        } else if k == 0 {
-            (0.5, 0.5, 0.24)
-        } else {
-            // A ring of lobes around a central one: a heaped, cauliflower puff.
-            let turn = (k as f32 - 1.0 + rng.range_f32(-0.25, 0.25)) / (lobes - 1) as f32;
-            let (sa, ca) = (turn * std::f32::consts::TAU).sin_cos();
-            let dist = rng.range_f32(0.14, 0.22);
-            (
-                0.5 + dist * ca,
-                0.5 + dist * sa * 0.85,
-                rng.range_f32(0.13, 0.19),
-            )
-        };
-        let d = ((wu - lu).powi(2) + (wv - lv).powi(2)).sqrt() / r;
-        let lobe = (1.0 - d * d).max(0.0);
-        if lobe > density {
-            height_light = (lv - wv) / r; // +1 at the lobe's top, -1 at its bottom
-        }
-        // Soft union: lobes merge into one heap instead of a pile of balls.
-        density = 1.0 - (1.0 - density) * (1.0 - lobe);
-    }
-    let detail = fbm(u * 9.0, v * 9.0, seed, 4, 0.55) - 0.5;
-    density += 0.35 * detail;
-    if flat_bottom {
-        density *= 1.0 - smoothstep(base_v - 0.03, base_v + 0.01, v);
-    }
-    let a = smoothstep(0.08, 0.45, density);
-    let creases = ridged(u * 8.0 + detail, v * 8.0, seed + 5, 4);
-    let shade = 0.82 + 0.12 * height_light.clamp(-1.0, 1.0) - 0.10 * (creases - 0.5).max(0.0) * 2.0
-        + 0.08 * detail;
+    let shape = PuffShape::new(cell, flat_bottom);
+    let density = shape.density(u, v);
+    let a = smoothstep(0.03, 0.6, density);
+    // Lobes bulge: bright where a lobe's sphere cap is high, darker in the creases between lobes
+    // and at the rims. No light direction is baked in, since sprites are rotated (Wang 2003 §3.2).
+    let cap = shape.cap(u, v);
+    let creases = ridged(u * 8.0, v * 8.0, shape.seed + 5, 4);
+    let shade = 0.66 + 0.34 * cap - 0.08 * (creases - 0.5).max(0.0) * 2.0;
     let under = if flat_bottom {
-        0.88 + 0.12 * (1.0 - smoothstep(base_v - 0.25, base_v, v))
+        0.88 + 0.12 * (1.0 - smoothstep(shape.base_v - 0.25, shape.base_v, v))
     } else {
         1.0
     };
@@ -302,6 +260,89 @@ fn puffy(cell: u8, u: f32, v: f32, flat_bottom: bool) -> Rgba {
         g: s,
         b: s * 1.01 + 0.01,
         a,
+    }
+}
+
+/// The lobes of one puffy cell.
+struct PuffShape {
+    seed: u64,
+    base_v: f32,
+    flat_bottom: bool,
+    lobes: Vec<(f32, f32, f32)>,
+}
+
+impl PuffShape {
+    fn new(cell: u8, flat_bottom: bool) -> Self {
+        let mut rng = cell_rng(cell);
+        let n = 5 + rng.range_u32(0, 3) as usize;
+        let base_v = if flat_bottom { 0.70 } else { 0.62 };
+        let lobes = (0..n)
+            .map(|k| {
+                if flat_bottom {
+                    // Lobes sit on a dome: wide at the bottom, one or two higher in the middle.
+                    let t = (k as f32 + 0.5) / n as f32;
+                    let rise = 1.0 - (2.0 * t - 1.0).abs();
+                    let r = 0.15 + 0.10 * rise + rng.range_f32(-0.02, 0.03);
+                    let lu = 0.2 + 0.6 * t + rng.range_f32(-0.04, 0.04);
+                    let lv = base_v - r * 0.5 - 0.2 * rise + rng.range_f32(-0.03, 0.03);
+                    (lu, lv, r)
+                } else if k == 0 {
+                    (0.5, 0.5, 0.24)
+                } else {
+                    // A ring of lobes around a central one: a heaped, cauliflower puff.
+                    let turn = (k as f32 - 1.0 + rng.range_f32(-0.25, 0.25)) / (n - 1) as f32;
+                    let (sa, ca) = (turn * std::f32::consts::TAU).sin_cos();
+                    let dist = rng.range_f32(0.14, 0.22);
+                    (
+                        0.5 + dist * ca,
+                        0.5 + dist * sa * 0.85,
+                        rng.range_f32(0.13, 0.19),
+                    )
+                }
+            })
+            .collect();
+        Self {
+            seed: cell as u64 * 131 + 11,
+            base_v,
+            flat_bottom,
+            lobes,
+        }
+    }
+
+    /// The highest lobe's sphere cap over (u, v), 0 (rim) ..= 1 (top of a lobe).
+    fn cap(&self, u: f32, v: f32) -> f32 {
+        let (wu, wv) = self.warp(u, v);
+        let mut cap: f32 = 0.0;
+        for &(lu, lv, r) in &self.lobes {
+            let d2 = ((wu - lu) * (wu - lu) + (wv - lv) * (wv - lv)) / (r * r);
+            cap = cap.max((1.0 - d2).max(0.0).sqrt());
+        }
+        (cap + 0.25 * (fbm(u * 12.0, v * 12.0, self.seed + 7, 3, 0.5) - 0.5)).clamp(0.0, 1.0)
+    }
+
+    fn warp(&self, u: f32, v: f32) -> (f32, f32) {
+        let seed = self.seed;
+        (
+            u + 0.12 * (fbm(u * 5.0, v * 5.0, seed + 3, 4, 0.5) - 0.5),
+            v + 0.12 * (fbm(u * 5.0 + 9.1, v * 5.0, seed + 4, 4, 0.5) - 0.5),
+        )
+    }
+
+    fn density(&self, u: f32, v: f32) -> f32 {
+        let seed = self.seed;
+        // Edge billows: perturb the sample point before measuring the lobes.
+        let (wu, wv) = self.warp(u, v);
+        let mut density: f32 = 0.0;
+        for &(lu, lv, r) in &self.lobes {
+            let d2 = ((wu - lu) * (wu - lu) + (wv - lv) * (wv - lv)) / (r * r);
+            // Soft union: lobes merge into one heap instead of a pile of balls.
+            density = 1.0 - (1.0 - density) * (1.0 - (1.0 - d2).max(0.0));
+        }
+        density += 0.3 * (fbm(u * 9.0, v * 9.0, seed, 4, 0.55) - 0.5);
+        if self.flat_bottom {
+            density *= 1.0 - smoothstep(self.base_v - 0.03, self.base_v + 0.01, v);
+        }
+        density
     }
 }
 
