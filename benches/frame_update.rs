@@ -16,6 +16,17 @@ use skycast::weather::{LocalFrame, StationTable, files};
 
 const FPS: f64 = 30.0;
 const FRAMES: usize = 90;
+/// Under `cargo test --all-targets` (no `--bench` flag) the bench runs once as a smoke test on a
+/// few frames; the full stretch is for `cargo bench`.
+const SMOKE_FRAMES: usize = 3;
+
+fn frames() -> usize {
+    if std::env::args().any(|a| a == "--bench") {
+        FRAMES
+    } else {
+        SMOKE_FRAMES
+    }
+}
 
 struct Cruise {
     blocks: Vec<SkyBlock>,
@@ -42,7 +53,7 @@ fn cruise() -> Cruise {
     );
     let mut world = World::new(field, &WorldSettings::default());
     // A stretch of the cruise 60 s in, at 30 frames a second.
-    let cameras: Vec<glam::DVec3> = (0..FRAMES)
+    let cameras: Vec<glam::DVec3> = (0..frames())
         .map(|k| flight.pose_at(60.0 + k as f64 / FPS).position_m)
         .collect();
     let blocks = world.sky_blocks_around(cameras[0]);
@@ -79,7 +90,8 @@ fn bench(crit: &mut Criterion) {
     let (with, drawn) = run(&c, &cached);
     let (without, _) = run(&c, &uncached);
     eprintln!(
-        "cruise, {FRAMES} frames at {FPS} fps: {} clouds, {drawn} sprites drawn; sprites recomputed {with} cached vs {without} uncached ({:.1}x less vertex work)",
+        "cruise, {} frames at {FPS} fps: {} clouds, {drawn} sprites drawn; sprites recomputed {with} cached vs {without} uncached ({:.1}x less vertex work)",
+        c.cameras.len(),
         c.blocks.iter().map(|b| b.clouds.len()).sum::<usize>(),
         without as f64 / with.max(1) as f64
     );
