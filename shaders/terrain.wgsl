@@ -41,8 +41,8 @@ fn vs_terrain(v: TerrainVertex) -> TerrainOut {
 fn fs_terrain(i: TerrainOut) -> @location(0) vec4<f32> {
     let n = normalize(i.normal);
     let slope = 1.0 - n.z;
-    var albedo = mix(vec3<f32>(0.05, 0.09, 0.03), vec3<f32>(0.1, 0.09, 0.06), smoothstep(300.0, 1500.0, i.height_m));
-    albedo = mix(albedo, vec3<f32>(0.12, 0.11, 0.1), smoothstep(0.15, 0.4, slope));
+    var albedo = mix(vec3<f32>(0.09, 0.16, 0.05), vec3<f32>(0.16, 0.14, 0.09), smoothstep(300.0, 1500.0, i.height_m));
+    albedo = mix(albedo, vec3<f32>(0.18, 0.16, 0.14), smoothstep(0.15, 0.4, slope));
     albedo = mix(albedo, vec3<f32>(0.7, 0.72, 0.75), smoothstep(2600.0, 3000.0, i.height_m) * (1.0 - smoothstep(0.3, 0.5, slope)));
     let sun = max(dot(n, terrain.sun_dir.xyz), 0.0);
     let lit = albedo * (terrain.sun_rgb.rgb * sun + vec3<f32>(terrain.sun_dir.w));
