@@ -90,6 +90,9 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         time: None,
         render_settings: None,
         time_of_day: None,
+        watch: false,
+        settle_ms: 500,
+        clouds: None,
     })?;
     println!(
         "The frames are in {}/ (frame_*.png, frames.csv).",

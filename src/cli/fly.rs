@@ -4,17 +4,27 @@
 //! `frames.csv` has one row per simulated frame (GPU milliseconds on drawn frames where the
 //! adapter has timestamp queries). The clouds live: the clouds stage's field
 //! generates blocks in the background, drifts them with the wind and forms and dissipates them.
+//!
+//! Live weather: with `--watch` the weather file is watched; the flight path's timed weather
+//! events (a front passing) go the same way. A new weather is decoded and its field built off the
+//! frame thread; each changed block's clouds dissipate while the new ones form (durations from
+//! `--clouds`). `frames.csv` says per frame how long the frame thread spent on weather
+//! (`weather_us`: polling and switching, never loading) and which file was applied.
 
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Args;
+use skycast::clouds::CloudsConfig;
 use skycast::flight::FlightPlan;
 use skycast::render::world::{World, WorldSettings};
 use skycast::render::{DemoHost, SkyConfig};
 use skycast::shading::sun_position;
-use skycast::weather::LocalFrame;
+use skycast::weather::live::{LiveChange, LiveWeather, Prepare};
+use skycast::weather::{LocalFrame, StationTable, WeatherField, theme};
 
 use super::render::{DEFAULT_TIME, load_look, parse_size, parse_time};
 use super::weather::{DEFAULT_STATIONS, load};
@@ -52,6 +62,16 @@ pub struct FlyArgs {
     /// Time-of-day table (default: the shipped config/time_of_day.toml).
     #[arg(long)]
     pub time_of_day: Option<PathBuf>,
+    /// Watch the weather file: when it changes, the sky follows (changed blocks re-form).
+    #[arg(long)]
+    pub watch: bool,
+    /// Quiet time after a change of the watched file before it is read, milliseconds.
+    #[arg(long, default_value_t = 500)]
+    pub settle_ms: u64,
+    /// Clouds config: how long clouds take to form and dissipate when the weather changes
+    /// (default: the shipped config/clouds.toml).
+    #[arg(long)]
+    pub clouds: Option<PathBuf>,
 }
 
 /// Runs `skycast fly`.
@@ -77,6 +97,41 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule),
         &WorldSettings::default(),
     );
+    if let Some(path) = &args.clouds {
+        world.set_clouds_config(CloudsConfig::load(path)?);
+    }
+    // Live weather: the watched file and the flight's timed events, prepared off the frame thread.
+    let mut live = LiveWeather::<WeatherField>::new();
+    let (field_settings, rule) = (loaded.settings.clone(), loaded.rule.clone());
+    let prepare: Prepare<WeatherField> =
+        Arc::new(move |input| input.field(LocalFrame::new(lat, lon), &field_settings, &rule));
+    let needs_table = (args.watch && !theme::is_theme_path(&args.weather))
+        || plan
+            .weather_events
+            .iter()
+            .any(|e| !theme::is_theme_path(&e.weather));
+    let stations = if needs_table {
+        Some(Arc::new(StationTable::load(&args.stations)?))
+    } else {
+        None
+    };
+    for event in &plan.weather_events {
+        live.schedule(
+            event.time_s,
+            &event.weather,
+            stations.clone(),
+            Arc::clone(&prepare),
+        )?;
+    }
+    if args.watch {
+        live.watch(
+            &args.weather,
+            stations.clone(),
+            Duration::from_millis(args.settle_ms),
+            Arc::clone(&prepare),
+        )?;
+        eprintln!("watching {}", args.weather.display());
+    }
     let mut host = DemoHost::new(
         args.size.0,
         args.size.1,
@@ -106,6 +161,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "clouds_recomputed",
         "cache_hit_rate",
         "cpu_update_us",
+        "weather_us",
+        "weather_applied",
         "written",
         "gpu_ms",
     ])?;
@@ -115,6 +172,22 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     for k in 0..frames {
         let time_s = flight.start_s() + k as f64 * dt_s;
         let pose = flight.pose_at(time_s);
+        // New weather: only what is ready; the frame never waits for a file.
+        let weather_start = Instant::now();
+        let mut applied = String::new();
+        for change in live.poll(time_s) {
+            match change {
+                LiveChange::Loaded { source, weather } => {
+                    world.set_field(weather);
+                    applied = source
+                        .file_name()
+                        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+                }
+                // Logged where it was found; the last good weather stays.
+                LiveChange::Rejected(_) => applied = "rejected".to_string(),
+            }
+        }
+        let weather_us = weather_start.elapsed().as_micros();
         // The clouds stage's living field: drift with the wind, formation and dissipation.
         let step_s = if k == 0 { 0.0 } else { dt_s };
         host.sky
@@ -153,6 +226,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             stats.clouds_recomputed.to_string(),
             format!("{:.3}", stats.cache_hit_rate),
             stats.cpu_update_us.to_string(),
+            weather_us.to_string(),
+            applied,
             (write as u8).to_string(),
             gpu_ms,
         ])?;

@@ -339,6 +339,12 @@ impl Sky {
         self.time_of_day.at(sun.elevation_deg as f32)
     }
 
+    /// Bytes of the GPU buffers the sky holds now (frame uniforms, sprite vertices and indices):
+    /// what a long flight watches for growth.
+    pub fn gpu_buffer_bytes(&self) -> u64 {
+        self.frame_buffer.size() + self.vertex_buffer.size() + self.index_buffer.size()
+    }
+
     /// CPU work of a frame: advances time by `dt_s`, sorts, faces, shades and caches sprites,
     /// uploads vertices and this frame's uniforms.
     pub fn prepare(

@@ -15,7 +15,10 @@ use super::demo_host::ground_from_field;
 use super::scene::{SkyBlock, SkyCloud, SkySprite};
 use super::sky::SpriteSheet;
 use super::terrain::HeightField;
-use crate::clouds::{Cloud, CloudField, CloudTypes, CloudsConfig, TextureSheet, generate_block};
+use crate::clouds::{
+    Cloud, CloudField, CloudTypes, CloudsConfig, TextureSheet, field::weather_changed,
+    generate_block,
+};
 use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
 use crate::weather::{BlockIndex, BlockWeather};
@@ -106,6 +109,7 @@ pub struct World {
     settings: WorldSettings,
     blocks: HashMap<BlockIndex, SkyBlock>,
     living: Option<LivingClouds>,
+    clouds_config: CloudsConfig,
 }
 
 impl World {
@@ -125,12 +129,41 @@ impl World {
             settings: *settings,
             blocks: HashMap::new(),
             living: None,
+            clouds_config: CloudsConfig::builtin(),
         }
     }
 
     /// The weather field.
     pub fn field(&self) -> &WeatherField {
         &self.field
+    }
+
+    /// Uses `config` (lifecycle durations: how long a changed block's clouds take to form and
+    /// dissipate) for the living clouds; call before the first [`Self::living_blocks`]. The
+    /// field radius and seed stay the world's.
+    pub fn set_clouds_config(&mut self, config: CloudsConfig) {
+        self.clouds_config = config;
+    }
+
+    /// Takes a new weather field (built off the frame thread, e.g. by a
+    /// [`LiveWeather`](crate::weather::live::LiveWeather)'s prepare) without stopping: the living
+    /// clouds of every block whose weather changed dissipate while the new ones form; unchanged
+    /// blocks stay as they are. The ground is kept (its elevations do not change with weather).
+    pub fn set_field(&mut self, field: WeatherField) {
+        let old = std::mem::replace(&mut self.field, field);
+        // Block weathers are looked up again lazily, from the new field.
+        if let Some(living) = self.living.as_mut() {
+            living.weather.clear();
+        }
+        let new = &self.field;
+        self.blocks.retain(|&index, _| {
+            !weather_changed(&old.block_weather(index), &new.block_weather(index))
+        });
+    }
+
+    /// The clouds stage's living field, once [`Self::living_blocks`] has run.
+    pub fn living_field(&self) -> Option<&CloudField> {
+        self.living.as_ref().map(|l| &l.field)
     }
 
     /// The ground.
@@ -209,7 +242,7 @@ impl World {
         dt_s: f64,
     ) -> Result<Vec<SkyBlock>, RenderError> {
         if self.living.is_none() {
-            let mut config = CloudsConfig::builtin();
+            let mut config = self.clouds_config;
             config.field.radius_m = self.settings.cloud_radius_m;
             config.field.seed = self.settings.seed;
             let field = CloudField::new(config, Arc::new(self.types.clone()), 0)

@@ -12,6 +12,7 @@ pub mod field;
 pub mod files;
 pub mod frame;
 pub mod input;
+pub mod live;
 pub mod metar;
 pub mod remarks;
 pub mod stations;
