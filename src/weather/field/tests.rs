@@ -305,3 +305,29 @@ fn on_the_real_bulk_file_every_cb_station_keeps_its_cb() {
     }
     assert!(checked >= 50, "{checked}");
 }
+
+#[test]
+fn collinear_stations_fall_back_to_the_nearest() {
+    // Three stations on the frame's meridian project onto one straight line: no triangle.
+    let reports = vec![
+        station(
+            49.0,
+            LON0,
+            1,
+            report(vec![layer(Cover::Ovc, 800, None)], 1.0, 270),
+        ),
+        station(
+            50.0,
+            LON0,
+            2,
+            report(vec![layer(Cover::Sct, 3000, None)], 2.0, 270),
+        ),
+        station(51.0, LON0, 3, cavok(3.0)),
+    ];
+    let f = field(&reports);
+    assert_eq!(f.station_count(), 3);
+    let w = f.weather_at_lat_lon(49.2, LON0 + 0.3);
+    assert_eq!(w.temperature_c, 1.0);
+    assert_eq!(w.layers[0].cloud_type, CloudType::Stratus);
+    assert!(f.weather_at_lat_lon(50.9, LON0).layers.is_empty());
+}
