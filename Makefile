@@ -7,7 +7,7 @@ VULKAN_PACKAGES := mesa-vulkan-drivers libvulkan1
 # Mesa's Vulkan loader complains on every start when this is unset; /tmp silences it.
 export XDG_RUNTIME_DIR ?= /tmp
 
-.PHONY: demo test vulkan fuzz
+.PHONY: demo test vulkan fuzz soak
 
 demo: vulkan
 	cargo run --release --quiet -- demo
@@ -17,6 +17,11 @@ test: vulkan
 	cargo clippy --all-targets -- -D warnings
 	cargo test --all-targets
 	cargo test --doc
+
+# The live-weather soak test (ignored by default): one simulated hour, a weather change every
+# five minutes; fails if memory (RSS) or the renderer's GPU buffers grow after the first changes.
+soak: vulkan
+	cargo test --test live -- --ignored --nocapture
 
 # Runs every cargo-fuzz target for FUZZ_SECONDS each (see fuzz/README.md); needs cargo-fuzz.
 FUZZ_SECONDS ?= 120
