@@ -168,6 +168,9 @@ pub struct CloudTypeConfig {
     pub boxes_per_cloud: [u32; 2],
     /// How much narrower the top box is than the bottom one, 0 (column) ..= 1 (cone).
     pub taper: f32,
+    /// Tallest a heaped cloud may be over its diameter: smaller clouds of a layer stay lower
+    /// (humilis wider than tall, congestus towering), their tops below the layer's.
+    pub max_height_over_size: f32,
     /// The anvil, for cumulonimbus.
     #[serde(default)]
     pub anvil: Option<AnvilConfig>,
@@ -480,6 +483,11 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
         "taper",
         "must be 0..=1 (0 column, 1 cone)",
     )?;
+    v.check(
+        c.max_height_over_size > 0.0 && c.max_height_over_size <= 20.0,
+        "max_height_over_size",
+        "must be above 0 and at most 20",
+    )?;
     if let Some(anvil) = c.anvil {
         v.check(
             anvil.from > 0.0 && anvil.from < 1.0 && anvil.width_scale >= 1.0,
@@ -641,7 +649,13 @@ mod tests {
                 "boxes_per_cloud = [0, 3]",
                 "boxes_per_cloud",
             ),
-            ("cumulus_humilis", "taper = 0.45", "taper = 1.5", "taper"),
+            ("cumulus_humilis", "taper = 0.3", "taper = 1.5", "taper"),
+            (
+                "cumulus_congestus",
+                "max_height_over_size = 2.0",
+                "max_height_over_size = 0.0",
+                "max_height_over_size",
+            ),
             (
                 "cumulonimbus",
                 "anvil = { from = 0.8,",
@@ -669,8 +683,8 @@ mod tests {
             ),
             (
                 "stratus",
-                "sprite_height_ratio = [0.35, 0.6]",
-                "sprite_height_ratio = [0.35, 1.6]",
+                "sprite_height_ratio = [0.45, 0.7]",
+                "sprite_height_ratio = [0.45, 1.6]",
                 "sprite_height_ratio",
             ),
             (
@@ -693,8 +707,8 @@ mod tests {
             ),
             (
                 "cumulus_humilis",
-                "{ up_to = 1.0, textures = [\"puffy\", \"puffy\", \"wispy\"]",
-                "{ up_to = 0.9, textures = [\"puffy\", \"puffy\", \"wispy\"]",
+                "{ up_to = 1.0, textures = [\"puffy\"]",
+                "{ up_to = 0.9, textures = [\"puffy\"]",
                 "texture_bands",
             ),
             (

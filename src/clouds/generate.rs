@@ -21,6 +21,7 @@ use glam::{DVec2, DVec3};
 
 use super::block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};
 use super::config::{CloudTypeConfig, CloudTypes, TextureCategory};
+use super::heap::heap_sprites;
 use super::rng::{SplitMix64, hash_keys};
 use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, CloudType};
 
@@ -267,12 +268,15 @@ fn lattice_layer(
     (keep as f64 / cells.len().max(1) as f64, boxes)
 }
 
-/// A sprite before texture, rotation and grouping.
-struct Raw {
-    pos: DVec3,
-    width: f64,
-    height: f64,
-    group: u32,
+/// A sprite before texture, rotation and grouping: centre relative to the cloud's horizontal
+/// centre and the layer base, metres.
+pub(super) struct Raw {
+    pub(super) pos: DVec3,
+    pub(super) width: f64,
+    pub(super) height: f64,
+    pub(super) group: u32,
+    /// Stands on the cloud base: takes the first texture band (flat-bottomed, small rotation).
+    pub(super) base: bool,
 }
 
 /// Builds one cloud of `d` metres diameter centred (horizontally) at `centre`; returns the cloud
@@ -294,61 +298,34 @@ fn build_cloud(
 ) -> (Cloud, u32) {
     let LayerCtx { config, frame, .. } = *ctx;
     let mut rng = SplitMix64::new(cloud_seed);
+    let density = config.density_by_cover.for_oktas(ctx.layer.coverage_oktas) as f64;
+    // Heaped clouds stand on a flat base and end in a dome (or an anvil).
+    if lattice_cell_m.is_none() && !config.continuous && !config.flat {
+        let height = frame
+            .thickness_m
+            .min(d * config.max_height_over_size as f64);
+        let (raws, n_boxes) = heap_sprites(config, d, height, density, &mut rng);
+        let kept = cull(raws, config.cull_radius_fraction as f64);
+        return (finish_cloud(ctx, centre, kept, &mut rng), n_boxes);
+    }
     let n_boxes = rng.range_u32(config.boxes_per_cloud[0], config.boxes_per_cloud[1]);
     let thickness = frame.thickness_m;
     let [wmin, wmax] = config.sprite_width_m.map(f64::from);
     let [rmin, rmax] = config.sprite_height_ratio.map(f64::from);
     let mut raws: Vec<Raw> = Vec::new();
     let mut group = 0u32;
-    // Continuous decks lay their boxes side by side; heaped clouds stack them.
-    let stacked = lattice_cell_m.is_none() && !config.continuous && !config.flat;
-    for k in 0..n_boxes {
-        let t = (k as f64 + 0.5) / n_boxes as f64;
-        let (mut half_w, z0, z1, offset) = if stacked {
-            let lo = thickness * k as f64 / n_boxes as f64;
-            let hi = thickness * (k as f64 + 1.3) / n_boxes as f64;
-            let wander = d * 0.12 * t;
-            let off = DVec2::new(
-                rng.range_f64(-wander, wander),
-                rng.range_f64(-wander, wander),
-            );
-            (
-                d / 2.0 * (1.0 - config.taper as f64 * t),
-                lo,
-                hi.min(thickness),
-                off,
-            )
-        } else if let Some(cell) = lattice_cell_m {
+    // Continuous decks lay their boxes side by side over their lattice cell; layered clouds
+    // (flat cirrus, a continuous type off the lattice) spread theirs around the centre.
+    for _ in 0..n_boxes {
+        let (half_w, offset) = if let Some(cell) = lattice_cell_m {
             // A lattice cell: every box spans the cell and a little of its neighbours.
-            (cell * 0.55, 0.0, thickness, DVec2::ZERO)
+            (cell * 0.55, DVec2::ZERO)
         } else {
             let off = DVec2::new(rng.range_f64(-0.15, 0.15), rng.range_f64(-0.15, 0.15)) * d;
-            (
-                d / 2.0 * if n_boxes > 1 { 0.75 } else { 1.0 },
-                0.0,
-                thickness,
-                off,
-            )
+            (d / 2.0 * if n_boxes > 1 { 0.75 } else { 1.0 }, off)
         };
-        let mut z_range = (z0, z1);
-        let in_anvil = stacked && config.anvil.is_some_and(|a| t >= a.from as f64);
-        if let Some(anvil) = config.anvil
-            && in_anvil
-        {
-            half_w = d / 2.0 * anvil.width_scale as f64;
-            z_range = (thickness * anvil.from as f64, thickness);
-        }
         let n = rng.range_u32(config.sprites_per_box[0], config.sprites_per_box[1]);
-        // Anvils spread the tower's sprites wide: more of them, at most 100 per box (§3.1).
-        let area_ratio = if in_anvil {
-            config
-                .anvil
-                .map_or(1.0, |a| a.width_scale as f64 * a.width_scale as f64)
-        } else {
-            1.0
-        };
-        let density = config.density_by_cover.for_oktas(ctx.layer.coverage_oktas) as f64;
-        let mut n = ((n as f64 * area_ratio * density).round() as u32).clamp(1, 100);
+        let mut n = ((n as f64 * density).round() as u32).clamp(1, 100);
         // On the lattice, enough sprites that the jittered grid leaves no hole (at most 100).
         let grid_side = lattice_cell_m.map(|_| {
             let cover = (2.0 * half_w / (0.5 * (wmin + wmax) / 2.0)).ceil();
@@ -387,34 +364,22 @@ fn build_cloud(
             } else {
                 (half_w - width * 0.25).max(half_w * 0.3)
             };
-            // Sprites keep their full height inside the cloud: flat bottoms sit on the base.
-            // Centres anywhere in the box, but sprites stay inside the layer: flat bottoms sit
-            // on the base.
+            // Sprites stay inside the layer.
             let half_h = height / 2.0;
-            let (lim_lo, lim_hi) = (
-                half_h.min(thickness / 2.0),
-                (thickness - half_h).max(thickness / 2.0),
-            );
-            let zlo = z_range.0.clamp(lim_lo, lim_hi);
-            let zhi = z_range.1.clamp(lim_lo, lim_hi).max(zlo);
             let z = if config.flat {
                 rng.range_f64(0.0, thickness)
-            } else if stacked {
-                // Heaped clouds end in a dome: the top box is lower towards its rim.
-                let dome = if k + 1 == n_boxes && !in_anvil {
-                    1.0 - 0.75 * (x * x + y * y)
-                } else {
-                    1.0
-                };
-                rng.range_f64(zlo, zlo + (zhi - zlo) * dome)
             } else {
-                rng.range_f64(zlo, zhi)
+                rng.range_f64(
+                    half_h.min(thickness / 2.0),
+                    (thickness - half_h).max(thickness / 2.0),
+                )
             };
             raws.push(Raw {
                 pos: DVec3::new(offset.x + x * spread, offset.y + y * spread, z),
                 width,
                 height,
                 group: group - 1,
+                base: false,
             });
         }
     }
@@ -465,7 +430,13 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
     let mut sprites = Vec::with_capacity(kept.len());
     for (r, &g) in kept.iter().zip(&sprite_groups) {
         let fraction = (r.pos.z / thickness).clamp(0.0, 1.0) as f32;
-        let (categories, rotation) = match config.band_at(fraction) {
+        // A sprite standing on the base takes the first band (flat-bottomed, small rotation).
+        let band = if r.base {
+            config.texture_bands.first()
+        } else {
+            config.band_at(fraction)
+        };
+        let (categories, rotation) = match band {
             Some(band) if !band.textures.is_empty() => {
                 (band.textures.as_slice(), band.rotation_deg)
             }
@@ -626,7 +597,18 @@ mod tests {
                         "{t}: z {z}"
                     );
                     let fraction = ((z - l.base_m as f64) / (l.top_m - l.base_m) as f64) as f32;
-                    let band = config.band_at(fraction.clamp(0.0, 1.0)).unwrap();
+                    // A sprite standing on the base (its flat underside on it) takes the first
+                    // band, the others the band of their centre's height.
+                    let on_base = (z
+                        - super::super::heap::BASE_CENTRE_FRACTION * s.height_m as f64
+                        - l.base_m as f64)
+                        .abs()
+                        < 0.05;
+                    let band = if on_base {
+                        config.texture_bands.first().unwrap()
+                    } else {
+                        config.band_at(fraction.clamp(0.0, 1.0)).unwrap()
+                    };
                     let cat = crate::clouds::TextureCategory::of_cell(s.texture);
                     assert!(band.textures.contains(&cat), "{t}: {cat:?} at {fraction}");
                     if s.width_m != s.height_m {
@@ -786,9 +768,9 @@ mod golden {
         assert_eq!(
             hashes,
             [
-                "4dc331662684200d",
-                "83150a6389ef7cc7",
-                "25eda867bd8c613d",
+                "509af9a53b3d460e",
+                "6ca8c91263fd5bf1",
+                "1fc363a4cc5f919a",
                 "0f4dac4f3a2b26f9"
             ]
         );

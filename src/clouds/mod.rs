@@ -20,6 +20,7 @@ pub mod block;
 pub mod config;
 pub mod field;
 pub mod generate;
+mod heap;
 pub mod lifecycle;
 pub mod noise;
 pub mod preview;

@@ -223,11 +223,12 @@ fn foggy(cell: u8, u: f32, v: f32) -> Rgba {
     // A rounded, slightly wider-than-tall envelope.
     let warp = fbm(u * 3.0, v * 3.0, seed + 1, 3, 0.5) - 0.5;
     let r = ((x / 0.47).powi(2) + (y / 0.42).powi(2)).sqrt() + 0.5 * warp;
-    let envelope = 1.0 - smoothstep(0.3, 1.0, r);
+    // A broad, nearly opaque core: overlapping foggy sprites close a deck seen from below.
+    let envelope = 1.0 - smoothstep(0.4, 1.0, r);
     let billow = fbm(u * 4.0 + warp, v * 4.0 - warp, seed, 5, 0.55);
     let eddy = ridged(u * 7.0 + 2.0 * warp, v * 7.0, seed + 2, 3);
     let density = envelope * (0.55 + 0.6 * (billow - 0.5) + 0.15 * (eddy - 0.5));
-    let a = smoothstep(0.05, 0.7, density) * 0.8;
+    let a = smoothstep(0.05, 0.55, density) * 0.92;
     let shade = 0.86 + 0.1 * (billow - 0.5) - 0.06 * (eddy - 0.5);
     Rgba {
         r: shade * 0.95,
@@ -263,6 +264,11 @@ fn puffy(cell: u8, u: f32, v: f32, flat_bottom: bool) -> Rgba {
     }
 }
 
+/// Where the flat underside of the flat-bottomed texture lies, as a fraction of the cell from its
+/// top edge: a sprite whose centre is `FLAT_BOTTOM_V - 0.5` of its height above a cloud base
+/// shows its flat underside exactly on the base.
+pub const FLAT_BOTTOM_V: f32 = 0.70;
+
 /// The lobes of one puffy cell.
 struct PuffShape {
     seed: u64,
@@ -275,7 +281,7 @@ impl PuffShape {
     fn new(cell: u8, flat_bottom: bool) -> Self {
         let mut rng = cell_rng(cell);
         let n = 5 + rng.range_u32(0, 3) as usize;
-        let base_v = if flat_bottom { 0.70 } else { 0.62 };
+        let base_v = if flat_bottom { FLAT_BOTTOM_V } else { 0.62 };
         let lobes = (0..n)
             .map(|k| {
                 if flat_bottom {

@@ -132,7 +132,7 @@ fn bad_input_exits_2_with_one_clear_message() {
     );
     // A cloud-types file with a bad field: file, line and field named.
     let text =
-        skycast::clouds::config::BUILTIN_CLOUD_TYPES.replacen("taper = 0.45", "taper = 4.5", 1);
+        skycast::clouds::config::BUILTIN_CLOUD_TYPES.replacen("taper = 0.3", "taper = 4.5", 1);
     let line = text[..text.find("taper = 4.5").unwrap()]
         .matches('\n')
         .count()
