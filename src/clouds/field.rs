@@ -24,7 +24,7 @@ use super::CloudsError;
 use super::block::CloudBlock;
 use super::config::{CloudTypes, CloudsConfig};
 use super::generate::generate_block;
-use super::lifecycle::{Phase, apply};
+use super::lifecycle::{Phase, apply, phase_at};
 use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockWeather};
 
 /// A finished generation job.
@@ -301,6 +301,9 @@ impl CloudField {
                 for cloud in &mut g.block.clouds {
                     next = apply(cloud, g.phase, now, &lifecycle);
                 }
+                if g.block.clouds.is_empty() {
+                    next = phase_at(g.phase, now, &lifecycle);
+                }
                 g.phase = next;
             }
             slot.generations.retain(|g| g.phase != Phase::Gone);
@@ -472,6 +475,27 @@ mod tests {
             let ground = i.centre_m() + field.drift_m();
             assert!(ground.length() <= 9_000.0 + BLOCK_SIZE_M * 1.5);
         }
+    }
+
+    #[test]
+    fn generations_without_clouds_also_go() {
+        let mut field = small_field();
+        let clear = BlockWeather::default();
+        field.update(DVec2::ZERO, &|_| clear.clone());
+        field.wait_for_pending();
+        let index = BlockIndex::new(0, 0);
+        let calm = |oktas| BlockWeather {
+            wind: Wind::default(),
+            ..weather(oktas)
+        };
+        // Clear, cloudy, clear again, cloudy: each change leaves a generation to dissipate.
+        for w in [calm(4.0), clear.clone(), calm(6.0)] {
+            field.update(DVec2::ZERO, &|_| w.clone());
+            field.wait_for_pending();
+            field.advance(2_000.0);
+        }
+        assert_eq!(field.generations(index).len(), 1, "old generations stay");
+        assert_eq!(field.generations(index)[0].phase, Phase::Steady);
     }
 
     #[test]

@@ -54,6 +54,18 @@ pub fn dissipation_alpha(q: f32, radius_fraction: f32, config: &LifecycleConfig)
     1.0 - (s * (1.0 + edge)).min(1.0)
 }
 
+/// The phase `phase` has reached at `now_s` (what [`apply`] returns, without a cloud): a
+/// generation without clouds still forms, settles, dissipates and goes.
+pub fn phase_at(phase: Phase, now_s: f64, config: &LifecycleConfig) -> Phase {
+    match phase {
+        Phase::Forming { since_s } if now_s - since_s >= config.formation_s as f64 => Phase::Steady,
+        Phase::Dissipating { since_s } if now_s - since_s >= config.dissipation_s as f64 => {
+            Phase::Gone
+        }
+        other => other,
+    }
+}
+
 /// Sets every sprite's `alpha_morph` for a phase at field time `now_s`; returns the phase after
 /// (Forming becomes Steady once complete, Dissipating becomes Gone).
 pub fn apply(cloud: &mut Cloud, phase: Phase, now_s: f64, config: &LifecycleConfig) -> Phase {
