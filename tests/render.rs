@@ -493,3 +493,141 @@ fn fly_command_writes_frames_and_csv() {
     );
     assert!(dir.join("frame_00000.png").exists() && dir.join("frame_00006.png").exists());
 }
+
+/// `cumulus` scaled up `scale` times (a far cloud big enough to see at 30 km in 320 x 180).
+fn big_cumulus(centre: DVec3, scale: f32) -> SkyCloud {
+    let mut cloud = cumulus(centre);
+    for s in &mut cloud.sprites {
+        s.offset_m *= scale;
+        s.width_m *= scale;
+        s.height_m *= scale;
+    }
+    for g in &mut cloud.group_centres_m {
+        *g *= scale;
+    }
+    cloud.colour_levels = levels(centre.z as f32, centre.z as f32 + 500.0 * scale);
+    cloud
+}
+
+/// The ring scene: a cumulus 6 km north (near), a big one 30 km north at the camera's height
+/// (far: in the impostors), and one 30 km north-east 4,100 m above the camera (beyond the
+/// 10,000 ft rule: sprites).
+fn ring_blocks(with_far: bool) -> Vec<SkyBlock> {
+    let mut blocks = vec![
+        SkyBlock {
+            id: 1,
+            centre_m: DVec3::new(-2000.0, 6000.0, 1300.0),
+            clouds: vec![cumulus(DVec3::new(-2000.0, 6000.0, 1000.0))],
+        },
+        SkyBlock {
+            id: 3,
+            centre_m: DVec3::new(9000.0, 30_000.0, 5100.0),
+            clouds: vec![cumulus(DVec3::new(9000.0, 30_000.0, 5100.0))],
+        },
+    ];
+    if with_far {
+        blocks.push(SkyBlock {
+            id: 2,
+            centre_m: DVec3::new(0.0, 30_000.0, 1500.0),
+            clouds: vec![big_cumulus(DVec3::new(0.0, 30_000.0, 1500.0), 6.0)],
+        });
+    }
+    blocks
+}
+
+/// Pixels that differ between two frames, and their mean column and row.
+fn changed_pixels(a: &Frame, b: &Frame) -> (usize, f32, f32) {
+    let (mut n, mut sx, mut sy) = (0usize, 0.0f32, 0.0f32);
+    for i in 0..a.rgba.len() {
+        if (luminance(a.rgba[i]) - luminance(b.rgba[i])).abs() > 0.004 {
+            n += 1;
+            sx += (i as u32 % W) as f32;
+            sy += (i as u32 / W) as f32;
+        }
+    }
+    (n, sx / n.max(1) as f32, sy / n.max(1) as f32)
+}
+
+/// Near blocks are sprites, far ones are in the impostors and still show where the all-sprites
+/// frame shows them; a block beyond the 10,000 ft rule stays sprites even 30 km away.
+#[test]
+fn ring_holds_far_blocks_and_near_ones_are_sprites() {
+    let cam_at = DVec3::new(0.0, 0.0, 1000.0);
+    let mut all_sprites = RenderSettings::default();
+    all_sprites.impostors.enabled = false;
+    let mut plain = Rig::with_settings(flat_ground(0.0), all_sprites);
+    let cam = plain.camera(cam_at, 0.0, 3.0);
+    plain.set_clouds(ring_blocks(false));
+    let (bare, _) = plain.frame("ring_bare", &cam);
+    plain.set_clouds(ring_blocks(true));
+    let (sprites_only, stats) = plain.frame("ring_all_sprites", &cam);
+    assert_eq!(stats.sprites_drawn, 180, "{stats:?}");
+    assert_eq!((stats.blocks_near, stats.blocks_far), (3, 0), "{stats:?}");
+    assert_eq!(stats.ring_gpu_bytes, 0);
+
+    let mut rig = Rig::new(flat_ground(0.0));
+    rig.set_clouds(ring_blocks(true));
+    let (ring, stats) = rig.frame("ring_impostors", &cam);
+    // The first ring is built at once; the far block is not sent as sprites.
+    assert_eq!(stats.impostors_rebuilt, 8, "{stats:?}");
+    assert_eq!((stats.blocks_near, stats.blocks_far), (2, 1), "{stats:?}");
+    // The near cumulus and the high one (10,000 ft rule) are sprites: 2 x 60.
+    assert_eq!(stats.sprites_drawn, 120, "{stats:?}");
+    assert!(stats.ring_gpu_bytes >= 2 * 8 * 256 * 256 * 4, "{stats:?}");
+
+    let (n_sprites, x_s, y_s) = changed_pixels(&sprites_only, &bare);
+    let (n_ring, x_r, y_r) = changed_pixels(&ring, &bare);
+    assert!(
+        n_sprites > 150,
+        "the far cloud shows as sprites: {n_sprites} px"
+    );
+    assert!(
+        n_ring as f32 > 0.6 * n_sprites as f32 && (n_ring as f32) < 1.5 * n_sprites as f32,
+        "the far cloud shows in the impostor: {n_ring} px vs {n_sprites} as sprites"
+    );
+    assert!(
+        (x_r - x_s).abs() < 4.0 && (y_r - y_s).abs() < 4.0,
+        "the impostor cloud is where the sprites were: ({x_r}, {y_r}) vs ({x_s}, {y_s})"
+    );
+}
+
+/// Moving past 15% of the ring radius rebuilds the ring one impostor per frame over 8 frames,
+/// then crossfades old -> new over `crossfade_s`; a smaller move rebuilds nothing.
+#[test]
+fn ring_rebuilds_over_eight_frames_then_crossfades() {
+    let mut rig = Rig::new(flat_ground(0.0));
+    rig.set_clouds(ring_blocks(true));
+    let fade_s = rig.host.sky.settings().impostors.crossfade_s;
+    assert_eq!(fade_s, 1.0);
+    let mut step = |rig: &mut Rig, y: f64, dt: f64| {
+        let cam = rig.camera(DVec3::new(0.0, y, 1000.0), 0.0, 3.0);
+        rig.host.frame(&cam, &sun(), dt, 40_000.0).unwrap()
+    };
+    let (_, first) = step(&mut rig, 0.0, 0.25);
+    assert_eq!(first.impostors_rebuilt, 8);
+    // 2,000 m is 10% of the 20 km radius: no rebuild.
+    for _ in 0..3 {
+        let (_, s) = step(&mut rig, 2000.0, 0.25);
+        assert_eq!((s.impostors_rebuilt, s.crossfade_weight), (0, 0.0), "{s:?}");
+    }
+    // 3,100 m is past 15%: one impostor a frame for 8 frames, the old ring still shown.
+    for k in 0..8 {
+        let (_, s) = step(&mut rig, 3100.0, 0.25);
+        assert_eq!(s.impostors_rebuilt, 1, "frame {k}: {s:?}");
+        assert_eq!(s.crossfade_weight, 0.0, "frame {k}: {s:?}");
+    }
+    let weights: Vec<f32> = (0..5)
+        .map(|_| {
+            let (_, s) = step(&mut rig, 3100.0, 0.25);
+            assert_eq!(s.impostors_rebuilt, 0, "{s:?}");
+            s.crossfade_weight
+        })
+        .collect();
+    assert_eq!(weights, vec![0.25, 0.5, 0.75, 0.0, 0.0]);
+    let (frame, s) = step(&mut rig, 3100.0, 0.25);
+    assert_eq!((s.blocks_near, s.blocks_far), (2, 1), "{s:?}");
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
+    frame
+        .write_png(&dir.join("ring_after_rebuild.png"))
+        .unwrap();
+}

@@ -17,6 +17,7 @@ pub mod camera;
 pub mod demo_host;
 pub mod gpu_types;
 pub mod headless;
+pub mod impostor;
 pub mod output;
 pub mod scene;
 pub mod settings;

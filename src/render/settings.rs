@@ -91,6 +91,9 @@ pub struct RenderSettings {
     pub sun: SunSettings,
     /// Vertex cache.
     pub vertex_cache: VertexCacheSettings,
+    /// The far-cloud impostor ring (Wang 6.2); built-in defaults when the table is absent.
+    #[serde(default)]
+    pub impostors: super::impostor::ImpostorSettings,
 }
 
 impl Default for RenderSettings {
@@ -126,6 +129,7 @@ impl Default for RenderSettings {
                 time_distance_m: 2000.0,
                 fading_max_age_s: 0.25,
             },
+            impostors: Default::default(),
         })
     }
 }
@@ -155,6 +159,14 @@ impl RenderSettings {
                     message: format!("must be greater than 0, is {value}"),
                 });
             }
+        }
+        if let Some((field, message)) = s.impostors.invalid_field() {
+            return Err(ConfigError {
+                path: path.to_path_buf(),
+                line: None,
+                field: Some(field.into()),
+                message,
+            });
         }
         if s.camera.far_m <= s.camera.near_m {
             return Err(ConfigError {

@@ -13,6 +13,7 @@ use wgpu::util::DeviceExt;
 use super::RenderError;
 use super::camera::Camera;
 use super::gpu_types::{GpuFrame, GpuSpriteVertex};
+use super::impostor::{ImpostorRing, RingFrame, RingShared};
 use super::scene::SkyBlock;
 use super::settings::RenderSettings;
 use super::vertices::{FrameStats, Lighting, SpriteVertexBuilder, quad_indices};
@@ -60,6 +61,7 @@ pub struct Sky {
     sprites_to_draw: u32,
     in_cloud: f32,
     light: TimeOfDay,
+    ring: ImpostorRing,
 }
 
 const SHARED_WGSL: &str = include_str!("../../shaders/shared/frame.wgsl");
@@ -281,6 +283,17 @@ impl Sky {
         let capacity_sprites = 1024;
         let (vertex_buffer, index_buffer) = sprite_buffers(device, capacity_sprites);
         let light = config.time_of_day.at(45.0);
+        let ring = ImpostorRing::new(
+            device,
+            queue,
+            config.settings.impostors,
+            &RingShared {
+                colour_format: format,
+                frame_layout: &frame_layout,
+                sheet_layout: &sheet_layout,
+                blend: premultiplied_over(),
+            },
+        );
         Ok(Self {
             device: device.clone(),
             settings: config.settings,
@@ -300,6 +313,7 @@ impl Sky {
             sprites_to_draw: 0,
             in_cloud: 0.0,
             light,
+            ring,
         })
     }
 
@@ -342,7 +356,10 @@ impl Sky {
     /// Bytes of the GPU buffers the sky holds now (frame uniforms, sprite vertices and indices):
     /// what a long flight watches for growth.
     pub fn gpu_buffer_bytes(&self) -> u64 {
-        self.frame_buffer.size() + self.vertex_buffer.size() + self.index_buffer.size()
+        self.frame_buffer.size()
+            + self.vertex_buffer.size()
+            + self.index_buffer.size()
+            + self.ring.gpu_bytes()
     }
 
     /// CPU work of a frame: advances time by `dt_s`, sorts, faces, shades and caches sprites,
@@ -362,8 +379,12 @@ impl Sky {
             time_of_day: self.light,
             mapping: self.time_of_day.directional_mapping,
         };
+        let near = self
+            .ring
+            .split(&self.blocks, camera.position_m, sun_dir, dt_s);
+        let near: Vec<&SkyBlock> = near.iter().map(|&i| &self.blocks[i]).collect();
         let mut stats = self.builder.update(
-            &self.blocks,
+            &near,
             camera.position_m,
             self.elapsed_s,
             &lighting,
@@ -412,6 +433,15 @@ impl Sky {
             haze: [self.settings.clouds.haze_distance_m, 0.0, 0.0, 0.0],
         };
         queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&frame));
+        let ring_frame = RingFrame {
+            blocks: &self.blocks,
+            template: &frame,
+            lighting: &lighting,
+            time_s: self.elapsed_s,
+            render: &self.settings,
+            camera_m: camera.position_m,
+        };
+        self.ring.prepare_builds(queue, &ring_frame, &mut stats);
         stats.cpu_update_us += upload_start.elapsed().as_micros() as u64;
         stats
     }
@@ -438,6 +468,7 @@ impl Sky {
                 },
             ],
         });
+        self.ring.record_builds(encoder, &self.sheet_group);
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sky"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -457,6 +488,7 @@ impl Sky {
         pass.set_bind_group(0, &frame_group, &[]);
         pass.set_pipeline(&self.sky_pipeline);
         pass.draw(0..3, 0..1);
+        self.ring.draw(&mut pass);
         if self.sprites_to_draw > 0 {
             pass.set_pipeline(&self.sprite_pipeline);
             pass.set_bind_group(1, &self.sheet_group, &[]);

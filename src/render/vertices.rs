@@ -33,6 +33,16 @@ pub struct FrameStats {
     pub cpu_update_us: u64,
     /// How far inside a cloud the camera is, 0..=1.
     pub in_cloud: f32,
+    /// Impostors of the far-cloud ring rendered this frame (Wang 6.2), 0..=8.
+    pub impostors_rebuilt: u32,
+    /// Blocks drawn as sprites (inside the ring, or beyond the 10,000 ft rule).
+    pub blocks_near: u32,
+    /// Blocks drawn into the impostors of the displayed ring.
+    pub blocks_far: u32,
+    /// Weight of the new ring while crossfading from the old one, 0..=1 (0 when not fading).
+    pub crossfade_weight: f32,
+    /// Bytes of the ring's GPU textures and buffers.
+    pub ring_gpu_bytes: u64,
 }
 
 /// The light a frame is shaded with.
@@ -137,9 +147,9 @@ impl SpriteVertexBuilder {
     }
 
     /// Builds this frame's vertices for `camera_m` at `time_s`.
-    pub fn update(
+    pub fn update<B: std::borrow::Borrow<SkyBlock>>(
         &mut self,
-        blocks: &[SkyBlock],
+        blocks: &[B],
         camera_m: DVec3,
         time_s: f64,
         lighting: &Lighting,
@@ -154,13 +164,13 @@ impl SpriteVertexBuilder {
         let mut block_order: Vec<(usize, f64)> = blocks
             .iter()
             .enumerate()
-            .map(|(i, b)| (i, (b.centre_m - camera_m).length_squared()))
+            .map(|(i, b)| (i, (b.borrow().centre_m - camera_m).length_squared()))
             .collect();
         block_order.sort_by(|a, b| b.1.total_cmp(&a.1));
 
         self.vertices.clear();
         for (bi, _) in block_order {
-            let block = &blocks[bi];
+            let block = blocks[bi].borrow();
             // Per-cloud bounds are computed once per cloud (and on each recompute), not per frame.
             let mut cloud_order: Vec<(usize, f64, f64)> = Vec::with_capacity(block.clouds.len());
             for (ci, cloud) in block.clouds.iter().enumerate() {
