@@ -599,7 +599,7 @@ fn ring_rebuilds_over_eight_frames_then_crossfades() {
     rig.set_clouds(ring_blocks(true));
     let fade_s = rig.host.sky.settings().impostors.crossfade_s;
     assert_eq!(fade_s, 1.0);
-    let mut step = |rig: &mut Rig, y: f64, dt: f64| {
+    let step = |rig: &mut Rig, y: f64, dt: f64| {
         let cam = rig.camera(DVec3::new(0.0, y, 1000.0), 0.0, 3.0);
         rig.host.frame(&cam, &sun(), dt, 40_000.0).unwrap()
     };
