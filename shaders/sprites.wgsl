@@ -32,6 +32,11 @@ fn vs_sprite(v: VertexIn) -> VertexOut {
 
 @fragment
 fn fs_sprite(i: VertexOut) -> @location(0) vec4<f32> {
+    return sprite_colour(i);
+}
+
+// Premultiplied colour of a sprite fragment (also used by the impostor pass).
+fn sprite_colour(i: VertexOut) -> vec4<f32> {
     let texel = textureSample(sheet, sheet_sampler, i.uv);
     let scene_m = linear_depth_m(scene_depth_at(i.position.xy));
     let soft = clamp((scene_m - i.view_depth_m) / frame.params.z, 0.0, 1.0);

@@ -631,3 +631,96 @@ fn ring_rebuilds_over_eight_frames_then_crossfades() {
         .write_png(&dir.join("ring_after_rebuild.png"))
         .unwrap();
 }
+
+/// Beyond Wang: the impostors keep each texel's cloud depth. A 3,000 m ridge 45 km north stands
+/// in front of a cloud 60 km out (hidden where the ridge is) and behind one 30 km out (drawn over
+/// the ridge), both in the impostors (ring radius 20 km), as the all-sprites frame has them.
+#[test]
+fn ring_depth_puts_a_far_mountain_between_impostored_clouds() {
+    let ridge = HeightField::from_fn(DVec2::new(0.0, 40_000.0), 130_000.0, 256, |p| {
+        3000.0 * (-((p.y - 45_000.0) / 2500.0).powi(2)).exp()
+    });
+    let blocks = |front: bool, behind: bool| {
+        let mut b = Vec::new();
+        if front {
+            let c = DVec3::new(-6000.0, 30_000.0, 1500.0);
+            b.push(SkyBlock {
+                id: 10,
+                centre_m: c,
+                clouds: vec![big_cumulus(c, 6.0)],
+            });
+        }
+        if behind {
+            let c = DVec3::new(12_000.0, 59_000.0, 1500.0);
+            b.push(SkyBlock {
+                id: 11,
+                centre_m: c,
+                clouds: vec![big_cumulus(c, 6.0)],
+            });
+        }
+        b
+    };
+    let mut all_sprites = RenderSettings::default();
+    all_sprites.impostors.enabled = false;
+    let mut plain = Rig::with_settings(ridge.clone(), all_sprites);
+    let cam = plain.camera(DVec3::new(0.0, 0.0, 1000.0), 0.0, 2.0);
+    plain.set_clouds(Vec::new());
+    let (bare, _) = plain.frame("mountain_bare", &cam);
+    let on_ridge = |f: &Frame, left: bool| {
+        fraction(&bare, |i| {
+            let x = i as u32 % W;
+            bare.depth[i] < 1.0
+                && (x < W / 2) == left
+                && (luminance(f.rgba[i]) - luminance(bare.rgba[i])).abs() > 0.004
+        }) * (W * H) as f32
+    };
+    let in_sky = |f: &Frame| {
+        fraction(&bare, |i| {
+            bare.depth[i] >= 1.0 && (luminance(f.rgba[i]) - luminance(bare.rgba[i])).abs() > 0.004
+        }) * (W * H) as f32
+    };
+    plain.set_clouds(blocks(true, true));
+    let (sprites, _) = plain.frame("mountain_sprites", &cam);
+
+    let mut rig = Rig::new(ridge);
+    rig.set_clouds(blocks(true, true));
+    let (ring, stats) = rig.frame("mountain_impostors", &cam);
+    assert_eq!((stats.blocks_near, stats.blocks_far), (0, 2), "{stats:?}");
+    let (s_front, s_behind, s_sky) = (
+        on_ridge(&sprites, true),
+        on_ridge(&sprites, false),
+        in_sky(&sprites),
+    );
+    let (r_front, r_behind, r_sky) = (on_ridge(&ring, true), on_ridge(&ring, false), in_sky(&ring));
+    eprintln!(
+        "sprites: front {s_front} behind {s_behind} sky {s_sky}; ring: {r_front} {r_behind} {r_sky}"
+    );
+    assert!(
+        s_front > 30.0 && s_behind < 3.0,
+        "the all-sprites reference"
+    );
+    assert!(
+        r_front > 0.6 * s_front,
+        "the near far cloud is drawn over the ridge: {r_front} px vs {s_front}"
+    );
+    assert!(
+        r_behind < 3.0,
+        "the cloud behind the ridge shows on it: {r_behind} px"
+    );
+    assert!(
+        r_sky > 0.6 * s_sky && r_sky < 1.5 * s_sky,
+        "both clouds show in the sky: {r_sky} px vs {s_sky}"
+    );
+    // The cloud behind the ridge is cut by it, not culled: it shows in the sky above it.
+    let right_sky = fraction(&bare, |i| {
+        bare.depth[i] >= 1.0
+            && i as u32 % W >= W / 2
+            && (luminance(ring.rgba[i]) - luminance(bare.rgba[i])).abs() > 0.004
+    }) * (W * H) as f32;
+    assert!(
+        right_sky > 10.0,
+        "the cloud behind the ridge shows above it: {right_sky} px"
+    );
+    // Without the stored depth (the quad's own depth, 20 km) it would cover the ridge: this test
+    // fails with `along = 1.0` in impostor_quad.wgsl (126 px on the ridge).
+}
