@@ -12,8 +12,10 @@
 //! first ring is built in one frame (there is nothing to fade from).
 //!
 //! In: the sky's blocks, camera, light and frame uniform. Out: which blocks are near (sprites),
-//! the impostor render passes, and the quads drawn into the host frame, depth-tested against the
-//! host's depth (terrain inside the ring radius hides them). Units: metres, degrees.
+//! the impostor render passes, and the quads drawn into the host frame. Beyond Wang, each
+//! impostor also stores the alpha-weighted depth of its clouds, so the quads put their clouds
+//! back at that depth and the host's depth hides them where its scene is nearer (a mountain
+//! beyond the ring radius among far clouds). Rules and geometry: `layout`. Units: metres, degrees.
 
 mod layout;
 
