@@ -110,6 +110,7 @@ pub struct World {
     blocks: HashMap<BlockIndex, SkyBlock>,
     living: Option<LivingClouds>,
     clouds_config: CloudsConfig,
+    synchronous_clouds: bool,
 }
 
 impl World {
@@ -130,6 +131,7 @@ impl World {
             blocks: HashMap::new(),
             living: None,
             clouds_config: CloudsConfig::builtin(),
+            synchronous_clouds: false,
         }
     }
 
@@ -143,6 +145,13 @@ impl World {
     /// field radius and seed stay the world's.
     pub fn set_clouds_config(&mut self, config: CloudsConfig) {
         self.clouds_config = config;
+    }
+
+    /// When `on`, every frame of [`Self::living_blocks`] waits for the blocks it queued, so what
+    /// a frame shows does not depend on thread timing: for tests and reproducible renders, never
+    /// for a simulator's frame loop (off by default: blocks arrive when generated).
+    pub fn set_synchronous_clouds(&mut self, on: bool) {
+        self.synchronous_clouds = on;
     }
 
     /// Takes a new weather field (built off the frame thread, e.g. by a
@@ -267,7 +276,7 @@ impl World {
         };
         living.field.update(camera_m.truncate(), &weather);
         living.weather = cache.into_inner();
-        if first {
+        if first || self.synchronous_clouds {
             living.field.wait_for_pending();
         }
         living.field.advance(dt_s);
