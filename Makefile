@@ -7,7 +7,7 @@ VULKAN_PACKAGES := mesa-vulkan-drivers libvulkan1
 # Mesa's Vulkan loader complains on every start when this is unset; /tmp silences it.
 export XDG_RUNTIME_DIR ?= /tmp
 
-.PHONY: demo test vulkan fuzz soak
+.PHONY: demo test vulkan fuzz soak pictures
 
 demo: vulkan
 	cargo run --release --quiet -- demo
@@ -22,6 +22,26 @@ test: vulkan
 # five minutes; fails if memory (RSS) or the renderer's GPU buffers grow after the first changes.
 soak: vulkan
 	cargo test --test live -- --ignored --nocapture
+
+# Regenerates the README's pictures: one block of each type (CPU), each theme over Orlando at
+# 2 pm local, and frames along the three shipped flights (lavapipe is enough; ~1 minute).
+SKYCAST := cargo run --quiet --
+METARS := weather/awc-metars-2025-01-27T22Z.cache.csv
+THEME = $(SKYCAST) render --at 28.5,-81.45 --time 2025-01-27T19:00:00Z --size 480x270
+FRAME = $(SKYCAST) render --size 640x360
+pictures: vulkan
+	$(SKYCAST) preview --all --out tests/pictures/types/
+	$(THEME) --weather weather/themes/fair_weather_cumulus.toml --alt-ft 2500 --heading 90 --pitch 6 --out tests/pictures/themes/fair_weather_cumulus.png
+	$(THEME) --weather weather/themes/building_cumulus_cb_line.toml --alt-ft 3000 --heading 90 --pitch 8 --out tests/pictures/themes/building_cumulus_cb_line.png
+	$(THEME) --weather weather/themes/low_stratus_and_fog.toml --alt-ft 2600 --heading 90 --pitch -8 --out tests/pictures/themes/low_stratus_and_fog.png
+	$(THEME) --weather weather/themes/frontal_nimbostratus.toml --alt-ft 900 --heading 90 --pitch 8 --out tests/pictures/themes/frontal_nimbostratus.png
+	$(THEME) --weather weather/themes/high_cirrus.toml --alt-ft 5000 --heading 205 --pitch 20 --out tests/pictures/themes/high_cirrus.png
+	$(FRAME) --weather $(METARS) --at 33.90,-118.36 --alt-ft 3000 --heading 135 --pitch 8 --out tests/pictures/frames/cruise_under_cumulus.png
+	$(FRAME) --weather $(METARS) --at 33.90,-118.36 --alt-ft 5500 --heading 135 --pitch -8 --out tests/pictures/frames/cruise_over_cumulus.png
+	$(FRAME) --weather weather/themes/building_cumulus_cb_line.toml --at 28.392,-81.3 --alt-ft 3000 --heading 0 --pitch 10 --out tests/pictures/frames/cumulonimbus_line.png
+	$(FRAME) --weather $(METARS) --at 29.4270,-98.6080 --alt-ft 5000 --heading 40 --pitch -3 --out tests/pictures/frames/approach_above_deck.png
+	$(FRAME) --weather $(METARS) --at 29.4800,-98.5480 --alt-ft 3300 --heading 40 --pitch -3 --out tests/pictures/frames/approach_in_deck.png
+	$(FRAME) --weather $(METARS) --at 29.5230,-98.5000 --alt-ft 1500 --heading 40 --pitch 10 --out tests/pictures/frames/approach_below_deck.png
 
 # Runs every cargo-fuzz target for FUZZ_SECONDS each (see fuzz/README.md); needs cargo-fuzz.
 FUZZ_SECONDS ?= 120

@@ -768,9 +768,9 @@ mod golden {
         assert_eq!(
             hashes,
             [
-                "509af9a53b3d460e",
+                "3c1c7251d7d87b07",
                 "6ca8c91263fd5bf1",
-                "1fc363a4cc5f919a",
+                "912bf15ef04ff3e5",
                 "0f4dac4f3a2b26f9"
             ]
         );

@@ -42,7 +42,7 @@ pub(super) fn heap_sprites(
 
     // The base: a jittered grid of flat-bottomed sprites over the bottom box's footprint.
     let w_mean = 0.5 * (wmin + wmax);
-    let step = 0.72 * w_mean;
+    let step = 0.85 * w_mean;
     let rim = (base_half_w - 0.3 * w_mean).max(0.3 * base_half_w);
     let m = ((2.0 * rim / step).ceil() as i64).clamp(1, 12);
     let cell = 2.0 * rim / m as f64;

@@ -285,12 +285,12 @@ impl PuffShape {
         let lobes = (0..n)
             .map(|k| {
                 if flat_bottom {
-                    // Lobes sit on a dome: wide at the bottom, one or two higher in the middle.
+                    // Lobes sit on a low, broad loaf: a rounded top over a wide flat underside.
                     let t = (k as f32 + 0.5) / n as f32;
                     let rise = 1.0 - (2.0 * t - 1.0).abs();
-                    let r = 0.15 + 0.10 * rise + rng.range_f32(-0.02, 0.03);
-                    let lu = 0.2 + 0.6 * t + rng.range_f32(-0.04, 0.04);
-                    let lv = base_v - r * 0.5 - 0.2 * rise + rng.range_f32(-0.03, 0.03);
+                    let r = 0.17 + 0.06 * rise + rng.range_f32(-0.02, 0.03);
+                    let lu = 0.18 + 0.64 * t + rng.range_f32(-0.03, 0.03);
+                    let lv = base_v - r * 0.5 - 0.1 * rise + rng.range_f32(-0.03, 0.03);
                     (lu, lv, r)
                 } else if k == 0 {
                     (0.5, 0.5, 0.24)
