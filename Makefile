@@ -30,6 +30,8 @@ METARS := weather/awc-metars-2025-01-27T22Z.cache.csv
 THEME = $(SKYCAST) render --at 28.5,-81.45 --time 2025-01-27T19:00:00Z --size 480x270
 FRAME = $(SKYCAST) render --size 640x360
 pictures: vulkan
+	$(SKYCAST) sheet --out /tmp/skycast-sheet.png --over-sky tests/pictures/sheet_over_sky.png
+	$(SKYCAST) preview --type cumulus_mediocris --lifecycle --out tests/pictures/lifecycle.png
 	$(SKYCAST) preview --all --out tests/pictures/types/
 	$(THEME) --weather weather/themes/fair_weather_cumulus.toml --alt-ft 2500 --heading 90 --pitch 6 --out tests/pictures/themes/fair_weather_cumulus.png
 	$(THEME) --weather weather/themes/building_cumulus_cb_line.toml --alt-ft 3000 --heading 90 --pitch 8 --out tests/pictures/themes/building_cumulus_cb_line.png
@@ -38,7 +40,7 @@ pictures: vulkan
 	$(THEME) --weather weather/themes/high_cirrus.toml --alt-ft 5000 --heading 205 --pitch 20 --out tests/pictures/themes/high_cirrus.png
 	$(FRAME) --weather $(METARS) --at 33.90,-118.36 --alt-ft 3000 --heading 135 --pitch 8 --out tests/pictures/frames/cruise_under_cumulus.png
 	$(FRAME) --weather $(METARS) --at 33.90,-118.36 --alt-ft 5500 --heading 135 --pitch -8 --out tests/pictures/frames/cruise_over_cumulus.png
-	$(FRAME) --weather weather/themes/building_cumulus_cb_line.toml --at 28.392,-81.3 --alt-ft 3000 --heading 0 --pitch 10 --out tests/pictures/frames/cumulonimbus_line.png
+	$(FRAME) --weather weather/themes/building_cumulus_cb_line.toml --at 28.5,-81.62 --alt-ft 3000 --heading 90 --pitch 10 --out tests/pictures/frames/cumulonimbus_line.png
 	$(FRAME) --weather $(METARS) --at 29.4270,-98.6080 --alt-ft 5000 --heading 40 --pitch -3 --out tests/pictures/frames/approach_above_deck.png
 	$(FRAME) --weather $(METARS) --at 29.4800,-98.5480 --alt-ft 3300 --heading 40 --pitch -3 --out tests/pictures/frames/approach_in_deck.png
 	$(FRAME) --weather $(METARS) --at 29.5230,-98.5000 --alt-ft 1500 --heading 40 --pitch 10 --out tests/pictures/frames/approach_below_deck.png

@@ -768,9 +768,9 @@ mod golden {
         assert_eq!(
             hashes,
             [
-                "3c1c7251d7d87b07",
+                "eeb78ba381b1c4cc",
                 "6ca8c91263fd5bf1",
-                "912bf15ef04ff3e5",
+                "aebcb5666d0d72d6",
                 "0f4dac4f3a2b26f9"
             ]
         );

@@ -48,8 +48,8 @@ pub(super) fn heap_sprites(
     let cell = 2.0 * rim / m as f64;
     for gy in 0..m {
         for gx in 0..m {
-            let x = -rim + cell * (gx as f64 + 0.5 + rng.range_f64(-0.25, 0.25));
-            let y = -rim + cell * (gy as f64 + 0.5 + rng.range_f64(-0.25, 0.25));
+            let x = -rim + cell * (gx as f64 + 0.5 + rng.range_f64(-0.4, 0.4));
+            let y = -rim + cell * (gy as f64 + 0.5 + rng.range_f64(-0.4, 0.4));
             if x * x + y * y > rim * rim {
                 continue;
             }

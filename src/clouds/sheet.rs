@@ -288,9 +288,9 @@ impl PuffShape {
                     // Lobes sit on a low, broad loaf: a rounded top over a wide flat underside.
                     let t = (k as f32 + 0.5) / n as f32;
                     let rise = 1.0 - (2.0 * t - 1.0).abs();
-                    let r = 0.17 + 0.06 * rise + rng.range_f32(-0.02, 0.03);
-                    let lu = 0.18 + 0.64 * t + rng.range_f32(-0.03, 0.03);
-                    let lv = base_v - r * 0.5 - 0.1 * rise + rng.range_f32(-0.03, 0.03);
+                    let r = 0.16 + 0.08 * rise + rng.range_f32(-0.02, 0.03);
+                    let lu = 0.2 + 0.6 * t + rng.range_f32(-0.03, 0.03);
+                    let lv = base_v - r * 0.5 - 0.15 * rise + rng.range_f32(-0.03, 0.03);
                     (lu, lv, r)
                 } else if k == 0 {
                     (0.5, 0.5, 0.24)
