@@ -713,7 +713,7 @@ mod tests {
             ),
             (
                 "cumulus_humilis",
-                "textures = [\"flat_bottom\", \"flat_bottom\", \"foggy\"]",
+                "textures = [\"flat_bottom\", \"foggy\"]",
                 "textures = []",
                 "texture_bands",
             ),

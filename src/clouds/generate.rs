@@ -275,8 +275,9 @@ pub(super) struct Raw {
     pub(super) width: f64,
     pub(super) height: f64,
     pub(super) group: u32,
-    /// Stands on the cloud base: takes the first texture band (flat-bottomed, small rotation).
-    pub(super) base: bool,
+    /// Stands on the cloud base: takes the first texture band (small rotation), this category of
+    /// it where the band has it (flat-bottomed on the rim, foggy under the inside).
+    pub(super) base: Option<TextureCategory>,
 }
 
 /// Builds one cloud of `d` metres diameter centred (horizontally) at `centre`; returns the cloud
@@ -379,7 +380,7 @@ fn build_cloud(
                 width,
                 height,
                 group: group - 1,
-                base: false,
+                base: None,
             });
         }
     }
@@ -431,7 +432,7 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
     for (r, &g) in kept.iter().zip(&sprite_groups) {
         let fraction = (r.pos.z / thickness).clamp(0.0, 1.0) as f32;
         // A sprite standing on the base takes the first band (flat-bottomed, small rotation).
-        let band = if r.base {
+        let band = if r.base.is_some() {
             config.texture_bands.first()
         } else {
             config.band_at(fraction)
@@ -443,7 +444,11 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
             _ => (&[TextureCategory::Wispy][..], [0.0, 360.0]),
         };
         let pick = rng.range_u32(0, categories.len() as u32 - 1) as usize;
-        let cells = categories[pick].cells();
+        let category = match r.base {
+            Some(wanted) if categories.contains(&wanted) => wanted,
+            _ => categories[pick],
+        };
+        let cells = category.cells();
         let texture = rng.range_u32(cells.start as u32, cells.end as u32 - 1) as u8;
         let square = (r.height - r.width).abs() < 1e-6 * r.width.max(1.0);
         let rotation_deg = if square {
@@ -768,9 +773,9 @@ mod golden {
         assert_eq!(
             hashes,
             [
-                "eeb78ba381b1c4cc",
+                "46b08cfd5a004d7a",
                 "6ca8c91263fd5bf1",
-                "aebcb5666d0d72d6",
+                "55be694be1633ff5",
                 "0f4dac4f3a2b26f9"
             ]
         );

@@ -1,8 +1,9 @@
 //! Heaped clouds (cumulus, cumulonimbus): Wang 2003 §3.1's few boxes of sprites, shaped.
 //!
-//! A heap stands on the layer's base: a row of flat-bottomed sprites whose flat undersides lie
-//! exactly on the base (Wang's flat-bottomed texture with a small rotation), so every cloud of a
-//! layer shows the same flat, level base; above it a stack of boxes, the widest at the bottom,
+//! A heap stands on the layer's base: a row of sprites whose flat undersides lie exactly on the
+//! base (Wang's flat-bottomed texture with a small rotation on the rim, foggy ones under the
+//! inside where only a view from below sees them), so every cloud of a layer shows the same flat,
+//! level base; above it a stack of boxes, the widest at the bottom,
 //! each one higher narrower (`taper`) and shifted a little, never past the base's rim. Sprite
 //! centres are drawn inside an ellipsoid per box, denser towards its core, so the heap is
 //! rounded and ends in a dome. A cumulonimbus tower ends in an anvil: a slab `width_scale` times
@@ -13,7 +14,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::config::CloudTypeConfig;
+use super::config::{CloudTypeConfig, TextureCategory};
 use super::generate::Raw;
 use super::rng::SplitMix64;
 use super::sheet::FLAT_BOTTOM_V;
@@ -59,7 +60,13 @@ pub(super) fn heap_sprites(
                 width,
                 height,
                 group: group + (gx / 3 + gy / 3 * 4) as u32,
-                base: true,
+                // Flat-bottomed on the rim (what a side view shows), foggy under the inside
+                // (what a view from below shows: a smooth grey underside).
+                base: Some(if x * x + y * y < 0.36 * rim * rim {
+                    TextureCategory::Foggy
+                } else {
+                    TextureCategory::FlatBottom
+                }),
             });
         }
     }
@@ -128,7 +135,7 @@ pub(super) fn heap_sprites(
                 width,
                 height,
                 group: group - 1,
-                base: false,
+                base: None,
             });
         }
     }
@@ -166,7 +173,7 @@ pub(super) fn heap_sprites(
                 width,
                 height,
                 group: group - 1,
-                base: false,
+                base: None,
             });
         }
     }
