@@ -640,6 +640,81 @@ mod tests {
     }
 
     #[test]
+    fn cumulus_stand_on_a_flat_base_and_narrow_upwards() {
+        let bc = crate::clouds::heap::BASE_CENTRE_FRACTION;
+        for t in [
+            CloudType::CumulusHumilis,
+            CloudType::CumulusMediocris,
+            CloudType::CumulusCongestus,
+        ] {
+            let block = generate_block(
+                BlockIndex::new(2, 2),
+                &weather(t, 3.0, 4000.0, 8000.0),
+                9,
+                types(),
+            );
+            let base = block.layers[0].base_m as f64;
+            let shaped = block
+                .clouds
+                .iter()
+                .filter(|c| c.sprites.len() >= 30)
+                .count();
+            assert!(shaped >= 2, "{t}: {shaped} clouds with a shape");
+            for c in &block.clouds {
+                let z = |s: &Sprite| c.centre_m.z + s.offset_m[2] as f64;
+                // Nothing hangs below the base; a row stands exactly on it, flat-bottomed on
+                // its rim.
+                let on_base: Vec<&Sprite> = c
+                    .sprites
+                    .iter()
+                    .filter(|s| (z(s) - bc * s.height_m as f64 - base).abs() < 0.05)
+                    .collect();
+                for s in &c.sprites {
+                    assert!(
+                        z(s) - bc * s.height_m as f64 >= base - 0.05,
+                        "{t}: below base"
+                    );
+                }
+                assert!(
+                    !on_base.is_empty(),
+                    "{t}: {} sprites on the base",
+                    on_base.len()
+                );
+                assert!(
+                    on_base
+                        .iter()
+                        .any(|s| crate::clouds::TextureCategory::of_cell(s.texture)
+                            == crate::clouds::TextureCategory::FlatBottom),
+                    "{t}: no flat-bottomed sprite on the base"
+                );
+                // Rounded: the top third is narrower than the bottom third (for clouds big
+                // enough to have a shape; the shrunk last clouds of a layer are a few sprites).
+                if c.sprites.len() < 30 {
+                    continue;
+                }
+                let (lo, hi) = c
+                    .sprites
+                    .iter()
+                    .map(z)
+                    .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+                let extent = |from: f64, to: f64| {
+                    c.sprites
+                        .iter()
+                        .filter(|s| (from..=to).contains(&((z(s) - lo) / (hi - lo).max(1.0))))
+                        .map(|s| s.offset_m[0].hypot(s.offset_m[1]))
+                        .fold(0.0f32, f32::max)
+                };
+                assert!(
+                    extent(0.67, 1.0) < extent(0.0, 0.33),
+                    "{t}: top {} bottom {}",
+                    extent(0.67, 1.0),
+                    extent(0.0, 0.33)
+                );
+            }
+        }
+    }
+
+    #[test]
     fn coverage_is_honoured_for_every_cover_code() {
         // FEW 1-2, SCT 3-4, BKN 5-7, OVC 8 oktas, for heaped and layered types.
         for t in [
@@ -773,9 +848,9 @@ mod golden {
         assert_eq!(
             hashes,
             [
-                "46b08cfd5a004d7a",
+                "c6516121a3e3a2c2",
                 "6ca8c91263fd5bf1",
-                "55be694be1633ff5",
+                "94e59f42d13ef325",
                 "0f4dac4f3a2b26f9"
             ]
         );

@@ -20,7 +20,7 @@ use super::rng::SplitMix64;
 use super::sheet::FLAT_BOTTOM_V;
 
 /// Centre height of a base sprite above the base, in sprite heights: its flat underside on it.
-pub(super) const BASE_CENTRE_FRACTION: f64 = FLAT_BOTTOM_V as f64 - 0.5;
+pub(crate) const BASE_CENTRE_FRACTION: f64 = FLAT_BOTTOM_V as f64 - 0.5;
 
 /// Sprites of one heaped cloud of `d` metres diameter, `thickness` metres tall, and its box count.
 pub(super) fn heap_sprites(
@@ -49,10 +49,20 @@ pub(super) fn heap_sprites(
     let cell = 2.0 * rim / m as f64;
     for gy in 0..m {
         for gx in 0..m {
-            let x = -rim + cell * (gx as f64 + 0.5 + rng.range_f64(-0.4, 0.4));
-            let y = -rim + cell * (gy as f64 + 0.5 + rng.range_f64(-0.4, 0.4));
-            if x * x + y * y > rim * rim {
+            // Cells whose centre lies in the footprint disc; the jittered point kept inside it.
+            let (cx, cy) = (
+                -rim + cell * (gx as f64 + 0.5),
+                -rim + cell * (gy as f64 + 0.5),
+            );
+            if cx * cx + cy * cy > rim * rim {
                 continue;
+            }
+            let mut x = cx + cell * rng.range_f64(-0.4, 0.4);
+            let mut y = cy + cell * rng.range_f64(-0.4, 0.4);
+            let r2 = x * x + y * y;
+            if r2 > rim * rim {
+                let k = rim / r2.sqrt();
+                (x, y) = (x * k, y * k);
             }
             let (width, height) = sprite(rng);
             raws.push(Raw {
@@ -61,8 +71,9 @@ pub(super) fn heap_sprites(
                 height,
                 group: group + (gx / 3 + gy / 3 * 4) as u32,
                 // Flat-bottomed on the rim (what a side view shows), foggy under the inside
-                // (what a view from below shows: a smooth grey underside).
-                base: Some(if x * x + y * y < 0.36 * rim * rim {
+                // (what a view from below shows: a smooth grey underside); a small cloud's few
+                // are all rim.
+                base: Some(if m >= 3 && x * x + y * y < 0.36 * rim * rim {
                     TextureCategory::Foggy
                 } else {
                     TextureCategory::FlatBottom
