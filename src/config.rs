@@ -59,7 +59,13 @@ pub fn load_toml<T: DeserializeOwned>(path: &Path) -> Result<T, ConfigError> {
 
 /// Parses TOML text that came from `path` (used in messages only).
 pub fn parse_toml<T: DeserializeOwned>(text: &str, path: &Path) -> Result<T, ConfigError> {
-    toml::from_str(text).map_err(|err| {
+    toml::from_str(text).map_err(|err| ConfigError::from_toml(path, text, &err))
+}
+
+impl ConfigError {
+    /// The error of a failed TOML parse of `text` (from `path`): its line, the field at fault
+    /// and toml's message.
+    pub fn from_toml(path: &Path, text: &str, err: &toml::de::Error) -> Self {
         let line = err.span().map(|span| line_of(text, span.start));
         let message = err.message().trim_end().to_string();
         // serde names the field in "missing field `x`" and "unknown field `x`"; otherwise the
@@ -69,17 +75,14 @@ pub fn parse_toml<T: DeserializeOwned>(text: &str, path: &Path) -> Result<T, Con
         let field = names_field
             .then(|| backticked(&message))
             .flatten()
-            .or_else(|| {
-                let span = err.span()?;
-                key_on_line(text, span.start)
-            });
+            .or_else(|| key_on_line(text, err.span()?.start));
         ConfigError {
             path: path.to_path_buf(),
             line,
             field,
             message,
         }
-    })
+    }
 }
 
 /// 1-based line number of a byte offset.

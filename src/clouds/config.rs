@@ -12,6 +12,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::CloudsError;
+use crate::config::{ConfigError, line_of};
 use crate::weather::CloudType;
 
 /// The texture categories of the sheet (Wang 2003 §3.2, figure 6).
@@ -238,7 +239,7 @@ impl CloudTypes {
             if CloudType::from_name(name).is_none() {
                 return Err(CloudsError::Parse {
                     path: path.to_owned(),
-                    line: line_of_offset(text, spanned.span().start),
+                    line: line_of(text, spanned.span().start),
                     field: name.clone(),
                     message: format!(
                         "unknown cloud type; expected one of: {}",
@@ -365,12 +366,6 @@ fn read(path: &Path) -> Result<String, CloudsError> {
     })
 }
 
-/// 1-based line of a byte offset.
-fn line_of_offset(text: &str, offset: usize) -> usize {
-    text.get(..offset.min(text.len()))
-        .map_or(1, |head| head.matches('\n').count() + 1)
-}
-
 /// The `[section]` header before a byte offset, if any.
 fn section_before(text: &str, offset: usize) -> Option<String> {
     let head = text.get(..offset.min(text.len()))?;
@@ -381,29 +376,20 @@ fn section_before(text: &str, offset: usize) -> Option<String> {
     })
 }
 
-/// Turns a toml error into one naming the line and the field.
+/// Turns a toml error into one naming the line and the field, qualified by its `[section]`.
 fn toml_error(path: &Path, text: &str, err: &toml::de::Error) -> CloudsError {
+    let base = ConfigError::from_toml(path, text, err);
     let offset = err.span().map_or(0, |s| s.start);
-    let line = line_of_offset(text, offset);
-    let message = err.message().trim().to_owned();
-    // serde names the field in backticks ("missing field `x`", "unknown field `y`").
-    let named = message.split('`').nth(1).map(str::to_owned);
-    let key_on_line = text
-        .lines()
-        .nth(line.saturating_sub(1))
-        .and_then(|l| l.split_once('='))
-        .map(|(k, _)| k.trim().to_owned())
-        .filter(|k| !k.is_empty() && !k.starts_with('['));
-    let key = named.or(key_on_line).unwrap_or_else(|| "?".to_owned());
+    let key = base.field.unwrap_or_else(|| "?".to_owned());
     let field = match section_before(text, offset + 1) {
         Some(section) if section != key => format!("{section}.{key}"),
         _ => key,
     };
     CloudsError::Parse {
         path: path.to_owned(),
-        line,
+        line: base.line.unwrap_or(1),
         field,
-        message,
+        message: base.message,
     }
 }
 
