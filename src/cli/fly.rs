@@ -20,13 +20,12 @@ use anyhow::Context;
 use clap::Args;
 use skycast::clouds::CloudsConfig;
 use skycast::flight::FlightPlan;
-use skycast::render::world::{World, WorldSettings};
 use skycast::render::{DemoHost, SkyConfig};
 use skycast::shading::sun_position;
 use skycast::weather::live::{LiveChange, LiveWeather, Prepare};
 use skycast::weather::{LocalFrame, StationTable, WeatherField, theme};
 
-use super::render::{DEFAULT_TIME, load_look, parse_size, parse_time};
+use super::render::{load_look, parse_size, parse_time, time_or_default, world_at};
 use super::weather::{DEFAULT_STATIONS, load};
 
 /// Flags of `skycast fly`.
@@ -87,16 +86,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let flight = plan.place(&LocalFrame::new(lat, lon));
     let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
     let loaded = load(&args.weather, &args.stations, None, None)?;
-    let start_unix_s = match args.time {
-        Some(t) => t,
-        None => parse_time(DEFAULT_TIME).map_err(anyhow::Error::msg)?,
-    };
-    let mut world = World::new(
-        loaded
-            .input
-            .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule),
-        &WorldSettings::default(),
-    );
+    let start_unix_s = time_or_default(args.time)?;
+    let mut world = world_at(&loaded, lat, lon);
     if let Some(path) = &args.clouds {
         world.set_clouds_config(CloudsConfig::load(path)?);
     }

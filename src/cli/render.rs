@@ -10,14 +10,15 @@ use skycast::render::{DemoHost, RenderSettings, SkyConfig};
 use skycast::shading::{TimeOfDayTable, sun_position};
 use skycast::weather::LocalFrame;
 
-use super::weather::{DEFAULT_STATIONS, load, parse_lat_lon};
+use super::weather::{DEFAULT_STATIONS, Loaded, load, parse_lat_lon};
 
 const METRES_PER_FOOT: f64 = 0.3048;
 
 /// Flags of `skycast render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// The weather file: metars.cache.csv, a NOAA cycle file, or one METAR a line.
+    /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, or a weather
+    /// theme (`.toml`).
     #[arg(long)]
     pub weather: PathBuf,
     /// Station table placing reports the file does not place.
@@ -85,6 +86,21 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((side(w)?, side(h)?))
 }
 
+/// The time a `--time` flag gives, or the shipped weather file's ([`DEFAULT_TIME`]), Unix seconds.
+pub fn time_or_default(time: Option<f64>) -> anyhow::Result<f64> {
+    match time {
+        Some(t) => Ok(t),
+        None => parse_time(DEFAULT_TIME).map_err(anyhow::Error::msg),
+    }
+}
+
+/// The demo world of loaded weather, in the local frame around `lat`, `lon` (degrees).
+pub fn world_at(loaded: &Loaded, lat: f64, lon: f64) -> World {
+    let frame = LocalFrame::new(lat, lon);
+    let field = loaded.input.field(frame, &loaded.settings, &loaded.rule);
+    World::new(field, &WorldSettings::default())
+}
+
 /// Loads the renderer settings and time-of-day table the flags name (or the shipped ones).
 pub fn load_look(
     render: Option<&PathBuf>,
@@ -109,16 +125,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
     let loaded = load(&args.weather, &args.stations, None, None)?;
-    let unix_s = match args.time {
-        Some(t) => t,
-        None => parse_time(DEFAULT_TIME).map_err(anyhow::Error::msg)?,
-    };
-    let mut world = World::new(
-        loaded
-            .input
-            .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule),
-        &WorldSettings::default(),
-    );
+    let unix_s = time_or_default(args.time)?;
+    let mut world = world_at(&loaded, lat, lon);
     let sheet = world.sheet();
     let mut host = DemoHost::new(
         args.size.0,
