@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod bench;
 mod block;
 mod demo;
 mod fly;
@@ -43,6 +44,9 @@ enum Command {
     Preview(preview::PreviewArgs),
     /// The cloud block at a place: its layers and types, clouds, sprites and overdraw.
     Block(block::BlockArgs),
+    /// The frame-budget benchmark: the three overdraw scenarios along one path, impostors on
+    /// and off; a table, bench.csv and a plot of frame time.
+    Bench(bench::BenchArgs),
 }
 
 /// Runs the command line and maps errors to a message on standard error and exit status 2.
@@ -66,6 +70,7 @@ pub fn main() -> ExitCode {
         Command::Sheet(args) => sheet::run(&args),
         Command::Preview(args) => preview::run(&args),
         Command::Block(args) => block::run(&args),
+        Command::Bench(args) => bench::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -11,6 +11,7 @@ use glam::DVec2;
 
 use super::RenderError;
 use super::camera::Camera;
+use super::gpu_types::GpuSpriteVertex;
 use super::headless::{self, Frame, HeadlessGpu, OffscreenTarget};
 use super::sky::{Sky, SkyConfig};
 use super::terrain::{HeightField, Terrain, TerrainLight, procedural_relief_m};
@@ -184,6 +185,29 @@ impl DemoHost {
     /// has timestamp queries. Waits for the frame.
     pub fn last_gpu_ms(&self) -> Option<f64> {
         self.timer.as_ref()?.read_ms(&self.gpu)
+    }
+
+    /// Waits until the device has finished everything submitted (the benchmark's wall-time
+    /// frame clock where the device has no timestamp queries).
+    pub fn wait_idle(&self) -> Result<(), RenderError> {
+        self.gpu
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| RenderError::Device(e.to_string()))
+    }
+
+    /// The most sprites the sky can draw at once as sprites on this device: its vertex buffer
+    /// (four [`GpuSpriteVertex`]es a sprite) grows in powers of two up to the device's largest
+    /// buffer.
+    pub fn max_sprites(&self) -> u64 {
+        let per_sprite = 4 * std::mem::size_of::<GpuSpriteVertex>() as u64;
+        let fit = self.gpu.device.limits().max_buffer_size / per_sprite;
+        if fit == 0 {
+            0
+        } else {
+            1 << (63 - fit.leading_zeros())
+        }
     }
 
     /// Draws one frame and reads it back.

@@ -1,0 +1,537 @@
+//! `skycast bench [--size WxH] [--frames N] [--out DIR]`: the frame-budget benchmark of issue 6
+//! (Wang 2003 section 6.3, figure 15). The three scenarios of `weather/scenarios/` (sparse,
+//! scattered, overcast: about 170 %, 200 % and 475 % block overdraw) are flown along the same
+//! straight path, a cruise due east at 5,000 ft above the scenario's station, each once with
+//! the impostor ring (far blocks in impostors) and once without (every block as sprites). Both
+//! runs see the same view: clouds out to the ring's view radius, sprites drawn that far.
+//!
+//! Out: one table on standard output headed by the adapter's name (scenario, block overdraw,
+//! median and p95 frame milliseconds, the off/on ratio of the medians, sprites drawn and CPU
+//! update milliseconds, per scenario with impostors on and off); the same rows as `bench.csv`,
+//! every frame in `frames.csv`, and `frame_time.png`, frame time along the path. Frame time is
+//! the GPU time between timestamps around the frame's passes where the adapter has timestamp
+//! queries, else the wall time from submit to the end of the poll-wait; the table says which.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use clap::Args;
+use glam::{DVec2, DVec3};
+use skycast::clouds::{CloudTypes, generate_block};
+use skycast::render::world::{World, WorldSettings};
+use skycast::render::{DemoHost, RenderSettings, SkyConfig};
+use skycast::shading::{TimeOfDayTable, sun_position};
+use skycast::weather::{
+    BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, StationTable, WeatherInput,
+};
+
+use super::render::{DEFAULT_TIME, load_look, parse_size, parse_time};
+use super::weather::DEFAULT_STATIONS;
+
+mod plot;
+
+const METRES_PER_FOOT: f64 = 0.3048;
+/// The scenarios, in the order of the table.
+const SCENARIOS: [&str; 3] = ["sparse", "scattered", "overcast"];
+/// The path: due east, centred on the station, this long, at this height above its ground.
+const PATH_LENGTH_M: f64 = 12_000.0;
+const CRUISE_FT_AGL: f64 = 5_000.0;
+const PITCH_DEG: f64 = -3.0;
+/// Cruise speed, metres a second: sets the simulated time step between frames.
+const SPEED_M_S: f64 = 120.0;
+
+/// Flags of `skycast bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Image size, WIDTHxHEIGHT pixels.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Frames per run (spread evenly along the path), at least 2.
+    #[arg(long, default_value_t = 120)]
+    pub frames: u32,
+    /// Directory for bench.csv, frames.csv and frame_time.png (created).
+    #[arg(long, default_value = "out/bench")]
+    pub out: PathBuf,
+    /// Directory holding sparse.metar, scattered.metar and overcast.metar.
+    #[arg(long, default_value = "weather/scenarios")]
+    pub scenarios: PathBuf,
+    /// Station table placing the scenario reports.
+    #[arg(long, default_value = DEFAULT_STATIONS)]
+    pub stations: PathBuf,
+    /// Renderer settings (default: the shipped config/render.toml); `[impostors]` is switched on
+    /// and off by the benchmark.
+    #[arg(long)]
+    pub render_settings: Option<PathBuf>,
+    /// View radius, kilometres: clouds out to here, far ones in impostors or all as sprites
+    /// (default: the view radius of the renderer settings' `[impostors]`).
+    #[arg(long)]
+    pub view_km: Option<f64>,
+    /// Time-of-day table (default: the shipped config/time_of_day.toml).
+    #[arg(long)]
+    pub time_of_day: Option<PathBuf>,
+    /// UTC time, RFC 3339 (default: the shipped weather file's time).
+    #[arg(long, value_parser = parse_time)]
+    pub time: Option<f64>,
+}
+
+/// One frame of one run.
+struct FrameRecord {
+    distance_m: f64,
+    frame_ms: f64,
+    cpu_update_ms: f64,
+    sprites_drawn: u32,
+    blocks_near: u32,
+    blocks_far: u32,
+    impostors_rebuilt: u32,
+}
+
+/// One run: a scenario with impostors on or off.
+struct Run {
+    scenario: &'static str,
+    overdraw: f64,
+    impostors: bool,
+    frames: Vec<FrameRecord>,
+    /// Sprites in view where the run could not be drawn (too many for the device).
+    not_drawn: Option<u64>,
+}
+
+/// The `p`-quantile (0..=1) of `values`, nearest rank.
+fn quantile(values: &[f64], p: f64) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let rank = ((p * v.len() as f64).ceil() as usize).clamp(1, v.len());
+    v[rank - 1]
+}
+
+impl Run {
+    fn frame_ms(&self) -> Vec<f64> {
+        self.frames.iter().map(|f| f.frame_ms).collect()
+    }
+    fn median_ms(&self) -> f64 {
+        quantile(&self.frame_ms(), 0.5)
+    }
+    fn p95_ms(&self) -> f64 {
+        quantile(&self.frame_ms(), 0.95)
+    }
+    fn median_of(&self, f: impl Fn(&FrameRecord) -> f64) -> f64 {
+        quantile(&self.frames.iter().map(f).collect::<Vec<_>>(), 0.5)
+    }
+}
+
+/// Mean overdraw of the 5 x 5 blocks around block (0, 0) (as `tests/clouds/scenarios.rs`).
+fn mean_overdraw(world: &World, seed: u64) -> f64 {
+    let types = CloudTypes::builtin();
+    let weather = world.field().block_weather(BlockIndex::new(0, 0));
+    let sum: f64 = (-2..=2)
+        .flat_map(|j| (-2..=2).map(move |i| BlockIndex::new(i, j)))
+        .map(|index| generate_block(index, &weather, seed, &types).overdraw())
+        .sum();
+    sum / 25.0
+}
+
+/// The scenario's world, centred on its one station.
+fn scenario_world(
+    dir: &Path,
+    name: &str,
+    stations: &StationTable,
+    settings: &WorldSettings,
+) -> anyhow::Result<(World, (f64, f64))> {
+    let path = dir.join(format!("{name}.metar"));
+    let input = WeatherInput::load(&path, Some(stations))?;
+    let WeatherInput::Reports(file) = &input else {
+        anyhow::bail!(
+            "{}: a scenario is a report file, not a theme",
+            path.display()
+        );
+    };
+    let Some(report) = file.reports.first() else {
+        anyhow::bail!("{}: no report placed", path.display());
+    };
+    let at = (report.position.latitude_deg, report.position.longitude_deg);
+    let field = input.field(
+        LocalFrame::new(at.0, at.1),
+        &FieldSettings::default(),
+        &CloudTypeRule::default(),
+    );
+    Ok((World::new(field, settings), at))
+}
+
+/// What the runs share: the look, the size, the frame count and the time.
+struct Setup {
+    settings: RenderSettings,
+    table: TimeOfDayTable,
+    size: (u32, u32),
+    frames: u32,
+    unix_s: f64,
+}
+
+/// What a run came to.
+enum Flown {
+    /// Its frames, the adapter's name and whether GPU timestamps timed them.
+    Frames {
+        frames: Vec<FrameRecord>,
+        adapter: String,
+        timestamps: bool,
+    },
+    /// Without impostors, the view holds more sprites than the device can draw at once.
+    TooMany { sprites: u64, max_sprites: u64 },
+}
+
+/// Flies one run.
+fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> anyhow::Result<Flown> {
+    let mut settings = setup.settings;
+    settings.impostors.enabled = impostors;
+    let mut host = DemoHost::new(
+        setup.size.0,
+        setup.size.1,
+        world.ground(),
+        SkyConfig {
+            colour_format: skycast::render::headless::COLOUR_FORMAT,
+            settings,
+            time_of_day: setup.table.clone(),
+            sheet: world.sheet(),
+        },
+    )?;
+    let adapter = format!(
+        "{} ({:?})",
+        host.gpu.adapter_info.name, host.gpu.adapter_info.backend
+    );
+    let alt_m = world.ground().height_at_m(DVec2::ZERO) + CRUISE_FT_AGL * METRES_PER_FOOT;
+    let sun = sun_position(setup.unix_s, at.0, at.1);
+    let visibility_m = world.visibility_m();
+    let step_m = PATH_LENGTH_M / (setup.frames - 1) as f64;
+    let dt_s = step_m / SPEED_M_S;
+    let position = |k: u32| DVec3::new(-PATH_LENGTH_M / 2.0 + k as f64 * step_m, 0.0, alt_m);
+    let mut indices = Vec::new();
+    let mut records = Vec::new();
+    let mut timestamps = true;
+    // Frame 0 is drawn twice: the first (pipelines warming up, the whole ring built at once) is
+    // not counted.
+    for k in std::iter::once(0).chain(0..setup.frames) {
+        let p = position(k);
+        let now = world.block_indices(p);
+        if now != indices {
+            let blocks = world.sky_blocks(&now);
+            let sprites: u64 = blocks
+                .iter()
+                .flat_map(|b| &b.clouds)
+                .map(|c| c.sprites.len() as u64)
+                .sum();
+            if !impostors && sprites > host.max_sprites() {
+                // All of them as sprites do not fit the device's largest buffer.
+                return Ok(Flown::TooMany {
+                    sprites,
+                    max_sprites: host.max_sprites(),
+                });
+            }
+            host.sky.set_clouds(blocks);
+            indices = now;
+        }
+        let camera = host.camera(p, 90.0, PITCH_DEG);
+        let start = Instant::now();
+        let stats = host.draw(&camera, &sun, dt_s, visibility_m);
+        let frame_ms = match host.last_gpu_ms() {
+            Some(ms) => ms,
+            None => {
+                timestamps = false;
+                host.wait_idle()?;
+                // Submit to the end of the wait: the draw call minus its CPU update.
+                (start.elapsed().as_secs_f64() * 1e3 - stats.cpu_update_us as f64 / 1e3).max(0.0)
+            }
+        };
+        records.push(FrameRecord {
+            distance_m: k as f64 * step_m,
+            frame_ms,
+            cpu_update_ms: stats.cpu_update_us as f64 / 1e3,
+            sprites_drawn: stats.sprites_drawn,
+            blocks_near: stats.blocks_near,
+            blocks_far: stats.blocks_far,
+            impostors_rebuilt: stats.impostors_rebuilt,
+        });
+    }
+    records.remove(0);
+    Ok(Flown::Frames {
+        frames: records,
+        adapter,
+        timestamps,
+    })
+}
+
+/// Runs `skycast bench`.
+pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    if args.frames < 2 {
+        anyhow::bail!("--frames {} is less than 2", args.frames);
+    }
+    let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
+    let unix_s = match args.time {
+        Some(t) => t,
+        None => parse_time(DEFAULT_TIME).map_err(anyhow::Error::msg)?,
+    };
+    let stations =
+        StationTable::load(&args.stations).context("station table (choose one with --stations)")?;
+    let view_radius_m = match args.view_km {
+        Some(km) if (1.0..=200.0).contains(&km) => km * 1000.0,
+        Some(km) => anyhow::bail!("--view-km {km} is outside 1..=200"),
+        None => settings.impostors.view_radius_m,
+    };
+    // The same view with and without impostors: clouds out to the view radius, sprites drawn
+    // that far.
+    let mut setup = Setup {
+        settings,
+        table,
+        size: args.size,
+        frames: args.frames,
+        unix_s,
+    };
+    setup.settings.impostors.view_radius_m = view_radius_m;
+    let clouds = &mut setup.settings.clouds;
+    clouds.draw_distance_m = clouds.draw_distance_m.max(view_radius_m as f32);
+    let world_settings = WorldSettings {
+        cloud_radius_m: view_radius_m,
+        ..WorldSettings::default()
+    };
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let mut runs = Vec::new();
+    let mut adapter = String::new();
+    let mut timestamps = true;
+    for scenario in SCENARIOS {
+        let (mut world, at) =
+            scenario_world(&args.scenarios, scenario, &stations, &world_settings)?;
+        let overdraw = mean_overdraw(&world, world_settings.seed);
+        for impostors in [true, false] {
+            eprintln!(
+                "bench: {scenario}, impostors {}",
+                if impostors { "on" } else { "off" }
+            );
+            let mut not_drawn = None;
+            let frames = match fly(&setup, &mut world, at, impostors)? {
+                Flown::Frames {
+                    frames,
+                    adapter: name,
+                    timestamps: gpu,
+                } => {
+                    adapter = name;
+                    timestamps &= gpu;
+                    frames
+                }
+                Flown::TooMany {
+                    sprites,
+                    max_sprites,
+                } => {
+                    eprintln!(
+                        "bench: {scenario} without impostors: {sprites} sprites in view, this device draws at most {max_sprites} at once; not drawn (choose a smaller --view-km to compare)"
+                    );
+                    not_drawn = Some(sprites);
+                    Vec::new()
+                }
+            };
+            runs.push(Run {
+                scenario,
+                overdraw,
+                impostors,
+                frames,
+                not_drawn,
+            });
+        }
+    }
+    let timing = if timestamps {
+        "GPU timestamps"
+    } else {
+        "wall time, submit to poll-wait"
+    };
+    let rows = summary_rows(&runs);
+    print_table(&adapter, args, timing, &rows);
+    write_csv(&args.out.join("bench.csv"), &adapter, timing, &rows)?;
+    write_frames_csv(&args.out.join("frames.csv"), &runs)?;
+    let png = args.out.join("frame_time.png");
+    plot::write(&png, &runs_for_plot(&runs))?;
+    println!(
+        "{}: bench.csv, frames.csv, frame_time.png",
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// A row of the table and of `bench.csv`.
+struct Row {
+    scenario: &'static str,
+    overdraw_pct: f64,
+    impostors: bool,
+    median_ms: f64,
+    p95_ms: f64,
+    /// Median without impostors over median with them (the same on both rows of a scenario).
+    ratio: f64,
+    sprites_drawn: f64,
+    cpu_update_ms: f64,
+    /// False where the run did not fit the device (sprites_drawn is then the sprites in view).
+    drawn: bool,
+}
+
+fn summary_rows(runs: &[Run]) -> Vec<Row> {
+    runs.iter()
+        .map(|r| {
+            let other = runs
+                .iter()
+                .find(|o| o.scenario == r.scenario && o.impostors != r.impostors);
+            let (on, off) = match other {
+                Some(o) if r.impostors => (r.median_ms(), o.median_ms()),
+                Some(o) => (o.median_ms(), r.median_ms()),
+                None => (f64::NAN, f64::NAN),
+            };
+            Row {
+                scenario: r.scenario,
+                overdraw_pct: r.overdraw * 100.0,
+                impostors: r.impostors,
+                median_ms: r.median_ms(),
+                p95_ms: r.p95_ms(),
+                ratio: off / on,
+                sprites_drawn: match r.not_drawn {
+                    Some(n) => n as f64,
+                    None => r.median_of(|f| f.sprites_drawn as f64),
+                },
+                drawn: r.not_drawn.is_none(),
+                cpu_update_ms: r.median_of(|f| f.cpu_update_ms),
+            }
+        })
+        .collect()
+}
+
+const HEADER: [&str; 9] = [
+    "scenario",
+    "overdraw_pct",
+    "impostors",
+    "median_ms",
+    "p95_ms",
+    "off_on_ratio",
+    "sprites_drawn",
+    "cpu_update_ms",
+    "drawn",
+];
+
+fn print_table(adapter: &str, args: &BenchArgs, timing: &str, rows: &[Row]) {
+    println!(
+        "skycast bench on {adapter}: {}x{}, {} frames a run over {:.0} km at {:.0} ft AGL; frame time: {timing}",
+        args.size.0,
+        args.size.1,
+        args.frames,
+        PATH_LENGTH_M / 1000.0,
+        CRUISE_FT_AGL
+    );
+    println!(
+        "{:<10} {:>9} {:>9} {:>10} {:>8} {:>7} {:>10} {:>9}",
+        "scenario", "overdraw", "impostors", "median ms", "p95 ms", "off/on", "sprites", "cpu ms"
+    );
+    let ms = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.2}")
+        } else {
+            "-".to_string()
+        }
+    };
+    for r in rows {
+        println!(
+            "{:<10} {:>8.0}% {:>9} {:>10} {:>8} {:>7} {:>10.0} {:>9}{}",
+            r.scenario,
+            r.overdraw_pct,
+            if r.impostors { "on" } else { "off" },
+            ms(r.median_ms),
+            ms(r.p95_ms),
+            ms(r.ratio),
+            r.sprites_drawn,
+            ms(r.cpu_update_ms),
+            if r.drawn {
+                ""
+            } else {
+                "  not drawn: more sprites in view than the device draws at once"
+            }
+        );
+    }
+}
+
+fn write_csv(path: &Path, adapter: &str, timing: &str, rows: &[Row]) -> anyhow::Result<()> {
+    let mut csv =
+        csv::Writer::from_path(path).with_context(|| format!("cannot write {}", path.display()))?;
+    let mut header: Vec<&str> = HEADER.to_vec();
+    header.extend(["adapter", "frame_time"]);
+    csv.write_record(&header)?;
+    for r in rows {
+        csv.write_record([
+            r.scenario.to_string(),
+            format!("{:.0}", r.overdraw_pct),
+            (if r.impostors { "on" } else { "off" }).to_string(),
+            format!("{:.3}", r.median_ms),
+            format!("{:.3}", r.p95_ms),
+            format!("{:.3}", r.ratio),
+            format!("{:.0}", r.sprites_drawn),
+            format!("{:.3}", r.cpu_update_ms),
+            (if r.drawn {
+                "yes"
+            } else {
+                "no: too many sprites"
+            })
+            .to_string(),
+            adapter.to_string(),
+            timing.to_string(),
+        ])?;
+    }
+    csv.flush()?;
+    Ok(())
+}
+
+fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
+    let mut csv =
+        csv::Writer::from_path(path).with_context(|| format!("cannot write {}", path.display()))?;
+    csv.write_record([
+        "scenario",
+        "impostors",
+        "frame",
+        "distance_m",
+        "frame_ms",
+        "cpu_update_ms",
+        "sprites_drawn",
+        "blocks_near",
+        "blocks_far",
+        "impostors_rebuilt",
+    ])?;
+    for run in runs {
+        for (k, f) in run.frames.iter().enumerate() {
+            csv.write_record([
+                run.scenario.to_string(),
+                (if run.impostors { "on" } else { "off" }).to_string(),
+                k.to_string(),
+                format!("{:.0}", f.distance_m),
+                format!("{:.3}", f.frame_ms),
+                format!("{:.3}", f.cpu_update_ms),
+                f.sprites_drawn.to_string(),
+                f.blocks_near.to_string(),
+                f.blocks_far.to_string(),
+                f.impostors_rebuilt.to_string(),
+            ])?;
+        }
+    }
+    csv.flush()?;
+    Ok(())
+}
+
+fn runs_for_plot(runs: &[Run]) -> Vec<plot::Series> {
+    runs.iter()
+        .map(|r| plot::Series {
+            colour: match r.scenario {
+                "sparse" => [40, 110, 220],
+                "scattered" => [30, 160, 60],
+                _ => [210, 50, 40],
+            },
+            dashed: !r.impostors,
+            points: r
+                .frames
+                .iter()
+                .map(|f| (f.distance_m, f.frame_ms))
+                .collect(),
+        })
+        .collect()
+}

@@ -1,0 +1,104 @@
+//! `skycast bench` at a tiny size and frame count, so the frame-budget benchmark cannot rot: the
+//! table headed by the adapter, `bench.csv` with the three scenarios with impostors on and off,
+//! and the plot, a PNG that decodes.
+
+use std::path::PathBuf;
+
+#[test]
+fn bench_command_writes_table_csv_and_plot() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bench-command");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_skycast"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .args([
+            "bench",
+            "--size",
+            "64x36",
+            "--frames",
+            "3",
+            "--view-km",
+            "30",
+        ])
+        .args(["--out", dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert!(lines[0].starts_with("skycast bench on "), "{stdout}");
+    assert!(lines[0].contains("64x36, 3 frames"), "{stdout}");
+    assert!(
+        lines[1].split_whitespace().next() == Some("scenario"),
+        "{stdout}"
+    );
+    // Six table rows: each scenario with impostors on, then off.
+    let table: Vec<Vec<&str>> = lines[2..8]
+        .iter()
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    for (row, (scenario, impostors)) in table.iter().zip([
+        ("sparse", "on"),
+        ("sparse", "off"),
+        ("scattered", "on"),
+        ("scattered", "off"),
+        ("overcast", "on"),
+        ("overcast", "off"),
+    ]) {
+        assert_eq!((row[0], row[2]), (scenario, impostors), "{stdout}");
+    }
+
+    let mut csv = csv::Reader::from_path(dir.join("bench.csv")).unwrap();
+    let header = csv.headers().unwrap().clone();
+    let column = |name: &str| header.iter().position(|c| c == name).expect(name);
+    let rows: Vec<csv::StringRecord> = csv.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 6);
+    let number = |r: &csv::StringRecord, name: &str| r[column(name)].parse::<f64>().unwrap();
+    for pair in rows.chunks(2) {
+        let (on, off) = (&pair[0], &pair[1]);
+        assert_eq!(on[column("scenario")], off[column("scenario")]);
+        assert_eq!(
+            (&on[column("impostors")], &off[column("impostors")]),
+            ("on", "off")
+        );
+        // At 30 km everything fits: both runs drawn, with frame times, and the ratio is theirs.
+        assert_eq!(
+            (&on[column("drawn")], &off[column("drawn")]),
+            ("yes", "yes")
+        );
+        let (m_on, m_off) = (number(on, "median_ms"), number(off, "median_ms"));
+        assert!(m_on > 0.0 && m_off > 0.0, "{on:?} {off:?}");
+        assert!(number(on, "p95_ms") >= m_on && number(off, "p95_ms") >= m_off);
+        let ratio = number(on, "off_on_ratio");
+        assert!(
+            (ratio - m_off / m_on).abs() < 0.01 * ratio + 0.002,
+            "{on:?} {off:?}"
+        );
+        // The ring takes the far blocks: fewer sprites with it than without.
+        assert!(
+            number(on, "sprites_drawn") < number(off, "sprites_drawn"),
+            "{on:?} {off:?}"
+        );
+        assert!(
+            on[column("adapter")] == off[column("adapter")] && !on[column("adapter")].is_empty()
+        );
+    }
+    // The overdraw column: the scenarios' block overdraw, rising sparse -> overcast.
+    let overdraw: Vec<f64> = rows.iter().map(|r| number(r, "overdraw_pct")).collect();
+    assert!(
+        overdraw[0] > 120.0 && overdraw[4] > 2.0 * overdraw[0],
+        "{overdraw:?}"
+    );
+
+    let frames = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    assert_eq!(frames.lines().count(), 1 + 6 * 3);
+    let plot = image::open(dir.join("frame_time.png")).unwrap();
+    assert!(plot.width() >= 400 && plot.height() >= 200);
+    // Lines were drawn: the overcast colour is in it.
+    let rgb = plot.to_rgb8();
+    assert!(rgb.pixels().any(|p| p.0 == [210, 50, 40]));
+}
