@@ -1,56 +1,133 @@
-// Pass `ring.quads` (inside the sky pass): the far-cloud impostors of the ring (Wang 2003 6.2) as
-// world-fixed quads, premultiplied alpha scaled by the crossfade weight. Each texel's stored
-// alpha-weighted depth puts its clouds back where they were along the ray from the ring centre,
-// so the host's scene hides them only where it is nearer than the clouds, not the quad (a
-// mountain beyond the ring radius in front of some far clouds and behind others), with the
-// sprites' soft fade. Shared: shared/frame.wgsl.
+// Pass `ring.quads` (inside the sky pass): the far-cloud impostors of the ring (Wang 2003 6.2),
+// one full-screen pass. Each pixel's ray is intersected with the octagon of world-fixed quads of
+// the shown ring and, while crossfading, of the new ring; the two lookups are mixed in this one
+// pass (premultiplied `mix(old, new, weight)`), so a crossfade never dips towards the background
+// as two blended draws would. Each texel's stored alpha-weighted depth puts its clouds back where
+// they were along the ray from the ring centre, so the host's scene hides them only where it is
+// nearer than the clouds, not the quad (a mountain beyond the ring radius in front of some far
+// clouds and behind others), with the sprites' soft fade. Shared: shared/frame.wgsl.
 
-@group(1) @binding(0) var impostor: texture_2d<f32>;
-@group(1) @binding(1) var impostor_sampler: sampler;
-@group(1) @binding(2) var impostor_depth: texture_2d<f32>;
+@group(1) @binding(0) var old_colour: texture_2d_array<f32>;
+@group(1) @binding(1) var old_depth: texture_2d_array<f32>;
+@group(1) @binding(2) var new_colour: texture_2d_array<f32>;
+@group(1) @binding(3) var new_depth: texture_2d_array<f32>;
+@group(1) @binding(4) var impostor_sampler: sampler;
+@group(1) @binding(5) var<uniform> ring: Ring;
 
-// Keep in sync with `QuadVertex` in src/render/impostor.rs.
-struct QuadIn {
-    @location(0) position_m: vec3<f32>,
-    @location(1) uv: vec2<f32>,
-    @location(2) weight: f32,
-    @location(3) centre_m: vec3<f32>,
-    @location(4) radius_m: f32,
+// Keep in sync with `GpuRing` in src/render/impostor/mod.rs.
+struct Ring {
+    // xyz: the old (shown) ring's centre relative to the camera, metres; w: crossfade weight.
+    old_centre_weight: vec4<f32>,
+    // xyz: the new ring's centre relative to the camera (the old one when not fading).
+    new_centre: vec4<f32>,
+    // x: ring radius, metres; y: half side of a quad, metres; z, w: the old and new rings'
+    // first guess of their clouds' distance from the centre, metres.
+    size: vec4<f32>,
 };
 
-struct QuadOut {
+struct RingOut {
     @builtin(position) position: vec4<f32>,
-    @location(0) uv: vec2<f32>,
-    @location(1) weight: f32,
-    @location(2) position_m: vec3<f32>,
-    @location(3) centre_m: vec3<f32>,
-    @location(4) radius_m: f32,
+    @location(0) ndc: vec2<f32>,
 };
 
 @vertex
-fn vs_impostor(v: QuadIn) -> QuadOut {
-    var o: QuadOut;
-    o.position = frame.view_proj * vec4<f32>(v.position_m, 1.0);
-    o.uv = v.uv;
-    o.weight = v.weight;
-    o.position_m = v.position_m;
-    o.centre_m = v.centre_m;
-    o.radius_m = v.radius_m;
+fn vs_impostor(@builtin(vertex_index) vi: u32) -> RingOut {
+    var o: RingOut;
+    o.position = fullscreen_position(vi);
+    o.ndc = o.position.xy;
     return o;
 }
 
-@fragment
-fn fs_impostor(i: QuadOut) -> @location(0) vec4<f32> {
-    let texel = textureSample(impostor, impostor_sampler, i.uv);
-    let depth_km = textureSample(impostor_depth, impostor_sampler, i.uv).r;
-    // The quad lies at radius_m along the impostor's axis; the clouds at depth / alpha.
-    var along = 1.0;
-    if (texel.a > 0.002) {
-        along = max(depth_km * 1000.0 / texel.a / i.radius_m, 1.0);
+// Where `dir` (unit, from the camera) meets the sphere of `dist_m` around `centre` (the camera
+// is inside it).
+fn on_sphere(centre: vec3<f32>, dir: vec3<f32>, dist_m: f32) -> vec3<f32> {
+    let b = dot(dir, centre);
+    let t = b + sqrt(max(b * b - dot(centre, centre) + dist_m * dist_m, 0.0));
+    return dir * t;
+}
+
+// The impostor (xyz: texture coordinates and layer) that sees `from_centre` (a direction from
+// the ring centre), and how far along its axis a unit step in that direction goes (w);
+// layer 8 when the direction leaves every impostor (above or below them).
+fn impostor_at(from_centre: vec3<f32>) -> vec4<f32> {
+    let bearing = atan2(from_centre.x, from_centre.y);
+    let j = u32(round(bearing / 0.7853982) + 8.0) % 8u;
+    let h = f32(j) * 0.7853982;
+    let n = vec3<f32>(sin(h), cos(h), 0.0);
+    let right = vec3<f32>(cos(h), -sin(h), 0.0);
+    let facing = dot(from_centre, n);
+    let q = from_centre * (ring.size.x / max(facing, 1e-6));
+    let x = dot(q, right) / ring.size.y;
+    let y = q.z / ring.size.y;
+    var layer = f32(j);
+    if (abs(x) > 1.0 || abs(y) > 1.0 || facing <= 1e-6) {
+        layer = 8.0;
     }
-    let cloud = i.centre_m + (i.position_m - i.centre_m) * along;
+    return vec4<f32>((x + 1.0) * 0.5, (1.0 - y) * 0.5, layer, facing);
+}
+
+// The premultiplied colour of one ring along `dir` (unit, from the camera), scene-depth faded.
+// Beyond Wang: the impostor was seen from the ring centre, not from the camera, so the ray is
+// reprojected with the stored cloud depth: start with the clouds `guess_m` from the centre,
+// look up their stored distance there, and repeat; the clouds then sit where they are, not on
+// the quad, and move with the right parallax as the camera leaves the centre.
+fn ring_sample(
+    colour: texture_2d_array<f32>,
+    depth: texture_2d_array<f32>,
+    centre: vec3<f32>,
+    guess_m: f32,
+    dir: vec3<f32>,
+    frag_xy: vec2<f32>,
+) -> vec4<f32> {
+    var dist = guess_m;
+    var at = vec4<f32>(0.0, 0.0, 8.0, 1.0);
+    var texel = vec4<f32>(0.0);
+    var depth_km = 0.0;
+    for (var k = 0; k < 4; k++) {
+        let from_centre = normalize(on_sphere(centre, dir, dist) - centre);
+        at = impostor_at(from_centre);
+        if (at.z > 7.5) {
+            return vec4<f32>(0.0);
+        }
+        texel = textureSampleLevel(colour, impostor_sampler, at.xy, u32(at.z), 0.0);
+        depth_km = textureSampleLevel(depth, impostor_sampler, at.xy, u32(at.z), 0.0).r;
+        // The alpha-weighted depth around here (premultiplied depth over alpha, both summed
+        // over a few texels): smooth, and defined at silhouettes too.
+        var a = texel.a;
+        var d = depth_km;
+        let step = 3.0 / f32(textureDimensions(depth).x);
+        for (var n = 0; n < 4; n++) {
+            let ang = (f32(n) + 0.5) * 1.5707964;
+            let uv = at.xy + vec2<f32>(cos(ang), sin(ang)) * step;
+            a += textureSampleLevel(colour, impostor_sampler, uv, u32(at.z), 0.0).a;
+            d += textureSampleLevel(depth, impostor_sampler, uv, u32(at.z), 0.0).r;
+        }
+        if (a <= 0.002) {
+            break;
+        }
+        // Stored: distance along the impostor's axis; the sphere wants it from the centre.
+        dist = max(d * 1000.0 / a, ring.size.x) / max(at.w, 1e-3);
+    }
+    let cloud = on_sphere(centre, dir, dist);
     let cloud_m = (frame.view_proj * vec4<f32>(cloud, 1.0)).w;
-    let scene_m = linear_depth_m(scene_depth_at(i.position.xy));
+    let scene_m = linear_depth_m(scene_depth_at(frag_xy));
     let soft = clamp((scene_m - cloud_m) / frame.params.z, 0.0, 1.0);
-    return texel * (i.weight * soft);
+    return texel * soft;
+}
+
+@fragment
+fn fs_impostor(i: RingOut) -> @location(0) vec4<f32> {
+    let far = frame.inv_view_proj * vec4<f32>(i.ndc, 1.0, 1.0);
+    let dir = normalize(far.xyz / far.w);
+    let w = ring.old_centre_weight.w;
+    let before = ring_sample(
+        old_colour, old_depth, ring.old_centre_weight.xyz, ring.size.z, dir, i.position.xy
+    );
+    if (w <= 0.0) {
+        return before;
+    }
+    let after = ring_sample(
+        new_colour, new_depth, ring.new_centre.xyz, ring.size.w, dir, i.position.xy
+    );
+    return mix(before, after, w);
 }

@@ -1,8 +1,7 @@
 //! The geometry and rules of the impostor ring (Wang 2003 6.2), no GPU: the `[impostors]`
 //! settings, which blocks are far, when to rebuild, the impostor cameras and sectors, and the
-//! quads' corners. Units: metres, degrees, feet where named.
+//! quads' corners (checked against the impostor cameras). Units: metres, degrees, feet where named.
 
-use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -154,47 +153,31 @@ pub(super) fn in_sector(i: usize, centre_m: DVec3, block_m: DVec3) -> bool {
     off.abs() <= IMPOSTOR_FOV_DEG * 0.5 + margin
 }
 
-/// One corner of an impostor quad in the host frame. Keep in sync with `shaders/impostor_quad.wgsl`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub(super) struct QuadVertex {
-    pub(super) position_m: [f32; 3],
-    pub(super) uv: [f32; 2],
-    pub(super) weight: f32,
-    /// The ring centre relative to the camera, metres.
-    pub(super) centre_m: [f32; 3],
-    /// The ring radius (the quad's distance along its impostor's axis), metres.
-    pub(super) radius_m: f32,
-}
-
-/// The two triangles of impostor `i` (top left, bottom left, top right; top right, bottom left,
-/// bottom right), relative to the camera, with `weight`.
-pub(super) fn quad_corners(
-    i: usize,
-    centre_rel_m: DVec3,
-    s: &ImpostorSettings,
-    weight: f32,
-) -> [QuadVertex; 6] {
+/// The corners of impostor `i`'s quad relative to the ring centre (top left, bottom left, top
+/// right, bottom right) with their texture coordinates: the geometry `ring_sample` in
+/// `shaders/impostor_quad.wgsl` intersects rays with (octagon sides at the ring radius, each
+/// `2 * radius * tan(22.5 deg)` square). Keep the two in sync.
+#[cfg(test)]
+fn quad_corners(i: usize, s: &ImpostorSettings) -> [(Vec3, [f32; 2]); 4] {
     let h = heading_deg(i).to_radians();
     let forward = DVec3::new(h.sin(), h.cos(), 0.0);
     let right = DVec3::new(h.cos(), -h.sin(), 0.0);
     let half = s.ring_radius_m * (IMPOSTOR_FOV_DEG * 0.5).to_radians().tan();
-    let mid = centre_rel_m + forward * s.ring_radius_m;
-    let corner = |x: f64, y: f64, uv: [f32; 2]| QuadVertex {
-        position_m: (mid + right * (x * half) + DVec3::Z * (y * half))
-            .as_vec3()
-            .to_array(),
-        uv,
-        weight,
-        centre_m: centre_rel_m.as_vec3().to_array(),
-        radius_m: s.ring_radius_m as f32,
+    let mid = forward * s.ring_radius_m;
+    let corner = |x: f64, y: f64, uv: [f32; 2]| {
+        let p = mid + right * (x * half) + DVec3::Z * (y * half);
+        // The shader's mapping from a point on the quad to its texture coordinates.
+        let (u, v) = (p.dot(right) / half, p.z / half);
+        assert!(((u + 1.0) * 0.5 - uv[0] as f64).abs() < 1e-9);
+        assert!(((1.0 - v) * 0.5 - uv[1] as f64).abs() < 1e-9);
+        (p.as_vec3(), uv)
     };
-    let (tl, bl) = (
+    [
         corner(-1.0, 1.0, [0.0, 0.0]),
         corner(-1.0, -1.0, [0.0, 1.0]),
-    );
-    let (tr, br) = (corner(1.0, 1.0, [1.0, 0.0]), corner(1.0, -1.0, [1.0, 1.0]));
-    [tl, bl, tr, tr, bl, br]
+        corner(1.0, 1.0, [1.0, 0.0]),
+        corner(1.0, -1.0, [1.0, 1.0]),
+    ]
 }
 
 /// The projection of impostor `i`'s camera (for tests: a far point projects where its quad is).
@@ -244,11 +227,11 @@ mod tests {
         let s = ImpostorSettings::default();
         for i in 0..IMPOSTORS {
             let vp = impostor_view_proj(i, &s);
-            for c in quad_corners(i, DVec3::ZERO, &s, 1.0) {
-                let p = vp * Vec3::from(c.position_m).extend(1.0);
+            for (corner, corner_uv) in quad_corners(i, &s) {
+                let p = vp * corner.extend(1.0);
                 let ndc = p.truncate() / p.w;
                 let uv = [(ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5];
-                assert!((uv[0] - c.uv[0]).abs() < 1e-4 && (uv[1] - c.uv[1]).abs() < 1e-4);
+                assert!((uv[0] - corner_uv[0]).abs() < 1e-4 && (uv[1] - corner_uv[1]).abs() < 1e-4);
             }
         }
     }

@@ -12,10 +12,15 @@
 //! first ring is built in one frame (there is nothing to fade from).
 //!
 //! In: the sky's blocks, camera, light and frame uniform. Out: which blocks are near (sprites),
-//! the impostor render passes, and the quads drawn into the host frame. Beyond Wang, each
-//! impostor also stores the alpha-weighted depth of its clouds, so the quads put their clouds
-//! back at that depth and the host's depth hides them where its scene is nearer (a mountain
-//! beyond the ring radius among far clouds). Rules and geometry: `layout`. Units: metres, degrees.
+//! the impostor render passes, and one full-screen ring pass into the host frame
+//! (`shaders/impostor_quad.wgsl`): per pixel it finds where the ray leaves each ring's octagon and
+//! mixes the shown ring with the one fading in (`mix(old, new, w)` of premultiplied colour, one
+//! pass, so the crossfade never dips towards the background as two blended draws do). Beyond
+//! Wang, each impostor also stores the alpha-weighted depth of its clouds: the ring pass
+//! reprojects each ray with it (the clouds sit at their depth, not on the quad, so they move with
+//! the right parallax as the camera leaves the ring centre and a new ring shows nearly the same
+//! picture), and the host's depth hides them where its scene is nearer (a mountain beyond the
+//! ring radius among far clouds). Rules and geometry: `layout`. Units: metres, degrees.
 
 mod layout;
 
@@ -27,7 +32,7 @@ use wgpu::util::DeviceExt;
 pub use layout::{
     IMPOSTOR_FOV_DEG, IMPOSTORS, ImpostorSettings, impostor_view_proj, is_far, needs_rebuild,
 };
-use layout::{QuadVertex, impostor_camera, in_sector, quad_corners};
+use layout::{impostor_camera, in_sector};
 
 use super::gpu_types::{GpuFrame, GpuSpriteVertex};
 use super::scene::SkyBlock;
@@ -44,6 +49,9 @@ struct RingState {
     sun: Vec3,
     /// Ids of the blocks drawn into this ring.
     far_ids: BTreeSet<u64>,
+    /// Mean distance of those blocks from the centre (the ring radius if none), metres: the
+    /// first guess of the ring pass's depth reprojection.
+    far_mean_m: f64,
 }
 
 struct Build {
@@ -58,9 +66,10 @@ pub struct ImpostorRing {
     device: wgpu::Device,
     sprite_pipeline: wgpu::RenderPipeline,
     quad_pipeline: wgpu::RenderPipeline,
-    /// `[ring][impostor]` colour views and their bind groups for the quad pass.
+    /// `[ring][impostor]` colour and depth views the impostor passes render into.
     views: Vec<Vec<wgpu::TextureView>>,
     depth_views: Vec<Vec<wgpu::TextureView>>,
+    /// `[old ring][new ring]` bind groups of the ring pass (both rings' texture arrays).
     quad_groups: Vec<Vec<wgpu::BindGroup>>,
     /// Per impostor slot: frame uniform, its bind group, vertices and sprite count.
     slot_frames: Vec<wgpu::Buffer>,
@@ -68,7 +77,8 @@ pub struct ImpostorRing {
     slot_vertices: Vec<wgpu::Buffer>,
     index_buffer: wgpu::Buffer,
     capacity_sprites: u32,
-    quad_buffer: wgpu::Buffer,
+    /// The ring pass's uniform (`GpuRing`).
+    ring_uniform: wgpu::Buffer,
     builder: SpriteVertexBuilder,
     shown: Option<(usize, RingState)>,
     build: Option<Build>,
@@ -76,8 +86,8 @@ pub struct ImpostorRing {
     fade: Option<(usize, RingState, f64)>,
     /// This frame's impostor renders: (ring, impostor, sprites).
     pending: Vec<(usize, usize, u32)>,
-    /// This frame's quads: (ring, impostor, first vertex).
-    quads: Vec<(usize, usize, u32)>,
+    /// This frame's ring pass: (old ring, new ring), if any ring is shown.
+    quads: Option<(usize, usize)>,
     bytes: u64,
 }
 
@@ -129,32 +139,36 @@ impl ImpostorRing {
                 source: wgpu::ShaderSource::Wgsl(format!("{SHARED_WGSL}\n{wgsl}").into()),
             })
         };
+        let array_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            count: None,
+        };
         let tex_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ring.texture_layout"),
             entries: &[
+                array_entry(0),
+                array_entry(1),
+                array_entry(2),
+                array_entry(3),
                 wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
+                    binding: 4,
                     visibility: wgpu::ShaderStages::FRAGMENT,
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
                 wgpu::BindGroupLayoutEntry {
-                    binding: 2,
+                    binding: 5,
                     visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
                     },
                     count: None,
                 },
@@ -165,7 +179,7 @@ impl ImpostorRing {
                         vs: &str,
                         fs: &str,
                         layouts: &[Option<&wgpu::BindGroupLayout>],
-                        buffer: wgpu::VertexBufferLayout,
+                        buffers: &[Option<wgpu::VertexBufferLayout>],
                         formats: &[wgpu::TextureFormat]| {
             let m = module(label, wgsl);
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -180,7 +194,7 @@ impl ImpostorRing {
                     module: &m,
                     entry_point: Some(vs),
                     compilation_options: Default::default(),
-                    buffers: &[Some(buffer)],
+                    buffers,
                 },
                 primitive: wgpu::PrimitiveState {
                     cull_mode: None,
@@ -213,23 +227,16 @@ impl ImpostorRing {
             "vs_sprite",
             "fs_sprite_impostor",
             &[Some(shared.frame_layout), Some(shared.sheet_layout)],
-            GpuSpriteVertex::layout(),
+            &[Some(GpuSpriteVertex::layout())],
             &[IMPOSTOR_FORMAT, DEPTH_FORMAT],
         );
-        const QUAD_ATTRS: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
-            0 => Float32x3, 1 => Float32x2, 2 => Float32, 3 => Float32x3, 4 => Float32
-        ];
         let quad_pipeline = pipeline(
             "ring.quads",
             QUAD_WGSL,
             "vs_impostor",
             "fs_impostor",
             &[Some(shared.frame_layout), Some(&tex_layout)],
-            wgpu::VertexBufferLayout {
-                array_stride: std::mem::size_of::<QuadVertex>() as u64,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &QUAD_ATTRS,
-            },
+            &[],
             &[shared.colour_format],
         );
         let rings = if settings.enabled { 2 } else { 0 };
@@ -243,59 +250,87 @@ impl ImpostorRing {
         let mut bytes = 0u64;
         let mut views = Vec::new();
         let mut depth_views = Vec::new();
-        let mut quad_groups = Vec::new();
+        let mut arrays = Vec::new();
         for r in 0..rings {
-            let mut vs = Vec::new();
-            let mut ds = Vec::new();
-            let mut gs = Vec::new();
-            for i in 0..IMPOSTORS {
-                let make = |what: &str, format| {
-                    device
-                        .create_texture(&wgpu::TextureDescriptor {
-                            label: Some(&format!("ring.{r}.impostor.{i}.{what}")),
-                            size: wgpu::Extent3d {
-                                width: side,
-                                height: side,
-                                depth_or_array_layers: 1,
-                            },
-                            mip_level_count: 1,
-                            sample_count: 1,
-                            dimension: wgpu::TextureDimension::D2,
-                            format,
-                            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                                | wgpu::TextureUsages::TEXTURE_BINDING,
-                            view_formats: &[],
+            // One texture array per ring and kind: layer `i` is impostor `i`.
+            let make = |what: &str, format| {
+                let texture = device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(&format!("ring.{r}.{what}")),
+                    size: wgpu::Extent3d {
+                        width: side,
+                        height: side,
+                        depth_or_array_layers: IMPOSTORS as u32,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                        | wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                });
+                let layers: Vec<wgpu::TextureView> = (0..IMPOSTORS as u32)
+                    .map(|i| {
+                        texture.create_view(&wgpu::TextureViewDescriptor {
+                            dimension: Some(wgpu::TextureViewDimension::D2),
+                            base_array_layer: i,
+                            array_layer_count: Some(1),
+                            ..Default::default()
                         })
-                        .create_view(&wgpu::TextureViewDescriptor::default())
-                };
-                let view = make("colour", IMPOSTOR_FORMAT);
-                let depth = make("depth", DEPTH_FORMAT);
-                bytes += side as u64 * side as u64 * (4 + 2);
-                gs.push(device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("ring.quad_group"),
-                    layout: &tex_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: wgpu::BindingResource::TextureView(&view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::Sampler(&sampler),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: wgpu::BindingResource::TextureView(&depth),
-                        },
-                    ],
-                }));
-                ds.push(depth);
-                vs.push(view);
-            }
-            views.push(vs);
-            depth_views.push(ds);
-            quad_groups.push(gs);
+                    })
+                    .collect();
+                let array = texture.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
+                    ..Default::default()
+                });
+                (layers, array)
+            };
+            let (colour_layers, colour) = make("colour", IMPOSTOR_FORMAT);
+            let (depth_layers, depth) = make("depth", DEPTH_FORMAT);
+            bytes += side as u64 * side as u64 * (4 + 2) * IMPOSTORS as u64;
+            views.push(colour_layers);
+            depth_views.push(depth_layers);
+            arrays.push((colour, depth));
         }
+        let ring_uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ring.uniform"),
+            size: std::mem::size_of::<GpuRing>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        // `[old][new]`: the shown ring and the one fading in (the same one when not fading).
+        let quad_groups = arrays
+            .iter()
+            .map(|old| {
+                arrays
+                    .iter()
+                    .map(|new| {
+                        let view = |binding, view| wgpu::BindGroupEntry {
+                            binding,
+                            resource: wgpu::BindingResource::TextureView(view),
+                        };
+                        device.create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("ring.quad_group"),
+                            layout: &tex_layout,
+                            entries: &[
+                                view(0, &old.0),
+                                view(1, &old.1),
+                                view(2, &new.0),
+                                view(3, &new.1),
+                                wgpu::BindGroupEntry {
+                                    binding: 4,
+                                    resource: wgpu::BindingResource::Sampler(&sampler),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 5,
+                                    resource: ring_uniform.as_entire_binding(),
+                                },
+                            ],
+                        })
+                    })
+                    .collect()
+            })
+            .collect();
         // The impostor passes have no scene: a depth of 1 (the far plane) everywhere.
         let slots = if settings.enabled { IMPOSTORS } else { 0 };
         let no_scene = device.create_texture_with_data(
@@ -347,12 +382,6 @@ impl ImpostorRing {
             bytes += buffer.size();
             slot_frames.push(buffer);
         }
-        let quad_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("ring.quads"),
-            size: (2 * IMPOSTORS * 6 * std::mem::size_of::<QuadVertex>()) as u64,
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let mut ring = Self {
             settings,
             device: device.clone(),
@@ -364,15 +393,15 @@ impl ImpostorRing {
             slot_frames,
             slot_groups,
             slot_vertices: Vec::new(),
-            index_buffer: quad_buffer.clone(),
+            index_buffer: ring_uniform.clone(),
             capacity_sprites: 0,
-            quad_buffer,
+            ring_uniform,
             builder: SpriteVertexBuilder::new(),
             shown: None,
             build: None,
             fade: None,
             pending: Vec::new(),
-            quads: Vec::new(),
+            quads: None,
             bytes,
         };
         ring.grow(if settings.enabled { 1024 } else { 0 });
@@ -421,7 +450,7 @@ impl ImpostorRing {
     pub fn gpu_bytes(&self) -> u64 {
         self.bytes
             + if self.settings.enabled {
-                self.quad_buffer.size()
+                self.ring_uniform.size()
             } else {
                 0
             }
@@ -473,11 +502,19 @@ impl ImpostorRing {
             };
             if start {
                 let ring = self.shown.as_ref().map_or(0, |(r, _)| 1 - r);
-                let far_ids = blocks
+                let far: Vec<&SkyBlock> = blocks
                     .iter()
                     .filter(|b| is_far(b, camera_m, camera_m, &s))
-                    .map(|b| b.id)
                     .collect();
+                let far_mean_m = if far.is_empty() {
+                    s.ring_radius_m
+                } else {
+                    far.iter()
+                        .map(|b| (b.centre_m - camera_m).length())
+                        .sum::<f64>()
+                        / far.len() as f64
+                };
+                let far_ids = far.iter().map(|b| b.id).collect();
                 self.build = Some(Build {
                     ring,
                     next: 0,
@@ -485,6 +522,7 @@ impl ImpostorRing {
                         centre_m: camera_m,
                         sun,
                         far_ids,
+                        far_mean_m,
                     },
                 });
             }
@@ -518,7 +556,7 @@ impl ImpostorRing {
             camera_m,
         } = *frame_in;
         self.pending.clear();
-        self.quads.clear();
+        self.quads = None;
         stats.ring_gpu_bytes = self.gpu_bytes();
         if !self.settings.enabled {
             stats.blocks_near = blocks.len() as u32;
@@ -577,26 +615,33 @@ impl ImpostorRing {
                 self.build = Some(build);
             }
         }
-        // Quads: the shown ring (fading out while a new one fades in), then the new one.
-        let mut corners = Vec::with_capacity(2 * IMPOSTORS * 6);
+        // The ring pass: the shown ring, mixed with the one fading in by the crossfade weight.
         let w = self.fade.as_ref().map_or(0.0, |f| f.2);
         stats.crossfade_weight = w as f32;
-        let mut rings: Vec<(usize, DVec3, f32)> = Vec::new();
-        if let Some((r, st)) = &self.shown {
-            rings.push((*r, st.centre_m, (1.0 - w) as f32));
-        }
-        if let Some((r, st, _)) = &self.fade {
-            rings.push((*r, st.centre_m, w as f32));
-        }
-        for (r, centre, weight) in rings {
-            for i in 0..IMPOSTORS {
-                let first_vertex = corners.len() as u32;
-                corners.extend(quad_corners(i, centre - camera_m, &self.settings, weight));
-                self.quads.push((r, i, first_vertex));
-            }
-        }
-        if !corners.is_empty() {
-            queue.write_buffer(&self.quad_buffer, 0, bytemuck::cast_slice(&corners));
+        if let Some((old, old_state)) = &self.shown {
+            let (new, new_state) = self
+                .fade
+                .as_ref()
+                .map_or((*old, old_state), |(r, st, _)| (*r, st));
+            let half = self.settings.ring_radius_m * (IMPOSTOR_FOV_DEG * 0.5).to_radians().tan();
+            let uniform = GpuRing {
+                old_centre_weight: (old_state.centre_m - camera_m)
+                    .as_vec3()
+                    .extend(w as f32)
+                    .to_array(),
+                new_centre: (new_state.centre_m - camera_m)
+                    .as_vec3()
+                    .extend(0.0)
+                    .to_array(),
+                size: [
+                    self.settings.ring_radius_m as f32,
+                    half as f32,
+                    old_state.far_mean_m as f32,
+                    new_state.far_mean_m as f32,
+                ],
+            };
+            queue.write_buffer(&self.ring_uniform, 0, bytemuck::bytes_of(&uniform));
+            self.quads = Some((*old, new));
         }
         let far = self
             .fade
@@ -640,16 +685,26 @@ impl ImpostorRing {
         }
     }
 
-    /// Draws the ring's quads into the sky pass (group 0, the sky's frame, must be bound).
+    /// Draws the ring into the sky pass (group 0, the sky's frame, must be bound): one
+    /// full-screen pass that mixes the shown ring with the one fading in.
     pub fn draw(&self, pass: &mut wgpu::RenderPass) {
-        if self.quads.is_empty() {
+        let Some((old, new)) = self.quads else {
             return;
-        }
+        };
         pass.set_pipeline(&self.quad_pipeline);
-        pass.set_vertex_buffer(0, self.quad_buffer.slice(..));
-        for &(r, i, first) in &self.quads {
-            pass.set_bind_group(1, &self.quad_groups[r][i], &[]);
-            pass.draw(first..first + 6, 0..1);
-        }
+        pass.set_bind_group(1, &self.quad_groups[old][new], &[]);
+        pass.draw(0..3, 0..1);
     }
+}
+
+/// The ring pass's uniform. Keep in sync with `Ring` in `shaders/impostor_quad.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuRing {
+    /// The shown ring's centre relative to the camera, metres; w: the crossfade weight.
+    old_centre_weight: [f32; 4],
+    /// The centre of the ring fading in (the shown one's when not fading), metres.
+    new_centre: [f32; 4],
+    /// Ring radius, half side of a quad, the old and new rings' mean far distance, metres.
+    size: [f32; 4],
 }
