@@ -724,3 +724,81 @@ fn ring_depth_puts_a_far_mountain_between_impostored_clouds() {
     // Without the stored depth (the quad's own depth, 20 km) it would cover the ridge: this test
     // fails with `along = 1.0` in impostor_quad.wgsl (126 px on the ridge).
 }
+
+/// Mean absolute luminance change per frame along a slow straight flight across several ring
+/// rebuilds, and whether each frame was rebuilding or crossfading.
+fn popping_run(crossfade_s: f64) -> Vec<(f32, bool)> {
+    let mut settings = RenderSettings::default();
+    settings.impostors.ring_radius_m = 10_000.0;
+    settings.impostors.view_radius_m = 60_000.0;
+    settings.impostors.crossfade_s = crossfade_s;
+    // Ground far past the haze: the edge of `flat_ground` (40 km out) would creep down the
+    // horizon a pixel row at a time, a step that has nothing to do with the ring.
+    let ground = HeightField::from_fn(DVec2::ZERO, 400_000.0, 64, |_| 0.0);
+    let mut rig = Rig::with_settings(ground, settings);
+    let mut blocks = Vec::new();
+    for (k, (x, y)) in [
+        (-9000.0, 22_000.0),
+        (4000.0, 30_000.0),
+        (14_000.0, 26_000.0),
+        (-20_000.0, 34_000.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let c = DVec3::new(x, y, 1500.0);
+        blocks.push(SkyBlock {
+            id: 20 + k as u64,
+            centre_m: c,
+            clouds: vec![big_cumulus(c, 4.0)],
+        });
+    }
+    rig.set_clouds(blocks);
+    let mut last: Option<Frame> = None;
+    let mut out = Vec::new();
+    for k in 0..76 {
+        // 60 m a frame at 20 frames a second: a rebuild (1,500 m) every 25 frames.
+        let cam = rig.camera(DVec3::new(0.0, k as f64 * 60.0, 1000.0), 0.0, 3.0);
+        let (frame, s) = rig.host.frame(&cam, &sun(), 0.05, 40_000.0).unwrap();
+        if let Some(prev) = &last {
+            let change = frame
+                .rgba
+                .iter()
+                .zip(&prev.rgba)
+                .map(|(a, b)| (luminance(*a) - luminance(*b)).abs())
+                .sum::<f32>()
+                / frame.rgba.len() as f32;
+            out.push((change, s.impostors_rebuilt > 0 || s.crossfade_weight > 0.0));
+        }
+        last = Some(frame);
+    }
+    out
+}
+
+fn median(mut v: Vec<f32>) -> f32 {
+    v.sort_by(f32::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Popping, measured: frames during a rebuild or crossfade change no more than 1.5x the median
+/// change of plain motion frames; with the crossfade off, the switch frames exceed it.
+#[test]
+fn ring_rebuilds_do_not_pop() {
+    let run = popping_run(0.5);
+    let plain = median(run.iter().filter(|c| !c.1).map(|c| c.0).collect());
+    let worst = run.iter().filter(|c| c.1).map(|c| c.0).fold(0.0, f32::max);
+    eprintln!("crossfade: plain median {plain}, worst rebuild/fade {worst}, {run:?}");
+    let hard = popping_run(0.0);
+    let hard_plain = median(hard.iter().filter(|c| !c.1).map(|c| c.0).collect());
+    let hard_worst = hard.iter().map(|c| c.0).fold(0.0, f32::max);
+    eprintln!("no crossfade: plain median {hard_plain}, worst {hard_worst}, {hard:?}");
+    assert!(run.iter().filter(|c| c.1).count() >= 20, "{run:?}");
+    assert!(
+        worst <= 1.5 * plain,
+        "crossfaded rebuilds pop: {worst} vs median {plain}"
+    );
+    assert!(
+        hard_worst > 1.5 * hard_plain,
+        "without crossfade: {hard_worst} vs {hard_plain}"
+    );
+}
