@@ -161,12 +161,7 @@ impl SpriteVertexBuilder {
         let draw_m = clouds.draw_distance_m as f64;
 
         // Back to front: blocks, then clouds within a block.
-        let mut block_order: Vec<(usize, f64)> = blocks
-            .iter()
-            .enumerate()
-            .map(|(i, b)| (i, (b.borrow().centre_m - camera_m).length_squared()))
-            .collect();
-        block_order.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let block_order = blocks_back_to_front(blocks, camera_m);
 
         self.vertices.clear();
         for (bi, _) in block_order {
@@ -314,6 +309,35 @@ impl CloudInfo {
     }
 }
 
+/// The blocks' indices, farthest centre from `camera_m` first, with their squared distances
+/// (square metres): the first level of the frame's back-to-front sort.
+pub fn blocks_back_to_front<B: std::borrow::Borrow<SkyBlock>>(
+    blocks: &[B],
+    camera_m: DVec3,
+) -> Vec<(usize, f64)> {
+    let mut order: Vec<(usize, f64)> = blocks
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (i, (b.borrow().centre_m - camera_m).length_squared()))
+        .collect();
+    order.sort_by(|a, b| b.1.total_cmp(&a.1));
+    order
+}
+
+/// The cloud's sprite indices, farthest from the camera first, with their squared distances
+/// (square metres; `cam_local_m` is the camera relative to the cloud centre): the last level of
+/// the back-to-front sort, run whenever a cloud's vertices are recomputed.
+pub fn sprites_back_to_front(cloud: &SkyCloud, cam_local_m: Vec3) -> Vec<(usize, f32)> {
+    let mut order: Vec<(usize, f32)> = cloud
+        .sprites
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (i, s.offset_m.distance_squared(cam_local_m)))
+        .collect();
+    order.sort_by(|a, b| b.1.total_cmp(&a.1));
+    order
+}
+
 /// Faces, shades and sorts one cloud's sprites into `out` (positions relative to the centre).
 fn build_cloud(
     cloud: &SkyCloud,
@@ -325,13 +349,7 @@ fn build_cloud(
     out: &mut Vec<LocalVertex>,
 ) {
     let cam_local = (camera_m - cloud.centre_m).as_vec3();
-    let mut order: Vec<(usize, f32)> = cloud
-        .sprites
-        .iter()
-        .enumerate()
-        .map(|(i, s)| (i, s.offset_m.distance_squared(cam_local)))
-        .collect();
-    order.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let order = sprites_back_to_front(cloud, cam_local);
     let tod = &lighting.time_of_day;
     let lock_start = settings.lock_fade_start_deg.to_radians().cos();
     let lock_end = settings.lock_fade_end_deg.to_radians().cos();
