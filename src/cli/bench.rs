@@ -26,7 +26,7 @@ use skycast::weather::{
     BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, StationTable, WeatherInput,
 };
 
-use super::render::{DEFAULT_TIME, load_look, parse_size, parse_time};
+use super::render::{load_look, parse_size, parse_time, time_or_default};
 use super::weather::DEFAULT_STATIONS;
 
 mod plot;
@@ -267,10 +267,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         anyhow::bail!("--frames {} is less than 2", args.frames);
     }
     let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
-    let unix_s = match args.time {
-        Some(t) => t,
-        None => parse_time(DEFAULT_TIME).map_err(anyhow::Error::msg)?,
-    };
+    let unix_s = time_or_default(args.time)?;
     let stations =
         StationTable::load(&args.stations).context("station table (choose one with --stations)")?;
     let view_radius_m = match args.view_km {
@@ -459,16 +456,24 @@ fn write_csv(path: &Path, adapter: &str, timing: &str, rows: &[Row]) -> anyhow::
     let mut header: Vec<&str> = HEADER.to_vec();
     header.extend(["adapter", "frame_time"]);
     csv.write_record(&header)?;
+    // Runs that were not drawn have no times: empty cells.
+    let ms = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.3}")
+        } else {
+            String::new()
+        }
+    };
     for r in rows {
         csv.write_record([
             r.scenario.to_string(),
             format!("{:.0}", r.overdraw_pct),
             (if r.impostors { "on" } else { "off" }).to_string(),
-            format!("{:.3}", r.median_ms),
-            format!("{:.3}", r.p95_ms),
-            format!("{:.3}", r.ratio),
+            ms(r.median_ms),
+            ms(r.p95_ms),
+            ms(r.ratio),
             format!("{:.0}", r.sprites_drawn),
-            format!("{:.3}", r.cpu_update_ms),
+            ms(r.cpu_update_ms),
             (if r.drawn {
                 "yes"
             } else {
