@@ -591,6 +591,70 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     );
 }
 
+/// Wang translates the impostors vertically with the angle between clouds and camera. Here each
+/// pixel's ray is reprojected to the clouds' stored depth, which does that and more: after a
+/// climb of 2,000 m with no rebuild (climb threshold raised), the far cloud sits 30 km out where
+/// the all-sprites frame has it (within 0.1 px here), not where the quad at the 20 km radius
+/// would put it: with the reprojection switched off in `impostor_quad.wgsl` (`dist` held at the
+/// ring radius) it lands 4.9 rows lower and this test fails.
+#[test]
+fn ring_moves_far_clouds_with_the_camera_height() {
+    let blocks = |with_far: bool| {
+        let c = DVec3::new(0.0, 30_000.0, 1500.0);
+        let mut b = vec![SkyBlock {
+            id: 1,
+            centre_m: DVec3::new(-2000.0, 6000.0, 1300.0),
+            clouds: vec![cumulus(DVec3::new(-2000.0, 6000.0, 1000.0))],
+        }];
+        if with_far {
+            b.push(SkyBlock {
+                id: 2,
+                centre_m: c,
+                clouds: vec![big_cumulus(c, 6.0)],
+            });
+        }
+        b
+    };
+    let climbed = DVec3::new(0.0, 0.0, 3000.0);
+    let mut all_sprites = RenderSettings::default();
+    all_sprites.impostors.enabled = false;
+    let mut plain = Rig::with_settings(flat_ground(0.0), all_sprites);
+    let cam = plain.camera(climbed, 0.0, -2.0);
+    plain.set_clouds(blocks(false));
+    let (bare, _) = plain.frame("climb_bare", &cam);
+    plain.set_clouds(blocks(true));
+    let (sprites, _) = plain.frame("climb_all_sprites", &cam);
+
+    let mut settings = RenderSettings::default();
+    settings.impostors.rebuild_climb_fraction = 0.5;
+    let mut rig = Rig::with_settings(flat_ground(0.0), settings);
+    rig.set_clouds(blocks(true));
+    let (_, built) = rig.frame(
+        "climb_ring_built",
+        &rig.camera(DVec3::new(0.0, 0.0, 1000.0), 0.0, -2.0),
+    );
+    assert_eq!(built.impostors_rebuilt, 8, "{built:?}");
+    let (ring, stats) = rig.frame("climb_ring", &cam);
+    assert_eq!(
+        stats.impostors_rebuilt, 0,
+        "no rebuild after the climb: {stats:?}"
+    );
+    assert_eq!((stats.blocks_near, stats.blocks_far), (1, 1), "{stats:?}");
+
+    let (n_s, x_s, y_s) = changed_pixels(&sprites, &bare);
+    let (n_r, x_r, y_r) = changed_pixels(&ring, &bare);
+    eprintln!("climb: sprites {n_s} px at ({x_s}, {y_s}); ring {n_r} px at ({x_r}, {y_r})");
+    assert!(n_s > 150, "the far cloud shows as sprites: {n_s} px");
+    assert!(
+        n_r as f32 > 0.6 * n_s as f32 && (n_r as f32) < 1.5 * n_s as f32,
+        "the far cloud shows in the impostor: {n_r} px vs {n_s} as sprites"
+    );
+    assert!(
+        (x_r - x_s).abs() < 3.0 && (y_r - y_s).abs() < 3.0,
+        "the impostored cloud moved with the climb: ({x_r}, {y_r}) vs ({x_s}, {y_s}) as sprites"
+    );
+}
+
 /// Moving past 15% of the ring radius rebuilds the ring one impostor per frame over 8 frames,
 /// then crossfades old -> new over `crossfade_s`; a smaller move rebuilds nothing.
 #[test]
