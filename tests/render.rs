@@ -800,17 +800,12 @@ fn popping_run(crossfade_s: f64) -> Vec<(f32, bool)> {
     // horizon a pixel row at a time, a step that has nothing to do with the ring.
     let ground = HeightField::from_fn(DVec2::ZERO, 400_000.0, 64, |_| 0.0);
     let mut rig = Rig::with_settings(ground, settings);
+    // A row of far cumulus every 6 km east-west, flown past sideways: the view changes at a
+    // steady rate (no cloud comes much nearer), so plain motion has one typical change.
     let mut blocks = Vec::new();
-    for (k, (x, y)) in [
-        (-9000.0, 22_000.0),
-        (4000.0, 30_000.0),
-        (14_000.0, 26_000.0),
-        (-20_000.0, 34_000.0),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let c = DVec3::new(x, y, 1500.0);
+    for k in 0..16 {
+        let y = [22_000.0, 30_000.0, 26_000.0, 34_000.0][k % 4];
+        let c = DVec3::new(-42_000.0 + 6000.0 * k as f64, y, 1500.0);
         blocks.push(SkyBlock {
             id: 20 + k as u64,
             centre_m: c,
@@ -822,7 +817,7 @@ fn popping_run(crossfade_s: f64) -> Vec<(f32, bool)> {
     let mut out = Vec::new();
     for k in 0..76 {
         // 60 m a frame at 20 frames a second: a rebuild (1,500 m) every 25 frames.
-        let cam = rig.camera(DVec3::new(0.0, k as f64 * 60.0, 1000.0), 0.0, 3.0);
+        let cam = rig.camera(DVec3::new(k as f64 * 60.0, 0.0, 1000.0), 0.0, 3.0);
         let (frame, s) = rig.host.frame(&cam, &sun(), 0.05, 40_000.0).unwrap();
         if let Some(prev) = &last {
             let change = frame
