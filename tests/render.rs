@@ -251,6 +251,34 @@ fn clear_overcast_and_in_cloud_frames() {
         "the stratus deck covers {covered} of {sky_share} sky ({stats:?})"
     );
 
+    // Level under the deck: the sky shows in a band below its edge, 8 km out. Told the weather
+    // overhead, the sky turns grey (nothing blue left) and the ground loses its sun.
+    let level = rig.camera(DVec3::new(0.0, 0.0, 300.0), 0.0, 0.0);
+    let (blue_band, _) = rig.frame("under_stratus_clear_light", &level);
+    rig.host.sky.set_weather_overhead(&weather);
+    let (grey_band, _) = rig.frame("under_stratus", &level);
+    let blue = |f: &Frame| fraction(f, |i| f.depth[i] >= 1.0 && !cloud_like(f.rgba[i]));
+    let ground_lum = |f: &Frame| {
+        let ground: Vec<f32> = (0..f.rgba.len())
+            .filter(|&i| f.depth[i] < 1.0)
+            .map(|i| luminance(f.rgba[i]))
+            .collect();
+        ground.iter().sum::<f32>() / ground.len().max(1) as f32
+    };
+    assert!(
+        blue(&blue_band) > 0.02,
+        "clear light: a blue band below the deck: {}",
+        blue(&blue_band)
+    );
+    assert_eq!(blue(&grey_band), 0.0, "under the deck, blue sky shows");
+    assert!(
+        ground_lum(&grey_band) < 0.8 * ground_lum(&blue_band),
+        "the ground under the deck is as bright as in the sun: {} vs {}",
+        ground_lum(&grey_band),
+        ground_lum(&blue_band)
+    );
+    rig.host.sky.set_weather_overhead(&BlockWeather::default());
+
     rig.set_clouds(vec![SkyBlock {
         id: 7,
         centre_m: DVec3::new(0.0, 0.0, 1500.0),

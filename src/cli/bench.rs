@@ -231,6 +231,7 @@ fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> any
             host.sky.set_clouds(blocks);
             indices = now;
         }
+        host.sky.set_weather_overhead(&world.weather_over(p));
         let camera = host.camera(p, 90.0, PITCH_DEG);
         let start = Instant::now();
         let stats = host.draw(&camera, &sun, dt_s, visibility_m);

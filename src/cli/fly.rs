@@ -183,6 +183,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         let step_s = if k == 0 { 0.0 } else { dt_s };
         host.sky
             .set_clouds(world.living_blocks(pose.position_m, step_s)?);
+        host.sky
+            .set_weather_overhead(&world.weather_over(pose.position_m));
         let camera = host.camera(pose.position_m, pose.heading_deg, pose.pitch_deg);
         let sun = sun_position(start_unix_s + time_s, lat, lon);
         let write = k % args.every as u64 == 0 || k + 1 == frames;

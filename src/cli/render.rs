@@ -142,6 +142,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let position = glam::DVec3::new(0.0, 0.0, args.alt_ft * METRES_PER_FOOT);
     let camera = host.camera(position, args.heading, args.pitch);
     host.sky.set_clouds(world.sky_blocks_around(position));
+    host.sky.set_weather_overhead(&world.weather_over(position));
     let sun = sun_position(unix_s, lat, lon);
     let (frame, stats) = host.frame(&camera, &sun, 0.0, world.visibility_m())?;
     frame.write_png(&args.out)?;

@@ -17,7 +17,8 @@ use super::impostor::{ImpostorRing, RingFrame, RingShared};
 use super::scene::SkyBlock;
 use super::settings::RenderSettings;
 use super::vertices::{FrameStats, Lighting, SpriteVertexBuilder, quad_indices};
-use crate::shading::{SunPosition, TimeOfDay, TimeOfDayTable};
+use crate::shading::{SunPosition, TimeOfDay, TimeOfDayTable, hidden_above};
+use crate::weather::{BlockLayer, BlockWeather};
 
 /// The 4 x 4 sprite texture sheet, RGBA8 (linear), level 0 first, each level half the last.
 #[derive(Debug, Clone, PartialEq)]
@@ -60,7 +61,12 @@ pub struct Sky {
     elapsed_s: f64,
     sprites_to_draw: u32,
     in_cloud: f32,
-    light: TimeOfDay,
+    /// The time-of-day light of the last frame, clear sky: what the clouds are lit with.
+    clear_light: TimeOfDay,
+    /// `light` under the cloud cover over the camera: the sky colours and the host's light.
+    seen_light: TimeOfDay,
+    /// The weather over the camera: its cloud layers and ground elevation, metres.
+    overhead: (Vec<BlockLayer>, f32),
     ring: ImpostorRing,
 }
 
@@ -312,7 +318,9 @@ impl Sky {
             elapsed_s: 0.0,
             sprites_to_draw: 0,
             in_cloud: 0.0,
-            light,
+            clear_light: light,
+            seen_light: light,
+            overhead: (Vec::new(), 0.0),
             ring,
         })
     }
@@ -338,14 +346,35 @@ impl Sky {
         self.settings.vertex_cache.enabled = enabled;
     }
 
-    /// Colour a host should fog its distant ground towards (the horizon sky colour now).
-    pub fn horizon_rgb(&self) -> Vec3 {
-        self.light.sky_horizon_rgb
+    /// The weather over the camera (the layers and ground of its point of the weather field).
+    /// Each frame works out how much of the sky the layers above the camera hide
+    /// ([`crate::shading::hidden_above`]): below a thick deck the sky turns grey and dim and
+    /// [`Self::light`] loses its sun; above it nothing changes. The clouds keep their own light.
+    /// Until it is called the sky is taken as clear overhead.
+    pub fn set_weather_overhead(&mut self, weather: &BlockWeather) {
+        self.overhead = (weather.layers.clone(), weather.ground_elevation_m);
     }
 
-    /// The time-of-day light of the last prepared frame.
+    /// The fraction of the sky hidden above `altitude_m` by the weather overhead, 0..=1.
+    pub fn sky_hidden_at(&self, altitude_m: f64) -> f32 {
+        let (layers, ground_m) = &self.overhead;
+        hidden_above(
+            layers,
+            *ground_m,
+            altitude_m as f32,
+            &self.time_of_day.overcast,
+        )
+    }
+
+    /// Colour a host should fog its distant ground towards (the horizon sky colour now).
+    pub fn horizon_rgb(&self) -> Vec3 {
+        self.seen_light.sky_horizon_rgb
+    }
+
+    /// The light of the last prepared frame under the cloud cover (see [`Self::set_sky_hidden`]):
+    /// what a host lights its own scene with.
     pub fn light(&self) -> TimeOfDay {
-        self.light
+        self.seen_light
     }
 
     /// The time-of-day light for a sun position (for hosts lighting their own scene).
@@ -372,11 +401,15 @@ impl Sky {
         dt_s: f64,
     ) -> FrameStats {
         self.elapsed_s += dt_s.max(0.0);
-        self.light = self.time_of_day.at(sun.elevation_deg as f32);
+        self.clear_light = self.time_of_day.at(sun.elevation_deg as f32);
+        self.seen_light = self.clear_light.under_cover(
+            self.sky_hidden_at(camera.position_m.z),
+            &self.time_of_day.overcast,
+        );
         let sun_dir = sun.direction_enu().as_vec3();
         let lighting = Lighting {
             sun_dir,
-            time_of_day: self.light,
+            time_of_day: self.clear_light,
             mapping: self.time_of_day.directional_mapping,
         };
         let near = self
@@ -408,8 +441,8 @@ impl Sky {
         let view_proj = camera.view_proj_relative();
         let sun_cfg = &self.settings.sun;
         // In-cloud fog: the ambient of a mid-grey cloud at this time of day plus some sun.
-        let fog_rgb =
-            Vec3::splat(0.8) * self.light.ambient_percent + self.light.directional_rgb * 0.25;
+        let fog_rgb = Vec3::splat(0.8) * self.clear_light.ambient_percent
+            + self.clear_light.directional_rgb * 0.25;
         let frame = GpuFrame {
             view_proj: view_proj.to_cols_array_2d(),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
@@ -417,12 +450,12 @@ impl Sky {
                 .extend(sun_cfg.disc_radius_deg.to_radians().cos())
                 .to_array(),
             sun_rgb: self
-                .light
+                .seen_light
                 .directional_rgb
                 .extend(sun_cfg.glow_radius_deg.to_radians().cos())
                 .to_array(),
-            sky_zenith_rgb: self.light.sky_zenith_rgb.extend(1.0).to_array(),
-            sky_horizon_rgb: self.light.sky_horizon_rgb.extend(1.0).to_array(),
+            sky_zenith_rgb: self.seen_light.sky_zenith_rgb.extend(1.0).to_array(),
+            sky_horizon_rgb: self.seen_light.sky_horizon_rgb.extend(1.0).to_array(),
             in_cloud_rgba: fog_rgb.extend(stats.in_cloud).to_array(),
             params: [
                 camera.near_m,

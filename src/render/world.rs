@@ -192,6 +192,11 @@ impl World {
         if v >= 9_000.0 { 40_000.0 } else { v }
     }
 
+    /// The weather over `camera_m` (for [`crate::render::Sky::set_weather_overhead`]).
+    pub fn weather_over(&self, camera_m: DVec3) -> BlockWeather {
+        self.field.weather_at(camera_m.truncate())
+    }
+
     /// The blocks that get clouds around `camera_m`, in a fixed order.
     pub fn block_indices(&self, camera_m: DVec3) -> Vec<BlockIndex> {
         let r = self.settings.cloud_radius_m;

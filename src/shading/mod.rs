@@ -13,15 +13,19 @@
 //! - [`ambient`]: Wang 5.1, equation (1): five RGBA colour levels by height.
 //! - [`directional`]: Wang 5.2, equation (2): shading groups and the biased mapping
 //!   `[-1, 0] -> [Cmin, Cmedian]`, `[0, 1] -> [Cmedian, Cmax]`.
+//! - [`cover`]: beyond Wang, the daylight under the clouds: how much of the sky the layers above
+//!   a point hide, and the grey, sunless light below a thick deck.
 //!
 //! Plain data only: no wgpu here. Units: metres, degrees, linear RGB in 0..=1.
 
 pub mod ambient;
+pub mod cover;
 pub mod directional;
 pub mod sun;
 pub mod time_of_day;
 
 pub use ambient::{ColourLevel, ColourLevels};
+pub use cover::{OvercastLight, hidden_above};
 pub use directional::{DirectionalMapping, directional_percent};
 pub use sun::{SunPosition, sun_position};
 pub use time_of_day::{TimeOfDay, TimeOfDaySample, TimeOfDayTable};

@@ -8,7 +8,7 @@ use std::path::Path;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::{DirectionalMapping, ShadingError};
+use super::{DirectionalMapping, OvercastLight, ShadingError};
 use crate::config::{ConfigError, line_of, parse_toml};
 
 /// The built-in table, `config/time_of_day.toml`.
@@ -39,6 +39,9 @@ pub struct TimeOfDayTable {
     /// Rows in increasing sun elevation.
     #[serde(rename = "sample")]
     pub samples: Vec<TimeOfDaySample>,
+    /// The light under cloud cover (defaults when the table is absent).
+    #[serde(default)]
+    pub overcast: OvercastLight,
 }
 
 /// The light at one moment, interpolated from the table.
@@ -70,6 +73,7 @@ impl Default for TimeOfDayTable {
                 sky_zenith_rgb: [0.1, 0.25, 0.6],
                 sky_horizon_rgb: [0.5, 0.6, 0.8],
             }],
+            overcast: OvercastLight::default(),
         })
     }
 }
@@ -118,6 +122,14 @@ impl TimeOfDayTable {
                     format!("sample {}: {} is outside 0..=4", i + 1, s.ambient_percent),
                 ));
             }
+        }
+        if let Some((field, message)) = table.overcast.invalid_field() {
+            return Err(ShadingError::Config(ConfigError {
+                path: path.to_path_buf(),
+                line: text.find("[overcast]").map(|offset| line_of(text, offset)),
+                field: Some(field.to_owned()),
+                message,
+            }));
         }
         Ok(table)
     }
@@ -232,6 +244,18 @@ mod tests {
             .to_string();
         assert!(
             err.contains("sample 3") && err.contains("sun_elevation_deg"),
+            "{err}"
+        );
+        let text = DEFAULT_TIME_OF_DAY_TOML.replacen("grey_from = 0.6", "grey_from = 2.0", 1);
+        let err = TimeOfDayTable::from_toml_str(&text, "my_tod.toml")
+            .unwrap_err()
+            .to_string();
+        let line = 1 + DEFAULT_TIME_OF_DAY_TOML
+            [..DEFAULT_TIME_OF_DAY_TOML.find("[overcast]").unwrap()]
+            .matches('\n')
+            .count();
+        assert!(
+            err.starts_with(&format!("my_tod.toml:{line}: field `overcast.grey_from`")),
             "{err}"
         );
     }
