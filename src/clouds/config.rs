@@ -175,6 +175,10 @@ pub struct CloudTypeConfig {
     /// The anvil, for cumulonimbus.
     #[serde(default)]
     pub anvil: Option<AnvilConfig>,
+    /// Flat types: each cloud is a streak this many times longer than wide, laid along the wind
+    /// with every sprite lengthwise along it (cirrus fibres); `cloud_size_m` is its length.
+    #[serde(default)]
+    pub streak_length_over_width: Option<f32>,
     /// Most boxes per block, by cover.
     pub boxes_per_block: BoxesByCover,
     /// Sprites per box before the cull, 1..=100.
@@ -481,6 +485,13 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
             "needs 0 < from < 1 and width_scale >= 1",
         )?;
     }
+    if let Some(aspect) = c.streak_length_over_width {
+        v.check(
+            c.flat && (1.0..=50.0).contains(&aspect),
+            "streak_length_over_width",
+            "must be 1..=50, on a flat type",
+        )?;
+    }
     let b = c.boxes_per_block;
     v.check(
         [b.few, b.sct, b.bkn, b.ovc]
@@ -647,6 +658,12 @@ mod tests {
                 "anvil = { from = 0.8,",
                 "anvil = { from = 1.2,",
                 "anvil",
+            ),
+            (
+                "cirrus",
+                "streak_length_over_width = 5.0",
+                "streak_length_over_width = 0.5",
+                "streak_length_over_width",
             ),
             ("cumulus_humilis", "few = 40", "few = 10", "boxes_per_block"),
             (

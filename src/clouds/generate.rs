@@ -48,13 +48,21 @@ pub fn generate_block(
     for (li, layer) in weather.layers.iter().enumerate() {
         let config = types.get(layer.cloud_type);
         let frame = LayerFrame::new(layer, config, weather.ground_elevation_m as f64);
+        let ctx = LayerCtx {
+            config,
+            layer,
+            li,
+            frame: &frame,
+            // The only wind reported is the surface wind; high cloud streaks along it too.
+            wind_axis_deg: 90.0 - weather.wind.from_deg as f64,
+        };
         let first = block.clouds.len();
         let (covered, boxes) = if layer.coverage_oktas <= 0.0 {
             (0.0, 0)
         } else if config.continuous || layer.coverage_oktas >= OVERCAST_OKTAS {
-            lattice_layer(index, layer, li, config, &frame, seed, &mut block.clouds)
+            lattice_layer(index, &ctx, seed, &mut block.clouds)
         } else {
-            scattered_layer(index, layer, li, config, &frame, seed, &mut block.clouds)
+            scattered_layer(index, &ctx, seed, &mut block.clouds)
         };
         let clouds = &block.clouds[first..];
         let area: f64 = clouds.iter().map(Cloud::sprite_area_m2).sum();
@@ -97,13 +105,13 @@ fn type_key(t: CloudType) -> u64 {
 /// Random clouds until the coverage grid reaches oktas / 8 (or the box budget runs out).
 fn scattered_layer(
     index: BlockIndex,
-    layer: &BlockLayer,
-    li: usize,
-    config: &CloudTypeConfig,
-    frame: &LayerFrame,
+    ctx: &LayerCtx,
     seed: u64,
     out: &mut Vec<Cloud>,
 ) -> (f64, u32) {
+    let LayerCtx {
+        config, layer, li, ..
+    } = *ctx;
     let mut rng = SplitMix64::from_keys(&[
         seed,
         index.i as u64,
@@ -148,18 +156,7 @@ fn scattered_layer(
                 rng.range_f64(margin, BLOCK_SIZE_M - margin),
             );
         let cloud_seed = rng.next_u64();
-        let (cloud, n_boxes) = build_cloud(
-            &LayerCtx {
-                config,
-                layer,
-                li,
-                frame,
-            },
-            centre,
-            d,
-            None,
-            cloud_seed,
-        );
+        let (cloud, n_boxes) = build_cloud(ctx, centre, d, None, cloud_seed);
         let cells = cloud_cells(&cloud, corner);
         let new = cells.iter().filter(|&&c| !grid[c]).count();
         if cells.is_empty() || (new as f64) < min_new_share * cells.len() as f64 {
@@ -178,7 +175,8 @@ fn scattered_layer(
 }
 
 /// Coverage-grid cells (of the block, 100 m) under a cloud: those whose centre lies within
-/// 0.7 half-widths of a sprite centre horizontally (the sprite's dense core).
+/// 0.7 half-widths of a sprite centre horizontally (the sprite's dense core); for a flat sprite,
+/// within 0.7 of its half extents (an ellipse turned with it).
 fn cloud_cells(cloud: &Cloud, corner: DVec2) -> Vec<usize> {
     let cell = BLOCK_SIZE_M / GRID as f64;
     let mut cells = Vec::new();
@@ -187,15 +185,23 @@ fn cloud_cells(cloud: &Cloud, corner: DVec2) -> Vec<usize> {
             cloud.centre_m.x + s.offset_m[0] as f64,
             cloud.centre_m.y + s.offset_m[1] as f64,
         ) - corner;
-        let r = 0.35 * s.width_m as f64;
+        let a = 0.35 * s.width_m as f64;
+        let b = if cloud.flat {
+            0.35 * s.height_m as f64
+        } else {
+            a
+        };
+        let along = DVec2::from_angle((s.rotation_deg as f64).to_radians());
+        let r = a.max(b);
         let lo_x = ((p.x - r) / cell).floor().max(0.0) as usize;
         let hi_x = ((p.x + r) / cell).ceil().clamp(0.0, GRID as f64) as usize;
         let lo_y = ((p.y - r) / cell).floor().max(0.0) as usize;
         let hi_y = ((p.y + r) / cell).ceil().clamp(0.0, GRID as f64) as usize;
         for y in lo_y..hi_y {
             for x in lo_x..hi_x {
-                let q = DVec2::new((x as f64 + 0.5) * cell, (y as f64 + 0.5) * cell);
-                if q.distance_squared(p) <= r * r {
+                let q = DVec2::new((x as f64 + 0.5) * cell, (y as f64 + 0.5) * cell) - p;
+                let (u, v) = (q.dot(along) / a, q.perp_dot(along) / b);
+                if u * u + v * v <= 1.0 {
                     cells.push(y * GRID + x);
                 }
             }
@@ -208,15 +214,10 @@ fn cloud_cells(cloud: &Cloud, corner: DVec2) -> Vec<usize> {
 
 /// One cloud per world lattice cell whose origin lies in the block; below 8 oktas only the
 /// coverage share of them (those with the lowest per-cell random key).
-fn lattice_layer(
-    index: BlockIndex,
-    layer: &BlockLayer,
-    li: usize,
-    config: &CloudTypeConfig,
-    frame: &LayerFrame,
-    seed: u64,
-    out: &mut Vec<Cloud>,
-) -> (f64, u32) {
+fn lattice_layer(index: BlockIndex, ctx: &LayerCtx, seed: u64, out: &mut Vec<Cloud>) -> (f64, u32) {
+    let LayerCtx {
+        config, layer, li, ..
+    } = *ctx;
     let s = config.lattice_spacing_m as f64;
     let lo = index.min_corner_m();
     let hi = lo + DVec2::splat(BLOCK_SIZE_M);
@@ -250,18 +251,7 @@ fn lattice_layer(
         let [dmin, dmax] = config.cloud_size_m.map(f64::from);
         // Wide enough to cover the cell's corners: diagonal plus the jitter.
         let d = rng.range_f64(dmin, dmax).max(s * 1.5);
-        let (cloud, n) = build_cloud(
-            &LayerCtx {
-                config,
-                layer,
-                li,
-                frame,
-            },
-            centre,
-            d,
-            Some(s),
-            rng.next_u64(),
-        );
+        let (cloud, n) = build_cloud(ctx, centre, d, Some(s), rng.next_u64());
         boxes += n;
         out.push(cloud);
     }
@@ -275,6 +265,8 @@ pub(super) struct Raw {
     pub(super) width: f64,
     pub(super) height: f64,
     pub(super) group: u32,
+    /// A set rotation, degrees (streak sprites lie along their streak); `None`: the band's.
+    pub(super) rotation_deg: Option<f64>,
     /// Stands on the cloud base: takes the first texture band (small rotation), this category of
     /// it where the band has it (flat-bottomed on the rim, foggy under the inside).
     pub(super) base: Option<TextureCategory>,
@@ -288,6 +280,8 @@ struct LayerCtx<'a> {
     layer: &'a BlockLayer,
     li: usize,
     frame: &'a LayerFrame,
+    /// Direction of the wind's axis, degrees anticlockwise from east (streaks lie along it).
+    wind_axis_deg: f64,
 }
 
 fn build_cloud(
@@ -299,6 +293,14 @@ fn build_cloud(
 ) -> (Cloud, u32) {
     let LayerCtx { config, frame, .. } = *ctx;
     let mut rng = SplitMix64::new(cloud_seed);
+    // Streaks: the footprint squeezed across the wind axis, every sprite along it.
+    let streak = config
+        .streak_length_over_width
+        .filter(|_| config.flat && lattice_cell_m.is_none())
+        .map(|aspect| {
+            let (sin, cos) = ctx.wind_axis_deg.to_radians().sin_cos();
+            (aspect as f64, DVec2::new(cos, sin))
+        });
     let density = config.density_by_cover.for_oktas(ctx.layer.coverage_oktas) as f64;
     // Heaped clouds stand on a flat base and end in a dome (or an anvil).
     if lattice_cell_m.is_none() && !config.continuous && !config.flat {
@@ -323,6 +325,10 @@ fn build_cloud(
             (cell * 0.55, DVec2::ZERO)
         } else {
             let off = DVec2::new(rng.range_f64(-0.15, 0.15), rng.range_f64(-0.15, 0.15)) * d;
+            let off = match streak {
+                Some((aspect, along)) => along * off.x + along.perp() * (off.y / aspect),
+                None => off,
+            };
             (d / 2.0 * if n_boxes > 1 { 0.75 } else { 1.0 }, off)
         };
         let n = rng.range_u32(config.sprites_per_box[0], config.sprites_per_box[1]);
@@ -375,11 +381,20 @@ fn build_cloud(
                     (thickness - half_h).max(thickness / 2.0),
                 )
             };
+            let (local, rotation_deg) = match streak {
+                Some((aspect, along)) => {
+                    let across = along.perp();
+                    let p = along * (x * spread) + across * (y * spread / aspect);
+                    (p, Some(ctx.wind_axis_deg))
+                }
+                None => (DVec2::new(x, y) * spread, None),
+            };
             raws.push(Raw {
-                pos: DVec3::new(offset.x + x * spread, offset.y + y * spread, z),
+                pos: DVec3::new(offset.x + local.x, offset.y + local.y, z),
                 width,
                 height,
                 group: group - 1,
+                rotation_deg,
                 base: None,
             });
         }
@@ -409,6 +424,7 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
         layer,
         li,
         frame,
+        ..
     } = *ctx;
     let thickness = frame.thickness_m;
     let centre_z = frame.base_m + thickness / 2.0;
@@ -451,10 +467,10 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
         let cells = category.cells();
         let texture = rng.range_u32(cells.start as u32, cells.end as u32 - 1) as u8;
         let square = (r.height - r.width).abs() < 1e-6 * r.width.max(1.0);
-        let rotation_deg = if square {
-            rng.range_f32(rotation[0], rotation[1])
-        } else {
-            0.0
+        let rotation_deg = match r.rotation_deg {
+            Some(deg) => deg.rem_euclid(360.0) as f32,
+            None if square => rng.range_f32(rotation[0], rotation[1]),
+            None => 0.0,
         };
         let offset = r.pos - origin;
         sprites.push(Sprite {
@@ -573,6 +589,40 @@ mod tests {
         assert!(a.sprite_count() > 50);
     }
 
+    /// Cirrus clouds are streaks along the wind: each cloud's sprites spread at least 2.5 times
+    /// further along the wind's axis than across it, whatever the wind's direction.
+    #[test]
+    fn cirrus_are_streaks_along_the_wind() {
+        for from_deg in [270.0f32, 225.0, 0.0] {
+            let mut w = weather(CloudType::Cirrus, 4.0, 28_000.0, 800.0);
+            w.wind = Wind {
+                from_deg,
+                speed_kt: 40.0,
+            };
+            let block = generate_block(BlockIndex::new(2, 1), &w, 5, types());
+            let along = DVec2::from_angle((90.0 - from_deg as f64).to_radians());
+            let mut checked = 0;
+            for c in block.clouds.iter().filter(|c| c.sprites.len() >= 3) {
+                let extent = |axis: DVec2| {
+                    let d: Vec<f64> = c
+                        .sprites
+                        .iter()
+                        .map(|s| DVec2::new(s.offset_m[0] as f64, s.offset_m[1] as f64).dot(axis))
+                        .collect();
+                    d.iter().cloned().fold(f64::MIN, f64::max)
+                        - d.iter().cloned().fold(f64::MAX, f64::min)
+                };
+                let (l, a) = (extent(along), extent(along.perp()));
+                assert!(
+                    l > 2.5 * a,
+                    "from {from_deg}: {l:.0} m along, {a:.0} m across"
+                );
+                checked += 1;
+            }
+            assert!(checked >= 2, "from {from_deg}: {checked} streaks");
+        }
+    }
+
     #[test]
     fn sprites_follow_the_paper_and_the_config() {
         for t in CloudType::ALL {
@@ -616,7 +666,11 @@ mod tests {
                     };
                     let cat = crate::clouds::TextureCategory::of_cell(s.texture);
                     assert!(band.textures.contains(&cat), "{t}: {cat:?} at {fraction}");
-                    if s.width_m != s.height_m {
+                    if config.streak_length_over_width.is_some() {
+                        // Streak sprites lie along the wind's axis.
+                        let axis = (90.0 - w.wind.from_deg).rem_euclid(360.0);
+                        assert!((s.rotation_deg - axis).abs() < 1e-3, "{t}: streak off axis");
+                    } else if s.width_m != s.height_m {
                         assert_eq!(s.rotation_deg, 0.0, "{t}: non-square sprite rotated");
                     } else {
                         assert!(
@@ -851,7 +905,7 @@ mod golden {
                 "c6516121a3e3a2c2",
                 "6ca8c91263fd5bf1",
                 "94e59f42d13ef325",
-                "0f4dac4f3a2b26f9"
+                "f8230d2b16028c35"
             ]
         );
     }

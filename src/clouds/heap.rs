@@ -70,6 +70,7 @@ pub(super) fn heap_sprites(
                 width,
                 height,
                 group: group + (gx / 3 + gy / 3 * 4) as u32,
+                rotation_deg: None,
                 // Flat-bottomed on the rim (what a side view shows), foggy under the inside
                 // (what a view from below shows: a smooth grey underside); a small cloud's few
                 // are all rim.
@@ -146,6 +147,7 @@ pub(super) fn heap_sprites(
                 width,
                 height,
                 group: group - 1,
+                rotation_deg: None,
                 base: None,
             });
         }
@@ -184,6 +186,7 @@ pub(super) fn heap_sprites(
                 width,
                 height,
                 group: group - 1,
+                rotation_deg: None,
                 base: None,
             });
         }
