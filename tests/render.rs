@@ -603,19 +603,28 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     assert_eq!(stats.sprites_drawn, 120, "{stats:?}");
     assert!(stats.ring_gpu_bytes >= 2 * 8 * 256 * 256 * 4, "{stats:?}");
 
-    let (n_sprites, x_s, y_s) = changed_pixels(&sprites_only, &bare);
-    let (n_ring, x_r, y_r) = changed_pixels(&ring, &bare);
+    assert_far_cloud_where_sprites_have_it(&sprites_only, &ring, &bare, 4.0);
+}
+
+/// The far cloud (what `sprites` and `ring` add to `bare`) shows in the impostor with about the
+/// pixels it has as sprites (0.6-1.5x), its centroid within `tolerance_px` of theirs.
+fn assert_far_cloud_where_sprites_have_it(
+    sprites: &Frame,
+    ring: &Frame,
+    bare: &Frame,
+    tolerance_px: f32,
+) {
+    let (n_s, x_s, y_s) = changed_pixels(sprites, bare);
+    let (n_r, x_r, y_r) = changed_pixels(ring, bare);
+    eprintln!("far cloud: sprites {n_s} px at ({x_s}, {y_s}); ring {n_r} px at ({x_r}, {y_r})");
+    assert!(n_s > 150, "the far cloud shows as sprites: {n_s} px");
     assert!(
-        n_sprites > 150,
-        "the far cloud shows as sprites: {n_sprites} px"
+        n_r as f32 > 0.6 * n_s as f32 && (n_r as f32) < 1.5 * n_s as f32,
+        "the far cloud shows in the impostor: {n_r} px vs {n_s} as sprites"
     );
     assert!(
-        n_ring as f32 > 0.6 * n_sprites as f32 && (n_ring as f32) < 1.5 * n_sprites as f32,
-        "the far cloud shows in the impostor: {n_ring} px vs {n_sprites} as sprites"
-    );
-    assert!(
-        (x_r - x_s).abs() < 4.0 && (y_r - y_s).abs() < 4.0,
-        "the impostor cloud is where the sprites were: ({x_r}, {y_r}) vs ({x_s}, {y_s})"
+        (x_r - x_s).abs() < tolerance_px && (y_r - y_s).abs() < tolerance_px,
+        "the impostored cloud is where the sprites have it: ({x_r}, {y_r}) vs ({x_s}, {y_s})"
     );
 }
 
@@ -669,18 +678,7 @@ fn ring_moves_far_clouds_with_the_camera_height() {
     );
     assert_eq!((stats.blocks_near, stats.blocks_far), (1, 1), "{stats:?}");
 
-    let (n_s, x_s, y_s) = changed_pixels(&sprites, &bare);
-    let (n_r, x_r, y_r) = changed_pixels(&ring, &bare);
-    eprintln!("climb: sprites {n_s} px at ({x_s}, {y_s}); ring {n_r} px at ({x_r}, {y_r})");
-    assert!(n_s > 150, "the far cloud shows as sprites: {n_s} px");
-    assert!(
-        n_r as f32 > 0.6 * n_s as f32 && (n_r as f32) < 1.5 * n_s as f32,
-        "the far cloud shows in the impostor: {n_r} px vs {n_s} as sprites"
-    );
-    assert!(
-        (x_r - x_s).abs() < 3.0 && (y_r - y_s).abs() < 3.0,
-        "the impostored cloud moved with the climb: ({x_r}, {y_r}) vs ({x_s}, {y_s}) as sprites"
-    );
+    assert_far_cloud_where_sprites_have_it(&sprites, &ring, &bare, 3.0);
 }
 
 /// Moving past 15% of the ring radius rebuilds the ring one impostor per frame over 8 frames,

@@ -32,7 +32,8 @@ pub struct DemoHost {
     timer: Option<GpuTimer>,
 }
 
-/// Two timestamps around a frame's passes, where the device has timestamp queries.
+/// Three timestamps: before the frame's passes, between the ground and the sky, after; where the
+/// device has timestamp queries.
 struct GpuTimer {
     queries: wgpu::QuerySet,
     resolve: wgpu::Buffer,
@@ -50,12 +51,12 @@ impl GpuTimer {
         let queries = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("host.frame_time"),
             ty: wgpu::QueryType::Timestamp,
-            count: 2,
+            count: 3,
         });
         let buffer = |label, usage| {
             gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: 16,
+                size: 24,
                 usage,
                 mapped_at_creation: false,
             })
@@ -74,18 +75,20 @@ impl GpuTimer {
         })
     }
 
-    /// Milliseconds between the two timestamps of the last submitted frame (waits for it).
-    fn read_ms(&self, gpu: &HeadlessGpu) -> Option<f64> {
+    /// Milliseconds of the ground and of the sky passes of the last submitted frame (waits
+    /// for it).
+    fn read_ms(&self, gpu: &HeadlessGpu) -> Option<[f64; 2]> {
         self.read.map_async(wgpu::MapMode::Read, .., |_| {});
         gpu.device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
-        let ticks: [u64; 2] = {
+        let ticks: [u64; 3] = {
             let view = self.read.get_mapped_range(..).ok()?;
             let t =
                 |i: usize| u64::from_le_bytes(view[i * 8..i * 8 + 8].try_into().unwrap_or([0; 8]));
-            [t(0), t(1)]
+            [t(0), t(1), t(2)]
         };
         self.read.unmap();
-        Some(ticks[1].saturating_sub(ticks[0]) as f64 * self.period_ns as f64 / 1.0e6)
+        let ms = |a: u64, b: u64| b.saturating_sub(a) as f64 * self.period_ns as f64 / 1.0e6;
+        Some([ms(ticks[0], ticks[1]), ms(ticks[1], ticks[2])])
     }
 }
 
@@ -167,15 +170,18 @@ impl DemoHost {
             &self.target.colour_view,
             &self.target.depth_view,
         );
+        if let Some(t) = &self.timer {
+            encoder.write_timestamp(&t.queries, 1);
+        }
         self.sky.record(
             &mut encoder,
             &self.target.colour_view,
             &self.target.depth_view,
         );
         if let Some(t) = &self.timer {
-            encoder.write_timestamp(&t.queries, 1);
-            encoder.resolve_query_set(&t.queries, 0..2, &t.resolve, 0);
-            encoder.copy_buffer_to_buffer(&t.resolve, 0, &t.read, 0, 16);
+            encoder.write_timestamp(&t.queries, 2);
+            encoder.resolve_query_set(&t.queries, 0..3, &t.resolve, 0);
+            encoder.copy_buffer_to_buffer(&t.resolve, 0, &t.read, 0, 24);
         }
         self.gpu.queue.submit([encoder.finish()]);
         stats
@@ -184,6 +190,12 @@ impl DemoHost {
     /// GPU time of the last drawn frame (ground and sky passes), milliseconds, where the device
     /// has timestamp queries. Waits for the frame.
     pub fn last_gpu_ms(&self) -> Option<f64> {
+        self.last_gpu_split_ms().map(|[ground, sky]| ground + sky)
+    }
+
+    /// GPU time of the last drawn frame's ground passes and of its sky passes (impostor
+    /// renders included), milliseconds, where the device has timestamp queries. Waits for it.
+    pub fn last_gpu_split_ms(&self) -> Option<[f64; 2]> {
         self.timer.as_ref()?.read_ms(&self.gpu)
     }
 

@@ -94,8 +94,27 @@ fn bench_command_writes_table_csv_and_plot() {
         "{overdraw:?}"
     );
 
-    let frames = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
-    assert_eq!(frames.lines().count(), 1 + 6 * 3);
+    // One steady frame a sample; before it, with impostors, the frames that rebuild the ring
+    // (the 6 km steps are past 15% of the 20 km ring radius), timed as the rebuild column.
+    let mut frames = csv::Reader::from_path(dir.join("frames.csv")).unwrap();
+    let frames: Vec<csv::StringRecord> = frames.records().map(Result::unwrap).collect();
+    let steady = |run: &str| {
+        frames
+            .iter()
+            .filter(|f| &f[1] == run && &f[3] == "yes")
+            .count()
+    };
+    assert_eq!((steady("on"), steady("off")), (9, 9));
+    let rebuilt = frames
+        .iter()
+        .filter(|f| &f[1] == "on" && &f[3] == "no" && f[11].parse::<u32>().unwrap() > 0)
+        .count();
+    assert!(rebuilt >= 3 * 8, "{rebuilt} rebuild frames");
+    assert!(frames.iter().all(|f| &f[1] == "on" || &f[3] == "yes"));
+    for pair in rows.chunks(2) {
+        assert!(number(&pair[0], "rebuild_ms") > 0.0, "{:?}", pair[0]);
+        assert!(pair[1][column("rebuild_ms")].is_empty(), "{:?}", pair[1]);
+    }
     let plot = image::open(dir.join("frame_time.png")).unwrap();
     assert!(plot.width() >= 400 && plot.height() >= 200);
     // Lines were drawn: the overcast colour is in it.
