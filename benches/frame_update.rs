@@ -68,6 +68,7 @@ fn cruise() -> Cruise {
         sun_dir: sun.direction_enu().as_vec3(),
         time_of_day: table.at(sun.elevation_deg as f32),
         mapping: table.directional_mapping,
+        forward: table.forward_scattering,
     };
     Cruise {
         blocks,

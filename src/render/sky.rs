@@ -411,6 +411,7 @@ impl Sky {
             sun_dir,
             time_of_day: self.clear_light,
             mapping: self.time_of_day.directional_mapping,
+            forward: self.time_of_day.forward_scattering,
         };
         let near = self
             .ring

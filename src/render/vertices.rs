@@ -14,7 +14,7 @@ use glam::{DVec3, Vec3, Vec4};
 use super::gpu_types::GpuSpriteVertex;
 use super::scene::{SkyBlock, SkyCloud, SkySprite};
 use super::settings::{CloudSettings, RenderSettings, VertexCacheSettings};
-use crate::shading::{DirectionalMapping, TimeOfDay, vertex_colour};
+use crate::shading::{DirectionalMapping, ForwardScattering, TimeOfDay, vertex_colour};
 
 /// What one frame's update did.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -54,6 +54,8 @@ pub struct Lighting {
     pub time_of_day: TimeOfDay,
     /// Wang's Cmin / Cmedian / Cmax.
     pub mapping: DirectionalMapping,
+    /// Light scattered forward towards the eye (the silver lining).
+    pub forward: ForwardScattering,
 }
 
 /// A sprite corner relative to its cloud centre, as cached.
@@ -353,6 +355,7 @@ fn build_cloud(
     let tod = &lighting.time_of_day;
     let lock_start = settings.lock_fade_start_deg.to_radians().cos();
     let lock_end = settings.lock_fade_end_deg.to_radians().cos();
+    let cloud_radius = cloud.radius_m().max(1.0);
     for (i, dist2) in order {
         let s = &cloud.sprites[i];
         let to_cam = cam_local - s.offset_m;
@@ -397,9 +400,18 @@ fn build_cloud(
             let height_msl = cloud.centre_m.z as f32 + p.z;
             let ambient = cloud.colour_levels.at(height_msl);
             let ambient = (ambient.truncate() * tod.ambient_percent).extend(ambient.w);
-            let dir =
-                crate::shading::directional_percent(&lighting.mapping, p, group, lighting.sun_dir)
-                    * tod.directional_rgb;
+            let view = (p - cam_local).normalize_or_zero();
+            let forward =
+                lighting
+                    .forward
+                    .percent(view, lighting.sun_dir, p.length() / cloud_radius);
+            let dir = (crate::shading::directional_percent(
+                &lighting.mapping,
+                p,
+                group,
+                lighting.sun_dir,
+            ) + forward)
+                * tod.directional_rgb;
             let colour = vertex_colour(ambient, dir, s.alpha_morph * lock_alpha);
             // Texture v runs down the sheet: the top of the sprite is v = 0.
             out.push(LocalVertex {
@@ -469,6 +481,7 @@ mod tests {
             sun_dir: Vec3::new(0.0, -0.6, 0.8),
             time_of_day: table.at(40.0),
             mapping: table.directional_mapping,
+            forward: table.forward_scattering,
         }
     }
 
@@ -524,6 +537,41 @@ mod tests {
         off.vertex_cache.enabled = false;
         let again = builder.update(&b, cam + DVec3::new(0.0, 450.0, 0.0), 1.1, &l, &off);
         assert_eq!(again.clouds_recomputed, 10);
+    }
+
+    /// Seen with the sun behind it, a cloud's rim is brighter than with the sun behind the
+    /// camera by the forward-scattering lobe; its core hardly changes (Wang's shading stays).
+    #[test]
+    fn the_rim_of_a_cloud_against_the_sun_glows() {
+        let b = blocks();
+        let s = RenderSettings::default();
+        let cam = DVec3::new(0.0, 0.0, 1500.0);
+        // The first cloud is 5 km north: the sun low in the north, then low in the south.
+        let brightest = |sun_dir: Vec3, forward: ForwardScattering| {
+            let l = Lighting {
+                sun_dir: sun_dir.normalize(),
+                forward,
+                ..lighting()
+            };
+            let mut builder = SpriteVertexBuilder::new();
+            builder.update(&b[..], cam, 0.0, &l, &s);
+            builder
+                .vertices()
+                .iter()
+                .map(|v| v.colour[0])
+                .fold(0.0, f32::max)
+        };
+        let none = ForwardScattering {
+            strength: 0.0,
+            ..ForwardScattering::default()
+        };
+        let on = ForwardScattering::default();
+        let against = Vec3::new(0.0, 1.0, 0.05);
+        let behind = Vec3::new(0.0, -1.0, 0.05);
+        let glow = brightest(against, on) - brightest(against, none);
+        let other_way = brightest(behind, on) - brightest(behind, none);
+        assert!(glow > 0.1, "against the sun: +{glow}");
+        assert!(other_way < 0.01, "sun behind the camera: +{other_way}");
     }
 
     #[test]

@@ -13,6 +13,8 @@
 //! - [`ambient`]: Wang 5.1, equation (1): five RGBA colour levels by height.
 //! - [`directional`]: Wang 5.2, equation (2): shading groups and the biased mapping
 //!   `[-1, 0] -> [Cmin, Cmedian]`, `[0, 1] -> [Cmedian, Cmax]`.
+//! - [`scatter`]: beyond Wang, light scattered forward towards the eye (Harris and Lastra
+//!   2001): the silver lining of a cloud between the camera and the sun.
 //! - [`cover`]: beyond Wang, the daylight under the clouds: how much of the sky the layers above
 //!   a point hide, and the grey, sunless light below a thick deck.
 //!
@@ -21,12 +23,14 @@
 pub mod ambient;
 pub mod cover;
 pub mod directional;
+pub mod scatter;
 pub mod sun;
 pub mod time_of_day;
 
 pub use ambient::{ColourLevel, ColourLevels};
 pub use cover::{OvercastLight, hidden_above};
 pub use directional::{DirectionalMapping, directional_percent};
+pub use scatter::ForwardScattering;
 pub use sun::{SunPosition, sun_position};
 pub use time_of_day::{TimeOfDay, TimeOfDaySample, TimeOfDayTable};
 

@@ -8,7 +8,7 @@ use std::path::Path;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::{DirectionalMapping, OvercastLight, ShadingError};
+use super::{DirectionalMapping, ForwardScattering, OvercastLight, ShadingError};
 use crate::config::{ConfigError, line_of, parse_toml};
 
 /// The built-in table, `config/time_of_day.toml`.
@@ -42,6 +42,9 @@ pub struct TimeOfDayTable {
     /// The light under cloud cover (defaults when the table is absent).
     #[serde(default)]
     pub overcast: OvercastLight,
+    /// Light scattered forward towards the eye (defaults when the table is absent).
+    #[serde(default)]
+    pub forward_scattering: ForwardScattering,
 }
 
 /// The light at one moment, interpolated from the table.
@@ -74,6 +77,7 @@ impl Default for TimeOfDayTable {
                 sky_horizon_rgb: [0.5, 0.6, 0.8],
             }],
             overcast: OvercastLight::default(),
+            forward_scattering: ForwardScattering::default(),
         })
     }
 }
@@ -123,13 +127,22 @@ impl TimeOfDayTable {
                 ));
             }
         }
-        if let Some((field, message)) = table.overcast.invalid_field() {
-            return Err(ShadingError::Config(ConfigError {
-                path: path.to_path_buf(),
-                line: text.find("[overcast]").map(|offset| line_of(text, offset)),
-                field: Some(field.to_owned()),
-                message,
-            }));
+        let tables = [
+            ("[overcast]", table.overcast.invalid_field()),
+            (
+                "[forward_scattering]",
+                table.forward_scattering.invalid_field(),
+            ),
+        ];
+        for (heading, invalid) in tables {
+            if let Some((field, message)) = invalid {
+                return Err(ShadingError::Config(ConfigError {
+                    path: path.to_path_buf(),
+                    line: text.find(heading).map(|offset| line_of(text, offset)),
+                    field: Some(field.to_owned()),
+                    message,
+                }));
+            }
         }
         Ok(table)
     }
