@@ -30,6 +30,11 @@ pub struct Sprite {
     pub radius_fraction: f32,
     /// Formation/dissipation transparency factor, 0 (invisible) ..= 1 (Wang 2003 eq. 3).
     pub alpha_morph: f32,
+    /// Turns only about the vertical, so its flat bottom stays level: the flat-bottomed sprites
+    /// on a heaped cloud's rim, a level base from the side that fades out seen from below
+    /// (where the foggy ones under the inside make the smooth grey underside).
+    #[serde(default)]
+    pub upright: bool,
 }
 
 /// A shading group: sprites shaded as one clump (Wang 2003 §5.2, 1 to 30 sprites).
@@ -178,7 +183,7 @@ impl CloudBlock {
                 ] {
                     h = fnv1a(&v.to_le_bytes(), h);
                 }
-                h = fnv1a(&[s.texture], h);
+                h = fnv1a(&[s.texture, s.upright as u8], h);
                 h = fnv1a(&s.shading_group.to_le_bytes(), h);
             }
         }

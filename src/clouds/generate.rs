@@ -473,6 +473,8 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
             None => 0.0,
         };
         let offset = r.pos - origin;
+        // The flat-bottomed sprites standing on a heaped cloud's base stay upright.
+        let upright = r.base.is_some() && category == TextureCategory::FlatBottom;
         sprites.push(Sprite {
             offset_m: offset.as_vec3().to_array(),
             width_m: r.width as f32,
@@ -482,6 +484,7 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
             shading_group: g,
             radius_fraction: (offset.length() / radius).min(1.0) as f32,
             alpha_morph: 1.0,
+            upright,
         });
     }
     let shading_groups = sums
@@ -666,6 +669,15 @@ mod tests {
                     };
                     let cat = crate::clouds::TextureCategory::of_cell(s.texture);
                     assert!(band.textures.contains(&cat), "{t}: {cat:?} at {fraction}");
+                    // Only the flat-bottomed sprites standing on a heaped cloud's base are
+                    // upright (continuous decks have no base rows).
+                    let heaped = !config.continuous && !config.flat && c.sprites.len() > 1;
+                    assert_eq!(
+                        s.upright,
+                        heaped && on_base && cat == crate::clouds::TextureCategory::FlatBottom,
+                        "{t}: upright {} on base {on_base} {cat:?}",
+                        s.upright
+                    );
                     if config.streak_length_over_width.is_some() {
                         // Streak sprites lie along the wind's axis.
                         let axis = (90.0 - w.wind.from_deg).rem_euclid(360.0);
@@ -902,10 +914,10 @@ mod golden {
         assert_eq!(
             hashes,
             [
-                "c6516121a3e3a2c2",
-                "6ca8c91263fd5bf1",
-                "94e59f42d13ef325",
-                "f8230d2b16028c35"
+                "6ea2ffa12cd8ec62",
+                "656ebcbc069452f1",
+                "59cc129667aaccbe",
+                "5e9f9fbd940250a3"
             ]
         );
     }

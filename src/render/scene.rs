@@ -26,6 +26,9 @@ pub struct SkySprite {
     pub group: u16,
     /// Formation / dissipation factor multiplied into alpha, 0..=1 (Wang 4).
     pub alpha_morph: f32,
+    /// Turns only about the vertical (a cylindrical billboard: its bottom edge stays level) and
+    /// fades out as the camera looks at it from steeply below or above.
+    pub upright: bool,
 }
 
 /// One cloud: sprites around a centre, with its Wang 5 shading inputs.

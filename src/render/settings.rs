@@ -21,6 +21,14 @@ pub struct CameraSettings {
     pub far_m: f32,
 }
 
+fn default_upright_fade_start_deg() -> f32 {
+    15.0
+}
+
+fn default_upright_fade_end_deg() -> f32 {
+    35.0
+}
+
 /// Cloud sprite settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -33,6 +41,13 @@ pub struct CloudSettings {
     pub lock_fade_start_deg: f32,
     /// Locked sprites are fully transparent beyond this angle, degrees.
     pub lock_fade_end_deg: f32,
+    /// Upright sprites (a heaped cloud's flat-bottomed rim) stay opaque seen from up to this
+    /// angle above or below their level, degrees.
+    #[serde(default = "default_upright_fade_start_deg")]
+    pub upright_fade_start_deg: f32,
+    /// Upright sprites are fully transparent seen from beyond this angle, degrees.
+    #[serde(default = "default_upright_fade_end_deg")]
+    pub upright_fade_end_deg: f32,
     /// Sprites farther than this from the camera are not drawn, metres.
     pub draw_distance_m: f32,
     /// Distant sprites fade into the horizon haze: 63% at this distance, metres.
@@ -110,6 +125,8 @@ impl Default for RenderSettings {
                 lock_radius_fraction: 0.5,
                 lock_fade_start_deg: 20.0,
                 lock_fade_end_deg: 70.0,
+                upright_fade_start_deg: default_upright_fade_start_deg(),
+                upright_fade_end_deg: default_upright_fade_end_deg(),
                 draw_distance_m: 60_000.0,
                 haze_distance_m: 50_000.0,
             },
@@ -168,6 +185,18 @@ impl RenderSettings {
                 message,
             });
         }
+        let c = &s.clouds;
+        if !(0.0 <= c.upright_fade_start_deg
+            && c.upright_fade_start_deg < c.upright_fade_end_deg
+            && c.upright_fade_end_deg <= 90.0)
+        {
+            return Err(ConfigError {
+                path: path.to_path_buf(),
+                line: None,
+                field: Some("clouds.upright_fade_end_deg".into()),
+                message: "needs 0 <= upright_fade_start_deg < upright_fade_end_deg <= 90".into(),
+            });
+        }
         if s.camera.far_m <= s.camera.near_m {
             return Err(ConfigError {
                 path: path.to_path_buf(),
@@ -214,5 +243,19 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.starts_with("r.toml:7: field `near_m`"), "{err}");
+        let text = DEFAULT_RENDER_TOML
+            .replace("upright_fade_end_deg = 35.0", "upright_fade_end_deg = 10.0");
+        let err = RenderSettings::from_toml_str(&text, "r.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("clouds.upright_fade_end_deg"), "{err}");
+        // Files written before the upright fade existed still load, with its defaults.
+        let old = DEFAULT_RENDER_TOML
+            .lines()
+            .filter(|l| !l.starts_with("upright_fade"))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let s = RenderSettings::from_toml_str(&old, "old.toml").unwrap();
+        assert_eq!(s, RenderSettings::default());
     }
 }

@@ -123,6 +123,22 @@ fn facing_towards(normal: Vec3) -> Facing {
     Facing { right, up, normal }
 }
 
+/// The facing of an upright sprite seen along `to_cam` (sprite to camera): turned only about the
+/// vertical, so its bottom edge stays level; and its alpha, fading from 1 to 0 as the sine of
+/// the view's elevation goes from `fade.0` to `fade.1`.
+fn upright_facing(to_cam: Vec3, fade: (f32, f32)) -> (Facing, f32) {
+    let level = Vec3::new(to_cam.x, to_cam.y, 0.0);
+    let normal = level.normalize_or(Vec3::Y);
+    let facing = Facing {
+        right: Vec3::Z.cross(normal).normalize_or(Vec3::X),
+        up: Vec3::Z,
+        normal,
+    };
+    let sin_elevation = (to_cam.z / to_cam.length().max(1e-3)).abs();
+    let alpha = 1.0 - ((sin_elevation - fade.0) / (fade.1 - fade.0).max(1e-4)).clamp(0.0, 1.0);
+    (facing, alpha)
+}
+
 impl SpriteVertexBuilder {
     /// An empty builder.
     pub fn new() -> Self {
@@ -355,12 +371,22 @@ fn build_cloud(
     let tod = &lighting.time_of_day;
     let lock_start = settings.lock_fade_start_deg.to_radians().cos();
     let lock_end = settings.lock_fade_end_deg.to_radians().cos();
+    let upright_fade = (
+        settings.upright_fade_start_deg.to_radians().sin(),
+        settings.upright_fade_end_deg.to_radians().sin(),
+    );
     let cloud_radius = cloud.radius_m().max(1.0);
     for (i, dist2) in order {
         let s = &cloud.sprites[i];
         let to_cam = cam_local - s.offset_m;
         let radius = 0.5 * s.width_m.max(s.height_m);
         let lock_key = (key.0, key.1, i as u32);
+        // Upright sprites turn only about the vertical and fade seen from steeply above or below.
+        let (face, upright_alpha) = if s.upright {
+            upright_facing(to_cam, upright_fade)
+        } else {
+            (facing_towards(to_cam.normalize_or(Vec3::Y)), 1.0)
+        };
         // Wang 3.3: lock the facing inside half the radius; fade with the angle to the camera.
         let (facing, lock_alpha) = if cloud.flat {
             (
@@ -372,16 +398,15 @@ fn build_cloud(
                 1.0,
             )
         } else if dist2.sqrt() < settings.lock_radius_fraction * radius {
-            let f = *locks
-                .entry(lock_key)
-                .or_insert_with(|| facing_towards(to_cam.normalize_or(Vec3::Y)));
+            let f = *locks.entry(lock_key).or_insert(face);
             let cos = f.normal.dot(to_cam.normalize_or(f.normal)).abs();
             let alpha = ((cos - lock_end) / (lock_start - lock_end).max(1e-4)).clamp(0.0, 1.0);
             (f, alpha)
         } else {
             locks.remove(&lock_key);
-            (facing_towards(to_cam.normalize_or(Vec3::Y)), 1.0)
+            (face, 1.0)
         };
+        let lock_alpha = lock_alpha * upright_alpha;
         if lock_alpha <= 0.0 || s.alpha_morph <= 0.0 {
             continue;
         }
@@ -443,6 +468,7 @@ pub fn square_sprite(offset_m: Vec3, size_m: f32, cell: u8, group: u16) -> SkySp
         cell,
         group,
         alpha_morph: 1.0,
+        upright: false,
     }
 }
 
@@ -572,6 +598,63 @@ mod tests {
         let other_way = brightest(behind, on) - brightest(behind, none);
         assert!(glow > 0.1, "against the sun: +{glow}");
         assert!(other_way < 0.01, "sun behind the camera: +{other_way}");
+    }
+
+    /// An upright sprite keeps its bottom edge level and turns only about the vertical: seen
+    /// from the side it is whole, from 25 degrees below it is fading, from 40 degrees below it is
+    /// gone (fade 15..35 degrees); a camera-facing sprite beside it is whole from everywhere.
+    #[test]
+    fn upright_sprites_stay_level_and_fade_seen_from_below() {
+        let mut upright = square_sprite(Vec3::ZERO, 200.0, 3, 0);
+        upright.upright = true;
+        let cloud = SkyCloud {
+            centre_m: DVec3::new(0.0, 3000.0, 1500.0),
+            sprites: vec![upright, square_sprite(Vec3::X * 600.0, 200.0, 3, 0)],
+            group_centres_m: vec![Vec3::ZERO],
+            colour_levels: ColourLevels::even(1400.0, 1700.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+            flat: false,
+        };
+        let b = vec![SkyBlock {
+            id: 1,
+            centre_m: cloud.centre_m,
+            clouds: vec![cloud],
+        }];
+        let (l, s) = (lighting(), RenderSettings::default());
+        let alphas = |elevation_deg: f64| {
+            let cam = DVec3::new(0.0, 3000.0, 1500.0)
+                + DVec3::new(0.0, -1.0, 0.0) * 2000.0 * elevation_deg.to_radians().cos()
+                - DVec3::Z * 2000.0 * elevation_deg.to_radians().sin();
+            let mut builder = SpriteVertexBuilder::new();
+            builder.update(&b, cam, 0.0, &l, &s);
+            let v = builder.vertices().to_vec();
+            // The upright sprite's corners are those nearest x = 0.
+            let quads: Vec<&[GpuSpriteVertex]> = v.chunks(4).collect();
+            let up = quads
+                .iter()
+                .find(|q| q[0].position_m[0].abs() < 150.0)
+                .copied();
+            (up.map(|q| q.to_vec()), quads.len())
+        };
+        let (side, n) = alphas(0.0);
+        let side = side.expect("the upright sprite is drawn from the side");
+        assert_eq!(n, 2);
+        // Corners: top left, top right, bottom left, bottom right; the bottom edge is level and
+        // the quad stands vertical.
+        assert!((side[2].position_m[2] - side[3].position_m[2]).abs() < 1e-3);
+        assert!((side[0].position_m[1] - side[2].position_m[1]).abs() < 1e-3);
+        assert!((side[0].colour[3] - 1.0).abs() < 1e-3);
+        let (fading, _) = alphas(25.0);
+        let fading = fading.expect("still drawn at 25 degrees");
+        assert!(
+            fading[0].colour[3] > 0.2 && fading[0].colour[3] < 0.8,
+            "{fading:?}"
+        );
+        assert!((fading[0].position_m[1] - fading[2].position_m[1]).abs() < 1e-3);
+        let (gone, n) = alphas(40.0);
+        assert!(
+            gone.is_none() && n == 1,
+            "from 40 degrees below only the other sprite"
+        );
     }
 
     #[test]

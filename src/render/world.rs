@@ -68,6 +68,7 @@ impl From<&Cloud> for SkyCloud {
                     cell: s.texture,
                     group: s.shading_group,
                     alpha_morph: s.alpha_morph,
+                    upright: s.upright,
                 })
                 .collect(),
             group_centres_m: c
