@@ -17,6 +17,7 @@ test: vulkan
 	cargo clippy --all-targets -- -D warnings
 	cargo test --all-targets
 	cargo test --doc
+	RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 
 # The live-weather soak test (ignored by default): one simulated hour, a weather change every
 # five minutes; fails if memory (RSS) or the renderer's GPU buffers grow after the first changes.

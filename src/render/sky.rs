@@ -63,7 +63,7 @@ pub struct Sky {
     in_cloud: f32,
     /// The time-of-day light of the last frame, clear sky: what the clouds are lit with.
     clear_light: TimeOfDay,
-    /// `light` under the cloud cover over the camera: the sky colours and the host's light.
+    /// `clear_light` under the cloud cover over the camera: the sky colours and the host's light.
     seen_light: TimeOfDay,
     /// The weather over the camera: its cloud layers and ground elevation, metres.
     overhead: (Vec<BlockLayer>, f32),
@@ -371,7 +371,7 @@ impl Sky {
         self.seen_light.sky_horizon_rgb
     }
 
-    /// The light of the last prepared frame under the cloud cover (see [`Self::set_sky_hidden`]):
+    /// The light of the last prepared frame under the cloud cover (see [`Self::set_weather_overhead`]):
     /// what a host lights its own scene with.
     pub fn light(&self) -> TimeOfDay {
         self.seen_light

@@ -1,6 +1,6 @@
 //! Any weather input a command takes with `--weather FILE`: a bulk report file (METAR in any of
-//! the formats of [`files`](super::files)) or a weather theme (`.toml`, see
-//! [`theme`](super::theme)). Both become the same [`WeatherField`].
+//! the formats of [`files`]) or a weather theme (`.toml`, see
+//! [`theme`]). Both become the same [`WeatherField`].
 
 use std::path::Path;
 
