@@ -1,0 +1,368 @@
+//! Tests of `generate`.
+
+use super::*;
+use crate::weather::{TypeSource, Wind};
+
+fn weather(cloud_type: CloudType, oktas: f32, base_ft: f32, thickness_ft: f32) -> BlockWeather {
+    BlockWeather {
+        layers: vec![BlockLayer {
+            cloud_type,
+            type_source: TypeSource::HeightRule,
+            coverage_oktas: oktas,
+            base_ft_agl: base_ft,
+            thickness_ft,
+        }],
+        visibility_m: 9999.0,
+        wind: Wind::default(),
+        temperature_c: 10.0,
+        dewpoint_c: 5.0,
+        precipitation: 0.0,
+        ground_elevation_m: 250.0,
+    }
+}
+
+fn types() -> &'static CloudTypes {
+    static TYPES: std::sync::OnceLock<CloudTypes> = std::sync::OnceLock::new();
+    TYPES.get_or_init(CloudTypes::builtin)
+}
+
+/// Fraction of a 50 m grid over the block within 0.7 sprite half-widths (horizontally) of a
+/// sprite centre: the coverage a person looking up would see, measured from the sprites.
+fn sprite_coverage(blocks: &[&CloudBlock], index: BlockIndex) -> f64 {
+    let step = 50.0;
+    let n = (BLOCK_SIZE_M / step) as usize;
+    let corner = index.min_corner_m();
+    let mut grid = vec![false; n * n];
+    for block in blocks {
+        for c in &block.clouds {
+            for s in &c.sprites {
+                let p = DVec2::new(
+                    c.centre_m.x + s.offset_m[0] as f64,
+                    c.centre_m.y + s.offset_m[1] as f64,
+                ) - corner;
+                let r = 0.7 * s.width_m as f64 / 2.0;
+                let (x0, x1) = (
+                    ((p.x - r) / step).floor().max(0.0) as usize,
+                    (((p.x + r) / step).ceil().max(0.0) as usize).min(n),
+                );
+                let (y0, y1) = (
+                    ((p.y - r) / step).floor().max(0.0) as usize,
+                    (((p.y + r) / step).ceil().max(0.0) as usize).min(n),
+                );
+                for y in y0..y1 {
+                    for x in x0..x1 {
+                        let q = DVec2::new((x as f64 + 0.5) * step, (y as f64 + 0.5) * step);
+                        if q.distance_squared(p) <= r * r {
+                            grid[y * n + x] = true;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    grid.iter().filter(|&&g| g).count() as f64 / (n * n) as f64
+}
+
+#[test]
+fn generation_is_pure_and_seeded() {
+    let w = weather(CloudType::CumulusMediocris, 4.0, 3000.0, 2000.0);
+    let a = generate_block(BlockIndex::new(3, -2), &w, 7, types());
+    let b = generate_block(BlockIndex::new(3, -2), &w, 7, types());
+    assert_eq!(a, b);
+    assert_eq!(a.content_hash(), b.content_hash());
+    assert_ne!(
+        a.content_hash(),
+        generate_block(BlockIndex::new(3, -2), &w, 8, types()).content_hash()
+    );
+    assert_ne!(
+        a.content_hash(),
+        generate_block(BlockIndex::new(4, -2), &w, 7, types()).content_hash()
+    );
+    assert!(a.sprite_count() > 50);
+}
+
+/// Cirrus clouds are streaks along the wind: each cloud's sprites spread at least 2.5 times
+/// further along the wind's axis than across it, whatever the wind's direction.
+#[test]
+fn cirrus_are_streaks_along_the_wind() {
+    for from_deg in [270.0f32, 225.0, 0.0] {
+        let mut w = weather(CloudType::Cirrus, 4.0, 28_000.0, 800.0);
+        w.wind = Wind {
+            from_deg,
+            speed_kt: 40.0,
+        };
+        let block = generate_block(BlockIndex::new(2, 1), &w, 5, types());
+        let along = DVec2::from_angle((90.0 - from_deg as f64).to_radians());
+        let mut checked = 0;
+        for c in block.clouds.iter().filter(|c| c.sprites.len() >= 3) {
+            let extent = |axis: DVec2| {
+                let d: Vec<f64> = c
+                    .sprites
+                    .iter()
+                    .map(|s| DVec2::new(s.offset_m[0] as f64, s.offset_m[1] as f64).dot(axis))
+                    .collect();
+                d.iter().cloned().fold(f64::MIN, f64::max)
+                    - d.iter().cloned().fold(f64::MAX, f64::min)
+            };
+            let (l, a) = (extent(along), extent(along.perp()));
+            assert!(
+                l > 2.5 * a,
+                "from {from_deg}: {l:.0} m along, {a:.0} m across"
+            );
+            checked += 1;
+        }
+        assert!(checked >= 2, "from {from_deg}: {checked} streaks");
+    }
+}
+
+#[test]
+fn sprites_follow_the_paper_and_the_config() {
+    for t in CloudType::ALL {
+        let w = weather(t, 5.0, 3000.0, 1500.0);
+        let block = generate_block(BlockIndex::new(0, 0), &w, 1, types());
+        let config = types().get(t);
+        assert!(!block.clouds.is_empty(), "{t}: no clouds");
+        let l = block.layers[0];
+        assert!(
+            (l.base_m - (250.0 + 3000.0 * 0.3048)).abs() < 0.01,
+            "{t}: base {}",
+            l.base_m
+        );
+        for c in &block.clouds {
+            assert_eq!(c.flat, config.flat);
+            assert!(
+                c.sprites.len() <= 800,
+                "{t}: {} sprites in a cloud",
+                c.sprites.len()
+            );
+            for s in &c.sprites {
+                assert!(s.texture < 16);
+                assert!((s.shading_group as usize) < c.shading_groups.len());
+                let z = c.centre_m.z + s.offset_m[2] as f64;
+                assert!(
+                    z >= l.base_m as f64 - 0.5 && z <= l.top_m as f64 + 0.5,
+                    "{t}: z {z}"
+                );
+                let fraction = ((z - l.base_m as f64) / (l.top_m - l.base_m) as f64) as f32;
+                // A sprite standing on the base (its flat underside on it) takes the first
+                // band, the others the band of their centre's height.
+                let on_base = (z
+                    - super::super::heap::BASE_CENTRE_FRACTION * s.height_m as f64
+                    - l.base_m as f64)
+                    .abs()
+                    < 0.05;
+                let band = if on_base {
+                    config.texture_bands.first().unwrap()
+                } else {
+                    config.band_at(fraction.clamp(0.0, 1.0)).unwrap()
+                };
+                let cat = crate::clouds::TextureCategory::of_cell(s.texture);
+                assert!(band.textures.contains(&cat), "{t}: {cat:?} at {fraction}");
+                // Only the flat-bottomed sprites standing on a heaped cloud's base are
+                // upright (continuous decks have no base rows).
+                let heaped = !config.continuous && !config.flat && c.sprites.len() > 1;
+                assert_eq!(
+                    s.upright,
+                    heaped && on_base && cat == crate::clouds::TextureCategory::FlatBottom,
+                    "{t}: upright {} on base {on_base} {cat:?}",
+                    s.upright
+                );
+                if config.streak_length_over_width.is_some() {
+                    // Streak sprites lie along the wind's axis.
+                    let axis = (90.0 - w.wind.from_deg).rem_euclid(360.0);
+                    assert!((s.rotation_deg - axis).abs() < 1e-3, "{t}: streak off axis");
+                } else if s.width_m != s.height_m {
+                    assert_eq!(s.rotation_deg, 0.0, "{t}: non-square sprite rotated");
+                } else {
+                    assert!(
+                        s.rotation_deg >= band.rotation_deg[0]
+                            && s.rotation_deg <= band.rotation_deg[1]
+                    );
+                }
+            }
+            // The cull pass: no two sprites closer than the cull radius of the later one.
+            for (k, s) in c.sprites.iter().enumerate() {
+                for o in &c.sprites[..k] {
+                    let d2: f32 = (0..3)
+                        .map(|a| (s.offset_m[a] - o.offset_m[a]).powi(2))
+                        .sum();
+                    let r = config.cull_radius_fraction * s.height_m;
+                    assert!(d2 >= r * r * 0.999, "{t}: sprites {d2} apart");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn cumulus_stand_on_a_flat_base_and_narrow_upwards() {
+    let bc = crate::clouds::heap::BASE_CENTRE_FRACTION;
+    for t in [
+        CloudType::CumulusHumilis,
+        CloudType::CumulusMediocris,
+        CloudType::CumulusCongestus,
+    ] {
+        let block = generate_block(
+            BlockIndex::new(2, 2),
+            &weather(t, 3.0, 4000.0, 8000.0),
+            9,
+            types(),
+        );
+        let base = block.layers[0].base_m as f64;
+        let shaped = block
+            .clouds
+            .iter()
+            .filter(|c| c.sprites.len() >= 30)
+            .count();
+        assert!(shaped >= 2, "{t}: {shaped} clouds with a shape");
+        for c in &block.clouds {
+            let z = |s: &Sprite| c.centre_m.z + s.offset_m[2] as f64;
+            // Nothing hangs below the base; a row stands exactly on it, flat-bottomed on
+            // its rim.
+            let on_base: Vec<&Sprite> = c
+                .sprites
+                .iter()
+                .filter(|s| (z(s) - bc * s.height_m as f64 - base).abs() < 0.05)
+                .collect();
+            for s in &c.sprites {
+                assert!(
+                    z(s) - bc * s.height_m as f64 >= base - 0.05,
+                    "{t}: below base"
+                );
+            }
+            assert!(
+                !on_base.is_empty(),
+                "{t}: {} sprites on the base",
+                on_base.len()
+            );
+            assert!(
+                on_base
+                    .iter()
+                    .any(|s| crate::clouds::TextureCategory::of_cell(s.texture)
+                        == crate::clouds::TextureCategory::FlatBottom),
+                "{t}: no flat-bottomed sprite on the base"
+            );
+            // Rounded: the top third is narrower than the bottom third (for clouds big
+            // enough to have a shape; the shrunk last clouds of a layer are a few sprites).
+            if c.sprites.len() < 30 {
+                continue;
+            }
+            let (lo, hi) = c
+                .sprites
+                .iter()
+                .map(z)
+                .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+            let extent = |from: f64, to: f64| {
+                c.sprites
+                    .iter()
+                    .filter(|s| (from..=to).contains(&((z(s) - lo) / (hi - lo).max(1.0))))
+                    .map(|s| s.offset_m[0].hypot(s.offset_m[1]))
+                    .fold(0.0f32, f32::max)
+            };
+            assert!(
+                extent(0.67, 1.0) < extent(0.0, 0.33),
+                "{t}: top {} bottom {}",
+                extent(0.67, 1.0),
+                extent(0.0, 0.33)
+            );
+        }
+    }
+}
+
+#[test]
+fn coverage_is_honoured_for_every_cover_code() {
+    // FEW 1-2, SCT 3-4, BKN 5-7, OVC 8 oktas, for heaped and layered types.
+    for t in [
+        CloudType::CumulusHumilis,
+        CloudType::CumulusMediocris,
+        CloudType::Stratocumulus,
+        CloudType::Altocumulus,
+        CloudType::Stratus,
+    ] {
+        for oktas in [1.5f32, 3.5, 6.0, 8.0] {
+            let mut sum = 0.0;
+            let blocks = 6;
+            for i in 0..blocks {
+                let index = BlockIndex::new(i, 1);
+                let block = generate_block(index, &weather(t, oktas, 3000.0, 1500.0), 11, types());
+                sum += sprite_coverage(&[&block], index);
+            }
+            let got = sum / blocks as f64;
+            let want = oktas as f64 / 8.0;
+            assert!(
+                (got - want).abs() <= 0.15,
+                "{t} {oktas} oktas: covered {got:.2}, want {want:.2}"
+            );
+        }
+    }
+}
+
+#[test]
+fn overcast_neighbours_meet_without_a_gap() {
+    for t in [
+        CloudType::Stratus,
+        CloudType::Nimbostratus,
+        CloudType::Stratocumulus,
+        CloudType::Fog,
+    ] {
+        let w = weather(
+            t,
+            8.0,
+            if t == CloudType::Fog { 0.0 } else { 1200.0 },
+            800.0,
+        );
+        let a = generate_block(BlockIndex::new(0, 0), &w, 5, types());
+        let b = generate_block(BlockIndex::new(1, 0), &w, 5, types());
+        // Points along the shared border x = 4000 m, every 20 m: each lies under some sprite's
+        // disc (half its width), from one block or the other.
+        for k in 0..200 {
+            let p = DVec2::new(BLOCK_SIZE_M, 10.0 + 20.0 * k as f64);
+            let covered = [&a, &b].iter().any(|blk| {
+                blk.clouds.iter().any(|c| {
+                    c.sprites.iter().any(|s| {
+                        let q = DVec2::new(
+                            c.centre_m.x + s.offset_m[0] as f64,
+                            c.centre_m.y + s.offset_m[1] as f64,
+                        );
+                        q.distance(p) < s.width_m as f64 * 0.5
+                    })
+                })
+            });
+            assert!(covered, "{t}: gap at the border, y = {} m", p.y);
+        }
+    }
+}
+
+#[test]
+fn a_block_with_no_cloud_is_empty_and_cb_has_an_anvil() {
+    let block = generate_block(
+        BlockIndex::new(0, 0),
+        &weather(CloudType::Stratus, 0.0, 1000.0, 500.0),
+        1,
+        types(),
+    );
+    assert_eq!(block.sprite_count(), 0);
+    assert_eq!(block.overdraw(), 0.0);
+    let cb = generate_block(
+        BlockIndex::new(0, 0),
+        &weather(CloudType::Cumulonimbus, 3.0, 2500.0, 3000.0),
+        1,
+        types(),
+    );
+    let c = &cb.clouds[0];
+    let half_h = (cb.layers[0].top_m - cb.layers[0].base_m) / 2.0;
+    let spread = |lo: f32, hi: f32| {
+        c.sprites
+            .iter()
+            .filter(|s| s.offset_m[2] / half_h >= lo && s.offset_m[2] / half_h < hi)
+            .map(|s| s.offset_m[0].abs().max(s.offset_m[1].abs()))
+            .fold(0.0f32, f32::max)
+    };
+    // The anvil (top tenth) spreads wider than the tower's middle.
+    assert!(
+        spread(0.7, 1.01) > 1.5 * spread(-0.2, 0.2),
+        "anvil {} tower {}",
+        spread(0.7, 1.01),
+        spread(-0.2, 0.2)
+    );
+}
