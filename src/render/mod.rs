@@ -19,6 +19,7 @@ pub mod gpu_types;
 pub mod headless;
 pub mod impostor;
 pub mod output;
+mod pipeline;
 pub mod scene;
 pub mod settings;
 pub mod sky;

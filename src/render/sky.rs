@@ -14,6 +14,7 @@ use super::RenderError;
 use super::camera::Camera;
 use super::gpu_types::{GpuFrame, GpuSpriteVertex};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
+use super::pipeline::{PassDesc, pipeline, premultiplied_over};
 use super::scene::SkyBlock;
 use super::settings::RenderSettings;
 use super::vertices::{FrameStats, Lighting, SpriteVertexBuilder, quad_indices};
@@ -70,32 +71,9 @@ pub struct Sky {
     ring: ImpostorRing,
 }
 
-const SHARED_WGSL: &str = include_str!("../../shaders/shared/frame.wgsl");
 const SKY_WGSL: &str = include_str!("../../shaders/sky.wgsl");
 const SPRITES_WGSL: &str = include_str!("../../shaders/sprites.wgsl");
 const IN_CLOUD_WGSL: &str = include_str!("../../shaders/in_cloud.wgsl");
-
-fn shader(device: &wgpu::Device, label: &str, pass_wgsl: &str) -> wgpu::ShaderModule {
-    device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(format!("{SHARED_WGSL}\n{pass_wgsl}").into()),
-    })
-}
-
-fn premultiplied_over() -> wgpu::BlendState {
-    wgpu::BlendState {
-        color: wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-            operation: wgpu::BlendOperation::Add,
-        },
-        alpha: wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-            operation: wgpu::BlendOperation::Add,
-        },
-    }
-}
 
 impl Sky {
     /// Creates pipelines, the sheet texture and buffers on the host's device.
@@ -211,80 +189,45 @@ impl Sky {
                 },
             ],
         });
-        let frame_only = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sky.frame_only"),
-            bind_group_layouts: &[Some(&frame_layout)],
-            immediate_size: 0,
-        });
-        let with_sheet = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sky.with_sheet"),
-            bind_group_layouts: &[Some(&frame_layout), Some(&sheet_layout)],
-            immediate_size: 0,
-        });
         let format = config.colour_format;
-        let pipeline = |label: &str,
-                        wgsl: &str,
-                        vs: &str,
-                        fs: &str,
-                        layout: &wgpu::PipelineLayout,
-                        buffers: &[Option<wgpu::VertexBufferLayout>],
-                        blend: Option<wgpu::BlendState>| {
-            let module = shader(device, label, wgsl);
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(vs),
-                    compilation_options: Default::default(),
-                    buffers,
-                },
-                primitive: wgpu::PrimitiveState {
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format,
-                        blend,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
+        let frame_only = [Some(&frame_layout)];
+        let with_sheet = [Some(&frame_layout), Some(&sheet_layout)];
+        let over = Some(premultiplied_over());
         let sky_pipeline = pipeline(
-            "sky.background",
-            SKY_WGSL,
-            "vs_sky",
-            "fs_sky",
-            &frame_only,
-            &[],
-            None,
+            device,
+            &PassDesc {
+                label: "sky.background",
+                wgsl: SKY_WGSL,
+                vs: "vs_sky",
+                fs: "fs_sky",
+                bind_groups: &frame_only,
+                buffers: &[],
+                targets: &[(format, None)],
+            },
         );
         let sprite_pipeline = pipeline(
-            "sky.sprites",
-            SPRITES_WGSL,
-            "vs_sprite",
-            "fs_sprite",
-            &with_sheet,
-            &[Some(GpuSpriteVertex::layout())],
-            Some(premultiplied_over()),
+            device,
+            &PassDesc {
+                label: "sky.sprites",
+                wgsl: SPRITES_WGSL,
+                vs: "vs_sprite",
+                fs: "fs_sprite",
+                bind_groups: &with_sheet,
+                buffers: &[Some(GpuSpriteVertex::layout())],
+                targets: &[(format, over)],
+            },
         );
         let in_cloud_pipeline = pipeline(
-            "sky.in_cloud",
-            IN_CLOUD_WGSL,
-            "vs_in_cloud",
-            "fs_in_cloud",
-            &frame_only,
-            &[],
-            Some(premultiplied_over()),
+            device,
+            &PassDesc {
+                label: "sky.in_cloud",
+                wgsl: IN_CLOUD_WGSL,
+                vs: "vs_in_cloud",
+                fs: "fs_in_cloud",
+                bind_groups: &frame_only,
+                buffers: &[],
+                targets: &[(format, over)],
+            },
         );
         let capacity_sprites = 1024;
         let (vertex_buffer, index_buffer) = sprite_buffers(device, capacity_sprites);
@@ -297,7 +240,6 @@ impl Sky {
                 colour_format: format,
                 frame_layout: &frame_layout,
                 sheet_layout: &sheet_layout,
-                blend: premultiplied_over(),
             },
         );
         Ok(Self {

@@ -36,6 +36,7 @@ pub use layout::{
 use layout::{impostor_camera, in_sector};
 
 use super::gpu_types::{GpuFrame, GpuSpriteVertex};
+use super::pipeline::{PassDesc, pipeline, premultiplied_over};
 use super::scene::SkyBlock;
 use super::settings::RenderSettings;
 use super::vertices::{FrameStats, Lighting, SpriteVertexBuilder, quad_indices};
@@ -92,7 +93,6 @@ pub struct ImpostorRing {
     bytes: u64,
 }
 
-const SHARED_WGSL: &str = include_str!("../../../shaders/shared/frame.wgsl");
 const SPRITES_WGSL: &str = include_str!("../../../shaders/sprites.wgsl");
 const IMPOSTOR_SPRITES_WGSL: &str = include_str!("../../../shaders/impostor_sprites.wgsl");
 const QUAD_WGSL: &str = include_str!("../../../shaders/impostor_quad.wgsl");
@@ -122,8 +122,6 @@ pub struct RingShared<'a> {
     pub frame_layout: &'a wgpu::BindGroupLayout,
     /// Group 1 of the sprite pass (sheet and sampler).
     pub sheet_layout: &'a wgpu::BindGroupLayout,
-    /// Premultiplied-over blending.
-    pub blend: wgpu::BlendState,
 }
 
 impl ImpostorRing {
@@ -134,12 +132,6 @@ impl ImpostorRing {
         settings: ImpostorSettings,
         shared: &RingShared,
     ) -> Self {
-        let module = |label: &str, wgsl: &str| {
-            device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(label),
-                source: wgpu::ShaderSource::Wgsl(format!("{SHARED_WGSL}\n{wgsl}").into()),
-            })
-        };
         let array_entry = |binding| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::FRAGMENT,
@@ -175,70 +167,30 @@ impl ImpostorRing {
                 },
             ],
         });
-        let pipeline = |label: &str,
-                        wgsl: &str,
-                        vs: &str,
-                        fs: &str,
-                        layouts: &[Option<&wgpu::BindGroupLayout>],
-                        buffers: &[Option<wgpu::VertexBufferLayout>],
-                        formats: &[wgpu::TextureFormat]| {
-            let m = module(label, wgsl);
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(label),
-                bind_group_layouts: layouts,
-                immediate_size: 0,
-            });
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &m,
-                    entry_point: Some(vs),
-                    compilation_options: Default::default(),
-                    buffers,
-                },
-                primitive: wgpu::PrimitiveState {
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &m,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &formats
-                        .iter()
-                        .map(|&format| {
-                            Some(wgpu::ColorTargetState {
-                                format,
-                                blend: Some(shared.blend),
-                                write_mask: wgpu::ColorWrites::ALL,
-                            })
-                        })
-                        .collect::<Vec<_>>(),
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
+        let over = Some(premultiplied_over());
         let sprite_pipeline = pipeline(
-            "ring.sprites",
-            &format!("{SPRITES_WGSL}\n{IMPOSTOR_SPRITES_WGSL}"),
-            "vs_sprite",
-            "fs_sprite_impostor",
-            &[Some(shared.frame_layout), Some(shared.sheet_layout)],
-            &[Some(GpuSpriteVertex::layout())],
-            &[IMPOSTOR_FORMAT, DEPTH_FORMAT],
+            device,
+            &PassDesc {
+                label: "ring.sprites",
+                wgsl: &format!("{SPRITES_WGSL}\n{IMPOSTOR_SPRITES_WGSL}"),
+                vs: "vs_sprite",
+                fs: "fs_sprite_impostor",
+                bind_groups: &[Some(shared.frame_layout), Some(shared.sheet_layout)],
+                buffers: &[Some(GpuSpriteVertex::layout())],
+                targets: &[(IMPOSTOR_FORMAT, over), (DEPTH_FORMAT, over)],
+            },
         );
         let quad_pipeline = pipeline(
-            "ring.quads",
-            QUAD_WGSL,
-            "vs_impostor",
-            "fs_impostor",
-            &[Some(shared.frame_layout), Some(&tex_layout)],
-            &[],
-            &[shared.colour_format],
+            device,
+            &PassDesc {
+                label: "ring.quads",
+                wgsl: QUAD_WGSL,
+                vs: "vs_impostor",
+                fs: "fs_impostor",
+                bind_groups: &[Some(shared.frame_layout), Some(&tex_layout)],
+                buffers: &[],
+                targets: &[(shared.colour_format, over)],
+            },
         );
         let rings = if settings.enabled { 2 } else { 0 };
         let side = settings.size_px;

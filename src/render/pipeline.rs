@@ -1,0 +1,92 @@
+//! What every sky pipeline shares: the WGSL of `shaders/shared/frame.wgsl` put in front of each
+//! pass's shader, premultiplied-alpha blending, and one way to build a pipeline. None of them
+//! has a depth attachment (the host's depth is read as a texture) or culls (sprites and
+//! full-screen triangles face the camera either way).
+
+/// The structs and helpers every sky pass shares.
+const SHARED_WGSL: &str = include_str!("../../shaders/shared/frame.wgsl");
+
+/// A shader module of `shaders/shared/frame.wgsl` followed by `pass_wgsl`.
+pub(super) fn shader(device: &wgpu::Device, label: &str, pass_wgsl: &str) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(format!("{SHARED_WGSL}\n{pass_wgsl}").into()),
+    })
+}
+
+/// Premultiplied "over": what every cloud pass blends with.
+pub(super) fn premultiplied_over() -> wgpu::BlendState {
+    let over = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+        operation: wgpu::BlendOperation::Add,
+    };
+    wgpu::BlendState {
+        color: over,
+        alpha: over,
+    }
+}
+
+/// One sky pipeline: its shader (after the shared WGSL), entry points, bind group layouts,
+/// vertex buffers and colour targets with their blending.
+pub(super) struct PassDesc<'a> {
+    /// Label of the module, layout and pipeline.
+    pub label: &'a str,
+    /// The pass's WGSL.
+    pub wgsl: &'a str,
+    /// Vertex entry point.
+    pub vs: &'a str,
+    /// Fragment entry point.
+    pub fs: &'a str,
+    /// Bind group layouts, group 0 first.
+    pub bind_groups: &'a [Option<&'a wgpu::BindGroupLayout>],
+    /// Vertex buffers (none for full-screen passes).
+    pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+    /// Colour targets: format and blending.
+    pub targets: &'a [(wgpu::TextureFormat, Option<wgpu::BlendState>)],
+}
+
+/// Builds the pipeline `desc` describes.
+pub(super) fn pipeline(device: &wgpu::Device, desc: &PassDesc) -> wgpu::RenderPipeline {
+    let module = shader(device, desc.label, desc.wgsl);
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(desc.label),
+        bind_group_layouts: desc.bind_groups,
+        immediate_size: 0,
+    });
+    let targets: Vec<Option<wgpu::ColorTargetState>> = desc
+        .targets
+        .iter()
+        .map(|&(format, blend)| {
+            Some(wgpu::ColorTargetState {
+                format,
+                blend,
+                write_mask: wgpu::ColorWrites::ALL,
+            })
+        })
+        .collect();
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(desc.label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some(desc.vs),
+            compilation_options: Default::default(),
+            buffers: desc.buffers,
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some(desc.fs),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
