@@ -119,7 +119,9 @@ impl Sky {
             label: Some("sky.sheet_sampler"),
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            // The nearest level, not a blend of two: the soft puffs show no seam, and on a
+            // fill-bound frame it saved an eighth of the sprites' time (lavapipe, overcast).
+            mipmap_filter: wgpu::MipmapFilterMode::Nearest,
             ..Default::default()
         });
         let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
