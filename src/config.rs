@@ -39,6 +39,17 @@ impl ConfigError {
         }
     }
 
+    /// An error about the field `section.key` (or a top-level `key`) of the TOML `text`: its
+    /// line is where the key is set in that table, none when the file leaves it to its default.
+    pub fn at_key(path: &Path, text: &str, field: &str, message: impl Into<String>) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            line: line_of_key(text, field),
+            field: Some(field.to_string()),
+            message: message.into(),
+        }
+    }
+
     /// An error about the whole file (it cannot be read, or a rule spans several fields).
     pub fn whole_file(path: &Path, message: impl Into<String>) -> Self {
         Self {
@@ -85,6 +96,27 @@ impl ConfigError {
     }
 }
 
+/// 1-based line where `field` (`section.key`, or a top-level `key`) is set in the TOML `text`,
+/// read as lines: the `key = ...` line after the `[section]` header and before the next header.
+pub fn line_of_key(text: &str, field: &str) -> Option<usize> {
+    let (section, key) = field.rsplit_once('.').unwrap_or(("", field));
+    let mut in_section = section.is_empty();
+    for (n, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.starts_with('[') {
+            in_section = line.trim_start_matches('[').trim_end_matches(']').trim() == section;
+            continue;
+        }
+        let sets_key = line
+            .strip_prefix(key)
+            .is_some_and(|rest| rest.trim_start().starts_with('='));
+        if in_section && sets_key {
+            return Some(n + 1);
+        }
+    }
+    None
+}
+
 /// 1-based line number of a byte offset.
 pub fn line_of(text: &str, offset: usize) -> usize {
     let offset = offset.min(text.len());
@@ -114,6 +146,21 @@ fn key_on_line(text: &str, offset: usize) -> Option<String> {
 mod tests {
     use super::*;
     use serde::Deserialize;
+
+    #[test]
+    fn the_line_of_a_key_is_found_in_its_own_table() {
+        let text = "top = 1\n[a]\nx = 1\n\n[b]\n  x  = 2 # the one\ny=3\n[[c]]\nz = 4\n";
+        assert_eq!(line_of_key(text, "top"), Some(1));
+        assert_eq!(line_of_key(text, "a.x"), Some(3));
+        assert_eq!(line_of_key(text, "b.x"), Some(6));
+        assert_eq!(line_of_key(text, "b.y"), Some(7));
+        assert_eq!(line_of_key(text, "c.z"), Some(9));
+        // Left to its default, or a key that only starts the same: no line.
+        assert_eq!(line_of_key(text, "a.y"), None);
+        assert_eq!(line_of_key("[a]\nxx = 1\n", "a.x"), None);
+        let err = ConfigError::at_key(Path::new("f.toml"), text, "b.x", "too big");
+        assert_eq!(err.to_string(), "f.toml:6: field `b.x`: too big");
+    }
 
     #[derive(Debug, Deserialize)]
     #[serde(deny_unknown_fields)]

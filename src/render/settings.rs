@@ -169,41 +169,36 @@ impl RenderSettings {
         ];
         for (field, value) in positive {
             if value.is_nan() || value <= 0.0 {
-                return Err(ConfigError {
-                    path: path.to_path_buf(),
-                    line: None,
-                    field: Some(field.into()),
-                    message: format!("must be greater than 0, is {value}"),
-                });
+                return Err(ConfigError::at_key(
+                    path,
+                    text,
+                    field,
+                    format!("must be greater than 0, is {value}"),
+                ));
             }
         }
         if let Some((field, message)) = s.impostors.invalid_field() {
-            return Err(ConfigError {
-                path: path.to_path_buf(),
-                line: None,
-                field: Some(field.into()),
-                message,
-            });
+            return Err(ConfigError::at_key(path, text, field, message));
         }
         let c = &s.clouds;
         if !(0.0 <= c.upright_fade_start_deg
             && c.upright_fade_start_deg < c.upright_fade_end_deg
             && c.upright_fade_end_deg <= 90.0)
         {
-            return Err(ConfigError {
-                path: path.to_path_buf(),
-                line: None,
-                field: Some("clouds.upright_fade_end_deg".into()),
-                message: "needs 0 <= upright_fade_start_deg < upright_fade_end_deg <= 90".into(),
-            });
+            return Err(ConfigError::at_key(
+                path,
+                text,
+                "clouds.upright_fade_end_deg",
+                "needs 0 <= upright_fade_start_deg < upright_fade_end_deg <= 90",
+            ));
         }
         if s.camera.far_m <= s.camera.near_m {
-            return Err(ConfigError {
-                path: path.to_path_buf(),
-                line: None,
-                field: Some("camera.far_m".into()),
-                message: "must be greater than camera.near_m".into(),
-            });
+            return Err(ConfigError::at_key(
+                path,
+                text,
+                "camera.far_m",
+                "must be greater than camera.near_m",
+            ));
         }
         Ok(s)
     }
@@ -219,6 +214,7 @@ impl RenderSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::line_of_key;
 
     #[test]
     fn built_in_settings_parse() {
@@ -234,8 +230,9 @@ mod tests {
         let err = RenderSettings::from_toml_str(&text, "r.toml")
             .unwrap_err()
             .to_string();
+        let line = line_of_key(DEFAULT_RENDER_TOML, "clouds.soft_depth_fade_m").unwrap();
         assert!(
-            err.contains("r.toml") && err.contains("clouds.soft_depth_fade_m"),
+            err.starts_with(&format!("r.toml:{line}: field `clouds.soft_depth_fade_m`")),
             "{err}"
         );
         let text = DEFAULT_RENDER_TOML.replace("near_m = 2.0", "near_m = \"near\"");

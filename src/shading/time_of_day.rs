@@ -127,22 +127,12 @@ impl TimeOfDayTable {
                 ));
             }
         }
-        let tables = [
-            ("[overcast]", table.overcast.invalid_field()),
-            (
-                "[forward_scattering]",
-                table.forward_scattering.invalid_field(),
-            ),
-        ];
-        for (heading, invalid) in tables {
-            if let Some((field, message)) = invalid {
-                return Err(ShadingError::Config(ConfigError {
-                    path: path.to_path_buf(),
-                    line: text.find(heading).map(|offset| line_of(text, offset)),
-                    field: Some(field.to_owned()),
-                    message,
-                }));
-            }
+        let invalid = table
+            .overcast
+            .invalid_field()
+            .or(table.forward_scattering.invalid_field());
+        if let Some((field, message)) = invalid {
+            return Err(ConfigError::at_key(path, text, field, message).into());
         }
         Ok(table)
     }
@@ -264,9 +254,9 @@ mod tests {
             .unwrap_err()
             .to_string();
         let line = 1 + DEFAULT_TIME_OF_DAY_TOML
-            [..DEFAULT_TIME_OF_DAY_TOML.find("[overcast]").unwrap()]
-            .matches('\n')
-            .count();
+            .lines()
+            .position(|l| l.starts_with("grey_from"))
+            .unwrap();
         assert!(
             err.starts_with(&format!("my_tod.toml:{line}: field `overcast.grey_from`")),
             "{err}"

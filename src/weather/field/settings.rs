@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde::Deserialize;
 
-use crate::config::{ConfigError, load_toml, parse_toml};
+use crate::config::{ConfigError, parse_toml};
 use crate::weather::metar::Cover;
 
 /// The shipped settings file, built in.
@@ -126,23 +126,19 @@ pub struct Defaults {
 impl FieldSettings {
     /// Reads settings from a TOML file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let settings: Self = load_toml(path)?;
-        settings.validate(path)
+        let text = std::fs::read_to_string(path)
+            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
+        Self::parse(&text, path)
     }
 
     /// Parses settings text that came from `path`.
     pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
         let settings: Self = parse_toml(text, path)?;
-        settings.validate(path)
+        settings.validate(text, path)
     }
 
-    fn validate(self, path: &Path) -> Result<Self, ConfigError> {
-        let bad = |field: &str, message: &str| ConfigError {
-            path: path.to_path_buf(),
-            line: None,
-            field: Some(field.to_string()),
-            message: message.to_string(),
-        };
+    fn validate(self, text: &str, path: &Path) -> Result<Self, ConfigError> {
+        let bad = |field: &str, message: &str| ConfigError::at_key(path, text, field, message);
         if !(self.bands.low_top_ft > 0.0 && self.bands.low_top_ft <= self.bands.high_base_ft) {
             return Err(bad(
                 "bands.low_top_ft",
@@ -187,6 +183,15 @@ mod tests {
         assert_eq!(err.line, Some(line), "{err}");
         let text = BUILTIN.replace("weight_min = 0.5", "weight_min = 5.0");
         let err = FieldSettings::parse(&text, Path::new("f.toml")).unwrap_err();
-        assert!(err.to_string().contains("convective.weight_min"), "{err}");
+        let line = BUILTIN
+            .lines()
+            .position(|l| l.starts_with("weight_min"))
+            .unwrap()
+            + 1;
+        assert!(
+            err.to_string()
+                .starts_with(&format!("f.toml:{line}: field `convective.weight_min`")),
+            "{err}"
+        );
     }
 }
