@@ -11,7 +11,6 @@
 //! `--clouds`). `frames.csv` says per frame how long the frame thread spent on weather
 //! (`weather_us`: polling and switching, never loading) and which file was applied.
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -160,6 +159,13 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
     let mut written = 0u32;
+    // On a terminal only (indicatif hides it when stderr is a file or a pipe).
+    let progress = indicatif::ProgressBar::new(frames);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "[{bar:30}] {percent:>3}% {pos}/{len} frames, {msg} ({eta} left)",
+    ) {
+        progress.set_style(style.progress_chars("#> "));
+    }
     for k in 0..frames {
         let time_s = flight.start_s() + k as f64 * dt_s;
         let pose = flight.pose_at(time_s);
@@ -224,20 +230,10 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             (write as u8).to_string(),
             gpu_ms,
         ])?;
-        // The bar moves in whole percents; redraw only when it does.
-        let percent = (k + 1) * 100 / frames;
-        if percent != k * 100 / frames || k == 0 {
-            let bar = (percent * 30 / 100) as usize;
-            eprint!(
-                "\r[{}{}] {percent:3}% {}/{frames} frames, {written} written",
-                "#".repeat(bar),
-                " ".repeat(30 - bar),
-                k + 1
-            );
-            std::io::stderr().flush().ok();
-        }
+        progress.set_message(format!("{written} written"));
+        progress.inc(1);
     }
-    eprintln!();
+    progress.finish();
     csv.flush()?;
     println!(
         "{}: {written} frames and frames.csv ({frames} simulated at {} fps)",

@@ -51,9 +51,19 @@ enum Command {
 
 /// Runs the command line and maps errors to a message on standard error and exit status 2.
 pub fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
-        .format_timestamp(None)
-        .init();
+    // wgpu probes its OpenGL backend too; on a machine without EGL that logs an error that is
+    // none (the Vulkan adapter is used). A real failure to find an adapter is our own message.
+    env_logger::Builder::from_env(
+        env_logger::Env::default().default_filter_or("warn,wgpu_hal::gles=off"),
+    )
+    .format_timestamp(None)
+    .init();
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        // SAFETY: first thing in main, before any thread exists. Mesa's Vulkan loader prints
+        // "error: XDG_RUNTIME_DIR is invalid" twice on every start without it (harmless, and
+        // alarming); /tmp silences it, as the Makefile does.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", "/tmp") };
+    }
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
         Command::Types => {
