@@ -470,6 +470,64 @@ fn render_command_writes_png_and_exr() {
     ]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--size"));
+
+    // A real elevation model under the sky: a flat 16-bit PNG at a quarter of 0..2,000 m puts
+    // the ground 500 m up, and the camera's height above it says so.
+    let dem = dir.join("plateau.png");
+    image::ImageBuffer::from_pixel(32, 32, image::Luma([16_384u16]))
+        .save(&dem)
+        .unwrap();
+    let with_dem = |dem: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "--alt-ft",
+            "3000",
+            "--size",
+            "64x36",
+            "--out",
+            png.to_str().unwrap(),
+            "--elevation",
+            dem.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let out = with_dem(
+        &dem,
+        &["--elevation-size-km", "30", "--elevation-range-m", "0,2000"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let above_ft = 3000.0 - 16_384.0 / 65_535.0 * 2000.0 / 0.3048;
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains(&format!("{above_ft:.0} ft above the ground")),
+        "{said}"
+    );
+    // An 8-bit file, a missing size, a range upside down: status 2 and what is wrong.
+    let grey8 = dir.join("grey8.png");
+    image::ImageBuffer::from_pixel(8, 8, image::Luma([9u8]))
+        .save(&grey8)
+        .unwrap();
+    let ok_flags = ["--elevation-size-km", "30", "--elevation-range-m", "0,2000"];
+    for (file, extra, expected) in [
+        (&grey8, &ok_flags[..], "not a 16-bit greyscale PNG"),
+        (&dem, &ok_flags[2..], "--elevation-size-km"),
+        (
+            &dem,
+            &["--elevation-size-km", "30", "--elevation-range-m", "2000,0"][..],
+            "MIN below MAX",
+        ),
+    ] {
+        let bad = with_dem(file, extra);
+        let err = String::from_utf8_lossy(&bad.stderr);
+        assert_eq!(bad.status.code(), Some(2), "{err}");
+        assert!(err.contains(expected), "{expected}: {err}");
+    }
+    let err = String::from_utf8_lossy(&with_dem(&grey8, &ok_flags).stderr).into_owned();
+    assert!(err.contains("grey8.png"), "{err}");
 }
 
 /// `skycast fly` end to end: the approach through the San Antonio deck, a few simulated frames,

@@ -93,6 +93,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         watch: false,
         settle_ms: 500,
         clouds: None,
+        elevation: super::render::ElevationArgs::default(),
     })?;
     println!(
         "The frames are in {}/ (frame_*.png, frames.csv).",

@@ -24,7 +24,7 @@ use skycast::shading::sun_position;
 use skycast::weather::live::{LiveChange, LiveWeather, Prepare};
 use skycast::weather::{LocalFrame, StationTable, WeatherField, theme};
 
-use super::render::{load_look, parse_size, parse_time, time_or_default, world_at};
+use super::render::{ElevationArgs, load_look, parse_size, parse_time, time_or_default, world_at};
 use super::weather::{DEFAULT_STATIONS, load};
 
 /// Flags of `skycast fly`.
@@ -70,6 +70,9 @@ pub struct FlyArgs {
     /// (default: the shipped config/clouds.toml).
     #[arg(long)]
     pub clouds: Option<PathBuf>,
+    /// The ground from an elevation file instead of the stations' elevations.
+    #[command(flatten)]
+    pub elevation: ElevationArgs,
 }
 
 /// Runs `skycast fly`.
@@ -87,6 +90,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let start_unix_s = time_or_default(args.time)?;
     let mut world = world_at(&loaded, lat, lon);
+    args.elevation.apply(&mut world)?;
     if let Some(path) = &args.clouds {
         world.set_clouds_config(CloudsConfig::load(path)?);
     }

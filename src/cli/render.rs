@@ -5,8 +5,9 @@
 use std::path::PathBuf;
 
 use clap::Args;
+use glam::DVec2;
 use skycast::render::world::{World, WorldSettings};
-use skycast::render::{DemoHost, RenderSettings, SkyConfig};
+use skycast::render::{DemoHost, HeightField, RenderSettings, SkyConfig};
 use skycast::shading::{TimeOfDayTable, sun_position};
 use skycast::weather::LocalFrame;
 
@@ -54,6 +55,64 @@ pub struct RenderArgs {
     /// Time-of-day table (default: the shipped config/time_of_day.toml).
     #[arg(long)]
     pub time_of_day: Option<PathBuf>,
+    /// The ground from an elevation file instead of the stations' elevations.
+    #[command(flatten)]
+    pub elevation: ElevationArgs,
+}
+
+/// Flags that put a real elevation model under the sky (the demo host's ground).
+#[derive(Debug, Default, Args)]
+pub struct ElevationArgs {
+    /// A square 16-bit greyscale PNG elevation model centred on the flight area (`--at` or the
+    /// flight's origin), its top row the northern edge; replaces the ground made from the
+    /// stations' elevations.
+    #[arg(long, requires_all = ["elevation_size_km", "elevation_range_m"])]
+    pub elevation: Option<PathBuf>,
+    /// Side of the square the elevation file covers, kilometres.
+    #[arg(long)]
+    pub elevation_size_km: Option<f64>,
+    /// Metres above mean sea level of the file's values 0 and 65535.
+    #[arg(long, value_name = "MIN,MAX", value_parser = parse_range_m, allow_hyphen_values = true)]
+    pub elevation_range_m: Option<(f64, f64)>,
+}
+
+impl ElevationArgs {
+    /// Puts the elevation file, when given, under `world`.
+    pub fn apply(&self, world: &mut World) -> anyhow::Result<()> {
+        let (Some(path), Some(size_km), Some((min_m, max_m))) = (
+            &self.elevation,
+            self.elevation_size_km,
+            self.elevation_range_m,
+        ) else {
+            return Ok(());
+        };
+        if !(1.0..=1000.0).contains(&size_km) {
+            anyhow::bail!("--elevation-size-km {size_km} is outside 1..=1000");
+        }
+        let ground = HeightField::from_png16(path, DVec2::ZERO, size_km * 1000.0, min_m, max_m)?;
+        world.set_ground(ground);
+        Ok(())
+    }
+}
+
+/// Parses `MIN,MAX` metres with MIN below MAX.
+fn parse_range_m(s: &str) -> Result<(f64, f64), String> {
+    let (a, b) = s
+        .split_once(',')
+        .ok_or_else(|| format!("`{s}` is not MIN,MAX (metres, e.g. 0,3000)"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("`{v}` is not a number of metres"))
+    };
+    let (min, max) = (parse(a)?, parse(b)?);
+    let earthly = -500.0..=9000.0;
+    if !(min < max && earthly.contains(&min) && earthly.contains(&max)) {
+        return Err(format!(
+            "{min},{max}: needs MIN below MAX, both within -500..=9000 m"
+        ));
+    }
+    Ok((min, max))
 }
 
 /// The default time: that of the shipped weather file (afternoon in the Americas).
@@ -127,6 +186,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let unix_s = time_or_default(args.time)?;
     let mut world = world_at(&loaded, lat, lon);
+    args.elevation.apply(&mut world)?;
     let sheet = world.sheet();
     let mut host = DemoHost::new(
         args.size.0,

@@ -176,6 +176,13 @@ impl World {
         self.living.as_ref().map(|l| &l.field)
     }
 
+    /// Replaces the ground (a real elevation model, say) before the host is built from it.
+    /// Cloud bases stay above the weather field's ground (the stations' elevations), so a
+    /// mountain higher than that reaches into the clouds.
+    pub fn set_ground(&mut self, ground: HeightField) {
+        self.ground = ground;
+    }
+
     /// The ground.
     pub fn ground(&self) -> &HeightField {
         &self.ground
