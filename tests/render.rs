@@ -210,6 +210,16 @@ fn clear_overcast_and_in_cloud_frames() {
         stats.sprites_drawn > 1000 && stats.in_cloud == 0.0,
         "{stats:?}"
     );
+    // The vertex cache (Wang 6.1): a still camera recomputes no cloud after the first frame and
+    // draws the same picture; one moved past the threshold (5 m + 2% of the distance) does.
+    assert_eq!(stats.clouds_recomputed, stats.clouds_drawn, "{stats:?}");
+    let (again, still) = rig.frame("overcast_overhead_still", &up);
+    assert_eq!(still.clouds_recomputed, 0, "{still:?}");
+    assert_eq!(still.sprites_drawn, stats.sprites_drawn);
+    assert!(again.rgba == deck.rgba, "a still camera's frame changed");
+    let moved = rig.camera(DVec3::new(0.0, 0.0, 330.0), 0.0, 55.0);
+    let (_, after_move) = rig.frame("overcast_overhead_moved", &moved);
+    assert!(after_move.clouds_recomputed > 0, "{after_move:?}");
     let covered = fraction(&deck, |i| deck.depth[i] >= 1.0 && cloud_like(deck.rgba[i]));
     assert!(
         covered > 0.97 * sky_share,
