@@ -69,10 +69,16 @@ pub struct ElevationArgs {
     #[arg(long, requires_all = ["elevation_size_km", "elevation_range_m"])]
     pub elevation: Option<PathBuf>,
     /// Side of the square the elevation file covers, kilometres.
-    #[arg(long)]
+    #[arg(long, requires = "elevation")]
     pub elevation_size_km: Option<f64>,
     /// Metres above mean sea level of the file's values 0 and 65535.
-    #[arg(long, value_name = "MIN,MAX", value_parser = parse_range_m, allow_hyphen_values = true)]
+    #[arg(
+        long,
+        requires = "elevation",
+        value_name = "MIN,MAX",
+        value_parser = parse_range_m,
+        allow_hyphen_values = true
+    )]
     pub elevation_range_m: Option<(f64, f64)>,
 }
 
