@@ -24,7 +24,8 @@ use crate::weather::field::WeatherField;
 use crate::weather::{BlockIndex, BlockWeather};
 use std::sync::Arc;
 
-/// Settings of the demo world (`[world]` of `config/render.toml`).
+/// Settings of the demo world (`render` and `fly` use the defaults; `bench` widens the cloud
+/// radius to its view radius).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WorldSettings {
@@ -43,10 +44,12 @@ pub struct WorldSettings {
 impl Default for WorldSettings {
     fn default() -> Self {
         Self {
-            ground_size_m: 120_000.0,
+            ground_size_m: 130_000.0,
             ground_samples: 257,
             relief_m: 40.0,
-            cloud_radius_m: 24_000.0,
+            // As far as sprites are drawn (`draw_distance_m`): from altitude a deck that ended
+            // at 24 km showed its edge; beyond the 20 km ring radius they are impostors.
+            cloud_radius_m: 60_000.0,
             seed: 2003,
         }
     }
