@@ -31,7 +31,8 @@ use skycast::render::world::{World, WorldSettings};
 use skycast::render::{DemoHost, RenderSettings, SkyConfig};
 use skycast::shading::{TimeOfDayTable, sun_position};
 use skycast::weather::{
-    BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, StationTable, WeatherInput,
+    BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, METRES_PER_FOOT, StationTable,
+    WeatherInput,
 };
 
 use super::render::{load_look, parse_size, parse_time, time_or_default};
@@ -39,7 +40,6 @@ use super::weather::DEFAULT_STATIONS;
 
 mod plot;
 
-const METRES_PER_FOOT: f64 = 0.3048;
 /// The scenarios, in the order of the table.
 const SCENARIOS: [&str; 3] = ["sparse", "scattered", "overcast"];
 /// The path: due east, centred on the station, this long, at this height above its ground.

@@ -9,11 +9,9 @@ use glam::DVec2;
 use skycast::render::world::{World, WorldSettings};
 use skycast::render::{DemoHost, HeightField, RenderSettings, SkyConfig};
 use skycast::shading::{TimeOfDayTable, sun_position};
-use skycast::weather::LocalFrame;
+use skycast::weather::{LocalFrame, METRES_PER_FOOT};
 
 use super::weather::{DEFAULT_STATIONS, Loaded, load, parse_lat_lon};
-
-const METRES_PER_FOOT: f64 = 0.3048;
 
 /// Flags of `skycast render`.
 #[derive(Debug, Args)]

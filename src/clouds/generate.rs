@@ -23,10 +23,11 @@ use super::block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, S
 use super::config::{CloudTypeConfig, CloudTypes, TextureCategory};
 use super::heap::heap_sprites;
 use super::rng::{SplitMix64, hash_keys};
-use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, CloudType};
+use crate::weather::{
+    BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, CloudType, METRES_PER_FOOT,
+};
 
 /// Feet to metres.
-const M_PER_FT: f64 = 0.3048;
 /// Cells per side of the coverage grid.
 const GRID: usize = 40;
 /// Layers at or above this coverage are placed on the lattice, whatever their type.
@@ -90,9 +91,9 @@ struct LayerFrame {
 impl LayerFrame {
     fn new(layer: &BlockLayer, config: &CloudTypeConfig, ground_m: f64) -> Self {
         let [lo, hi] = config.thickness_m.map(f64::from);
-        let reported = layer.thickness_ft.max(0.0) as f64 * M_PER_FT;
+        let reported = layer.thickness_ft.max(0.0) as f64 * METRES_PER_FOOT;
         Self {
-            base_m: ground_m + layer.base_ft_agl.max(0.0) as f64 * M_PER_FT,
+            base_m: ground_m + layer.base_ft_agl.max(0.0) as f64 * METRES_PER_FOOT,
             thickness_m: reported.clamp(lo, hi),
         }
     }
@@ -296,11 +297,12 @@ fn build_cloud(
     // Streaks: the footprint squeezed across the wind axis, every sprite along it.
     let streak = config
         .streak_length_over_width
-        .filter(|_| config.flat && lattice_cell_m.is_none())
-        .map(|aspect| {
-            let (sin, cos) = ctx.wind_axis_deg.to_radians().sin_cos();
-            (aspect as f64, DVec2::new(cos, sin))
-        });
+        .filter(|_| config.flat && lattice_cell_m.is_none());
+    let along = DVec2::from_angle(ctx.wind_axis_deg.to_radians());
+    let lay = |v: DVec2| match streak {
+        Some(aspect) => along * v.x + along.perp() * (v.y / aspect as f64),
+        None => v,
+    };
     let density = config.density_by_cover.for_oktas(ctx.layer.coverage_oktas) as f64;
     // Heaped clouds stand on a flat base and end in a dome (or an anvil).
     if lattice_cell_m.is_none() && !config.continuous && !config.flat {
@@ -325,11 +327,7 @@ fn build_cloud(
             (cell * 0.55, DVec2::ZERO)
         } else {
             let off = DVec2::new(rng.range_f64(-0.15, 0.15), rng.range_f64(-0.15, 0.15)) * d;
-            let off = match streak {
-                Some((aspect, along)) => along * off.x + along.perp() * (off.y / aspect),
-                None => off,
-            };
-            (d / 2.0 * if n_boxes > 1 { 0.75 } else { 1.0 }, off)
+            (d / 2.0 * if n_boxes > 1 { 0.75 } else { 1.0 }, lay(off))
         };
         let n = rng.range_u32(config.sprites_per_box[0], config.sprites_per_box[1]);
         let mut n = ((n as f64 * density).round() as u32).clamp(1, 100);
@@ -381,20 +379,13 @@ fn build_cloud(
                     (thickness - half_h).max(thickness / 2.0),
                 )
             };
-            let (local, rotation_deg) = match streak {
-                Some((aspect, along)) => {
-                    let across = along.perp();
-                    let p = along * (x * spread) + across * (y * spread / aspect);
-                    (p, Some(ctx.wind_axis_deg))
-                }
-                None => (DVec2::new(x, y) * spread, None),
-            };
+            let local = lay(DVec2::new(x * spread, y * spread));
             raws.push(Raw {
                 pos: DVec3::new(offset.x + local.x, offset.y + local.y, z),
                 width,
                 height,
                 group: group - 1,
-                rotation_deg,
+                rotation_deg: streak.map(|_| ctx.wind_axis_deg),
                 base: None,
             });
         }

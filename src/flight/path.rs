@@ -8,9 +8,8 @@ use toml::Spanned;
 
 use super::spline::{self, Key};
 use crate::config::{ConfigError, parse_toml};
+use crate::weather::METRES_PER_FOOT;
 use crate::weather::frame::LocalFrame;
-
-const METRES_PER_FOOT: f64 = 0.3048;
 
 /// Where the camera is and where it looks: world position in the local frame and a view angle.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -12,9 +12,9 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::TimeOfDay;
-use crate::weather::{BlockLayer, CloudType};
+use crate::weather::{BlockLayer, CloudType, METRES_PER_FOOT};
 
-const M_PER_FT: f32 = 0.3048;
+const M_PER_FT: f32 = METRES_PER_FOOT as f32;
 
 /// The `[overcast]` table of `config/time_of_day.toml`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

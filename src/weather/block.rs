@@ -12,6 +12,9 @@ use super::cloud_type::CloudType;
 /// Side of a block, metres (Wang 2003: 16 km2 blocks).
 pub const BLOCK_SIZE_M: f64 = 4_000.0;
 
+/// Metres in a foot: METAR heights (bases, thicknesses) and flight altitudes are in feet.
+pub const METRES_PER_FOOT: f64 = 0.3048;
+
 /// Integer index of a block: `i` counts blocks east, `j` blocks north of the frame origin.
 /// Block (0, 0) spans [0, 4000) m east and [0, 4000) m north.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]

@@ -19,7 +19,9 @@ pub mod stations;
 pub mod theme;
 pub mod watch;
 
-pub use block::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, TypeSource, Wind};
+pub use block::{
+    BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, METRES_PER_FOOT, TypeSource, Wind,
+};
 pub use cloud_type::CloudType;
 pub use error::{LineWarning, WeatherError};
 pub use field::{CloudTypeRule, FieldSettings, WeatherField};

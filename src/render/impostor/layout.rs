@@ -7,12 +7,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::render::camera::Camera;
 use crate::render::scene::SkyBlock;
+use crate::weather::METRES_PER_FOOT;
 
 /// Number of impostors in a ring.
 pub const IMPOSTORS: usize = 8;
 /// Horizontal (and vertical) field of view of one impostor, degrees.
 pub const IMPOSTOR_FOV_DEG: f64 = 45.0;
-pub(super) const FT_TO_M: f64 = 0.3048;
 
 /// The `[impostors]` table of `config/render.toml`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -103,7 +103,9 @@ impl ImpostorSettings {
 pub fn is_far(block: &SkyBlock, centre_m: DVec3, camera_m: DVec3, s: &ImpostorSettings) -> bool {
     let d = (block.centre_m - centre_m).truncate().length();
     let dz = (block.centre_m.z - camera_m.z).abs();
-    d > s.ring_radius_m && d <= s.view_radius_m && dz <= s.max_height_difference_ft * FT_TO_M
+    d > s.ring_radius_m
+        && d <= s.view_radius_m
+        && dz <= s.max_height_difference_ft * METRES_PER_FOOT
 }
 
 /// Whether the camera (or sun) left a ring built at `built_m` with sun `built_sun`.

@@ -20,8 +20,9 @@
 //! reprojects each ray with it (the clouds sit at their depth, not on the quad, so they move with
 //! the right parallax as the camera leaves the ring centre and a new ring shows nearly the same
 //! picture; this is also Wang's vertical translation of the impostors with the angle between
-//! clouds and camera, done per pixel at each cloud's own distance), and the host's depth hides them where its scene is nearer (a mountain beyond the
-//! ring radius among far clouds). Rules and geometry: `layout`. Units: metres, degrees.
+//! clouds and camera, done per pixel at each cloud's own distance), and the host's depth hides
+//! them where its scene is nearer (a mountain beyond the ring radius among far clouds). Rules
+//! and geometry: `layout`. Units: metres, degrees.
 
 mod layout;
 
