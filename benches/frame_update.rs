@@ -1,21 +1,21 @@
-//! The CPU frame update of the sky (sort, face, shade the sprites; Wang 2003 6.1) along the
-//! shipped cruise flight through the real bulk weather, with and without the vertex cache.
-//! The ratio of the two is the README's cache figure; the sprites recomputed per frame are
-//! printed too (vertex work, independent of the machine). `sort_back_to_front/cruise_frame`: the
-//! back-to-front sort alone, for one frame of the same stretch: blocks by distance, then every
-//! cloud's sprites (what an uncached frame sorts; the cache skips the sprite level for clouds it
-//! keeps).
+//! The sky's CPU share of a frame along the shipped cruise flight through the real bulk weather
+//! (Wang 2003 6.1 on GPU-resident sprites): `Sky::prepare` (sort blocks and clouds, the cached
+//! per-cloud sprite orders, the draw list, the uploads of what changed) and `Sky::record` (the
+//! passes into an encoder, not submitted), with and without the order cache. The sprites whose
+//! order was recomputed and the bytes uploaded per frame are printed too (independent of the
+//! machine). `sort_back_to_front/cruise_frame`: every cloud's sprites sorted from one camera
+//! (what a frame without the cache sorts).
+//!
+//! Needs a graphics adapter (lavapipe is enough): the sprites live in GPU buffers.
 
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use skycast::flight::FlightPlan;
-use skycast::render::vertices::{
-    Lighting, SpriteVertexBuilder, blocks_back_to_front, sprites_back_to_front,
-};
+use skycast::render::draw_list::sprites_back_to_front;
 use skycast::render::world::{World, WorldSettings};
-use skycast::render::{RenderSettings, SkyBlock};
-use skycast::shading::{TimeOfDayTable, sun_position};
+use skycast::render::{Camera, DemoHost, SkyBlock, SkyConfig, headless};
+use skycast::shading::{SunPosition, TimeOfDayTable, sun_position};
 use skycast::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
 use skycast::weather::{LocalFrame, StationTable, files};
 
@@ -34,9 +34,10 @@ fn frames() -> usize {
 }
 
 struct Cruise {
+    host: DemoHost,
     blocks: Vec<SkyBlock>,
-    cameras: Vec<glam::DVec3>,
-    lighting: Lighting,
+    cameras: Vec<Camera>,
+    sun: SunPosition,
 }
 
 fn cruise() -> Cruise {
@@ -57,69 +58,93 @@ fn cruise() -> Cruise {
         &CloudTypeRule::default(),
     );
     let mut world = World::new(field, &WorldSettings::default());
+    let mut host = DemoHost::new(
+        32,
+        18,
+        world.ground(),
+        SkyConfig {
+            colour_format: headless::COLOUR_FORMAT,
+            settings: Default::default(),
+            time_of_day: TimeOfDayTable::default(),
+            sheet: world.sheet(),
+        },
+    )
+    .expect("the frame update bench needs a graphics adapter (lavapipe is enough)");
     // A stretch of the cruise 60 s in, at 30 frames a second.
-    let cameras: Vec<glam::DVec3> = (0..frames())
-        .map(|k| flight.pose_at(60.0 + k as f64 / FPS).position_m)
+    let cameras: Vec<Camera> = (0..frames())
+        .map(|k| {
+            let pose = flight.pose_at(60.0 + k as f64 / FPS);
+            host.camera(pose.position_m, pose.heading_deg, pose.pitch_deg)
+        })
         .collect();
-    let blocks = world.sky_blocks_around(cameras[0]);
-    let table = TimeOfDayTable::default();
-    let sun = sun_position(1_738_015_200.0 + 60.0, lat, lon);
-    let lighting = Lighting {
-        sun_dir: sun.direction_enu().as_vec3(),
-        time_of_day: table.at(sun.elevation_deg as f32),
-        mapping: table.directional_mapping,
-        forward: table.forward_scattering,
-    };
+    let blocks = world.sky_blocks_around(cameras[0].position_m);
+    host.sky.set_clouds(blocks.clone());
     Cruise {
+        host,
         blocks,
         cameras,
-        lighting,
+        sun: sun_position(1_738_015_200.0 + 60.0, lat, lon),
     }
 }
 
-fn run(c: &Cruise, settings: &RenderSettings) -> (u64, u64) {
-    let mut builder = SpriteVertexBuilder::new();
-    let (mut sprites_recomputed, mut sprites_drawn) = (0u64, 0u64);
-    for (k, cam) in c.cameras.iter().enumerate() {
-        let stats = builder.update(&c.blocks, *cam, k as f64 / FPS, &c.lighting, settings);
-        sprites_recomputed += stats.sprites_recomputed as u64;
-        sprites_drawn += stats.sprites_drawn as u64;
+/// Prepares and records every frame of the stretch (nothing submitted; the writes are flushed
+/// at the end); returns the sprites recomputed, the sprites drawn and the bytes uploaded.
+fn run(c: &mut Cruise, cache: bool) -> (u64, u64, u64) {
+    c.host.sky.set_vertex_cache(cache);
+    let (mut recomputed, mut drawn, mut uploaded) = (0u64, 0u64, 0u64);
+    for camera in &c.cameras {
+        let stats = c
+            .host
+            .sky
+            .prepare(&c.host.gpu.queue, camera, &c.sun, 1.0 / FPS);
+        let mut encoder = c
+            .host
+            .gpu
+            .device
+            .create_command_encoder(&Default::default());
+        c.host.sky.record(
+            &mut encoder,
+            &c.host.target.colour_view,
+            &c.host.target.depth_view,
+        );
+        recomputed += stats.sprites_recomputed as u64;
+        drawn += stats.sprites_drawn as u64;
+        uploaded += stats.upload_bytes;
     }
-    (sprites_recomputed, sprites_drawn)
+    c.host.gpu.queue.submit([]);
+    (recomputed, drawn, uploaded)
 }
 
-/// The frame's back-to-front sort from `camera_m`: blocks, then each cloud's sprites; returns
-/// the sprites sorted.
+/// Every cloud's sprites sorted back to front from `camera_m`; returns the sprites sorted.
 fn sort_frame(blocks: &[SkyBlock], camera_m: glam::DVec3) -> usize {
-    let mut sorted = 0;
-    for (bi, _) in blocks_back_to_front(blocks, camera_m) {
-        for cloud in &blocks[bi].clouds {
-            let cam_local = (camera_m - cloud.centre_m).as_vec3();
-            sorted += sprites_back_to_front(cloud, cam_local).len();
-        }
-    }
-    sorted
+    blocks
+        .iter()
+        .flat_map(|b| &b.clouds)
+        .map(|cloud| sprites_back_to_front(cloud, (camera_m - cloud.centre_m).as_vec3()).len())
+        .sum()
 }
 
 fn bench(crit: &mut Criterion) {
-    let c = cruise();
-    let cached = RenderSettings::default();
-    let mut uncached = cached;
-    uncached.vertex_cache.enabled = false;
-    let (with, drawn) = run(&c, &cached);
-    let (without, _) = run(&c, &uncached);
+    let mut c = cruise();
+    // The first frame uploads every block and builds the whole impostor ring: not a steady one.
+    run(&mut c, true);
+    let (with, drawn, uploaded) = run(&mut c, true);
+    let (without, _, _) = run(&mut c, false);
+    let n = c.cameras.len() as u64;
     eprintln!(
-        "cruise, {} frames at {FPS} fps: {} clouds, {drawn} sprites drawn; sprites recomputed {with} cached vs {without} uncached ({:.1}x less vertex work)",
-        c.cameras.len(),
+        "cruise, {n} frames at {FPS} fps: {} clouds, {} sprites drawn a frame; sprites re-sorted {with} cached vs {without} uncached ({:.1}x less sorting); {} bytes uploaded a frame",
         c.blocks.iter().map(|b| b.clouds.len()).sum::<usize>(),
-        without as f64 / with.max(1) as f64
+        drawn / n,
+        without as f64 / with.max(1) as f64,
+        uploaded / n,
     );
-    let mut group = crit.benchmark_group("sky_cpu_update_cruise");
+    let mut group = crit.benchmark_group("sky_cpu_frame_cruise");
     group.sample_size(10);
-    group.bench_function("cached", |b| b.iter(|| run(&c, &cached)));
-    group.bench_function("uncached", |b| b.iter(|| run(&c, &uncached)));
+    group.bench_function("cached", |b| b.iter(|| run(&mut c, true)));
+    group.bench_function("uncached", |b| b.iter(|| run(&mut c, false)));
     group.finish();
-    let sprites = sort_frame(&c.blocks, c.cameras[0]);
+    let camera = c.cameras[0].position_m;
+    let sprites = sort_frame(&c.blocks, camera);
     eprintln!(
         "sort: {sprites} sprites of {} blocks a frame",
         c.blocks.len()
@@ -127,7 +152,7 @@ fn bench(crit: &mut Criterion) {
     let mut group = crit.benchmark_group("sort_back_to_front");
     group.sample_size(10);
     group.bench_function("cruise_frame", |b| {
-        b.iter(|| sort_frame(std::hint::black_box(&c.blocks), c.cameras[0]))
+        b.iter(|| sort_frame(std::hint::black_box(&c.blocks), camera))
     });
     group.finish();
 }

@@ -146,8 +146,9 @@ impl Flight {
             });
         }
         let position = self.position();
-        let blocks = self.world.living_blocks(position, dt_s).unwrap();
-        self.host.sky.set_clouds(blocks);
+        self.world
+            .update_sky(&mut self.host.sky, position, dt_s)
+            .unwrap();
         let camera = self.host.camera(position, 90.0, 8.0);
         let frame = if draw {
             let (frame, _) = self

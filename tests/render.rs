@@ -7,8 +7,8 @@ use std::path::PathBuf;
 
 use glam::{DVec2, DVec3, Vec3};
 use skycast::clouds::{CloudTypes, generate_block};
+use skycast::render::square_sprite;
 use skycast::render::terrain::HeightField;
-use skycast::render::vertices::square_sprite;
 use skycast::render::world::block_id;
 use skycast::render::{
     Camera, DemoHost, Frame, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteSheet, headless,
@@ -954,4 +954,91 @@ fn ring_rebuilds_do_not_pop() {
         hard_worst > 1.5 * hard_plain,
         "without crossfade: {hard_worst} vs {hard_plain}"
     );
+}
+
+/// The GPU-resident sprites (faced, shaded and faded in the vertex shader) draw the frames the
+/// CPU-vertex path drew: five shipped views rendered with `skycast render` at 320 x 180 against
+/// the frames kept from that path in `tests/reference/` (a cumulus field from below and above,
+/// the Cb line, the San Antonio deck from above and below; impostor ring included).
+#[test]
+fn gpu_sprites_draw_the_frames_of_the_cpu_path() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("reference");
+    std::fs::create_dir_all(&dir).unwrap();
+    let metars = "weather/awc-metars-2025-01-27T22Z.cache.csv";
+    let cb = "weather/themes/building_cumulus_cb_line.toml";
+    let views: [(&str, &str, &str, &str, &str, &str); 5] = [
+        (
+            "cruise_under_cumulus",
+            metars,
+            "33.90,-118.36",
+            "3000",
+            "135",
+            "8",
+        ),
+        (
+            "cruise_over_cumulus",
+            metars,
+            "33.90,-118.36",
+            "5500",
+            "135",
+            "-8",
+        ),
+        ("cumulonimbus_line", cb, "28.5,-81.62", "3000", "90", "10"),
+        (
+            "approach_above_deck",
+            metars,
+            "29.4270,-98.6080",
+            "5000",
+            "40",
+            "-3",
+        ),
+        (
+            "approach_below_deck",
+            metars,
+            "29.5230,-98.5000",
+            "1500",
+            "40",
+            "10",
+        ),
+    ];
+    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    for (name, weather, at, alt, heading, pitch) in views {
+        let out = dir.join(format!("{name}.png"));
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_skycast"))
+            .current_dir(&manifest)
+            .env("XDG_RUNTIME_DIR", "/tmp")
+            .args([
+                "render",
+                "--size",
+                "320x180",
+                "--weather",
+                weather,
+                "--at",
+                at,
+            ])
+            .args(["--alt-ft", alt, "--heading", heading, "--pitch", pitch])
+            .args(["--out", out.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{name}: {run:?}");
+        let now = image::open(&out).unwrap().to_rgba8();
+        let kept = image::open(manifest.join("tests/reference").join(format!("{name}.png")))
+            .unwrap()
+            .to_rgba8();
+        assert_eq!(now.dimensions(), kept.dimensions());
+        let (mut sum, mut worst) = (0.0f64, 0u8);
+        for (a, b) in now.pixels().zip(kept.pixels()) {
+            for c in 0..3 {
+                let d = a[c].abs_diff(b[c]);
+                sum += d as f64;
+                worst = worst.max(d);
+            }
+        }
+        let mean = sum / (now.pixels().len() * 3) as f64 / 255.0;
+        eprintln!("{name}: mean absolute difference {mean:.5} per channel, worst {worst}/255");
+        assert!(
+            mean <= 0.01,
+            "{name}: mean absolute difference {mean} per channel"
+        );
+    }
 }

@@ -155,6 +155,13 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "clouds_recomputed",
         "cache_hit_rate",
         "cpu_update_us",
+        "field_us",
+        "record_us",
+        "sky_cpu_us",
+        "upload_bytes",
+        "sprite_gpu_bytes",
+        "blocks_left_out",
+        "impostors_rebuilt",
         "weather_us",
         "weather_applied",
         "written",
@@ -191,8 +198,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         let weather_us = weather_start.elapsed().as_micros();
         // The clouds stage's living field: drift with the wind, formation and dissipation.
         let step_s = if k == 0 { 0.0 } else { dt_s };
-        host.sky
-            .set_clouds(world.living_blocks(pose.position_m, step_s)?);
+        world.update_sky(&mut host.sky, pose.position_m, step_s)?;
         host.sky
             .set_weather_overhead(&world.weather_over(pose.position_m));
         let camera = host.camera(pose.position_m, pose.heading_deg, pose.pitch_deg);
@@ -229,6 +235,13 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             stats.clouds_recomputed.to_string(),
             format!("{:.3}", stats.cache_hit_rate),
             stats.cpu_update_us.to_string(),
+            stats.field_us.to_string(),
+            stats.record_us.to_string(),
+            stats.sky_cpu_us().to_string(),
+            stats.upload_bytes.to_string(),
+            stats.sprite_gpu_bytes.to_string(),
+            stats.blocks_left_out.to_string(),
+            stats.impostors_rebuilt.to_string(),
             weather_us.to_string(),
             applied,
             (write as u8).to_string(),

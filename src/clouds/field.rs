@@ -24,7 +24,7 @@ use super::CloudsError;
 use super::block::CloudBlock;
 use super::config::{CloudTypes, CloudsConfig};
 use super::generate::generate_block;
-use super::lifecycle::{Phase, apply, phase_at};
+use super::lifecycle::{Phase, phase_at};
 use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockWeather};
 
 /// A finished generation job.
@@ -165,10 +165,13 @@ pub fn weather_changed(a: &BlockWeather, b: &BlockWeather) -> bool {
 /// One generation of clouds in a block, with where it is in its life.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FieldBlock {
-    /// The clouds (sprites' `alpha_morph` set for the current time).
+    /// The clouds as generated (the sprites' fades follow from `phase`:
+    /// [`super::lifecycle::alpha_at`]; nothing is rewritten per frame).
     pub block: CloudBlock,
     /// Forming, steady or dissipating.
     pub phase: Phase,
+    /// Unique to this generation in its field (a weather change never reuses one).
+    pub serial: u64,
 }
 
 #[derive(Debug)]
@@ -188,6 +191,7 @@ pub struct CloudField {
     drift_m: DVec2,
     wind_m_s: DVec2,
     slots: BTreeMap<BlockIndex, Slot>,
+    next_serial: u64,
 }
 
 impl CloudField {
@@ -212,6 +216,7 @@ impl CloudField {
             drift_m: DVec2::ZERO,
             wind_m_s: DVec2::ZERO,
             slots: BTreeMap::new(),
+            next_serial: 0,
         }
     }
 
@@ -277,16 +282,18 @@ impl CloudField {
                     g.phase = Phase::Dissipating { since_s: now };
                 }
             }
-            let mut block = done.block;
-            for cloud in &mut block.clouds {
-                apply(cloud, phase, now, &self.config.lifecycle);
-            }
-            slot.generations.push(FieldBlock { block, phase });
+            self.next_serial += 1;
+            slot.generations.push(FieldBlock {
+                block: done.block,
+                phase,
+                serial: self.next_serial,
+            });
         }
     }
 
-    /// Advances field time by `dt_s`: clouds drift, forming and dissipating ones change their
-    /// `alpha_morph`, dissipated ones go.
+    /// Advances field time by `dt_s`: clouds drift, forming ones settle once formed,
+    /// dissipated ones go. Per generation, not per sprite: the fades themselves are worked out
+    /// where they are drawn ([`super::lifecycle::alpha_at`]).
     pub fn advance(&mut self, dt_s: f64) {
         self.time_s += dt_s;
         self.drift_m += self.wind_m_s * dt_s;
@@ -294,21 +301,22 @@ impl CloudField {
         let lifecycle = self.config.lifecycle;
         for slot in self.slots.values_mut() {
             for g in &mut slot.generations {
-                if g.phase == Phase::Steady {
-                    continue;
-                }
-                let mut next = g.phase;
-                for cloud in &mut g.block.clouds {
-                    next = apply(cloud, g.phase, now, &lifecycle);
-                }
-                if g.block.clouds.is_empty() {
-                    next = phase_at(g.phase, now, &lifecycle);
-                }
-                g.phase = next;
+                g.phase = phase_at(g.phase, now, &lifecycle);
             }
             slot.generations.retain(|g| g.phase != Phase::Gone);
         }
         self.take_finished();
+    }
+
+    /// Takes in the blocks generated since the last call, without asking for any (what
+    /// [`Self::update`] does after asking).
+    pub fn poll(&mut self) {
+        self.take_finished();
+    }
+
+    /// The lifecycle settings the field fades with.
+    pub fn lifecycle(&self) -> &super::config::LifecycleConfig {
+        &self.config.lifecycle
     }
 
     /// Waits until every queued block is generated and taken in (tools and tests).
@@ -515,12 +523,14 @@ mod tests {
         assert_eq!(gens.len(), 2);
         assert!(matches!(gens[0].phase, Phase::Dissipating { .. }));
         assert!(matches!(gens[1].phase, Phase::Forming { .. }));
-        let opacity = |g: &FieldBlock| -> f32 {
+        let opacity = |g: &FieldBlock, now: f64| -> f32 {
             g.block
                 .clouds
                 .iter()
                 .flat_map(|c| &c.sprites)
-                .map(|s| s.alpha_morph)
+                .map(|s| {
+                    crate::clouds::lifecycle::alpha_at(g.phase, now, s.radius_fraction, &config)
+                })
                 .sum::<f32>()
         };
         let (mut old_last, mut new_last) = (f32::MAX, -1.0);
@@ -533,23 +543,26 @@ mod tests {
             // Never nothing, never a swap: the new clouds are there from the start.
             assert!(!gens.is_empty());
             let new = gens.last().unwrap();
-            assert!(opacity(new) >= new_last);
-            new_last = opacity(new);
+            let now = field.time_s();
+            assert!(opacity(new, now) >= new_last);
+            new_last = opacity(new, now);
             if gens.len() == 2 {
-                assert!(opacity(&gens[0]) <= old_last);
-                old_last = opacity(&gens[0]);
+                assert!(opacity(&gens[0], now) <= old_last);
+                old_last = opacity(&gens[0], now);
             }
         }
         let gens = field.generations(index);
         assert_eq!(gens.len(), 1, "the old clouds are gone");
         assert_eq!(gens[0].phase, Phase::Steady);
+        assert_eq!(opacity(&gens[0], field.time_s()), new_last);
         assert!(
             gens[0]
                 .block
                 .clouds
                 .iter()
                 .flat_map(|c| &c.sprites)
-                .all(|s| s.alpha_morph == 1.0)
+                .all(|s| s.alpha_morph == 1.0),
+            "the field never rewrites the sprites"
         );
     }
 }

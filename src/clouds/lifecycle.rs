@@ -66,8 +66,31 @@ pub fn phase_at(phase: Phase, now_s: f64, config: &LifecycleConfig) -> Phase {
     }
 }
 
-/// Sets every sprite's `alpha_morph` for a phase at field time `now_s`; returns the phase after
-/// (Forming becomes Steady once complete, Dissipating becomes Gone).
+/// Progress of a formation or dissipation at field time `now_s`, 0..=1 (1 for Steady and Gone).
+pub fn progress(phase: Phase, now_s: f64, config: &LifecycleConfig) -> f32 {
+    let frac = |since_s: f64, span_s: f32| ((now_s - since_s) / span_s as f64).clamp(0.0, 1.0);
+    match phase {
+        Phase::Forming { since_s } => frac(since_s, config.formation_s) as f32,
+        Phase::Dissipating { since_s } => frac(since_s, config.dissipation_s) as f32,
+        Phase::Steady | Phase::Gone => 1.0,
+    }
+}
+
+/// The opacity factor of a sprite at `radius_fraction` in a cloud of phase `phase` at field time
+/// `now_s` (what [`apply`] sets; the renderer works the same out on the GPU).
+pub fn alpha_at(phase: Phase, now_s: f64, radius_fraction: f32, config: &LifecycleConfig) -> f32 {
+    let p = progress(phase, now_s, config);
+    match phase {
+        Phase::Steady => 1.0,
+        Phase::Gone => 0.0,
+        Phase::Forming { .. } => formation_alpha(p, radius_fraction, config),
+        Phase::Dissipating { .. } => dissipation_alpha(p, radius_fraction, config),
+    }
+}
+
+/// Sets every sprite's `alpha_morph` for a phase at field time `now_s` (for CPU pictures; the
+/// living field leaves the sprites alone and the renderer fades them on the GPU); returns the
+/// phase after (Forming becomes Steady once complete, Dissipating becomes Gone).
 pub fn apply(cloud: &mut Cloud, phase: Phase, now_s: f64, config: &LifecycleConfig) -> Phase {
     match phase {
         Phase::Steady => {

@@ -11,11 +11,11 @@ use glam::DVec2;
 
 use super::RenderError;
 use super::camera::Camera;
-use super::gpu_types::GpuSpriteVertex;
+use super::gpu_types::GpuSprite;
 use super::headless::{self, Frame, HeadlessGpu, OffscreenTarget};
 use super::sky::{Sky, SkyConfig};
+use super::stats::FrameStats;
 use super::terrain::{HeightField, Terrain, TerrainLight, procedural_relief_m};
-use super::vertices::FrameStats;
 use crate::shading::SunPosition;
 use crate::weather::field::WeatherField;
 
@@ -143,7 +143,7 @@ impl DemoHost {
         dt_s: f64,
         visibility_m: f32,
     ) -> FrameStats {
-        let stats = self.sky.prepare(&self.gpu.queue, camera, sun, dt_s);
+        let mut stats = self.sky.prepare(&self.gpu.queue, camera, sun, dt_s);
         let light = self.sky.light();
         self.terrain.prepare(
             &self.gpu.queue,
@@ -178,6 +178,7 @@ impl DemoHost {
             &self.target.colour_view,
             &self.target.depth_view,
         );
+        stats.record_us = self.sky.last_record_us();
         if let Some(t) = &self.timer {
             encoder.write_timestamp(&t.queries, 2);
             encoder.resolve_query_set(&t.queries, 0..3, &t.resolve, 0);
@@ -209,17 +210,15 @@ impl DemoHost {
             .map_err(|e| RenderError::Device(e.to_string()))
     }
 
-    /// The most sprites the sky can draw at once as sprites on this device: its vertex buffer
-    /// (four [`GpuSpriteVertex`]es a sprite) grows in powers of two up to the device's largest
-    /// buffer.
+    /// The most sprites the sky can hold on the GPU on this device: its sprite records
+    /// ([`GpuSprite`]) in one storage buffer, six quad indices each in one index buffer.
     pub fn max_sprites(&self) -> u64 {
-        let per_sprite = 4 * std::mem::size_of::<GpuSpriteVertex>() as u64;
-        let fit = self.gpu.device.limits().max_buffer_size / per_sprite;
-        if fit == 0 {
-            0
-        } else {
-            1 << (63 - fit.leading_zeros())
-        }
+        let limits = self.gpu.device.limits();
+        let records = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size)
+            / std::mem::size_of::<GpuSprite>() as u64;
+        records.min(limits.max_buffer_size / 24)
     }
 
     /// Draws one frame and reads it back.

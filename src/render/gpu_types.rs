@@ -1,5 +1,6 @@
 //! The structs the GPU reads, each with a WGSL twin of the same field names. Keep in sync with
-//! `shaders/shared/frame.wgsl` (`Frame`), `shaders/sprites.wgsl` (`SpriteVertex`) and
+//! `shaders/shared/frame.wgsl` (`Frame`), `shaders/sprites.wgsl` (`Sprite`, `Cloud`, `DrawCloud`,
+//! `Lock`, `SpriteView`) and
 //! `shaders/terrain.wgsl` (`TerrainFrame`, `TerrainVertex`).
 
 use bytemuck::{Pod, Zeroable};
@@ -29,51 +30,106 @@ pub struct GpuFrame {
 }
 const _: () = assert!(std::mem::size_of::<GpuFrame>() == 240);
 
-/// One corner of a cloud sprite, camera-relative. Keep in sync with `VertexIn` in
-/// `shaders/sprites.wgsl`.
+/// One sprite as it lives on the GPU from the moment its block arrives until the block goes
+/// (written once, never per frame). Keep in sync with `Sprite` in `shaders/sprites.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuSpriteVertex {
-    /// Position relative to the camera, metres (east, north, up).
-    pub position_m: [f32; 3],
-    /// Padding to 16 bytes.
-    pub _pad0: f32,
-    /// Texture coordinate on the sheet.
-    pub uv: [f32; 2],
-    /// Padding to 16 bytes.
-    pub _pad1: [f32; 2],
-    /// Wang 5.3 vertex colour `(C_amb + C_dir)` and alpha (ambient alpha times alpha_morph).
-    pub colour: [f32; 4],
+pub struct GpuSprite {
+    /// xyz: centre, metres from the cloud centre (east, north, up); w: width, metres.
+    pub offset_width: [f32; 4],
+    /// xyz: its shading group's centre, metres from the cloud centre; w: height, metres.
+    pub group_height: [f32; 4],
+    /// Rotation in the sprite plane, radians.
+    pub rotation_rad: f32,
+    /// Formation / dissipation factor of the sprite itself, 0..=1 (multiplied by the block's fade).
+    pub alpha_morph: f32,
+    /// Distance from the cloud centre over the cloud radius (which sprites fade first, Wang 4).
+    pub radius_fraction: f32,
+    /// Bits 0..4: sheet cell; bit 8: upright (cylindrical billboard).
+    pub bits: u32,
 }
-const _: () = assert!(std::mem::size_of::<GpuSpriteVertex>() == 48);
+const _: () = assert!(std::mem::size_of::<GpuSprite>() == 48);
 
-impl GpuSpriteVertex {
-    /// The buffer layout (offsets of uv and colour match the struct).
-    pub fn layout() -> wgpu::VertexBufferLayout<'static> {
-        const ATTRS: [wgpu::VertexAttribute; 3] = [
-            wgpu::VertexAttribute {
-                format: wgpu::VertexFormat::Float32x3,
-                offset: 0,
-                shader_location: 0,
-            },
-            wgpu::VertexAttribute {
-                format: wgpu::VertexFormat::Float32x2,
-                offset: 16,
-                shader_location: 1,
-            },
-            wgpu::VertexAttribute {
-                format: wgpu::VertexFormat::Float32x4,
-                offset: 32,
-                shader_location: 2,
-            },
-        ];
-        wgpu::VertexBufferLayout {
-            array_stride: std::mem::size_of::<GpuSpriteVertex>() as u64,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &ATTRS,
-        }
-    }
+/// The `bits` flag of an upright sprite.
+pub const SPRITE_UPRIGHT: u32 = 1 << 8;
+
+/// One cloud's shading constants on the GPU (written with its block). Keep in sync with
+/// `Cloud` in `shaders/sprites.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuCloud {
+    /// The five ambient colour levels, RGBA (Wang 5.1).
+    pub level_rgba: [[f32; 4]; 5],
+    /// Heights of levels 0..4, metres above mean sea level.
+    pub level_height: [f32; 4],
+    /// x: height of level 4, metres; y: cloud radius, metres; z: 1 for a flat cloud (cirrus);
+    /// w unused.
+    pub level4_radius_flat: [f32; 4],
 }
+const _: () = assert!(std::mem::size_of::<GpuCloud>() == 112);
+
+/// One cloud of a frame's draw list, back to front: where it is relative to the camera (f64 on
+/// the CPU, so nothing jitters far out) and where its sprite order lives. Keep in sync with
+/// `DrawCloud` in `shaders/sprites.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuDrawCloud {
+    /// Cloud centre minus the camera position, metres.
+    pub centre_rel: [f32; 3],
+    /// Index of its first sprite in the frame's sequence of drawn sprites.
+    pub first: u32,
+    /// Its slot in the cloud buffer.
+    pub cloud: u32,
+    /// Where its back-to-front sprite order starts in the bound order buffer.
+    pub order_base: u32,
+    /// 0 steady, 1 forming, 2 dissipating (Wang 4).
+    pub fade_kind: u32,
+    /// Progress of the formation or dissipation, 0..=1.
+    pub fade_progress: f32,
+}
+const _: () = assert!(std::mem::size_of::<GpuDrawCloud>() == 32);
+
+/// Most facings locked at once (Wang 3.3); beyond it a sprite faces the camera.
+pub const MAX_LOCKS: usize = 128;
+
+/// A locked facing (Wang 3.3). Keep in sync with `Lock` in `shaders/sprites.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuLock {
+    /// xyz: the sprite's right axis; w unused.
+    pub right: [f32; 4],
+    /// xyz: its up axis; w unused.
+    pub up: [f32; 4],
+    /// Its normal towards the camera when it locked.
+    pub normal: [f32; 3],
+    /// Its sprite slot.
+    pub sprite: u32,
+}
+
+/// What the sprite vertex shader needs besides the sprites: light, thresholds, the locks.
+/// One per view (the sky's camera, each impostor's). Keep in sync with `SpriteView` in
+/// `shaders/sprites.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct GpuSpriteView {
+    /// xyz: unit vector towards the sun; w: camera height above mean sea level, metres.
+    pub sun_dir_camera_z: [f32; 4],
+    /// rgb: time-of-day directional colour; w: time-of-day ambient percentage.
+    pub directional_ambient: [f32; 4],
+    /// Wang's Cmin, Cmedian, Cmax; w: forward scattering g.
+    pub mapping_g: [f32; 4],
+    /// x: forward scattering strength; y: lock radius fraction; z, w: cosines of the lock fade
+    /// start and end angles.
+    pub forward_lock: [f32; 4],
+    /// x, y: sines of the upright fade start and end angles; z: lifecycle inner radius fraction;
+    /// w: lifecycle outer start opacity.
+    pub upright_lifecycle: [f32; 4],
+    /// x: clouds in the draw list; y: locks; zw unused.
+    pub counts: [u32; 4],
+    /// The locked facings.
+    pub locks: [GpuLock; MAX_LOCKS],
+}
+const _: () = assert!(std::mem::size_of::<GpuSpriteView>() == 96 + 48 * MAX_LOCKS);
 
 /// Per-frame uniform of the demo terrain. Keep in sync with `shaders/terrain.wgsl`.
 #[repr(C)]

@@ -1,12 +1,17 @@
 //! The renderer: the only stage that uses wgpu. A host simulator creates a [`Sky`] with its own
-//! device and queue, gives it clouds ([`SkyBlock`]s), and each frame calls [`Sky::prepare`]
-//! (camera, sun, dt: CPU work and uploads, returns [`FrameStats`]) and [`Sky::record`] (its
-//! passes into the host's encoder, reading the host's depth, never writing it).
+//! device and queue, gives it clouds ([`SkyBlock`]s, uploaded to the GPU once each; per frame
+//! only a block's [`BlockMotion`] changes), and each frame calls [`Sky::prepare`] (camera, sun,
+//! dt: the CPU's small share and the uploads of what changed, returns [`FrameStats`]) and
+//! [`Sky::record`] (its passes into the host's encoder, reading the host's depth, never writing
+//! it).
 //!
-//! - `vertices`: sort (blocks, clouds, sprites back to front), facing and its lock (Wang 2003
-//!   3.3), Wang 5 shading per corner, the vertex cache (Wang 6.1). Plain CPU data.
-//! - `sky`: pipelines and passes: sky gradient and sun, sprites with soft depth fades (Bahnassi),
-//!   in-cloud fog (Wang 7.1). Shaders in `shaders/*.wgsl`, structs with twins in `gpu_types`.
+//! - `resident`, `slots`: the sprites and clouds on the GPU, each block in slots it keeps.
+//! - `draw_list`: per frame on the CPU: blocks and clouds back to front, each cloud's sprite
+//!   order recomputed only when Wang's cache thresholds say (6.1), the facing locks (3.3), the
+//!   draw list. `sprite_view`: a view's uniform, draw list and orders on the GPU.
+//! - `sky`: pipelines and passes: sky gradient and sun, sprites (built, faced and shaded by the
+//!   vertex shader, Wang 3.3 and 5) with soft depth fades (Bahnassi), in-cloud fog (Wang 7.1).
+//!   Shaders in `shaders/*.wgsl`, structs with twins in `gpu_types`.
 //! - `terrain`, `headless`, `output`: the demo host (height-field ground with fog, an offscreen
 //!   device and target on any adapter, lavapipe included) and PNG / EXR output.
 //!
@@ -15,26 +20,31 @@
 
 pub mod camera;
 pub mod demo_host;
+pub mod draw_list;
 pub mod gpu_types;
 pub mod headless;
 pub mod impostor;
 pub mod output;
 mod pipeline;
+mod resident;
 pub mod scene;
 pub mod settings;
 pub mod sky;
+mod slots;
+mod sprite_view;
+pub mod stats;
 pub mod terrain;
-pub mod vertices;
 pub mod world;
 
 pub use camera::Camera;
 pub use demo_host::{DemoHost, ground_from_field};
 pub use headless::{Frame, HeadlessGpu, OffscreenTarget};
-pub use scene::{SkyBlock, SkyCloud, SkySprite};
+pub use resident::BYTES_PER_SPRITE;
+pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};
 pub use settings::RenderSettings;
 pub use sky::{Sky, SkyConfig, SpriteSheet};
+pub use stats::{FrameStats, Lighting};
 pub use terrain::{HeightField, Terrain, TerrainLight};
-pub use vertices::{FrameStats, Lighting};
 
 /// Errors of the renderer.
 #[derive(Debug, thiserror::Error)]

@@ -1,6 +1,7 @@
-//! What the renderer draws: blocks of clouds of sprites, in the plain form the vertex builder
-//! reads. The clouds stage's `CloudBlock` converts into these; tests and hosts can also build
-//! them directly.
+//! What the renderer draws: blocks of clouds of sprites, in plain form. A block is uploaded to
+//! the GPU once when the sky gets it (`Sky::insert_block`, `Sky::set_clouds`); after that only
+//! its [`BlockMotion`] (drift offset and [`Fade`]) changes per frame. The clouds stage's
+//! `CloudBlock` converts into these; tests and hosts can also build them directly.
 //!
 //! Units: positions metres in the local east-north-up frame (z above mean sea level), cloud
 //! centres in f64, sprite offsets from the cloud centre in f32.
@@ -24,8 +25,12 @@ pub struct SkySprite {
     pub cell: u8,
     /// Index into the cloud's shading group centres.
     pub group: u16,
-    /// Formation / dissipation factor multiplied into alpha, 0..=1 (Wang 4).
+    /// A fixed transparency factor multiplied into alpha, 0..=1 (1 for a generated cloud: its
+    /// formation and dissipation come from the block's [`Fade`]).
     pub alpha_morph: f32,
+    /// Distance of the centre from the cloud centre over the cloud radius, 0..=1: which sprites
+    /// form first and dissipate last (Wang 4).
+    pub radius_fraction: f32,
     /// Turns only about the vertical (a cylindrical billboard: its bottom edge stays level) and
     /// fades out as the camera looks at it from steeply below or above.
     pub upright: bool,
@@ -50,7 +55,8 @@ pub struct SkyCloud {
 /// A 4 km x 4 km block of clouds.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SkyBlock {
-    /// Identifies the block across frames for the vertex cache (e.g. a hash of its index).
+    /// Identifies the block while the sky holds it. A different content must come with a
+    /// different id (the clouds stage gives every generation of a block its own).
     pub id: u64,
     /// Centre of the block, metres (the sort key of the block pass).
     pub centre_m: DVec3,
@@ -82,9 +88,41 @@ impl SkyCloud {
             .map(|s| s.offset_m.length() + 0.5 * s.width_m.max(s.height_m))
             .fold(0.0, f32::max)
     }
+}
 
-    /// Whether any sprite is forming or dissipating.
-    pub fn is_fading(&self) -> bool {
-        self.sprites.iter().any(|s| s.alpha_morph < 0.999)
+/// Where a block is in its life (Wang 4). The sprites' fades are worked out from it on the GPU:
+/// forming, the inner sprites come first; dissipating, the outer ones go first.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Fade {
+    /// Fully formed.
+    #[default]
+    Steady,
+    /// Forming; progress 0 (nothing shows) ..= 1 (formed).
+    Forming(f32),
+    /// Dissipating; progress 0 (whole) ..= 1 (gone).
+    Dissipating(f32),
+}
+
+/// What changes of a block from frame to frame without a new upload.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BlockMotion {
+    /// Added to every cloud centre (the drift with the wind), metres.
+    pub offset_m: DVec3,
+    /// Formation or dissipation.
+    pub fade: Fade,
+}
+
+/// A sprite convenience for tests and hosts: a square sprite, fully opaque.
+pub fn square_sprite(offset_m: Vec3, size_m: f32, cell: u8, group: u16) -> SkySprite {
+    SkySprite {
+        offset_m,
+        width_m: size_m,
+        height_m: size_m,
+        rotation_deg: 0.0,
+        cell,
+        group,
+        alpha_morph: 1.0,
+        radius_fraction: 0.0,
+        upright: false,
     }
 }

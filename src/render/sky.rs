@@ -1,23 +1,32 @@
 //! [`Sky`]: the library object a host simulator embeds. Created once with the host's device,
-//! given clouds, and each frame `prepare`d (CPU: sort, face, shade, cache; uniforms) and
-//! `record`ed into the host's encoder. It draws into the host's colour target and reads the
+//! given clouds (uploaded to the GPU once per block), and each frame `prepare`d (CPU: sort blocks
+//! and clouds, the cached sprite orders, the draw list; uniforms) and `record`ed into the host's
+//! encoder. It draws into the host's colour target and reads the
 //! host's depth texture (never writes it): the sky gradient and sun where the host drew nothing,
 //! the cloud sprites with soft depth fades (Bahnassi), and in-cloud fog (Wang 7.1).
 //!
 //! The host's depth texture needs `TEXTURE_BINDING` usage and must be drawn with the projection
 //! of [`Camera::projection`] (standard `[0, 1]` depth, near and far from the camera).
 
+use std::cell::Cell;
+use std::collections::HashSet;
+use std::time::Instant;
+
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use super::RenderError;
 use super::camera::Camera;
-use super::gpu_types::{GpuFrame, GpuSpriteVertex};
+use super::draw_list::{Locks, OrderCopy, main_view};
+use super::gpu_types::{GpuDrawCloud, GpuFrame};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
 use super::pipeline::{PassDesc, pipeline, premultiplied_over};
-use super::scene::SkyBlock;
+use super::resident::ResidentSet;
+use super::scene::{BlockMotion, SkyBlock};
 use super::settings::RenderSettings;
-use super::vertices::{FrameStats, Lighting, SpriteVertexBuilder, quad_indices};
+use super::sprite_view::{self, ViewBuffers, ViewLight};
+use super::stats::{FrameStats, Lighting};
+use crate::clouds::{CloudsConfig, LifecycleConfig};
 use crate::shading::{SunPosition, TimeOfDay, TimeOfDayTable, hidden_above};
 use crate::weather::{BlockLayer, BlockWeather};
 
@@ -43,25 +52,32 @@ pub struct SkyConfig {
     pub sheet: SpriteSheet,
 }
 
-/// The sky subsystem: pipelines, buffers, the clouds and their vertex cache.
+/// The sky subsystem: pipelines, the GPU-resident clouds, their sprite orders and the ring.
 pub struct Sky {
     device: wgpu::Device,
     settings: RenderSettings,
     time_of_day: TimeOfDayTable,
+    lifecycle: LifecycleConfig,
     frame_buffer: wgpu::Buffer,
     frame_layout: wgpu::BindGroupLayout,
     sheet_group: wgpu::BindGroup,
     sky_pipeline: wgpu::RenderPipeline,
     sprite_pipeline: wgpu::RenderPipeline,
     in_cloud_pipeline: wgpu::RenderPipeline,
-    vertex_buffer: wgpu::Buffer,
-    index_buffer: wgpu::Buffer,
-    capacity_sprites: u32,
-    blocks: Vec<SkyBlock>,
-    builder: SpriteVertexBuilder,
+    resident: ResidentSet,
+    view_layout: wgpu::BindGroupLayout,
+    view: ViewBuffers,
+    draws: Vec<GpuDrawCloud>,
+    locks: Locks,
     elapsed_s: f64,
     sprites_to_draw: u32,
     in_cloud: f32,
+    /// CPU time of block changes since the last prepare, and the host's field time.
+    pending_us: u64,
+    field_us: u64,
+    record_us: Cell<u64>,
+    /// Whether the last prepared frame was recorded (if not, its writes are flushed).
+    recorded: Cell<bool>,
     /// The time-of-day light of the last frame, clear sky: what the clouds are lit with.
     clear_light: TimeOfDay,
     /// `clear_light` under the cloud cover over the camera: the sky colours and the host's light.
@@ -192,8 +208,15 @@ impl Sky {
             ],
         });
         let format = config.colour_format;
+        let resident = ResidentSet::new(device, 0);
+        let view_layout = sprite_view::layout(device);
         let frame_only = [Some(&frame_layout)];
-        let with_sheet = [Some(&frame_layout), Some(&sheet_layout)];
+        let sprite_groups = [
+            Some(&frame_layout),
+            Some(&sheet_layout),
+            Some(resident.layout()),
+            Some(&view_layout),
+        ];
         let over = Some(premultiplied_over());
         let sky_pipeline = pipeline(
             device,
@@ -214,8 +237,8 @@ impl Sky {
                 wgsl: SPRITES_WGSL,
                 vs: "vs_sprite",
                 fs: "fs_sprite",
-                bind_groups: &with_sheet,
-                buffers: &[Some(GpuSpriteVertex::layout())],
+                bind_groups: &sprite_groups,
+                buffers: &[],
                 targets: &[(format, over)],
             },
         );
@@ -231,8 +254,6 @@ impl Sky {
                 targets: &[(format, over)],
             },
         );
-        let capacity_sprites = 1024;
-        let (vertex_buffer, index_buffer) = sprite_buffers(device, capacity_sprites);
         let light = config.time_of_day.at(45.0);
         let ring = ImpostorRing::new(
             device,
@@ -242,6 +263,8 @@ impl Sky {
                 colour_format: format,
                 frame_layout: &frame_layout,
                 sheet_layout: &sheet_layout,
+                resident_layout: resident.layout(),
+                view_layout: &view_layout,
             },
         );
         Ok(Self {
@@ -254,14 +277,19 @@ impl Sky {
             sky_pipeline,
             sprite_pipeline,
             in_cloud_pipeline,
-            vertex_buffer,
-            index_buffer,
-            capacity_sprites,
-            blocks: Vec::new(),
-            builder: SpriteVertexBuilder::new(),
+            resident,
+            view: ViewBuffers::new(device, false),
+            view_layout,
+            draws: Vec::new(),
+            locks: Locks::default(),
+            lifecycle: CloudsConfig::builtin().lifecycle,
             elapsed_s: 0.0,
             sprites_to_draw: 0,
             in_cloud: 0.0,
+            pending_us: 0,
+            field_us: 0,
+            record_us: Cell::new(0),
+            recorded: Cell::new(true),
             clear_light: light,
             seen_light: light,
             overhead: (Vec::new(), 0.0),
@@ -269,15 +297,116 @@ impl Sky {
         })
     }
 
-    /// Replaces the clouds. Cached vertices of blocks that stay (same id) are kept.
+    /// Replaces the clouds with `blocks` (none drifting, all steady). A block the sky already
+    /// holds with the same id and content stays on the GPU as it is, with its cached orders;
+    /// the others are uploaded by the next [`Self::prepare`]. For a whole new scene; a living
+    /// field hands over its changes with [`Self::insert_block`], [`Self::remove_block`] and
+    /// [`Self::set_block_motion`] instead.
     pub fn set_clouds(&mut self, blocks: Vec<SkyBlock>) {
-        self.builder.retain(&blocks);
-        self.blocks = blocks;
+        let start = Instant::now();
+        let ids: HashSet<u64> = blocks.iter().map(|b| b.id).collect();
+        let gone: Vec<u64> = self
+            .resident
+            .blocks
+            .keys()
+            .filter(|id| !ids.contains(id))
+            .copied()
+            .collect();
+        for id in gone {
+            self.retire(id);
+        }
+        for block in blocks {
+            match self.resident.blocks.get_mut(&block.id) {
+                Some(r) if r.block == block => r.motion = BlockMotion::default(),
+                _ => self.resident.insert(block, BlockMotion::default()),
+            }
+        }
+        self.pending_us += start.elapsed().as_micros() as u64;
     }
 
-    /// The clouds being drawn.
-    pub fn clouds(&self) -> &[SkyBlock] {
-        &self.blocks
+    /// Adds a block (or replaces the one with its id); it is uploaded to the GPU once, by the
+    /// next [`Self::prepare`].
+    pub fn insert_block(&mut self, block: SkyBlock, motion: BlockMotion) {
+        let start = Instant::now();
+        self.retire(block.id);
+        self.resident.insert(block, motion);
+        self.pending_us += start.elapsed().as_micros() as u64;
+    }
+
+    /// Retires a block; false if the sky did not hold it.
+    pub fn remove_block(&mut self, id: u64) -> bool {
+        let start = Instant::now();
+        let held = self.retire(id);
+        self.pending_us += start.elapsed().as_micros() as u64;
+        held
+    }
+
+    fn retire(&mut self, id: u64) -> bool {
+        match self.resident.remove(id) {
+            Some(slots) => {
+                self.locks.release(slots);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Moves a block (its drift) and sets where it is in its life; nothing is uploaded but the
+    /// frame's draw list. False if the sky does not hold it.
+    pub fn set_block_motion(&mut self, id: u64, motion: BlockMotion) -> bool {
+        match self.resident.blocks.get_mut(&id) {
+            Some(r) => {
+                r.motion = motion;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The ids of the blocks the sky holds.
+    pub fn block_ids(&self) -> impl Iterator<Item = u64> + '_ {
+        self.resident.blocks.keys().copied()
+    }
+
+    /// A block the sky holds.
+    pub fn block(&self, id: u64) -> Option<&SkyBlock> {
+        self.resident.blocks.get(&id).map(|r| &r.block)
+    }
+
+    /// How clouds form and dissipate (the clouds stage's `[lifecycle]`): which sprites of a
+    /// forming or dissipating block show at a given progress.
+    pub fn set_lifecycle(&mut self, lifecycle: LifecycleConfig) {
+        self.lifecycle = lifecycle;
+    }
+
+    /// Caps the GPU memory of the sprites (records, orders, quad indices) at `bytes` (0: only
+    /// the device's limits). Past it the farthest blocks are left out and counted in
+    /// [`FrameStats::blocks_left_out`]. Every block is uploaded again.
+    pub fn set_sprite_budget_bytes(&mut self, bytes: u64) {
+        let mut old = ResidentSet::new(&self.device, bytes);
+        std::mem::swap(&mut old, &mut self.resident);
+        for (_, r) in old.blocks {
+            self.resident.insert(r.block, r.motion);
+        }
+        self.locks = Locks::default();
+    }
+
+    /// Counts `us` microseconds of the host's cloud field work for this frame into the next
+    /// prepared frame's [`FrameStats::field_us`].
+    pub fn add_field_cpu_us(&mut self, us: u64) {
+        self.field_us += us;
+    }
+
+    /// CPU time of the block changes handed over since the last [`Self::prepare`] (inserts,
+    /// removals, [`Self::set_clouds`]), microseconds: part of the next frame's
+    /// [`FrameStats::cpu_update_us`].
+    pub fn pending_cpu_us(&self) -> u64 {
+        self.pending_us
+    }
+
+    /// CPU time of the last [`Self::record`], microseconds.
+    pub fn last_record_us(&self) -> u64 {
+        self.record_us.get()
     }
 
     /// The settings the sky was made with.
@@ -326,17 +455,20 @@ impl Sky {
         self.time_of_day.at(sun.elevation_deg as f32)
     }
 
-    /// Bytes of the GPU buffers the sky holds now (frame uniforms, sprite vertices and indices):
-    /// what a long flight watches for growth.
+    /// Bytes of the GPU buffers the sky holds now (frame uniforms, the resident sprites, the
+    /// draw list, the ring): what a long flight watches for growth.
     pub fn gpu_buffer_bytes(&self) -> u64 {
         self.frame_buffer.size()
-            + self.vertex_buffer.size()
-            + self.index_buffer.size()
+            + self.resident.gpu_bytes()
+            + self.view.gpu_bytes()
             + self.ring.gpu_bytes()
     }
 
-    /// CPU work of a frame: advances time by `dt_s`, sorts, faces, shades and caches sprites,
-    /// uploads vertices and this frame's uniforms.
+    /// CPU work of a frame: advances time by `dt_s`, uploads blocks that arrived, sorts blocks
+    /// and clouds, recomputes the sprite orders Wang's cache says are stale, and writes the draw
+    /// list and this frame's uniforms (only what changed goes to the GPU). A frame prepared and
+    /// never recorded is flushed by the next prepare, so nothing piles up however the host
+    /// drives it.
     pub fn prepare(
         &mut self,
         queue: &wgpu::Queue,
@@ -344,6 +476,11 @@ impl Sky {
         sun: &SunPosition,
         dt_s: f64,
     ) -> FrameStats {
+        let start = Instant::now();
+        if !self.recorded.replace(false) {
+            // The last frame's writes never reached a submit: send them, so they are freed.
+            queue.submit([]);
+        }
         self.elapsed_s += dt_s.max(0.0);
         self.clear_light = self.time_of_day.at(sun.elevation_deg as f32);
         self.seen_light = self.clear_light.under_cover(
@@ -357,31 +494,49 @@ impl Sky {
             mapping: self.time_of_day.directional_mapping,
             forward: self.time_of_day.forward_scattering,
         };
+        let mut stats = FrameStats::default();
+        let (mut upload_bytes, left_out) = self.resident.place_and_upload(queue, camera.position_m);
+        stats.blocks_left_out = left_out;
         let near = self
             .ring
-            .split(&self.blocks, camera.position_m, sun_dir, dt_s);
-        let near: Vec<&SkyBlock> = near.iter().map(|&i| &self.blocks[i]).collect();
-        let mut stats = self.builder.update(
+            .split(&self.resident, camera.position_m, sun_dir, dt_s);
+        let in_cloud = main_view(
+            &mut self.resident.blocks,
+            OrderCopy {
+                slots: &mut self.resident.orders_cpu,
+                dirty: &mut self.resident.dirty_orders,
+            },
             &near,
             camera.position_m,
             self.elapsed_s,
-            &lighting,
             &self.settings,
+            &mut self.locks,
+            &mut self.draws,
+            &mut stats,
         );
-        let upload_start = std::time::Instant::now();
-        let vertices = self.builder.vertices();
-        let sprites = (vertices.len() / 4) as u32;
-        if sprites > self.capacity_sprites {
-            self.capacity_sprites = sprites.next_power_of_two();
-            let (v, i) = sprite_buffers(&self.device, self.capacity_sprites);
-            self.vertex_buffer = v;
-            self.index_buffer = i;
-        }
-        if sprites > 0 {
-            queue.write_buffer(&self.vertex_buffer, 0, bytemuck::cast_slice(vertices));
-        }
-        self.sprites_to_draw = sprites;
-        self.in_cloud = stats.in_cloud;
+        upload_bytes += self.resident.upload_orders(queue);
+        let locks = self.locks.gpu();
+        let light = ViewLight {
+            lighting: &lighting,
+            clouds: &self.settings.clouds,
+            lifecycle: &self.lifecycle,
+            camera_z_m: camera.position_m.z as f32,
+        };
+        let header = sprite_view::header(&light, self.draws.len() as u32, locks.len() as u32);
+        let changed_locks = self.locks.take_changed().then_some(&locks[..]);
+        upload_bytes += self.view.write(
+            &self.device,
+            queue,
+            &self.view_layout,
+            &header,
+            changed_locks,
+            &self.draws,
+            None,
+            Some((&self.resident.order_buffer, self.resident.generation)),
+        );
+        self.sprites_to_draw = stats.sprites_drawn;
+        self.in_cloud = in_cloud;
+        stats.in_cloud = in_cloud;
 
         let view_proj = camera.view_proj_relative();
         let sun_cfg = &self.settings.sun;
@@ -401,7 +556,7 @@ impl Sky {
                 .to_array(),
             sky_zenith_rgb: self.seen_light.sky_zenith_rgb.extend(1.0).to_array(),
             sky_horizon_rgb: self.seen_light.sky_horizon_rgb.extend(1.0).to_array(),
-            in_cloud_rgba: fog_rgb.extend(stats.in_cloud).to_array(),
+            in_cloud_rgba: fog_rgb.extend(in_cloud).to_array(),
             params: [
                 camera.near_m,
                 camera.far_m,
@@ -411,16 +566,19 @@ impl Sky {
             haze: [self.settings.clouds.haze_distance_m, 0.0, 0.0, 0.0],
         };
         queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&frame));
+        upload_bytes += std::mem::size_of::<GpuFrame>() as u64;
         let ring_frame = RingFrame {
-            blocks: &self.blocks,
+            resident: &self.resident,
             template: &frame,
-            lighting: &lighting,
-            time_s: self.elapsed_s,
-            render: &self.settings,
+            view: &light,
             camera_m: camera.position_m,
         };
-        self.ring.prepare_builds(queue, &ring_frame, &mut stats);
-        stats.cpu_update_us += upload_start.elapsed().as_micros() as u64;
+        upload_bytes += self.ring.prepare_builds(queue, &ring_frame, &mut stats);
+        stats.upload_bytes = upload_bytes;
+        stats.sprite_gpu_bytes = self.resident.gpu_bytes() + self.view.gpu_bytes();
+        stats.field_us = std::mem::take(&mut self.field_us);
+        stats.cpu_update_us =
+            start.elapsed().as_micros() as u64 + std::mem::take(&mut self.pending_us);
         stats
     }
 
@@ -432,6 +590,7 @@ impl Sky {
         colour_view: &wgpu::TextureView,
         depth_view: &wgpu::TextureView,
     ) {
+        let start = Instant::now();
         let frame_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sky.frame_group"),
             layout: &self.frame_layout,
@@ -446,7 +605,12 @@ impl Sky {
                 },
             ],
         });
-        self.ring.record_builds(encoder, &self.sheet_group);
+        self.ring.record_builds(
+            encoder,
+            &self.sheet_group,
+            &self.resident.group,
+            &self.resident.index_buffer,
+        );
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sky"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -467,31 +631,25 @@ impl Sky {
         pass.set_pipeline(&self.sky_pipeline);
         pass.draw(0..3, 0..1);
         self.ring.draw(&mut pass);
-        if self.sprites_to_draw > 0 {
+        if self.sprites_to_draw > 0
+            && let Some(view_group) = self.view.group()
+        {
             pass.set_pipeline(&self.sprite_pipeline);
             pass.set_bind_group(1, &self.sheet_group, &[]);
-            pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
-            pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+            pass.set_bind_group(2, &self.resident.group, &[]);
+            pass.set_bind_group(3, view_group, &[]);
+            pass.set_index_buffer(
+                self.resident.index_buffer.slice(..),
+                wgpu::IndexFormat::Uint32,
+            );
             pass.draw_indexed(0..self.sprites_to_draw * 6, 0, 0..1);
         }
         if self.in_cloud > 0.0 {
             pass.set_pipeline(&self.in_cloud_pipeline);
             pass.draw(0..3, 0..1);
         }
+        drop(pass);
+        self.recorded.set(true);
+        self.record_us.set(start.elapsed().as_micros() as u64);
     }
-}
-
-fn sprite_buffers(device: &wgpu::Device, sprites: u32) -> (wgpu::Buffer, wgpu::Buffer) {
-    let vertex = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("sky.sprite_vertices"),
-        size: sprites as u64 * 4 * std::mem::size_of::<GpuSpriteVertex>() as u64,
-        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let index = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("sky.sprite_indices"),
-        contents: bytemuck::cast_slice(&quad_indices(sprites)),
-        usage: wgpu::BufferUsages::INDEX,
-    });
-    (vertex, index)
 }

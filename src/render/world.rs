@@ -3,21 +3,25 @@
 //! the camera come out, the blocks converted to [`SkyBlock`]s for the [`super::Sky`].
 //!
 //! Blocks are generated on demand (a pure function of block index, block weather and seed) and
-//! kept, so a flight regenerates nothing it has seen.
+//! kept, so a flight regenerates nothing it has seen. A living world hands the sky its changes
+//! only ([`World::update_sky`]): a generation that appears is uploaded once, one that goes is
+//! retired, and every frame the rest only move with the wind and fade.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
+use std::time::Instant;
 
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
 use super::RenderError;
 use super::demo_host::ground_from_field;
-use super::scene::{SkyBlock, SkyCloud, SkySprite};
-use super::sky::SpriteSheet;
+use super::scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite};
+use super::sky::{Sky, SpriteSheet};
 use super::terrain::HeightField;
+use crate::clouds::lifecycle::{Phase, progress};
 use crate::clouds::{
-    Cloud, CloudField, CloudTypes, CloudsConfig, TextureSheet, field::weather_changed,
-    generate_block,
+    Cloud, CloudField, CloudTypes, CloudsConfig, TextureSheet, field::FieldBlock,
+    field::weather_changed, generate_block,
 };
 use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
@@ -71,6 +75,7 @@ impl From<&Cloud> for SkyCloud {
                     cell: s.texture,
                     group: s.shading_group,
                     alpha_morph: s.alpha_morph,
+                    radius_fraction: s.radius_fraction,
                     upright: s.upright,
                 })
                 .collect(),
@@ -99,10 +104,15 @@ pub fn sprite_sheet(sheet: &TextureSheet) -> SpriteSheet {
 }
 
 /// The clouds stage's living field (background generation, drift, formation and dissipation)
-/// as a [`World`] flies through it.
+/// as a [`World`] flies through it, and which of its generations the sky holds.
 pub struct LivingClouds {
     field: CloudField,
     weather: HashMap<BlockIndex, BlockWeather>,
+    /// The camera's air block, the drift's block and the field version when the blocks around
+    /// were last asked for: asked again only when one changes.
+    asked: Option<(BlockIndex, BlockIndex, u64)>,
+    in_sky: HashSet<u64>,
+    seen: HashSet<u64>,
 }
 
 /// Weather field, ground and cloud blocks around a reference point.
@@ -115,6 +125,8 @@ pub struct World {
     living: Option<LivingClouds>,
     clouds_config: CloudsConfig,
     synchronous_clouds: bool,
+    /// Counts weather fields taken ([`World::set_field`]).
+    field_version: u64,
 }
 
 impl World {
@@ -136,6 +148,7 @@ impl World {
             living: None,
             clouds_config: CloudsConfig::builtin(),
             synchronous_clouds: false,
+            field_version: 0,
         }
     }
 
@@ -145,13 +158,13 @@ impl World {
     }
 
     /// Uses `config` (lifecycle durations: how long a changed block's clouds take to form and
-    /// dissipate) for the living clouds; call before the first [`Self::living_blocks`]. The
+    /// dissipate) for the living clouds; call before the first [`Self::update_sky`]. The
     /// field radius and seed stay the world's.
     pub fn set_clouds_config(&mut self, config: CloudsConfig) {
         self.clouds_config = config;
     }
 
-    /// When `on`, every frame of [`Self::living_blocks`] waits for the blocks it queued, so what
+    /// When `on`, every frame of [`Self::update_sky`] waits for the blocks it queued, so what
     /// a frame shows does not depend on thread timing: for tests and reproducible renders, never
     /// for a simulator's frame loop (off by default: blocks arrive when generated).
     pub fn set_synchronous_clouds(&mut self, on: bool) {
@@ -164,6 +177,7 @@ impl World {
     /// blocks stay as they are. The ground is kept (its elevations do not change with weather).
     pub fn set_field(&mut self, field: WeatherField) {
         let old = std::mem::replace(&mut self.field, field);
+        self.field_version += 1;
         // Block weathers are looked up again lazily, from the new field.
         if let Some(living) = self.living.as_mut() {
             living.weather.clear();
@@ -174,7 +188,7 @@ impl World {
         });
     }
 
-    /// The clouds stage's living field, once [`Self::living_blocks`] has run.
+    /// The clouds stage's living field, once [`Self::update_sky`] has run.
     pub fn living_field(&self) -> Option<&CloudField> {
         self.living.as_ref().map(|l| &l.field)
     }
@@ -258,74 +272,108 @@ impl World {
 }
 
 impl World {
-    /// The clouds of the clouds stage's [`CloudField`] around `camera_m` after `dt_s` more
-    /// seconds: blocks generated in the background (the first call waits for them), drifting
-    /// with the wind, forming and dissipating when the weather changes.
-    pub fn living_blocks(
+    /// Advances the clouds stage's [`CloudField`] around `camera_m` by `dt_s` seconds (blocks
+    /// generated in the background, the first call waits for them; drifting with the wind;
+    /// forming and dissipating when the weather changes) and hands `sky` what changed: new
+    /// generations are inserted (uploaded once), gone ones removed, and every block's drift and
+    /// fade set. Its own CPU time goes into the sky's next [`crate::render::FrameStats::field_us`].
+    pub fn update_sky(
         &mut self,
+        sky: &mut Sky,
         camera_m: DVec3,
         dt_s: f64,
-    ) -> Result<Vec<SkyBlock>, RenderError> {
+    ) -> Result<(), RenderError> {
+        let start = Instant::now();
         if self.living.is_none() {
             let mut config = self.clouds_config;
             config.field.radius_m = self.settings.cloud_radius_m;
             config.field.seed = self.settings.seed;
             let field = CloudField::new(config, Arc::new(self.types.clone()), 0)
                 .map_err(|e| RenderError::Clouds(e.to_string()))?;
+            sky.set_lifecycle(config.lifecycle);
             self.living = Some(LivingClouds {
                 field,
                 weather: HashMap::new(),
+                asked: None,
+                in_sky: HashSet::new(),
+                seen: HashSet::new(),
             });
         }
         let weather_field = &self.field;
         let Some(living) = self.living.as_mut() else {
-            return Ok(Vec::new());
+            return Ok(());
         };
         let first = living.field.time_s() == 0.0 && living.field.block_count() == 0;
-        let cache = std::cell::RefCell::new(std::mem::take(&mut living.weather));
-        let weather = |index: BlockIndex| {
-            cache
-                .borrow_mut()
-                .entry(index)
-                .or_insert_with(|| weather_field.block_weather(index))
-                .clone()
-        };
-        living.field.update(camera_m.truncate(), &weather);
-        living.weather = cache.into_inner();
+        // The blocks around are asked for again only when the camera entered another block of
+        // the moving air, the air drifted past a block, or the weather changed.
+        let drift = living.field.drift_m();
+        let key = (
+            BlockIndex::containing(camera_m.truncate() - drift),
+            BlockIndex::containing(drift),
+            self.field_version,
+        );
+        if living.asked != Some(key) {
+            let cache = std::cell::RefCell::new(std::mem::take(&mut living.weather));
+            let weather = |index: BlockIndex| {
+                cache
+                    .borrow_mut()
+                    .entry(index)
+                    .or_insert_with(|| weather_field.block_weather(index))
+                    .clone()
+            };
+            living.field.update(camera_m.truncate(), &weather);
+            living.weather = cache.into_inner();
+            living.asked = Some(key);
+        } else {
+            living.field.poll();
+        }
         if first || self.synchronous_clouds {
             living.field.wait_for_pending();
         }
         living.field.advance(dt_s);
         let drift = living.field.drift_m();
-        let drift3 = DVec3::new(drift.x, drift.y, 0.0);
-        let mut generation = HashMap::new();
-        Ok(living
-            .field
-            .blocks()
-            .map(|(index, fb)| {
-                let g: &mut u64 = generation.entry(index).or_insert(0);
-                let id = block_id(index) ^ (*g << 62);
-                *g += 1;
-                let clouds: Vec<SkyCloud> = fb
-                    .block
-                    .clouds
-                    .iter()
-                    .map(|c| {
-                        let mut sky = SkyCloud::from(c);
-                        sky.centre_m += drift3;
-                        sky
-                    })
-                    .collect();
-                let c = index.centre_m() + drift;
-                let mean_z =
-                    clouds.iter().map(|c| c.centre_m.z).sum::<f64>() / clouds.len().max(1) as f64;
-                SkyBlock {
-                    id,
-                    centre_m: DVec3::new(c.x, c.y, mean_z),
-                    clouds,
-                }
-            })
-            .collect())
+        let offset_m = DVec3::new(drift.x, drift.y, 0.0);
+        let now = living.field.time_s();
+        let lifecycle = *living.field.lifecycle();
+        let sky_before_us = sky.pending_cpu_us();
+        living.seen.clear();
+        for (index, fb) in living.field.blocks() {
+            let fade = match fb.phase {
+                Phase::Steady => Fade::Steady,
+                Phase::Forming { .. } => Fade::Forming(progress(fb.phase, now, &lifecycle)),
+                Phase::Dissipating { .. } => Fade::Dissipating(progress(fb.phase, now, &lifecycle)),
+                Phase::Gone => Fade::Dissipating(1.0),
+            };
+            let motion = BlockMotion { offset_m, fade };
+            living.seen.insert(fb.serial);
+            if living.in_sky.insert(fb.serial) {
+                sky.insert_block(living_block(index, fb), motion);
+            } else {
+                sky.set_block_motion(fb.serial, motion);
+            }
+        }
+        let gone: Vec<u64> = living.in_sky.difference(&living.seen).copied().collect();
+        for id in gone {
+            living.in_sky.remove(&id);
+            sky.remove_block(id);
+        }
+        // The sky counts its own share (the blocks inserted and removed) in its update.
+        let sky_us = sky.pending_cpu_us() - sky_before_us;
+        sky.add_field_cpu_us((start.elapsed().as_micros() as u64).saturating_sub(sky_us));
+        Ok(())
+    }
+}
+
+/// A living generation as the sky's block: its id is the generation's serial, its clouds where
+/// they were generated (the drift is the block's motion).
+fn living_block(index: BlockIndex, fb: &FieldBlock) -> SkyBlock {
+    let clouds: Vec<SkyCloud> = fb.block.clouds.iter().map(SkyCloud::from).collect();
+    let c = index.centre_m();
+    let mean_z = clouds.iter().map(|c| c.centre_m.z).sum::<f64>() / clouds.len().max(1) as f64;
+    SkyBlock {
+        id: fb.serial,
+        centre_m: DVec3::new(c.x, c.y, mean_z),
+        clouds,
     }
 }
 

@@ -36,11 +36,12 @@ pub use layout::{
 };
 use layout::{impostor_camera, in_sector};
 
-use super::gpu_types::{GpuFrame, GpuSpriteVertex};
+use super::draw_list::fresh_view;
+use super::gpu_types::{GpuDrawCloud, GpuFrame};
 use super::pipeline::{PassDesc, pipeline, premultiplied_over};
-use super::scene::SkyBlock;
-use super::settings::RenderSettings;
-use super::vertices::{FrameStats, Lighting, SpriteVertexBuilder, quad_indices};
+use super::resident::ResidentSet;
+use super::sprite_view::{self, ViewBuffers, ViewLight};
+use super::stats::FrameStats;
 
 const IMPOSTOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// Alpha-weighted cloud depth, kilometres times alpha (half floats: about 30 m at 60 km).
@@ -74,15 +75,16 @@ pub struct ImpostorRing {
     depth_views: Vec<Vec<wgpu::TextureView>>,
     /// `[old ring][new ring]` bind groups of the ring pass (both rings' texture arrays).
     quad_groups: Vec<Vec<wgpu::BindGroup>>,
-    /// Per impostor slot: frame uniform, its bind group, vertices and sprite count.
+    /// Per impostor slot: frame uniform, its bind group, and its view of the resident sprites
+    /// (draw list and sprite orders from the ring centre).
     slot_frames: Vec<wgpu::Buffer>,
     slot_groups: Vec<wgpu::BindGroup>,
-    slot_vertices: Vec<wgpu::Buffer>,
-    index_buffer: wgpu::Buffer,
-    capacity_sprites: u32,
+    slot_views: Vec<ViewBuffers>,
+    view_layout: wgpu::BindGroupLayout,
+    draws: Vec<GpuDrawCloud>,
+    orders: Vec<u32>,
     /// The ring pass's uniform (`GpuRing`).
     ring_uniform: wgpu::Buffer,
-    builder: SpriteVertexBuilder,
     shown: Option<(usize, RingState)>,
     build: Option<Build>,
     /// The ring fading in and the fade so far, 0..=1.
@@ -100,17 +102,13 @@ const QUAD_WGSL: &str = include_str!("../../../shaders/impostor_quad.wgsl");
 
 /// What a frame's impostor builds need from the sky.
 #[derive(Clone, Copy)]
-pub struct RingFrame<'a> {
-    /// All blocks of the sky.
-    pub blocks: &'a [SkyBlock],
+pub(super) struct RingFrame<'a> {
+    /// The sky's blocks on the GPU.
+    pub resident: &'a ResidentSet,
     /// The sky's frame uniform (light, haze); the view is replaced per impostor.
     pub template: &'a GpuFrame,
-    /// The light of the frame.
-    pub lighting: &'a Lighting,
-    /// Sky time, seconds.
-    pub time_s: f64,
-    /// Renderer settings.
-    pub render: &'a RenderSettings,
+    /// The light of the frame's sprites (the camera height is replaced per ring).
+    pub view: &'a ViewLight<'a>,
     /// Camera position, metres.
     pub camera_m: DVec3,
 }
@@ -123,6 +121,10 @@ pub struct RingShared<'a> {
     pub frame_layout: &'a wgpu::BindGroupLayout,
     /// Group 1 of the sprite pass (sheet and sampler).
     pub sheet_layout: &'a wgpu::BindGroupLayout,
+    /// Group 2 of the sprite pass (the resident sprites and clouds).
+    pub resident_layout: &'a wgpu::BindGroupLayout,
+    /// Group 3 of the sprite pass (a view: uniform, draw list, orders).
+    pub view_layout: &'a wgpu::BindGroupLayout,
 }
 
 impl ImpostorRing {
@@ -176,8 +178,13 @@ impl ImpostorRing {
                 wgsl: &format!("{SPRITES_WGSL}\n{IMPOSTOR_SPRITES_WGSL}"),
                 vs: "vs_sprite",
                 fs: "fs_sprite_impostor",
-                bind_groups: &[Some(shared.frame_layout), Some(shared.sheet_layout)],
-                buffers: &[Some(GpuSpriteVertex::layout())],
+                bind_groups: &[
+                    Some(shared.frame_layout),
+                    Some(shared.sheet_layout),
+                    Some(shared.resident_layout),
+                    Some(shared.view_layout),
+                ],
+                buffers: &[],
                 targets: &[(IMPOSTOR_FORMAT, over), (DEPTH_FORMAT, over)],
             },
         );
@@ -336,7 +343,7 @@ impl ImpostorRing {
             bytes += buffer.size();
             slot_frames.push(buffer);
         }
-        let mut ring = Self {
+        Self {
             settings,
             device: device.clone(),
             sprite_pipeline,
@@ -344,65 +351,30 @@ impl ImpostorRing {
             views,
             depth_views,
             quad_groups,
+            slot_views: (0..slots).map(|_| ViewBuffers::new(device, true)).collect(),
             slot_frames,
             slot_groups,
-            slot_vertices: Vec::new(),
-            index_buffer: ring_uniform.clone(),
-            capacity_sprites: 0,
+            view_layout: shared.view_layout.clone(),
+            draws: Vec::new(),
+            orders: Vec::new(),
             ring_uniform,
-            builder: SpriteVertexBuilder::new(),
             shown: None,
             build: None,
             fade: None,
             pending: Vec::new(),
             quads: None,
             bytes,
-        };
-        ring.grow(if settings.enabled { 1024 } else { 0 });
-        ring
-    }
-
-    fn grow(&mut self, sprites: u32) {
-        let bytes = |b: &wgpu::Buffer| b.size();
-        let old: u64 = self.slot_vertices.iter().map(bytes).sum::<u64>()
-            + if self.capacity_sprites > 0 {
-                self.index_buffer.size()
-            } else {
-                0
-            };
-        self.capacity_sprites = sprites;
-        let slots = self.slot_frames.len();
-        self.slot_vertices = (0..slots)
-            .map(|_| {
-                self.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("ring.sprite_vertices"),
-                    size: sprites as u64 * 4 * std::mem::size_of::<GpuSpriteVertex>() as u64,
-                    usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                })
-            })
-            .collect();
-        if sprites > 0 {
-            self.index_buffer = self
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("ring.sprite_indices"),
-                    contents: bytemuck::cast_slice(&quad_indices(sprites)),
-                    usage: wgpu::BufferUsages::INDEX,
-                });
         }
-        let new: u64 = self.slot_vertices.iter().map(bytes).sum::<u64>()
-            + if sprites > 0 {
-                self.index_buffer.size()
-            } else {
-                0
-            };
-        self.bytes = self.bytes + new - old;
     }
 
     /// Bytes of the ring's textures and buffers.
     pub fn gpu_bytes(&self) -> u64 {
         self.bytes
+            + self
+                .slot_views
+                .iter()
+                .map(ViewBuffers::gpu_bytes)
+                .sum::<u64>()
             + if self.settings.enabled {
                 self.ring_uniform.size()
             } else {
@@ -410,18 +382,20 @@ impl ImpostorRing {
             }
     }
 
-    /// Decides this frame's near blocks (indices into `blocks`, drawn as sprites) and starts or
-    /// advances a rebuild. Call [`Self::prepare_builds`] after, with the frame's uniform.
-    pub fn split(
+    /// Decides this frame's near blocks (ids of `resident`'s blocks, drawn as sprites) and
+    /// starts or advances a rebuild. Call [`Self::prepare_builds`] after, with the frame's
+    /// uniform.
+    pub(super) fn split(
         &mut self,
-        blocks: &[SkyBlock],
+        resident: &ResidentSet,
         camera_m: DVec3,
         sun: Vec3,
         dt_s: f64,
-    ) -> Vec<usize> {
+    ) -> Vec<u64> {
         let s = self.settings;
+        let blocks = &resident.blocks;
         if !s.enabled {
-            return (0..blocks.len()).collect();
+            return blocks.keys().copied().collect();
         }
         // Advance the crossfade; a finished fade makes the new ring the shown one.
         if let Some((ring, state, w)) = self.fade.take() {
@@ -445,30 +419,37 @@ impl ImpostorRing {
             let start = match newest {
                 None => true,
                 Some(st) if self.fade.is_none() => {
-                    let far_now: BTreeSet<u64> = blocks
-                        .iter()
-                        .filter(|b| is_far(b, st.centre_m, camera_m, &s))
-                        .map(|b| b.id)
-                        .collect();
-                    needs_rebuild(st.centre_m, st.sun, camera_m, sun, &s) || far_now != st.far_ids
+                    // The far set of the ring's centre now, compared without building it.
+                    let mut far_now = 0;
+                    let mut same = true;
+                    for r in blocks.values() {
+                        if is_far(r.centre_m(), st.centre_m, camera_m, &s) {
+                            far_now += 1;
+                            if !st.far_ids.contains(&r.block.id) {
+                                same = false;
+                                break;
+                            }
+                        }
+                    }
+                    needs_rebuild(st.centre_m, st.sun, camera_m, sun, &s)
+                        || !same
+                        || far_now != st.far_ids.len()
                 }
                 Some(_) => false,
             };
             if start {
                 let ring = self.shown.as_ref().map_or(0, |(r, _)| 1 - r);
-                let far: Vec<&SkyBlock> = blocks
-                    .iter()
-                    .filter(|b| is_far(b, camera_m, camera_m, &s))
+                let far: Vec<(u64, f64)> = blocks
+                    .values()
+                    .filter(|r| is_far(r.centre_m(), camera_m, camera_m, &s))
+                    .map(|r| (r.block.id, (r.centre_m() - camera_m).length()))
                     .collect();
                 let far_mean_m = if far.is_empty() {
                     s.ring_radius_m
                 } else {
-                    far.iter()
-                        .map(|b| (b.centre_m - camera_m).length())
-                        .sum::<f64>()
-                        / far.len() as f64
+                    far.iter().map(|f| f.1).sum::<f64>() / far.len() as f64
                 };
-                let far_ids = far.iter().map(|b| b.id).collect();
+                let far_ids = far.iter().map(|f| f.0).collect();
                 self.build = Some(Build {
                     ring,
                     next: 0,
@@ -488,58 +469,72 @@ impl ImpostorRing {
             .or(self.shown.as_ref().map(|(_, st)| &st.far_ids));
         // Before the first ring exists it is built this frame, so its blocks are far already.
         let far = far.or(self.build.as_ref().map(|b| &b.state.far_ids));
-        (0..blocks.len())
-            .filter(|&i| far.is_none_or(|f| !f.contains(&blocks[i].id)))
+        blocks
+            .keys()
+            .filter(|id| far.is_none_or(|f| !f.contains(id)))
+            .copied()
             .collect()
     }
 
-    /// Builds this frame's impostor vertices (all 8 for a first ring, else the next one),
-    /// uploads them with their uniforms, lays out the quads, and fills the ring's frame stats.
-    pub fn prepare_builds(
+    /// Writes this frame's impostor builds (all 8 for a first ring, else the next one): each
+    /// sector's draw list and sprite orders from the ring centre, with its uniforms; lays out
+    /// the quads and fills the ring's frame stats. Returns the bytes written.
+    pub(super) fn prepare_builds(
         &mut self,
         queue: &wgpu::Queue,
         frame_in: &RingFrame,
         stats: &mut FrameStats,
-    ) {
+    ) -> u64 {
         let RingFrame {
-            blocks,
+            resident,
             template,
-            lighting,
-            time_s,
-            render,
+            view,
             camera_m,
         } = *frame_in;
+        let blocks = &resident.blocks;
         self.pending.clear();
         self.quads = None;
         stats.ring_gpu_bytes = self.gpu_bytes();
         if !self.settings.enabled {
             stats.blocks_near = blocks.len() as u32;
-            return;
+            return 0;
         }
+        let mut bytes = 0;
         let first = self.shown.is_none() && self.fade.is_none();
         if let Some(mut build) = self.build.take() {
             let count = if first { IMPOSTORS } else { 1 };
-            let mut settings = *render;
-            settings.clouds.draw_distance_m = self.settings.view_radius_m as f32;
-            settings.vertex_cache.enabled = false;
             for _ in 0..count {
                 let i = build.next;
                 let centre = build.state.centre_m;
-                let sector: Vec<&SkyBlock> = blocks
-                    .iter()
-                    .filter(|b| build.state.far_ids.contains(&b.id))
-                    .filter(|b| in_sector(i, centre, b.centre_m))
+                let sector: Vec<u64> = blocks
+                    .values()
+                    .filter(|r| build.state.far_ids.contains(&r.block.id))
+                    .filter(|r| in_sector(i, centre, r.centre_m()))
+                    .map(|r| r.block.id)
                     .collect();
-                self.builder
-                    .update(&sector, centre, time_s, lighting, &settings);
-                let sprites = (self.builder.vertices().len() / 4) as u32;
-                if sprites > self.capacity_sprites {
-                    self.grow(sprites.next_power_of_two());
-                }
-                if sprites > 0 {
-                    let vertices = bytemuck::cast_slice(self.builder.vertices());
-                    queue.write_buffer(&self.slot_vertices[i], 0, vertices);
-                }
+                let sprites = fresh_view(
+                    &resident.blocks,
+                    &sector,
+                    centre,
+                    self.settings.view_radius_m,
+                    &mut self.draws,
+                    &mut self.orders,
+                );
+                let light = ViewLight {
+                    camera_z_m: centre.z as f32,
+                    ..*view
+                };
+                let header = sprite_view::header(&light, self.draws.len() as u32, 0);
+                bytes += self.slot_views[i].write(
+                    &self.device,
+                    queue,
+                    &self.view_layout,
+                    &header,
+                    None,
+                    &self.draws,
+                    Some(&self.orders),
+                    None,
+                );
                 let cam = impostor_camera(i, centre, &self.settings);
                 let vp = cam.view_proj_relative();
                 let frame = GpuFrame {
@@ -555,6 +550,7 @@ impl ImpostorRing {
                     ..*template
                 };
                 queue.write_buffer(&self.slot_frames[i], 0, bytemuck::bytes_of(&frame));
+                bytes += std::mem::size_of::<GpuFrame>() as u64;
                 self.pending.push((build.ring, i, sprites));
                 build.next += 1;
             }
@@ -595,6 +591,7 @@ impl ImpostorRing {
                 ],
             };
             queue.write_buffer(&self.ring_uniform, 0, bytemuck::bytes_of(&uniform));
+            bytes += std::mem::size_of::<GpuRing>() as u64;
             self.quads = Some((*old, new));
         }
         let far = self
@@ -602,13 +599,21 @@ impl ImpostorRing {
             .as_ref()
             .map(|(_, st, _)| &st.far_ids)
             .or(self.shown.as_ref().map(|(_, st)| &st.far_ids));
-        let far_count = far.map_or(0, |f| blocks.iter().filter(|b| f.contains(&b.id)).count());
+        let far_count = far.map_or(0, |f| blocks.keys().filter(|id| f.contains(id)).count());
         stats.blocks_far = far_count as u32;
         stats.blocks_near = (blocks.len() - far_count) as u32;
+        bytes
     }
 
-    /// Records this frame's impostor renders (their own passes, before the sky pass).
-    pub fn record_builds(&self, encoder: &mut wgpu::CommandEncoder, sheet: &wgpu::BindGroup) {
+    /// Records this frame's impostor renders (their own passes, before the sky pass), from the
+    /// resident sprites (`resident`: group 2; `indices`: the quad index buffer).
+    pub(super) fn record_builds(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        sheet: &wgpu::BindGroup,
+        resident: &wgpu::BindGroup,
+        indices: &wgpu::Buffer,
+    ) {
         for &(r, i, sprites) in &self.pending {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("ring.impostor"),
@@ -628,12 +633,15 @@ impl ImpostorRing {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            if sprites > 0 {
+            if sprites > 0
+                && let Some(view) = self.slot_views[i].group()
+            {
                 pass.set_pipeline(&self.sprite_pipeline);
                 pass.set_bind_group(0, &self.slot_groups[i], &[]);
                 pass.set_bind_group(1, sheet, &[]);
-                pass.set_vertex_buffer(0, self.slot_vertices[i].slice(..));
-                pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+                pass.set_bind_group(2, resident, &[]);
+                pass.set_bind_group(3, view, &[]);
+                pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..sprites * 6, 0, 0..1);
             }
         }

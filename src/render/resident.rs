@@ -1,0 +1,512 @@
+//! The clouds on the GPU. A block's sprites and clouds are written into storage buffers once,
+//! when it arrives, into a range of slots it keeps until it goes ([`SlotRanges`]); after that a
+//! frame writes only what changed: a cloud's back-to-front order when Wang's cache says so, and
+//! the small draw list. The buffers grow in powers of two up to the device's limits (or the
+//! host's budget); past that the farthest blocks are left out and counted, never a validation
+//! error.
+//!
+//! Units: metres; sprite and cloud data relative to the cloud centre, cloud centres f64.
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use glam::{DVec3, Vec3};
+
+use super::gpu_types::{GpuCloud, GpuSprite, SPRITE_UPRIGHT};
+use super::scene::{BlockMotion, SkyBlock, SkyCloud};
+use super::slots::SlotRanges;
+
+/// Bytes of GPU memory each sprite slot costs: its record, its order entry, six quad indices.
+pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4 + 6 * 4;
+
+/// A cloud's bounds (computed once when its block arrives) and its order cache.
+#[derive(Debug, Clone)]
+pub(super) struct CloudState {
+    /// Radius of a sphere around the centre holding every sprite, metres.
+    pub radius_m: f32,
+    /// Half extents and centre offset of the box of its sprite cores (in-cloud fog).
+    pub core_half_m: Vec3,
+    pub core_centre_m: Vec3,
+    /// First sprite slot (its order lives at the same slots of the order buffer).
+    pub sprite_base: u32,
+    /// Its slot in the cloud buffer.
+    pub cloud_slot: u32,
+    /// Camera relative to the cloud and sky time when its order was last computed.
+    pub ordered_at: Option<(DVec3, f64)>,
+}
+
+/// A block the sky holds.
+#[derive(Debug, Clone)]
+pub(super) struct Resident {
+    pub block: SkyBlock,
+    pub motion: BlockMotion,
+    /// Its slots, while it is on the GPU.
+    pub place: Option<(Range<u32>, Range<u32>)>,
+    /// Written to its slots yet.
+    pub uploaded: bool,
+    pub clouds: Vec<CloudState>,
+}
+
+impl Resident {
+    fn new(block: SkyBlock, motion: BlockMotion) -> Self {
+        let clouds = block
+            .clouds
+            .iter()
+            .map(|c| {
+                let (core_half_m, core_centre_m) = c.core_box_m();
+                CloudState {
+                    radius_m: c.radius_m(),
+                    core_half_m,
+                    core_centre_m,
+                    sprite_base: 0,
+                    cloud_slot: 0,
+                    ordered_at: None,
+                }
+            })
+            .collect();
+        Self {
+            block,
+            motion,
+            place: None,
+            uploaded: false,
+            clouds,
+        }
+    }
+
+    /// Sprites of all its clouds.
+    pub fn sprite_count(&self) -> u32 {
+        self.block
+            .clouds
+            .iter()
+            .map(|c| c.sprites.len() as u32)
+            .sum()
+    }
+
+    /// Its centre now (with the drift), metres.
+    pub fn centre_m(&self) -> DVec3 {
+        self.block.centre_m + self.motion.offset_m
+    }
+}
+
+/// The GPU record of a sprite.
+pub fn gpu_sprite(cloud: &SkyCloud, s: &super::scene::SkySprite) -> GpuSprite {
+    let group = cloud
+        .group_centres_m
+        .get(s.group as usize)
+        .copied()
+        .unwrap_or(Vec3::ZERO);
+    GpuSprite {
+        offset_width: s.offset_m.extend(s.width_m).to_array(),
+        group_height: group.extend(s.height_m).to_array(),
+        rotation_rad: s.rotation_deg.to_radians(),
+        alpha_morph: s.alpha_morph,
+        radius_fraction: s.radius_fraction,
+        bits: (s.cell as u32).min(15) | if s.upright { SPRITE_UPRIGHT } else { 0 },
+    }
+}
+
+/// The GPU record of a cloud.
+pub fn gpu_cloud(cloud: &SkyCloud) -> GpuCloud {
+    let l = &cloud.colour_levels.0;
+    GpuCloud {
+        level_rgba: l.map(|level| level.rgba),
+        level_height: [l[0].height_m, l[1].height_m, l[2].height_m, l[3].height_m],
+        level4_radius_flat: [
+            l[4].height_m,
+            cloud.radius_m().max(1.0),
+            if cloud.flat { 1.0 } else { 0.0 },
+            0.0,
+        ],
+    }
+}
+
+/// The blocks the sky holds and their GPU buffers.
+pub(super) struct ResidentSet {
+    device: wgpu::Device,
+    pub blocks: HashMap<u64, Resident>,
+    sprite_slots: SlotRanges,
+    cloud_slots: SlotRanges,
+    /// Most sprite slots the device (or the budget) allows.
+    limit_sprites: u32,
+    pub sprite_buffer: wgpu::Buffer,
+    pub cloud_buffer: wgpu::Buffer,
+    /// The sky camera's per-cloud orders, at the clouds' sprite slots.
+    pub order_buffer: wgpu::Buffer,
+    pub index_buffer: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    /// Group 2 of the sprite passes: sprites and clouds.
+    pub group: wgpu::BindGroup,
+    /// A CPU copy of the order buffer; `dirty_orders` are the spans to write this frame.
+    pub orders_cpu: Vec<u32>,
+    pub dirty_orders: Vec<Range<u32>>,
+    /// Counts buffer rebuilds: bind groups made with the old buffers must be made again.
+    pub generation: u64,
+}
+
+const FIRST_SPRITES: u32 = 4096;
+const FIRST_CLOUDS: u32 = 256;
+
+impl ResidentSet {
+    /// Empty buffers on `device`; `budget_bytes` caps the sprite memory (0: the device's
+    /// limits alone).
+    pub fn new(device: &wgpu::Device, budget_bytes: u64) -> Self {
+        let limits = device.limits();
+        let storage_max = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        let by_device = (storage_max / std::mem::size_of::<GpuSprite>() as u64)
+            .min(limits.max_buffer_size / 24)
+            .min(u32::MAX as u64 / 6);
+        let by_budget = if budget_bytes == 0 {
+            u64::MAX
+        } else {
+            budget_bytes / BYTES_PER_SPRITE
+        };
+        let limit_sprites = by_device.min(by_budget) as u32;
+        let storage = |b: u32| wgpu::BindGroupLayoutEntry {
+            binding: b,
+            visibility: wgpu::ShaderStages::VERTEX,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sky.resident_layout"),
+            entries: &[storage(0), storage(1)],
+        });
+        let sprites = FIRST_SPRITES.min(limit_sprites.max(1));
+        let (sprite_buffer, cloud_buffer, order_buffer, index_buffer, group) =
+            buffers(device, &layout, sprites, FIRST_CLOUDS);
+        Self {
+            device: device.clone(),
+            blocks: HashMap::new(),
+            sprite_slots: SlotRanges::new(sprites),
+            cloud_slots: SlotRanges::new(FIRST_CLOUDS),
+            limit_sprites,
+            sprite_buffer,
+            cloud_buffer,
+            order_buffer,
+            index_buffer,
+            layout,
+            group,
+            orders_cpu: vec![0; sprites as usize],
+            dirty_orders: Vec::new(),
+            generation: 0,
+        }
+    }
+
+    /// The layout of [`Self::group`].
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// Bytes of the sprite, cloud, order and index buffers.
+    pub fn gpu_bytes(&self) -> u64 {
+        self.sprite_buffer.size()
+            + self.cloud_buffer.size()
+            + self.order_buffer.size()
+            + self.index_buffer.size()
+    }
+
+    /// Adds or replaces a block (uploaded by the next [`Self::place_and_upload`]).
+    pub fn insert(&mut self, block: SkyBlock, motion: BlockMotion) {
+        self.remove(block.id);
+        self.blocks.insert(block.id, Resident::new(block, motion));
+    }
+
+    /// Retires a block and frees its slots; returns the sprite slots it had, if it was held.
+    pub fn remove(&mut self, id: u64) -> Option<Range<u32>> {
+        let old = self.blocks.remove(&id)?;
+        match old.place {
+            Some((sprites, clouds)) => {
+                self.sprite_slots.release(sprites.clone());
+                self.cloud_slots.release(clouds);
+                Some(sprites)
+            }
+            None => Some(0..0),
+        }
+    }
+
+    /// Places every block not on the GPU yet (growing the buffers where the limits allow;
+    /// past them the farthest from `camera_m` are left out) and writes the new ones. Returns
+    /// the bytes written and the blocks left out.
+    pub fn place_and_upload(&mut self, queue: &wgpu::Queue, camera_m: DVec3) -> (u64, u32) {
+        let mut waiting: Vec<(f64, u64)> = self
+            .blocks
+            .values()
+            .filter(|r| r.place.is_none())
+            .map(|r| ((r.centre_m() - camera_m).length_squared(), r.block.id))
+            .collect();
+        if !waiting.is_empty() {
+            waiting.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let mut left_out = 0;
+            for &(d2, id) in &waiting {
+                if !self.place(id, d2, camera_m) {
+                    left_out += 1;
+                }
+            }
+            if left_out > 0 {
+                return (self.upload(queue), left_out);
+            }
+        }
+        (self.upload(queue), 0)
+    }
+
+    /// Places one block: in free slots, else after growing, else in place of farther ones.
+    fn place(&mut self, id: u64, d2: f64, camera_m: DVec3) -> bool {
+        loop {
+            if self.try_place(id) {
+                return true;
+            }
+            if self.grow_for(id) {
+                continue;
+            }
+            // Full: give the slots of the farthest placed block, if it is farther, to this one.
+            let farthest = self
+                .blocks
+                .values()
+                .filter(|r| r.place.is_some())
+                .map(|r| ((r.centre_m() - camera_m).length_squared(), r.block.id))
+                .max_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            match farthest {
+                Some((far_d2, far_id)) if far_d2 > d2 => {
+                    if let Some(r) = self.blocks.get_mut(&far_id)
+                        && let Some((s, c)) = r.place.take()
+                    {
+                        r.uploaded = false;
+                        self.sprite_slots.release(s);
+                        self.cloud_slots.release(c);
+                    }
+                }
+                _ => return false,
+            }
+        }
+    }
+
+    fn try_place(&mut self, id: u64) -> bool {
+        let Some(r) = self.blocks.get(&id) else {
+            return true;
+        };
+        let (n_sprites, n_clouds) = (r.sprite_count(), r.block.clouds.len() as u32);
+        let Some(sprites) = self.sprite_slots.allocate(n_sprites) else {
+            return false;
+        };
+        let Some(clouds) = self.cloud_slots.allocate(n_clouds) else {
+            self.sprite_slots.release(sprites);
+            return false;
+        };
+        let Some(r) = self.blocks.get_mut(&id) else {
+            return true;
+        };
+        let mut base = sprites.start;
+        for (k, (state, cloud)) in r.clouds.iter_mut().zip(&r.block.clouds).enumerate() {
+            state.sprite_base = base;
+            state.cloud_slot = clouds.start + k as u32;
+            state.ordered_at = None;
+            base += cloud.sprites.len() as u32;
+        }
+        r.place = Some((sprites, clouds));
+        r.uploaded = false;
+        true
+    }
+
+    /// Grows the buffers so that block `id` fits, if the limits allow: every block is placed
+    /// and written again (rare: the capacity doubles each time).
+    fn grow_for(&mut self, id: u64) -> bool {
+        let Some(r) = self.blocks.get(&id) else {
+            return false;
+        };
+        let need_sprites = self.sprite_slots.used() + r.sprite_count();
+        let need_clouds = self.cloud_slots.used() + r.block.clouds.len() as u32;
+        let cap = self.sprite_slots.capacity();
+        if need_sprites > self.limit_sprites || (need_sprites <= cap && cap >= self.limit_sprites) {
+            return false;
+        }
+        let sprites = need_sprites
+            .max(cap.saturating_mul(2))
+            .next_power_of_two()
+            .min(self.limit_sprites)
+            .max(need_sprites);
+        let clouds = need_clouds
+            .max(self.cloud_slots.capacity().saturating_mul(2))
+            .next_power_of_two();
+        if sprites <= cap && clouds <= self.cloud_slots.capacity() {
+            return false;
+        }
+        let (s, c, o, i, g) = buffers(&self.device, &self.layout, sprites, clouds);
+        (
+            self.sprite_buffer,
+            self.cloud_buffer,
+            self.order_buffer,
+            self.index_buffer,
+            self.group,
+        ) = (s, c, o, i, g);
+        self.sprite_slots = SlotRanges::new(sprites);
+        self.cloud_slots = SlotRanges::new(clouds);
+        self.orders_cpu = vec![0; sprites as usize];
+        self.dirty_orders.clear();
+        self.generation += 1;
+        let mut placed: Vec<u64> = self
+            .blocks
+            .values()
+            .filter(|r| r.place.is_some())
+            .map(|r| r.block.id)
+            .collect();
+        placed.sort_unstable();
+        for r in self.blocks.values_mut() {
+            r.place = None;
+        }
+        for id in placed {
+            self.try_place(id);
+        }
+        true
+    }
+
+    /// Writes every placed block not written yet; returns the bytes.
+    fn upload(&mut self, queue: &wgpu::Queue) -> u64 {
+        let mut bytes = 0;
+        let mut sprites: Vec<GpuSprite> = Vec::new();
+        let mut clouds: Vec<GpuCloud> = Vec::new();
+        for r in self.blocks.values_mut() {
+            let Some((s, c)) = &r.place else { continue };
+            if r.uploaded {
+                continue;
+            }
+            sprites.clear();
+            clouds.clear();
+            for cloud in &r.block.clouds {
+                sprites.extend(cloud.sprites.iter().map(|sp| gpu_sprite(cloud, sp)));
+                clouds.push(gpu_cloud(cloud));
+            }
+            let sprite_bytes = std::mem::size_of::<GpuSprite>() as u64;
+            let cloud_bytes = std::mem::size_of::<GpuCloud>() as u64;
+            if !sprites.is_empty() {
+                queue.write_buffer(
+                    &self.sprite_buffer,
+                    s.start as u64 * sprite_bytes,
+                    bytemuck::cast_slice(&sprites),
+                );
+            }
+            if !clouds.is_empty() {
+                queue.write_buffer(
+                    &self.cloud_buffer,
+                    c.start as u64 * cloud_bytes,
+                    bytemuck::cast_slice(&clouds),
+                );
+            }
+            bytes += sprites.len() as u64 * sprite_bytes + clouds.len() as u64 * cloud_bytes;
+            r.uploaded = true;
+        }
+        bytes
+    }
+
+    /// Writes the orders changed this frame, nearby spans merged; returns the bytes.
+    pub fn upload_orders(&mut self, queue: &wgpu::Queue) -> u64 {
+        if self.dirty_orders.is_empty() {
+            return 0;
+        }
+        self.dirty_orders.sort_by_key(|r| r.start);
+        // Spans closer than this many slots go in one write: fewer calls for a few more bytes.
+        const MERGE_GAP: u32 = 64;
+        let mut bytes = 0;
+        let mut spans = std::mem::take(&mut self.dirty_orders).into_iter();
+        let Some(mut run) = spans.next() else {
+            return 0;
+        };
+        let mut write = |run: &Range<u32>| {
+            let data = &self.orders_cpu[run.start as usize..run.end as usize];
+            queue.write_buffer(
+                &self.order_buffer,
+                run.start as u64 * 4,
+                bytemuck::cast_slice(data),
+            );
+            bytes += data.len() as u64 * 4;
+        };
+        for span in spans {
+            if span.start <= run.end + MERGE_GAP {
+                run.end = run.end.max(span.end);
+            } else {
+                write(&run);
+                run = span;
+            }
+        }
+        write(&run);
+        bytes
+    }
+}
+
+type Buffers = (
+    wgpu::Buffer,
+    wgpu::Buffer,
+    wgpu::Buffer,
+    wgpu::Buffer,
+    wgpu::BindGroup,
+);
+
+/// Sprite, cloud, order and quad-index buffers for `sprites` and `clouds` slots.
+fn buffers(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    sprites: u32,
+    clouds: u32,
+) -> Buffers {
+    let storage = |label, size: u64| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(16),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    };
+    let sprite_buffer = storage(
+        "sky.sprites",
+        sprites as u64 * std::mem::size_of::<GpuSprite>() as u64,
+    );
+    let cloud_buffer = storage(
+        "sky.clouds",
+        clouds as u64 * std::mem::size_of::<GpuCloud>() as u64,
+    );
+    let order_buffer = storage("sky.orders", sprites as u64 * 4);
+    let index_buffer = quad_index_buffer(device, sprites);
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("sky.resident_group"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: sprite_buffer.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: cloud_buffer.as_entire_binding(),
+            },
+        ],
+    });
+    (
+        sprite_buffer,
+        cloud_buffer,
+        order_buffer,
+        index_buffer,
+        group,
+    )
+}
+
+/// Index list for `sprites` quads of four corners (two triangles each): the vertex shader
+/// builds corner `v % 4` of the frame's sprite `v / 4`.
+pub fn quad_index_buffer(device: &wgpu::Device, sprites: u32) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    let indices: Vec<u32> = (0..sprites.max(1))
+        .flat_map(|q| {
+            let b = q * 4;
+            [b, b + 2, b + 1, b + 1, b + 2, b + 3]
+        })
+        .collect();
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("sky.quad_indices"),
+        contents: bytemuck::cast_slice(&indices),
+        usage: wgpu::BufferUsages::INDEX,
+    })
+}

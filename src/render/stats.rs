@@ -1,0 +1,72 @@
+//! What a frame of the sky cost and drew ([`FrameStats`]), and the light it is shaded with
+//! ([`Lighting`]). Plain data.
+
+use glam::Vec3;
+
+use crate::shading::{DirectionalMapping, ForwardScattering, TimeOfDay};
+
+/// What one frame's update did and cost.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FrameStats {
+    /// Sprites drawn as sprites this frame (the impostors' not counted).
+    pub sprites_drawn: u32,
+    /// Clouds within the draw distance.
+    pub clouds_drawn: u32,
+    /// Clouds whose back-to-front sprite order was recomputed this frame (Wang 6.1's cache).
+    pub clouds_recomputed: u32,
+    /// Sprites of those clouds (the sorting work of the frame).
+    pub sprites_recomputed: u32,
+    /// Fraction of drawn clouds served from the cache, 0..=1 (1 when nothing was drawn).
+    pub cache_hit_rate: f32,
+    /// CPU time of [`crate::render::Sky::prepare`] plus the block changes handed to the sky since
+    /// the last one (inserts, removals, motions), microseconds.
+    pub cpu_update_us: u64,
+    /// CPU time the host's cloud field spent on the frame thread for this frame (drift,
+    /// lifecycle, the blocks handed over), microseconds, as reported to the sky with
+    /// [`crate::render::Sky::add_field_cpu_us`].
+    pub field_us: u64,
+    /// CPU time of the last [`crate::render::Sky::record`], microseconds (filled in by hosts that
+    /// record after they prepare, like the demo host).
+    pub record_us: u64,
+    /// Bytes written to the GPU by this frame's update (new blocks, changed sprite orders, the
+    /// draw list, uniforms, impostor builds).
+    pub upload_bytes: u64,
+    /// Bytes of the GPU buffers holding the sprites, clouds, orders and draw list.
+    pub sprite_gpu_bytes: u64,
+    /// Blocks the sky holds but left out of the GPU buffers (the farthest first) because the
+    /// device's buffer limit or the sky's budget is reached.
+    pub blocks_left_out: u32,
+    /// How far inside a cloud the camera is, 0..=1.
+    pub in_cloud: f32,
+    /// Impostors of the far-cloud ring rendered this frame (Wang 6.2), 0..=8.
+    pub impostors_rebuilt: u32,
+    /// Blocks drawn as sprites (inside the ring, or beyond the 10,000 ft rule).
+    pub blocks_near: u32,
+    /// Blocks drawn into the impostors of the displayed ring.
+    pub blocks_far: u32,
+    /// Weight of the new ring while crossfading from the old one, 0..=1 (0 when not fading).
+    pub crossfade_weight: f32,
+    /// Bytes of the ring's GPU textures and buffers.
+    pub ring_gpu_bytes: u64,
+}
+
+impl FrameStats {
+    /// All the CPU time the sky cost the frame thread: the cloud field, the update and the
+    /// recording, microseconds.
+    pub fn sky_cpu_us(&self) -> u64 {
+        self.field_us + self.cpu_update_us + self.record_us
+    }
+}
+
+/// The light a frame is shaded with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lighting {
+    /// Unit vector towards the sun (east, north, up).
+    pub sun_dir: Vec3,
+    /// Time-of-day light.
+    pub time_of_day: TimeOfDay,
+    /// Wang's Cmin / Cmedian / Cmax.
+    pub mapping: DirectionalMapping,
+    /// Light scattered forward towards the eye (the silver lining).
+    pub forward: ForwardScattering,
+}
