@@ -194,9 +194,17 @@ fn locked_facing(slot: u32, fallback: Facing) -> Facing {
     return fallback;
 }
 
-@vertex
-fn vs_sprite(@builtin(vertex_index) vi: u32) -> VertexOut {
-    var o: VertexOut;
+// One corner as the vertex shader builds it, relative to the camera.
+struct Corner {
+    rel_m: vec3<f32>,
+    visible: bool,
+    uv: vec2<f32>,
+    colour: vec4<f32>,
+};
+
+// Corner `vi % 4` of the frame's sprite `vi / 4` (in drawing order).
+fn sprite_corner(vi: u32) -> Corner {
+    var o: Corner;
     let k = vi / 4u;
     let corner_id = vi % 4u;
     let d = draws[draw_of(k)];
@@ -230,11 +238,7 @@ fn vs_sprite(@builtin(vertex_index) vi: u32) -> VertexOut {
         alpha *= clamp((cos_angle - lock.w) / max(lock.z - lock.w, 1e-4), 0.0, 1.0);
     }
     let morph = s.alpha_morph * lifecycle_alpha(d.fade_kind, d.fade_progress, s.radius_fraction);
-    if (alpha <= 0.0 || morph <= 0.0) {
-        // Nothing to draw: every corner outside the clip volume.
-        o.position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-        return o;
-    }
+    o.visible = alpha > 0.0 && morph > 0.0;
 
     let corner = vec2<f32>(f32(corner_id & 1u), 1.0 - f32(corner_id >> 1u));
     let sc = vec2<f32>(sin(s.rotation_rad), cos(s.rotation_rad));
@@ -255,7 +259,22 @@ fn vs_sprite(@builtin(vertex_index) vi: u32) -> VertexOut {
     o.colour = vec4<f32>(ambient.rgb * light.w + directional, ambient.a * morph * alpha);
     // Texture v runs down the sheet: the top of the sprite is v = 0.
     o.uv = cell_uv(s.bits & 15u, vec2<f32>(corner.x, 1.0 - corner.y));
-    o.position = frame.view_proj * vec4<f32>(d.centre_rel + p, 1.0);
+    o.rel_m = d.centre_rel + p;
+    return o;
+}
+
+@vertex
+fn vs_sprite(@builtin(vertex_index) vi: u32) -> VertexOut {
+    var o: VertexOut;
+    let c = sprite_corner(vi);
+    if (!c.visible) {
+        // Nothing to draw: every corner outside the clip volume.
+        o.position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return o;
+    }
+    o.colour = c.colour;
+    o.uv = c.uv;
+    o.position = frame.view_proj * vec4<f32>(c.rel_m, 1.0);
     o.view_depth_m = o.position.w;
     // Aerial perspective: distant clouds fade into the horizon haze.
     o.haze = 1.0 - exp(-max(o.position.w, 0.0) / frame.haze.x);

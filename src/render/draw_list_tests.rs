@@ -1,1 +1,69 @@
+//! Tests of `draw_list`'s CPU rules (the GPU side is in `tests/sprites.rs`).
 
+use super::*;
+
+fn cache() -> VertexCacheSettings {
+    RenderSettings::default().vertex_cache
+}
+
+#[test]
+fn the_order_ages_and_moves_out_by_distance_and_sooner_while_fading() {
+    let c = cache();
+    let at = (DVec3::new(0.0, -1000.0, 0.0), 10.0);
+    // 1 km from its edge: 5 m + 2% = 25 m of movement, 2 s x 1.5 = 3 s of age.
+    let moved = |m: f64| DVec3::new(m, -1000.0, 0.0);
+    assert!(!needs_recompute(at, false, moved(24.0), 10.0, 1000.0, &c));
+    assert!(needs_recompute(at, false, moved(26.0), 10.0, 1000.0, &c));
+    assert!(!needs_recompute(at, false, moved(0.0), 12.9, 1000.0, &c));
+    assert!(needs_recompute(at, false, moved(0.0), 13.1, 1000.0, &c));
+    // 10 km out the same 26 m keeps the order (limit 205 m).
+    assert!(!needs_recompute(at, false, moved(26.0), 10.0, 10_000.0, &c));
+    // Fading: every 0.25 s whatever the distance.
+    assert!(needs_recompute(at, true, moved(0.0), 10.3, 10_000.0, &c));
+    assert!(!needs_recompute(at, true, moved(0.0), 10.2, 10_000.0, &c));
+    // Time running backwards (a new flight in the same sky) recomputes.
+    assert!(needs_recompute(at, false, moved(0.0), 9.0, 1000.0, &c));
+}
+
+#[test]
+fn locks_start_once_stay_and_go_when_the_camera_leaves() {
+    let mut locks = Locks::default();
+    let north = facing_towards(Vec3::Y);
+    locks.begin();
+    locks.keep_or_lock(7, north);
+    locks.end();
+    assert!(locks.take_changed());
+    assert_eq!(locks.gpu().len(), 1);
+    // Still inside: the facing it locked with stays, whatever is offered now.
+    locks.begin();
+    locks.keep_or_lock(7, facing_towards(Vec3::X));
+    locks.end();
+    assert!(!locks.take_changed());
+    let gpu = locks.gpu();
+    assert_eq!((gpu[0].sprite, gpu[0].normal), (7, Vec3::Y.to_array()));
+    // Not seen this frame: released.
+    locks.begin();
+    locks.end();
+    assert!(locks.take_changed());
+    assert!(locks.gpu().is_empty());
+    // A block that goes takes its locks with it.
+    locks.begin();
+    locks.keep_or_lock(3, north);
+    locks.keep_or_lock(40, north);
+    locks.end();
+    locks.release(0..10);
+    assert_eq!(locks.gpu().len(), 1);
+    assert_eq!(locks.gpu()[0].sprite, 40);
+}
+
+#[test]
+fn facings_keep_up_up_and_upright_ones_level() {
+    let f = facing_towards(Vec3::new(1.0, 1.0, 0.5).normalize());
+    assert!(f.right.z.abs() < 1e-6, "right stays horizontal");
+    assert!(f.up.z > 0.0 && f.right.dot(f.normal).abs() < 1e-6);
+    // Straight below: falls back to east.
+    assert_eq!(facing_towards(-Vec3::Z).right, Vec3::X);
+    let u = upright_facing(Vec3::new(0.0, -300.0, -800.0));
+    assert_eq!(u.up, Vec3::Z);
+    assert!((u.normal - -Vec3::Y).length() < 1e-6);
+}

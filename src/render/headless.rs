@@ -48,7 +48,13 @@ impl HeadlessGpu {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("skycast.headless"),
             required_features,
-            required_limits: wgpu::Limits::downlevel_defaults(),
+            // WebGPU's 8 storage buffers per stage where the adapter has them (the sprite corner
+            // read-back uses 5); the rest as any downlevel device.
+            required_limits: wgpu::Limits {
+                max_storage_buffers_per_shader_stage:
+                    adapter.limits().max_storage_buffers_per_shader_stage.min(8),
+                ..wgpu::Limits::downlevel_defaults()
+            },
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,

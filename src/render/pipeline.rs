@@ -7,7 +7,7 @@
 const SHARED_WGSL: &str = include_str!("../../shaders/shared/frame.wgsl");
 
 /// A shader module of `shaders/shared/frame.wgsl` followed by `pass_wgsl`.
-fn shader(device: &wgpu::Device, label: &str, pass_wgsl: &str) -> wgpu::ShaderModule {
+pub(super) fn shader(device: &wgpu::Device, label: &str, pass_wgsl: &str) -> wgpu::ShaderModule {
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(format!("{SHARED_WGSL}\n{pass_wgsl}").into()),

@@ -242,24 +242,20 @@ impl ResidentSet {
             .collect();
         if !waiting.is_empty() {
             waiting.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            let mut left_out = 0;
             for &(d2, id) in &waiting {
-                if !self.place(id, d2, camera_m) {
-                    left_out += 1;
-                }
-            }
-            if left_out > 0 {
-                return (self.upload(queue), left_out);
+                self.place(id, d2, camera_m);
             }
         }
-        (self.upload(queue), 0)
+        // Blocks that did not fit, and any a nearer one took the place of.
+        let left_out = self.blocks.values().filter(|r| r.place.is_none()).count() as u32;
+        (self.upload(queue), left_out)
     }
 
     /// Places one block: in free slots, else after growing, else in place of farther ones.
-    fn place(&mut self, id: u64, d2: f64, camera_m: DVec3) -> bool {
+    fn place(&mut self, id: u64, d2: f64, camera_m: DVec3) {
         loop {
             if self.try_place(id) {
-                return true;
+                return;
             }
             if self.grow_for(id) {
                 continue;
@@ -281,7 +277,7 @@ impl ResidentSet {
                         self.cloud_slots.release(c);
                     }
                 }
-                _ => return false,
+                _ => return,
             }
         }
     }

@@ -404,6 +404,24 @@ impl Sky {
         self.pending_us
     }
 
+    /// The corners of the last prepared frame's sprites, four per sprite in drawing order, as
+    /// the vertex shader builds them (position relative to the camera, colour, drawn or not):
+    /// for tests and tools. Runs the shader's corner code in a compute pass and waits.
+    pub fn read_back_corners(
+        &self,
+        queue: &wgpu::Queue,
+    ) -> Result<Vec<super::SpriteCorner>, RenderError> {
+        let (view, draws) = self.view.buffers();
+        let sources = super::readback::CornerSources {
+            sprites: &self.resident.sprite_buffer,
+            clouds: &self.resident.cloud_buffer,
+            view,
+            draws,
+            orders: &self.resident.order_buffer,
+        };
+        super::readback::read_corners(&self.device, queue, &sources, self.sprites_to_draw)
+    }
+
     /// CPU time of the last [`Self::record`], microseconds.
     pub fn last_record_us(&self) -> u64 {
         self.record_us.get()

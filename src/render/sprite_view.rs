@@ -204,6 +204,11 @@ impl ViewBuffers {
         bytes
     }
 
+    /// The uniform and the draw list (for the corner read-back).
+    pub fn buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
+        (&self.uniform, &self.draws)
+    }
+
     /// Group 3 of the sprite passes (after the first [`Self::write`]).
     pub fn group(&self) -> Option<&wgpu::BindGroup> {
         self.group.as_ref()

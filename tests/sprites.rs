@@ -1,0 +1,420 @@
+//! The sprites as the vertex shader builds them (Wang 2003 3.3, 5 and 6.1 on GPU-resident
+//! sprites), read back from the GPU (`Sky::read_back_corners` runs the shader's own corner code):
+//! the order cache, the back-to-front order, facing the camera, the facing lock and its fade,
+//! upright base sprites, the forward-scattering rim, precision far from the origin. Small scenes
+//! on whatever adapter there is (lavapipe here).
+
+use glam::{DVec2, DVec3, Vec3};
+use skycast::render::terrain::HeightField;
+use skycast::render::{
+    BlockMotion, Camera, DemoHost, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteCorner,
+    SpriteSheet, headless, square_sprite,
+};
+use skycast::shading::{ColourLevels, ForwardScattering, SunPosition, TimeOfDayTable};
+
+/// A rig: a tiny headless target (the corners do not depend on it) and the sky.
+fn host(table: TimeOfDayTable) -> DemoHost {
+    let ground = HeightField::from_fn(DVec2::ZERO, 20_000.0, 9, |_| 0.0);
+    let sheet = SpriteSheet {
+        size_px: 4,
+        mips: vec![vec![255; 64], vec![255; 16], vec![255; 4]],
+    };
+    DemoHost::new(
+        64,
+        36,
+        &ground,
+        SkyConfig {
+            colour_format: headless::COLOUR_FORMAT,
+            settings: RenderSettings::default(),
+            time_of_day: table,
+            sheet,
+        },
+    )
+    .unwrap_or_else(|e| panic!("sprite tests need an adapter: {e}"))
+}
+
+/// The sun 53 degrees up in the south (towards (0, -0.6, 0.8)).
+const SUN: SunPosition = SunPosition {
+    elevation_deg: 53.13,
+    azimuth_deg: 180.0,
+    declination_deg: 0.0,
+};
+
+/// Ten clouds of 20 sprites, 1.5 km apart along a line 5 km north, at 1,500 m.
+fn blocks() -> Vec<SkyBlock> {
+    let cloud = |x: f64| SkyCloud {
+        centre_m: DVec3::new(x, 5000.0, 1500.0),
+        sprites: (0..20)
+            .map(|k| {
+                square_sprite(
+                    Vec3::new(k as f32 * 20.0, 0.0, (k % 5) as f32 * 40.0),
+                    200.0,
+                    k as u8,
+                    0,
+                )
+            })
+            .collect(),
+        group_centres_m: vec![Vec3::new(200.0, 0.0, 100.0)],
+        colour_levels: ColourLevels::even(1500.0, 1800.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+        flat: false,
+    };
+    vec![SkyBlock {
+        id: 1,
+        centre_m: DVec3::new(0.0, 5000.0, 1500.0),
+        clouds: (0..10).map(|i| cloud(i as f64 * 1500.0)).collect(),
+    }]
+}
+
+fn one_cloud(cloud: SkyCloud) -> Vec<SkyBlock> {
+    vec![SkyBlock {
+        id: 1,
+        centre_m: cloud.centre_m,
+        clouds: vec![cloud],
+    }]
+}
+
+fn camera(host: &DemoHost, at: DVec3) -> Camera {
+    host.camera(at, 0.0, 0.0)
+}
+
+/// Prepares a frame from `at` at sky time step `dt_s` and reads its corners back.
+fn corners(host: &mut DemoHost, at: DVec3, dt_s: f64) -> Vec<SpriteCorner> {
+    let cam = camera(host, at);
+    host.sky.prepare(&host.gpu.queue, &cam, &SUN, dt_s);
+    host.sky
+        .read_back_corners(&host.gpu.queue)
+        .expect("corners read back")
+}
+
+fn centre(quad: &[SpriteCorner]) -> Vec3 {
+    quad.iter().map(|c| c.rel_m).sum::<Vec3>() / 4.0
+}
+
+/// Wang 6.1 on the orders: a still camera re-sorts nothing after the first frame and draws the
+/// same corners; handing the same blocks again or drifting them with the camera keeps the
+/// cache; moving past the threshold (5 m + 2% of the distance) re-sorts, near clouds first.
+#[test]
+fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
+    let mut host = host(TimeOfDayTable::default());
+    host.sky.set_clouds(blocks());
+    let cam = DVec3::new(0.0, 0.0, 1000.0);
+    let at = |host: &DemoHost, p: DVec3| camera(host, p);
+    let c0 = at(&host, cam);
+    let first = host.sky.prepare(&host.gpu.queue, &c0, &SUN, 0.0);
+    assert_eq!(
+        (
+            first.clouds_drawn,
+            first.clouds_recomputed,
+            first.sprites_drawn
+        ),
+        (10, 10, 200)
+    );
+    let first_corners = host.sky.read_back_corners(&host.gpu.queue).unwrap();
+    for frame in 1..30 {
+        let still = host.sky.prepare(&host.gpu.queue, &c0, &SUN, 1.0 / 30.0);
+        assert_eq!(still.clouds_recomputed, 0, "frame {frame}");
+        assert_eq!(still.cache_hit_rate, 1.0);
+    }
+    assert_eq!(
+        host.sky.read_back_corners(&host.gpu.queue).unwrap(),
+        first_corners
+    );
+    // Handing the same blocks again (as a host does when the block set changes) keeps them.
+    host.sky.set_clouds(blocks());
+    let again = host.sky.prepare(&host.gpu.queue, &c0, &SUN, 0.0);
+    assert_eq!(again.clouds_recomputed, 0);
+    // Clouds drifting with the wind and a camera flying along with them: nothing moved
+    // relative to each other, nothing re-sorts.
+    let drift = DVec3::new(400.0, -250.0, 0.0);
+    host.sky.set_block_motion(
+        1,
+        BlockMotion {
+            offset_m: drift,
+            ..BlockMotion::default()
+        },
+    );
+    let along = at(&host, cam + drift);
+    assert_eq!(
+        host.sky
+            .prepare(&host.gpu.queue, &along, &SUN, 0.0)
+            .clouds_recomputed,
+        0
+    );
+    host.sky.set_block_motion(1, BlockMotion::default());
+    // 300 m is past the threshold of every cloud (at most 5 m + 2% of ~19 km).
+    let moved = at(&host, cam + DVec3::new(0.0, 300.0, 0.0));
+    assert_eq!(
+        host.sky
+            .prepare(&host.gpu.queue, &moved, &SUN, 0.0)
+            .clouds_recomputed,
+        10
+    );
+    // 150 m more: past the threshold of the near clouds (about 90 m at 4 km) only, not of
+    // the far ones (about 280 m at 14 km).
+    let nudged = at(&host, cam + DVec3::new(0.0, 450.0, 0.0));
+    let stats = host.sky.prepare(&host.gpu.queue, &nudged, &SUN, 0.0);
+    assert!(
+        stats.clouds_recomputed > 0 && stats.clouds_recomputed < 10,
+        "{stats:?}"
+    );
+    // Uncached, every frame re-sorts everything.
+    host.sky.set_vertex_cache(false);
+    let stats = host.sky.prepare(&host.gpu.queue, &nudged, &SUN, 0.0);
+    assert_eq!(stats.clouds_recomputed, 10);
+}
+
+/// Every cloud's sprites are drawn farthest first (strictly by distance within each cloud, the
+/// clouds farthest first), and every quad faces the camera.
+#[test]
+fn sprites_are_sorted_back_to_front_and_face_the_camera() {
+    let mut host = host(TimeOfDayTable::default());
+    host.sky.set_clouds(blocks());
+    let quads = corners(&mut host, DVec3::new(0.0, 0.0, 1000.0), 0.0);
+    assert_eq!(quads.len(), 200 * 4);
+    let dists: Vec<f32> = quads.chunks(4).map(|q| centre(q).length()).collect();
+    // Each cloud's 20 sprites in a row, each no nearer than the next.
+    for (c, cloud) in dists.chunks(20).enumerate() {
+        for w in cloud.windows(2) {
+            assert!(
+                w[0] >= w[1] - 1e-3,
+                "cloud {c} not back to front: {cloud:?}"
+            );
+        }
+        assert!(cloud[0] > cloud[19] + 20.0, "cloud {c}: {cloud:?}");
+    }
+    let cloud_first: Vec<f32> = dists.chunks(20).map(|c| c[0]).collect();
+    assert!(
+        cloud_first.windows(2).all(|w| w[0] > w[1]),
+        "{cloud_first:?}"
+    );
+    for q in quads.chunks(4) {
+        let a = q[1].rel_m - q[0].rel_m;
+        let b = q[2].rel_m - q[0].rel_m;
+        let normal = a.cross(b).normalize();
+        assert!(
+            normal.dot(centre(q).normalize()).abs() > 0.999,
+            "sprite does not face the camera"
+        );
+        assert!(q.iter().all(|c| c.visible));
+    }
+}
+
+/// Wang 3.3: inside half its radius a sprite's facing locks; it fades with the angle between
+/// the locked facing and the camera, is gone edge-on, and faces the camera again outside.
+#[test]
+fn facing_locks_inside_half_the_radius_and_fades_with_the_angle() {
+    let mut host = host(TimeOfDayTable::default());
+    host.sky.set_vertex_cache(false);
+    host.sky.set_clouds(one_cloud(SkyCloud {
+        centre_m: DVec3::new(0.0, 0.0, 1000.0),
+        sprites: vec![square_sprite(Vec3::ZERO, 200.0, 0, 0)],
+        group_centres_m: vec![Vec3::ZERO],
+        colour_levels: ColourLevels::even(900.0, 1100.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+        flat: false,
+    }));
+    // 40 m south of the centre (inside 50 m = half the 100 m radius): locks facing north.
+    let locked = corners(&mut host, DVec3::new(0.0, -40.0, 1000.0), 0.0);
+    assert_eq!(locked.len(), 4);
+    assert!(
+        locked
+            .iter()
+            .all(|c| (c.rel_m.y - 40.0).abs() < 1e-3 && c.visible),
+        "plane faces the camera: {locked:?}"
+    );
+    // Step to 30 m east and 20 m south, still inside: the facing stays, seen at ~56 degrees.
+    let turned = corners(&mut host, DVec3::new(30.0, -20.0, 1000.0), 0.1);
+    let ys: Vec<f32> = turned.iter().map(|c| c.rel_m.y).collect();
+    assert!(
+        ys.windows(2).all(|w| (w[0] - w[1]).abs() < 1e-3),
+        "facing stayed locked: {ys:?}"
+    );
+    assert!(
+        turned[0].colour.w < locked[0].colour.w && turned[0].colour.w > 0.0,
+        "faded with the angle: {} then {}",
+        locked[0].colour.w,
+        turned[0].colour.w
+    );
+    // Beside it edge-on: gone.
+    let edge_on = corners(&mut host, DVec3::new(45.0, -0.5, 1000.0), 0.2);
+    assert!(edge_on.iter().all(|c| !c.visible), "{edge_on:?}");
+    // Out of the lock radius: faces the camera again, opaque.
+    let outside = corners(&mut host, DVec3::new(300.0, 0.0, 1000.0), 0.3);
+    assert!(
+        outside
+            .iter()
+            .all(|c| (c.rel_m.x + 300.0).abs() < 1e-3 && c.visible && c.colour.w > 0.99),
+        "{outside:?}"
+    );
+}
+
+/// An upright sprite keeps its bottom edge level and turns only about the vertical: seen
+/// from the side it is whole, from 25 degrees below it is fading, from 40 degrees below it is
+/// gone (fade 15..35 degrees); a camera-facing sprite beside it is whole from everywhere.
+#[test]
+fn upright_sprites_stay_level_and_fade_seen_from_below() {
+    let mut host = host(TimeOfDayTable::default());
+    let mut upright = square_sprite(Vec3::ZERO, 200.0, 3, 0);
+    upright.upright = true;
+    host.sky.set_clouds(one_cloud(SkyCloud {
+        centre_m: DVec3::new(0.0, 3000.0, 1500.0),
+        sprites: vec![upright, square_sprite(Vec3::X * 600.0, 200.0, 3, 0)],
+        group_centres_m: vec![Vec3::ZERO],
+        colour_levels: ColourLevels::even(1400.0, 1700.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+        flat: false,
+    }));
+    let mut quads = |elevation_deg: f64| {
+        let cam = DVec3::new(0.0, 3000.0, 1500.0)
+            + DVec3::new(0.0, -1.0, 0.0) * 2000.0 * elevation_deg.to_radians().cos()
+            - DVec3::Z * 2000.0 * elevation_deg.to_radians().sin();
+        let all = corners(&mut host, cam, 0.0);
+        assert_eq!(all.len(), 8);
+        let at = cam - DVec3::new(0.0, 3000.0, 1500.0);
+        // The upright sprite's corners are those nearest the cloud centre's x.
+        let (up, other): (Vec<&[SpriteCorner]>, Vec<&[SpriteCorner]>) = all
+            .chunks(4)
+            .partition(|q| (centre(q).x + at.x as f32).abs() < 150.0);
+        assert!(
+            other[0].iter().all(|c| c.visible),
+            "the other sprite is drawn"
+        );
+        up[0].to_vec()
+    };
+    let side = quads(0.0);
+    // Corners: top left, top right, bottom left, bottom right; the bottom edge is level and
+    // the quad stands vertical.
+    assert!(side.iter().all(|c| c.visible));
+    assert!((side[2].rel_m.z - side[3].rel_m.z).abs() < 1e-3);
+    assert!((side[0].rel_m.y - side[2].rel_m.y).abs() < 1e-3);
+    assert!((side[0].colour.w - 1.0).abs() < 1e-3);
+    let fading = quads(25.0);
+    assert!(
+        fading[0].visible && fading[0].colour.w > 0.2 && fading[0].colour.w < 0.8,
+        "{fading:?}"
+    );
+    assert!((fading[0].rel_m.y - fading[2].rel_m.y).abs() < 1e-3);
+    let gone = quads(40.0);
+    assert!(
+        gone.iter().all(|c| !c.visible),
+        "from 40 degrees below: {gone:?}"
+    );
+}
+
+/// Seen with the sun behind it, a cloud's rim is brighter than with the sun behind the camera
+/// by the forward-scattering lobe (Harris and Lastra's eye scattering); switched off, no glow.
+#[test]
+fn the_rim_of_a_cloud_against_the_sun_glows() {
+    let cam = DVec3::new(0.0, 0.0, 1500.0);
+    // The first cloud is 5 km north: the sun low in the north, then low in the south.
+    let brightest = |azimuth_deg: f64, forward: ForwardScattering| {
+        let mut table = TimeOfDayTable::default();
+        table.forward_scattering = forward;
+        let mut host = host(table);
+        host.sky.set_clouds(blocks());
+        let sun = SunPosition {
+            elevation_deg: 2.86,
+            azimuth_deg,
+            declination_deg: 0.0,
+        };
+        let c = camera(&host, cam);
+        host.sky.prepare(&host.gpu.queue, &c, &sun, 0.0);
+        host.sky
+            .read_back_corners(&host.gpu.queue)
+            .unwrap()
+            .iter()
+            .map(|c| c.colour.x)
+            .fold(0.0, f32::max)
+    };
+    let none = ForwardScattering {
+        strength: 0.0,
+        ..ForwardScattering::default()
+    };
+    let on = ForwardScattering::default();
+    let glow = brightest(0.0, on) - brightest(0.0, none);
+    let other_way = brightest(180.0, on) - brightest(180.0, none);
+    assert!(glow > 0.1, "against the sun: +{glow}");
+    assert!(other_way < 0.01, "sun behind the camera: +{other_way}");
+}
+
+/// Positions go to the GPU relative to the camera, worked out in f64: 300 km from the origin the
+/// corners are where they are at the origin.
+#[test]
+fn far_from_the_origin_the_corners_are_as_precise_as_near_it() {
+    let shifted = |offset: DVec3| -> Vec<SpriteCorner> {
+        let mut host = host(TimeOfDayTable::default());
+        let mut b = blocks();
+        for block in &mut b {
+            block.centre_m += offset;
+            for c in &mut block.clouds {
+                c.centre_m += offset;
+            }
+        }
+        host.sky.set_clouds(b);
+        corners(&mut host, DVec3::new(0.0, 0.0, 1000.0) + offset, 0.0)
+    };
+    let near = shifted(DVec3::ZERO);
+    let far = shifted(DVec3::new(250_000.0, -180_000.0, 0.0));
+    assert_eq!(near.len(), far.len());
+    for (a, b) in near.iter().zip(&far) {
+        let d = a.rel_m - b.rel_m;
+        assert!(d.length() < 1e-3, "jitter of {} m 300 km out", d.length());
+    }
+}
+
+/// Past the sprite budget (or the device's buffer limits) the farthest blocks are left out and
+/// counted, never a validation error; flying towards one brings it in and leaves out another.
+#[test]
+fn past_the_sprite_budget_the_farthest_blocks_are_left_out() {
+    let mut host = host(TimeOfDayTable::default());
+    let block = |id: u64, north_m: f64| {
+        let mut b = blocks().remove(0);
+        b.id = id;
+        b.centre_m.y = north_m;
+        for c in &mut b.clouds {
+            c.centre_m.y = north_m;
+        }
+        b
+    };
+    // Room for two of the three 200-sprite blocks.
+    host.sky
+        .set_sprite_budget_bytes(500 * skycast::render::BYTES_PER_SPRITE);
+    host.sky.set_clouds(vec![
+        block(1, 3_000.0),
+        block(2, 6_000.0),
+        block(3, -12_000.0),
+    ]);
+    let drawn_from = |host: &mut DemoHost, at: DVec3| {
+        let c = camera(host, at);
+        let stats = host.sky.prepare(&host.gpu.queue, &c, &SUN, 0.1);
+        let norths: Vec<f32> = host
+            .sky
+            .read_back_corners(&host.gpu.queue)
+            .unwrap()
+            .chunks(4)
+            .map(|q| centre(q).y + at.y as f32)
+            .collect();
+        (stats, norths)
+    };
+    let (stats, norths) = drawn_from(&mut host, DVec3::new(5_000.0, 0.0, 1000.0));
+    assert_eq!(
+        (stats.blocks_left_out, stats.sprites_drawn),
+        (1, 400),
+        "{stats:?}"
+    );
+    assert!(
+        norths.iter().all(|&y| y > 0.0),
+        "the block 12 km south is left out"
+    );
+    assert!(stats.sprite_gpu_bytes > 0);
+    // 10 km south: the southern block is nearest now and the northern one farthest.
+    let (stats, norths) = drawn_from(&mut host, DVec3::new(5_000.0, -10_000.0, 1000.0));
+    assert_eq!(
+        (stats.blocks_left_out, stats.sprites_drawn),
+        (1, 400),
+        "{stats:?}"
+    );
+    assert!(
+        norths.iter().any(|&y| y < -10_000.0),
+        "the southern block came in"
+    );
+    assert!(norths.iter().all(|&y| y < 5_000.0), "the northern one went");
+}
