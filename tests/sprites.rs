@@ -306,9 +306,10 @@ fn the_rim_of_a_cloud_against_the_sun_glows() {
     let cam = DVec3::new(0.0, 0.0, 1500.0);
     // The first cloud is 5 km north: the sun low in the north, then low in the south.
     let brightest = |azimuth_deg: f64, forward: ForwardScattering| {
-        let mut table = TimeOfDayTable::default();
-        table.forward_scattering = forward;
-        let mut host = host(table);
+        let mut host = host(TimeOfDayTable {
+            forward_scattering: forward,
+            ..TimeOfDayTable::default()
+        });
         host.sky.set_clouds(blocks());
         let sun = SunPosition {
             elevation_deg: 2.86,
