@@ -14,8 +14,9 @@
 //!
 //! Out: one table on standard output headed by the adapter's name (scenario, block overdraw,
 //! median and p95 of the steady frames' milliseconds, the median of the frames rendering an
-//! impostor, the off/on ratio of the medians, sprites drawn and CPU update milliseconds, per
-//! scenario with impostors on and off); the same rows as `bench.csv`, every frame in
+//! impostor, the off/on ratio of the medians, sprites drawn, the sky's CPU milliseconds (update
+//! and recording) and the GPU memory of the resident sprites, per scenario with impostors on
+//! and off); the same rows as `bench.csv`, every frame in
 //! `frames.csv`, and `frame_time.png`, steady frame time along the path. Frame time is
 //! the GPU time between timestamps around the frame's passes where the adapter has timestamp
 //! queries, else the wall time from submit to the end of the poll-wait; the table says which.
@@ -92,6 +93,8 @@ struct FrameRecord {
     /// The sky's passes alone (the host's ground left out); NaN without GPU timestamps.
     sky_ms: f64,
     cpu_update_ms: f64,
+    upload_bytes: u64,
+    sprite_gpu_bytes: u64,
     sprites_drawn: u32,
     blocks_near: u32,
     blocks_far: u32,
@@ -283,7 +286,9 @@ fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> any
                 distance_m: k as f64 * step_m,
                 frame_ms,
                 sky_ms,
-                cpu_update_ms: stats.cpu_update_us as f64 / 1e3,
+                cpu_update_ms: stats.sky_cpu_us() as f64 / 1e3,
+                upload_bytes: stats.upload_bytes,
+                sprite_gpu_bytes: stats.sprite_gpu_bytes,
                 sprites_drawn: stats.sprites_drawn,
                 blocks_near: stats.blocks_near,
                 blocks_far: stats.blocks_far,
@@ -412,6 +417,8 @@ struct Row {
     sky_ratio: f64,
     sprites_drawn: f64,
     cpu_update_ms: f64,
+    /// Median GPU memory of the resident sprites (records, orders, indices, draw list), MB.
+    sprite_mb: f64,
     /// False where the run did not fit the device (sprites_drawn is then the sprites in view).
     drawn: bool,
 }
@@ -448,12 +455,13 @@ fn summary_rows(runs: &[Run]) -> Vec<Row> {
                 },
                 drawn: r.not_drawn.is_none(),
                 cpu_update_ms: r.median_of(|f| f.cpu_update_ms),
+                sprite_mb: r.median_of(|f| f.sprite_gpu_bytes as f64 / 1e6),
             }
         })
         .collect()
 }
 
-const HEADER: [&str; 12] = [
+const HEADER: [&str; 13] = [
     "scenario",
     "overdraw_pct",
     "impostors",
@@ -465,6 +473,7 @@ const HEADER: [&str; 12] = [
     "sky_off_on_ratio",
     "sprites_drawn",
     "cpu_update_ms",
+    "sprite_gpu_mb",
     "drawn",
 ];
 
@@ -478,7 +487,7 @@ fn print_table(adapter: &str, args: &BenchArgs, timing: &str, rows: &[Row]) {
         CRUISE_FT_AGL
     );
     println!(
-        "{:<10} {:>9} {:>9} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>10} {:>9}",
+        "{:<10} {:>9} {:>9} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>10} {:>9} {:>9}",
         "scenario",
         "overdraw",
         "impostors",
@@ -489,7 +498,8 @@ fn print_table(adapter: &str, args: &BenchArgs, timing: &str, rows: &[Row]) {
         "off/on",
         "sky off/on",
         "sprites",
-        "cpu ms"
+        "cpu ms",
+        "gpu MB"
     );
     let ms = |v: f64| {
         if v.is_finite() {
@@ -500,7 +510,7 @@ fn print_table(adapter: &str, args: &BenchArgs, timing: &str, rows: &[Row]) {
     };
     for r in rows {
         println!(
-            "{:<10} {:>8.0}% {:>9} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>10.0} {:>9}{}",
+            "{:<10} {:>8.0}% {:>9} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>10.0} {:>9} {:>9.1}{}",
             r.scenario,
             r.overdraw_pct,
             if r.impostors { "on" } else { "off" },
@@ -512,6 +522,7 @@ fn print_table(adapter: &str, args: &BenchArgs, timing: &str, rows: &[Row]) {
             ms(r.sky_ratio),
             r.sprites_drawn,
             ms(r.cpu_update_ms),
+            r.sprite_mb,
             if r.drawn {
                 ""
             } else {
@@ -548,6 +559,7 @@ fn write_csv(path: &Path, adapter: &str, timing: &str, rows: &[Row]) -> anyhow::
             ms(r.sky_ratio),
             format!("{:.0}", r.sprites_drawn),
             ms(r.cpu_update_ms),
+            format!("{:.1}", r.sprite_mb),
             (if r.drawn {
                 "yes"
             } else {
@@ -574,6 +586,8 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
         "frame_ms",
         "sky_ms",
         "cpu_update_ms",
+        "upload_bytes",
+        "sprite_gpu_bytes",
         "sprites_drawn",
         "blocks_near",
         "blocks_far",
@@ -594,6 +608,8 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
                     String::new()
                 },
                 format!("{:.3}", f.cpu_update_ms),
+                f.upload_bytes.to_string(),
+                f.sprite_gpu_bytes.to_string(),
                 f.sprites_drawn.to_string(),
                 f.blocks_near.to_string(),
                 f.blocks_far.to_string(),

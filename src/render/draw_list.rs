@@ -167,7 +167,8 @@ fn fade_code(fade: Fade) -> (u32, f32) {
 /// The blocks the sky holds, by id.
 pub(super) type Blocks = HashMap<u64, Resident>;
 
-/// Blocks' ids, farthest centre (with its drift) from `from_m` first; equal distances by id.
+/// Blocks' ids, farthest centre (with its drift) from `from_m` first; equal distances by id (the
+/// impostor views; the sky camera's sorts the near blocks themselves).
 fn blocks_back_to_front(blocks: &Blocks, ids: &[u64], from_m: DVec3) -> Vec<(f64, u64)> {
     let mut order: Vec<(f64, u64)> = ids
         .iter()
@@ -186,14 +187,16 @@ pub(super) struct OrderCopy<'a> {
     pub dirty: &'a mut Vec<std::ops::Range<u32>>,
 }
 
-/// The sky camera's frame: fills `out` with the draw list of the blocks `near`, recomputes the
-/// orders the cache says are stale (into `orders`, marked dirty), updates `locks`, and counts
-/// into `stats`.
-#[allow(clippy::too_many_arguments)]
+/// The sky camera's frame: fills `out` with the draw list of the blocks marked near and placed,
+/// recomputes the orders the cache says are stale (into `orders`, marked dirty), updates
+/// `locks`, and counts into `stats`. Returns how far inside a cloud the camera is, 0..=1.
+///
+/// Per frame this reads every near cloud's centre, radius and cache state (`CloudState`, kept
+/// together per block) and touches a cloud's sprites only to re-sort them or when the camera
+/// is inside it.
 pub(super) fn main_view(
     blocks: &mut Blocks,
     orders: OrderCopy,
-    near: &[u64],
     camera_m: DVec3,
     time_s: f64,
     settings: &RenderSettings,
@@ -204,7 +207,12 @@ pub(super) fn main_view(
     let (clouds_cfg, cache) = (&settings.clouds, &settings.vertex_cache);
     let draw_m = clouds_cfg.draw_distance_m as f64;
     let lock_fraction = clouds_cfg.lock_radius_fraction;
-    let order = blocks_back_to_front(blocks, near, camera_m);
+    let mut order: Vec<(f64, &mut Resident)> = blocks
+        .values_mut()
+        .filter(|r| r.near && r.place.is_some())
+        .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
+        .collect();
+    order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.block.id.cmp(&b.1.block.id)));
     let OrderCopy {
         slots: orders_cpu,
         dirty: dirty_orders,
@@ -214,29 +222,26 @@ pub(super) fn main_view(
     let mut total = 0u32;
     out.clear();
     locks.begin();
-    for (_, id) in order {
-        let Some(r) = blocks.get_mut(&id) else {
-            continue;
-        };
+    for (_, r) in order {
         let offset = r.motion.offset_m;
+        let fading = r.motion.fade != Fade::Steady;
         let (fade_kind, fade_progress) = fade_code(r.motion.fade);
         cloud_order.clear();
-        for (ci, (cloud, state)) in r.block.clouds.iter().zip(&r.clouds).enumerate() {
-            let d = (cloud.centre_m + offset - camera_m).length();
+        for (ci, state) in r.clouds.iter().enumerate() {
+            let d = (state.centre_m + offset - camera_m).length();
             let near_edge = (d - state.radius_m as f64).max(0.0);
-            if near_edge <= draw_m && !cloud.sprites.is_empty() {
+            if near_edge <= draw_m && state.sprites > 0 {
                 cloud_order.push((ci, d, near_edge));
             }
         }
         cloud_order.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
         for &(ci, d, near_edge) in &cloud_order {
-            let cloud = &r.block.clouds[ci];
             let state = &mut r.clouds[ci];
-            let centre = cloud.centre_m + offset;
-            let rel = camera_m - centre;
+            let rel = camera_m - (state.centre_m + offset);
             let cam_local = rel.as_vec3();
-            let n = cloud.sprites.len() as u32;
+            let n = state.sprites;
             if d < state.radius_m as f64 {
+                let cloud = &r.block.clouds[ci];
                 let inside = in_cloud_factor(state, cam_local, settings.in_cloud.ramp_fraction);
                 in_cloud = in_cloud.max(inside);
                 if !cloud.flat {
@@ -256,22 +261,13 @@ pub(super) fn main_view(
             }
             let stale = !cache.enabled
                 || state.ordered_at.is_none_or(|at| {
-                    needs_recompute(
-                        at,
-                        r.motion.fade != Fade::Steady,
-                        rel,
-                        time_s,
-                        near_edge,
-                        cache,
-                    )
+                    needs_recompute(at, fading, rel, time_s, near_edge, cache)
                 });
             if stale {
                 let base = state.sprite_base as usize;
                 let slots = &mut orders_cpu[base..base + n as usize];
-                for (slot, (i, _)) in slots
-                    .iter_mut()
-                    .zip(sprites_back_to_front(cloud, cam_local))
-                {
+                let sorted = sprites_back_to_front(&r.block.clouds[ci], cam_local);
+                for (slot, (i, _)) in slots.iter_mut().zip(sorted) {
                     *slot = state.sprite_base + i as u32;
                 }
                 dirty_orders.push(state.sprite_base..state.sprite_base + n);

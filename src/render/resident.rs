@@ -22,6 +22,10 @@ pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4 + 
 /// A cloud's bounds (computed once when its block arrives) and its order cache.
 #[derive(Debug, Clone)]
 pub(super) struct CloudState {
+    /// Its centre, metres (a copy of the cloud's: what a frame reads of every cloud, together).
+    pub centre_m: DVec3,
+    /// Its sprites.
+    pub sprites: u32,
     /// Radius of a sphere around the centre holding every sprite, metres.
     pub radius_m: f32,
     /// Half extents and centre offset of the box of its sprite cores (in-cloud fog).
@@ -44,6 +48,8 @@ pub(super) struct Resident {
     pub place: Option<(Range<u32>, Range<u32>)>,
     /// Written to its slots yet.
     pub uploaded: bool,
+    /// Drawn as sprites this frame (not in the impostor ring); set by the ring's split.
+    pub near: bool,
     pub clouds: Vec<CloudState>,
 }
 
@@ -55,6 +61,8 @@ impl Resident {
             .map(|c| {
                 let (core_half_m, core_centre_m) = c.core_box_m();
                 CloudState {
+                    centre_m: c.centre_m,
+                    sprites: c.sprites.len() as u32,
                     radius_m: c.radius_m(),
                     core_half_m,
                     core_centre_m,
@@ -69,6 +77,7 @@ impl Resident {
             motion,
             place: None,
             uploaded: false,
+            near: true,
             clouds,
         }
     }
@@ -406,7 +415,7 @@ impl ResidentSet {
         }
         self.dirty_orders.sort_by_key(|r| r.start);
         // Spans closer than this many slots go in one write: fewer calls for a few more bytes.
-        const MERGE_GAP: u32 = 64;
+        const MERGE_GAP: u32 = 2048;
         let mut bytes = 0;
         let mut spans = std::mem::take(&mut self.dirty_orders).into_iter();
         let Some(mut run) = spans.next() else {

@@ -363,6 +363,25 @@ impl Sky {
         }
     }
 
+    /// Moves every block the sky holds to the same drift offset (a field drifting with the air as
+    /// one): one write a block, no lookups, nothing uploaded.
+    pub fn set_drift(&mut self, offset_m: glam::DVec3) {
+        for r in self.resident.blocks.values_mut() {
+            r.motion.offset_m = offset_m;
+        }
+    }
+
+    /// Sets where a block is in its life, keeping its drift; false if the sky does not hold it.
+    pub fn set_block_fade(&mut self, id: u64, fade: super::Fade) -> bool {
+        match self.resident.blocks.get_mut(&id) {
+            Some(r) => {
+                r.motion.fade = fade;
+                true
+            }
+            None => false,
+        }
+    }
+
     /// The ids of the blocks the sky holds.
     pub fn block_ids(&self) -> impl Iterator<Item = u64> + '_ {
         self.resident.blocks.keys().copied()
@@ -515,16 +534,14 @@ impl Sky {
         let mut stats = FrameStats::default();
         let (mut upload_bytes, left_out) = self.resident.place_and_upload(queue, camera.position_m);
         stats.blocks_left_out = left_out;
-        let near = self
-            .ring
-            .split(&self.resident, camera.position_m, sun_dir, dt_s);
+        self.ring
+            .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
         let in_cloud = main_view(
             &mut self.resident.blocks,
             OrderCopy {
                 slots: &mut self.resident.orders_cpu,
                 dirty: &mut self.resident.dirty_orders,
             },
-            &near,
             camera.position_m,
             self.elapsed_s,
             &self.settings,

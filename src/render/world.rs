@@ -113,6 +113,11 @@ pub struct LivingClouds {
     asked: Option<(BlockIndex, BlockIndex, u64)>,
     in_sky: HashSet<u64>,
     seen: HashSet<u64>,
+    /// The newest generation handed to the sky.
+    newest_serial: u64,
+    /// Generations forming or dissipating this frame and the last.
+    fading: Vec<u64>,
+    was_fading: Vec<u64>,
 }
 
 /// Weather field, ground and cloud blocks around a reference point.
@@ -277,6 +282,7 @@ impl World {
     /// forming and dissipating when the weather changes) and hands `sky` what changed: new
     /// generations are inserted (uploaded once), gone ones removed, and every block's drift and
     /// fade set. Its own CPU time goes into the sky's next [`crate::render::FrameStats::field_us`].
+    /// Hand it the same sky every frame.
     pub fn update_sky(
         &mut self,
         sky: &mut Sky,
@@ -297,6 +303,9 @@ impl World {
                 asked: None,
                 in_sky: HashSet::new(),
                 seen: HashSet::new(),
+                newest_serial: 0,
+                fading: Vec::new(),
+                was_fading: Vec::new(),
             });
         }
         let weather_field = &self.field;
@@ -336,26 +345,51 @@ impl World {
         let now = living.field.time_s();
         let lifecycle = *living.field.lifecycle();
         let sky_before_us = sky.pending_cpu_us();
-        living.seen.clear();
+        // Generations are handed over when they appear (serials only grow) and when they go;
+        // per frame only the drift (one value) and the fades of the blocks forming or
+        // dissipating change.
+        let mut count = 0;
+        let newest = living.newest_serial;
+        living.fading.clear();
         for (index, fb) in living.field.blocks() {
+            count += 1;
             let fade = match fb.phase {
                 Phase::Steady => Fade::Steady,
                 Phase::Forming { .. } => Fade::Forming(progress(fb.phase, now, &lifecycle)),
-                Phase::Dissipating { .. } => Fade::Dissipating(progress(fb.phase, now, &lifecycle)),
+                Phase::Dissipating { .. } => {
+                    Fade::Dissipating(progress(fb.phase, now, &lifecycle))
+                }
                 Phase::Gone => Fade::Dissipating(1.0),
             };
-            let motion = BlockMotion { offset_m, fade };
-            living.seen.insert(fb.serial);
-            if living.in_sky.insert(fb.serial) {
-                sky.insert_block(living_block(index, fb), motion);
-            } else {
-                sky.set_block_motion(fb.serial, motion);
+            if fb.serial > newest {
+                living.newest_serial = living.newest_serial.max(fb.serial);
+                living.in_sky.insert(fb.serial);
+                sky.insert_block(living_block(index, fb), BlockMotion { offset_m, fade });
+            } else if fade != Fade::Steady {
+                sky.set_block_fade(fb.serial, fade);
+            }
+            if fade != Fade::Steady {
+                living.fading.push(fb.serial);
             }
         }
-        let gone: Vec<u64> = living.in_sky.difference(&living.seen).copied().collect();
-        for id in gone {
-            living.in_sky.remove(&id);
-            sky.remove_block(id);
+        // The ones that finished forming since the last frame.
+        living.fading.sort_unstable();
+        for &id in &living.was_fading {
+            if living.fading.binary_search(&id).is_err() {
+                sky.set_block_fade(id, Fade::Steady);
+            }
+        }
+        std::mem::swap(&mut living.was_fading, &mut living.fading);
+        sky.set_drift(offset_m);
+        // Every block of the field is in the sky; more there means some went.
+        if living.in_sky.len() != count {
+            living.seen.clear();
+            living.seen.extend(living.field.blocks().map(|(_, fb)| fb.serial));
+            let gone: Vec<u64> = living.in_sky.difference(&living.seen).copied().collect();
+            for id in gone {
+                living.in_sky.remove(&id);
+                sky.remove_block(id);
+            }
         }
         // The sky counts its own share (the blocks inserted and removed) in its update.
         let sky_us = sky.pending_cpu_us() - sky_before_us;

@@ -93,6 +93,8 @@ pub struct ImpostorRing {
     pending: Vec<(usize, usize, u32)>,
     /// This frame's ring pass: (old ring, new ring), if any ring is shown.
     quads: Option<(usize, usize)>,
+    /// Blocks drawn into the ring this frame.
+    blocks_far: u32,
     bytes: u64,
 }
 
@@ -363,6 +365,7 @@ impl ImpostorRing {
             fade: None,
             pending: Vec::new(),
             quads: None,
+            blocks_far: 0,
             bytes,
         }
     }
@@ -382,20 +385,22 @@ impl ImpostorRing {
             }
     }
 
-    /// Decides this frame's near blocks (ids of `resident`'s blocks, drawn as sprites) and
+    /// Decides this frame's near blocks (marks `resident`'s blocks `near`: drawn as sprites) and
     /// starts or advances a rebuild. Call [`Self::prepare_builds`] after, with the frame's
-    /// uniform.
+    /// uniform. One pass over the blocks.
     pub(super) fn split(
         &mut self,
-        resident: &ResidentSet,
+        resident: &mut ResidentSet,
         camera_m: DVec3,
         sun: Vec3,
         dt_s: f64,
-    ) -> Vec<u64> {
+    ) {
         let s = self.settings;
-        let blocks = &resident.blocks;
+        let blocks = &mut resident.blocks;
+        self.blocks_far = 0;
         if !s.enabled {
-            return blocks.keys().copied().collect();
+            blocks.values_mut().for_each(|r| r.near = true);
+            return;
         }
         // Advance the crossfade; a finished fade makes the new ring the shown one.
         if let Some((ring, state, w)) = self.fade.take() {
@@ -410,70 +415,80 @@ impl ImpostorRing {
                 self.fade = Some((ring, state, w));
             }
         }
-        let newest = self
-            .fade
-            .as_ref()
-            .map(|(_, st, _)| st)
-            .or(self.shown.as_ref().map(|(_, st)| st));
-        if self.build.is_none() {
-            let start = match newest {
-                None => true,
-                Some(st) if self.fade.is_none() => {
-                    // The far set of the ring's centre now, compared without building it.
-                    let mut far_now = 0;
-                    let mut same = true;
-                    for r in blocks.values() {
-                        if is_far(r.centre_m(), st.centre_m, camera_m, &s) {
-                            far_now += 1;
-                            if !st.far_ids.contains(&r.block.id) {
-                                same = false;
-                                break;
-                            }
-                        }
+        // The far set shown (or fading in), and whether the blocks far from the shown ring's
+        // centre are still the ones in it (else a rebuild starts).
+        let steady_shown = self.fade.is_none() && self.build.is_none();
+        let mut far_now = 0;
+        let mut same = true;
+        let mut far_count = 0;
+        {
+            let shown = self.shown.as_ref().map(|(_, st)| st);
+            let far = self
+                .fade
+                .as_ref()
+                .map(|(_, st, _)| &st.far_ids)
+                .or(shown.map(|st| &st.far_ids))
+                .or(self.build.as_ref().map(|b| &b.state.far_ids));
+            for r in blocks.values_mut() {
+                let in_far = far.is_some_and(|f| f.contains(&r.block.id));
+                r.near = !in_far;
+                far_count += in_far as u32;
+                if steady_shown && let Some(st) = shown {
+                    if is_far(r.centre_m(), st.centre_m, camera_m, &s) {
+                        far_now += 1;
+                        same &= in_far;
                     }
-                    needs_rebuild(st.centre_m, st.sun, camera_m, sun, &s)
-                        || !same
-                        || far_now != st.far_ids.len()
                 }
-                Some(_) => false,
-            };
-            if start {
-                let ring = self.shown.as_ref().map_or(0, |(r, _)| 1 - r);
-                let far: Vec<(u64, f64)> = blocks
-                    .values()
-                    .filter(|r| is_far(r.centre_m(), camera_m, camera_m, &s))
-                    .map(|r| (r.block.id, (r.centre_m() - camera_m).length()))
-                    .collect();
-                let far_mean_m = if far.is_empty() {
-                    s.ring_radius_m
-                } else {
-                    far.iter().map(|f| f.1).sum::<f64>() / far.len() as f64
-                };
-                let far_ids = far.iter().map(|f| f.0).collect();
-                self.build = Some(Build {
-                    ring,
-                    next: 0,
-                    state: RingState {
-                        centre_m: camera_m,
-                        sun,
-                        far_ids,
-                        far_mean_m,
-                    },
-                });
             }
         }
-        let far = self
-            .fade
-            .as_ref()
-            .map(|(_, st, _)| &st.far_ids)
-            .or(self.shown.as_ref().map(|(_, st)| &st.far_ids));
-        // Before the first ring exists it is built this frame, so its blocks are far already.
-        let far = far.or(self.build.as_ref().map(|b| &b.state.far_ids));
-        blocks
-            .keys()
-            .filter(|id| far.is_none_or(|f| !f.contains(id)))
-            .copied()
-            .collect()
+        self.blocks_far = far_count;
+        if self.build.is_some() {
+            return;
+        }
+        let start = match (&self.shown, &self.fade) {
+            (None, None) => true,
+            (Some((_, st)), None) => {
+                needs_rebuild(st.centre_m, st.sun, camera_m, sun, &s)
+                    || !same
+                    || far_now != st.far_ids.len()
+            }
+            _ => false,
+        };
+        if !start {
+            return;
+        }
+        let ring = self.shown.as_ref().map_or(0, |(r, _)| 1 - r);
+        let far: Vec<(u64, f64)> = blocks
+            .values()
+            .filter(|r| is_far(r.centre_m(), camera_m, camera_m, &s))
+            .map(|r| (r.block.id, (r.centre_m() - camera_m).length()))
+            .collect();
+        let far_mean_m = if far.is_empty() {
+            s.ring_radius_m
+        } else {
+            far.iter().map(|f| f.1).sum::<f64>() / far.len() as f64
+        };
+        let far_ids: BTreeSet<u64> = far.iter().map(|f| f.0).collect();
+        let first = self.shown.is_none();
+        if first {
+            // Before the first ring exists it is built this frame, so its blocks are far
+            // already.
+            self.blocks_far = 0;
+            for r in blocks.values_mut() {
+                r.near = !far_ids.contains(&r.block.id);
+                self.blocks_far += !r.near as u32;
+            }
+        }
+        self.build = Some(Build {
+            ring,
+            next: 0,
+            state: RingState {
+                centre_m: camera_m,
+                sun,
+                far_ids,
+                far_mean_m,
+            },
+        });
     }
 
     /// Writes this frame's impostor builds (all 8 for a first ring, else the next one): each
@@ -594,14 +609,8 @@ impl ImpostorRing {
             bytes += std::mem::size_of::<GpuRing>() as u64;
             self.quads = Some((*old, new));
         }
-        let far = self
-            .fade
-            .as_ref()
-            .map(|(_, st, _)| &st.far_ids)
-            .or(self.shown.as_ref().map(|(_, st)| &st.far_ids));
-        let far_count = far.map_or(0, |f| blocks.keys().filter(|id| f.contains(id)).count());
-        stats.blocks_far = far_count as u32;
-        stats.blocks_near = (blocks.len() - far_count) as u32;
+        stats.blocks_far = self.blocks_far;
+        stats.blocks_near = blocks.len() as u32 - self.blocks_far;
         bytes
     }
 
