@@ -1,6 +1,7 @@
 // Pass `sky.sprites`: cloud sprites, back to front, premultiplied alpha. The sprites live on the
 // GPU (written once per block); each frame the CPU sends only the draw list (one entry per
-// cloud, back to front, its centre relative to the camera) and the sprite orders that changed.
+// block, back to front, its centre relative to the camera) and the cloud lists and sprite
+// orders that changed.
 // The vertex shader builds each quad: the sprite's facing (camera facing, upright cylindrical
 // base sprites, flat cirrus, the facing lock of Wang 3.3 with its angle fade), Wang's equation
 // (3) shading per corner (ambient colour levels by height, directional shading groups), the
@@ -24,19 +25,28 @@ struct Sprite {
 
 // Keep in sync with `GpuCloud`.
 struct Cloud {
+    centre_block: vec4<f32>,
     level_rgba: array<vec4<f32>, 5>,
     level_height: vec4<f32>,
     level4_radius_flat: vec4<f32>,
 };
 
-// Keep in sync with `GpuDrawCloud`.
-struct DrawCloud {
-    centre_rel: vec3<f32>,
+// Keep in sync with `GpuDrawBlock`.
+struct DrawBlock {
+    origin_rel: vec3<f32>,
     first: u32,
-    cloud: u32,
-    order_base: u32,
+    list_base: u32,
+    list_len: u32,
     fade_kind: u32,
     fade_progress: f32,
+};
+
+// Keep in sync with `GpuListCloud`.
+struct ListCloud {
+    cloud: u32,
+    first: u32,
+    order_base: u32,
+    pad: u32,
 };
 
 // Keep in sync with `GpuLock`.
@@ -61,8 +71,9 @@ struct SpriteView {
 @group(2) @binding(0) var<storage, read> sprites: array<Sprite>;
 @group(2) @binding(1) var<storage, read> clouds: array<Cloud>;
 @group(3) @binding(0) var<uniform> view: SpriteView;
-@group(3) @binding(1) var<storage, read> draws: array<DrawCloud>;
-@group(3) @binding(2) var<storage, read> orders: array<u32>;
+@group(3) @binding(1) var<storage, read> draws: array<DrawBlock>;
+@group(3) @binding(2) var<storage, read> lists: array<ListCloud>;
+@group(3) @binding(3) var<storage, read> orders: array<u32>;
 
 struct VertexOut {
     @builtin(position) position: vec4<f32>,
@@ -168,13 +179,28 @@ fn cell_uv(cell: u32, corner: vec2<f32>) -> vec2<f32> {
     return uv * 0.25;
 }
 
-// The draw-list entry holding the frame's sprite `k`: the last whose `first` is <= k.
-fn draw_of(k: u32) -> u32 {
+// The block of the draw list holding the frame's sprite `k`: the last whose `first` is <= k.
+fn block_of(k: u32) -> u32 {
     var lo = 0u;
     var hi = view.counts.x;
     while (hi - lo > 1u) {
         let mid = (lo + hi) / 2u;
         if (draws[mid].first <= k) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// The cloud of a block's list holding its sprite `k`: the last whose `first` is <= k.
+fn cloud_of(b: DrawBlock, k: u32) -> u32 {
+    var lo = b.list_base;
+    var hi = b.list_base + b.list_len;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (lists[mid].first <= k) {
             lo = mid;
         } else {
             hi = mid;
@@ -207,14 +233,17 @@ fn sprite_corner(vi: u32) -> Corner {
     var o: Corner;
     let k = vi / 4u;
     let corner_id = vi % 4u;
-    let d = draws[draw_of(k)];
-    let slot = orders[d.order_base + (k - d.first)];
+    let b = draws[block_of(k)];
+    let in_block = k - b.first;
+    let entry = lists[cloud_of(b, in_block)];
+    let slot = orders[entry.order_base + (in_block - entry.first)];
     let s = sprites[slot];
-    let flat_radius = clouds[d.cloud].level4_radius_flat;
+    let flat_radius = clouds[entry.cloud].level4_radius_flat;
+    let centre_rel = b.origin_rel + clouds[entry.cloud].centre_block.xyz;
     let offset = s.offset_width.xyz;
     let width = s.offset_width.w;
     let height = s.group_height.w;
-    let cam_local = -d.centre_rel;
+    let cam_local = -centre_rel;
     let to_cam = cam_local - offset;
     let radius = 0.5 * max(width, height);
 
@@ -237,7 +266,7 @@ fn sprite_corner(vi: u32) -> Corner {
         let lock = view.forward_lock;
         alpha *= clamp((cos_angle - lock.w) / max(lock.z - lock.w, 1e-4), 0.0, 1.0);
     }
-    let morph = s.alpha_morph * lifecycle_alpha(d.fade_kind, d.fade_progress, s.radius_fraction);
+    let morph = s.alpha_morph * lifecycle_alpha(b.fade_kind, b.fade_progress, s.radius_fraction);
     o.visible = alpha > 0.0 && morph > 0.0;
 
     let corner = vec2<f32>(f32(corner_id & 1u), 1.0 - f32(corner_id >> 1u));
@@ -248,8 +277,8 @@ fn sprite_corner(vi: u32) -> Corner {
 
     // Wang eq. (3): (ambient + directional) x alpha_morph; the texture is the fragment's.
     let light = view.directional_ambient;
-    let height_msl = view.sun_dir_camera_z.w + d.centre_rel.z + p.z;
-    let ambient = level_colour(d.cloud, height_msl);
+    let height_msl = view.sun_dir_camera_z.w + centre_rel.z + p.z;
+    let ambient = level_colour(entry.cloud, height_msl);
     let view_dir = normalize_or(p - cam_local, vec3<f32>(0.0));
     let rim = length(p) / flat_radius.y;
     let group_dir = normalize_or(p - s.group_height.xyz, vec3<f32>(0.0));
@@ -259,7 +288,7 @@ fn sprite_corner(vi: u32) -> Corner {
     o.colour = vec4<f32>(ambient.rgb * light.w + directional, ambient.a * morph * alpha);
     // Texture v runs down the sheet: the top of the sprite is v = 0.
     o.uv = cell_uv(s.bits & 15u, vec2<f32>(corner.x, 1.0 - corner.y));
-    o.rel_m = d.centre_rel + p;
+    o.rel_m = centre_rel + p;
     return o;
 }
 

@@ -1,20 +1,23 @@
 //! The CPU's share of a frame of sprites (Wang 2003 sections 3.3 and 6.1), now that the sprites
-//! live on the GPU: sort blocks and clouds back to front (thousands, not 100,000s), recompute a
-//! cloud's back-to-front sprite order only when the camera has moved relative to it, or time
-//! has passed, beyond thresholds that grow with its distance (the vertex cache's rule, applied
-//! to the order), keep the locked facings of the sprites the camera is inside of, and write the
-//! draw list the vertex shader reads (one entry per cloud). Facing, shading and fades are the
-//! vertex shader's (`shaders/sprites.wgsl`).
+//! live on the GPU. Per frame: sort the near blocks back to front (hundreds) and write the draw
+//! list the vertex shader reads (one entry per block: its centre relative to the camera, worked
+//! out in f64, and its fade). A cloud's back-to-front sprite order is recomputed only when the
+//! camera has moved relative to it, or time has passed, beyond thresholds that grow with its
+//! distance (the vertex cache's rule, applied to the order); a block's list of clouds, back to
+//! front, is looked at again only when the camera has used up the smallest slack of its
+//! clouds, so most frames touch no cloud at all. The locked facings of the sprites the camera is
+//! inside of are kept. Facing, shading and fades are the vertex shader's
+//! (`shaders/sprites.wgsl`).
 //!
-//! In: the resident blocks, the camera (f64), the time. Out: [`GpuDrawCloud`]s, changed orders,
-//! locks, [`FrameStats`]. No wgpu calls.
+//! In: the resident blocks, the camera (f64), the time. Out: [`GpuDrawBlock`]s, changed orders
+//! and cloud lists, locks, [`FrameStats`]. No wgpu calls.
 
 use std::collections::HashMap;
 
 use glam::{DVec3, Vec3};
 
-use super::gpu_types::{GpuDrawCloud, GpuLock, MAX_LOCKS};
-use super::resident::{CloudState, Resident};
+use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, MAX_LOCKS};
+use super::resident::{BlockCheck, CloudState, Resident};
 use super::scene::{Fade, SkyCloud};
 use super::settings::{RenderSettings, VertexCacheSettings};
 use super::stats::FrameStats;
@@ -131,6 +134,26 @@ fn needs_recompute(
     moved_m > move_limit_m || time_s - ordered_at.1 > max_age_s || time_s < ordered_at.1
 }
 
+/// Whether less than a third of a cloud's movement or age threshold is left.
+fn nearly_stale(
+    ordered_at: (DVec3, f64),
+    fading: bool,
+    camera_rel_m: DVec3,
+    time_s: f64,
+    near_edge_m: f64,
+    cache: &VertexCacheSettings,
+) -> bool {
+    const LEFT: f64 = 1.0 / 3.0;
+    let moved_m = (camera_rel_m - ordered_at.0).length();
+    let move_limit_m = cache.min_move_m as f64 + cache.move_fraction as f64 * near_edge_m;
+    let max_age_s = if fading {
+        cache.fading_max_age_s as f64
+    } else {
+        cache.max_age_s as f64 * (1.0 + near_edge_m / cache.time_distance_m as f64)
+    };
+    moved_m > (1.0 - LEFT) * move_limit_m || time_s - ordered_at.1 > (1.0 - LEFT) * max_age_s
+}
+
 /// How far inside the cloud's core box the camera is: 0 outside, rising to 1 over `ramp` of the
 /// half-extent inside the boundary.
 fn in_cloud_factor(state: &CloudState, camera_rel_m: Vec3, ramp: f32) -> f32 {
@@ -154,6 +177,34 @@ pub fn sprites_back_to_front(cloud: &SkyCloud, cam_local_m: Vec3) -> Vec<(usize,
         .collect();
     order.sort_by(|a, b| b.1.total_cmp(&a.1));
     order
+}
+
+/// Squared distances (as bits) and sprite indices of a cloud being sorted.
+type SortKeys = Vec<(u32, u32)>;
+
+/// Writes the cloud's sprite slots (`base` + index), farthest from the camera first, into
+/// `slots` (`cam_local_m`: the camera relative to the cloud centre). The same order as
+/// [`sprites_back_to_front`], on integer keys (squared distances are positive floats, whose bits
+/// sort as integers) and a reused buffer: this runs for a hundred clouds a frame.
+fn order_into(
+    cloud: &SkyCloud,
+    cam_local_m: Vec3,
+    base: u32,
+    slots: &mut [u32],
+    keys: &mut SortKeys,
+) {
+    keys.clear();
+    keys.extend(
+        cloud
+            .sprites
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (s.offset_m.distance_squared(cam_local_m).to_bits(), i as u32)),
+    );
+    keys.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    for (slot, &(_, i)) in slots.iter_mut().zip(keys.iter()) {
+        *slot = base + i;
+    }
 }
 
 fn fade_code(fade: Fade) -> (u32, f32) {
@@ -180,112 +231,86 @@ fn blocks_back_to_front(blocks: &Blocks, ids: &[u64], from_m: DVec3) -> Vec<(f64
     order
 }
 
-/// Where the sky camera's sprite orders go: a CPU copy of the order buffer and the spans of it
-/// changed this frame.
-pub(super) struct OrderCopy<'a> {
-    pub slots: &'a mut [u32],
-    pub dirty: &'a mut Vec<std::ops::Range<u32>>,
+/// Where the sky camera's sprite orders and cloud lists go: CPU copies of the order and list
+/// buffers and the spans of them changed this frame.
+pub(super) struct Copies<'a> {
+    pub orders: &'a mut [u32],
+    pub dirty_orders: &'a mut Vec<std::ops::Range<u32>>,
+    pub lists: &'a mut [GpuListCloud],
+    pub dirty_lists: &'a mut Vec<std::ops::Range<u32>>,
 }
 
 /// The sky camera's frame: fills `out` with the draw list of the blocks marked near and placed,
-/// recomputes the orders the cache says are stale (into `orders`, marked dirty), updates
-/// `locks`, and counts into `stats`. Returns how far inside a cloud the camera is, 0..=1.
-///
-/// Per frame this reads every near cloud's centre, radius and cache state (`CloudState`, kept
-/// together per block) and touches a cloud's sprites only to re-sort them or when the camera
-/// is inside it.
+/// looks again at the blocks whose slack is used up (re-sorting their clouds, recomputing the
+/// orders the cache says are stale, into `copies`, marked dirty), updates `locks`, and counts
+/// into `stats`. Returns how far inside a cloud the camera is, 0..=1.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn main_view(
     blocks: &mut Blocks,
-    orders: OrderCopy,
+    copies: Copies,
     camera_m: DVec3,
     time_s: f64,
     settings: &RenderSettings,
     locks: &mut Locks,
-    out: &mut Vec<GpuDrawCloud>,
+    out: &mut Vec<GpuDrawBlock>,
     stats: &mut FrameStats,
 ) -> f32 {
-    let (clouds_cfg, cache) = (&settings.clouds, &settings.vertex_cache);
-    let draw_m = clouds_cfg.draw_distance_m as f64;
-    let lock_fraction = clouds_cfg.lock_radius_fraction;
     let mut order: Vec<(f64, &mut Resident)> = blocks
         .values_mut()
         .filter(|r| r.near && r.place.is_some())
         .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
         .collect();
     order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.block.id.cmp(&b.1.block.id)));
-    let OrderCopy {
-        slots: orders_cpu,
-        dirty: dirty_orders,
-    } = orders;
     let mut in_cloud = 0.0f32;
-    let mut cloud_order: Vec<(usize, f64, f64)> = Vec::new();
     let mut total = 0u32;
     out.clear();
     locks.begin();
-    for (_, r) in order {
-        let offset = r.motion.offset_m;
-        let fading = r.motion.fade != Fade::Steady;
-        let (fade_kind, fade_progress) = fade_code(r.motion.fade);
-        cloud_order.clear();
-        for (ci, state) in r.clouds.iter().enumerate() {
-            let d = (state.centre_m + offset - camera_m).length();
-            let near_edge = (d - state.radius_m as f64).max(0.0);
-            if near_edge <= draw_m && state.sprites > 0 {
-                cloud_order.push((ci, d, near_edge));
-            }
-        }
-        cloud_order.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-        for &(ci, d, near_edge) in &cloud_order {
-            let state = &mut r.clouds[ci];
-            let rel = camera_m - (state.centre_m + offset);
-            let cam_local = rel.as_vec3();
-            let n = state.sprites;
-            if d < state.radius_m as f64 {
-                let cloud = &r.block.clouds[ci];
-                let inside = in_cloud_factor(state, cam_local, settings.in_cloud.ramp_fraction);
-                in_cloud = in_cloud.max(inside);
-                if !cloud.flat {
-                    for (k, s) in cloud.sprites.iter().enumerate() {
-                        let to_cam = cam_local - s.offset_m;
-                        let radius = 0.5 * s.width_m.max(s.height_m);
-                        if to_cam.length() < lock_fraction * radius {
-                            let face = if s.upright {
-                                upright_facing(to_cam)
-                            } else {
-                                facing_towards(to_cam.normalize_or(Vec3::Y))
-                            };
-                            locks.keep_or_lock(state.sprite_base + k as u32, face);
-                        }
-                    }
-                }
-            }
-            let stale = !cache.enabled
-                || state.ordered_at.is_none_or(|at| {
-                    needs_recompute(at, fading, rel, time_s, near_edge, cache)
-                });
-            if stale {
-                let base = state.sprite_base as usize;
-                let slots = &mut orders_cpu[base..base + n as usize];
-                let sorted = sprites_back_to_front(&r.block.clouds[ci], cam_local);
-                for (slot, (i, _)) in slots.iter_mut().zip(sorted) {
-                    *slot = state.sprite_base + i as u32;
-                }
-                dirty_orders.push(state.sprite_base..state.sprite_base + n);
-                state.ordered_at = Some((rel, time_s));
-                stats.clouds_recomputed += 1;
-                stats.sprites_recomputed += n;
-            }
-            out.push(GpuDrawCloud {
-                centre_rel: (-rel).as_vec3().to_array(),
-                first: total,
-                cloud: state.cloud_slot,
-                order_base: state.sprite_base,
-                fade_kind,
-                fade_progress,
+    let Copies {
+        orders,
+        dirty_orders,
+        lists,
+        dirty_lists,
+    } = copies;
+    let (mut scratch, mut keys) = (Vec::new(), Vec::new());
+    for (d2, r) in order {
+        let rel = camera_m - r.centre_m();
+        let fresh = settings.vertex_cache.enabled
+            && r.check.is_some_and(|c| {
+                (rel - c.camera_rel_m).length() <= c.move_budget_m
+                    && time_s <= c.deadline_s
+                    && time_s >= c.checked_s
             });
-            total += n;
-            stats.clouds_drawn += 1;
+        if !fresh {
+            recheck(
+                r,
+                camera_m,
+                time_s,
+                settings,
+                orders,
+                dirty_orders,
+                stats,
+                (&mut scratch, &mut keys),
+            );
+            if let Some((_, clouds)) = &r.place {
+                let n = r.list.len() as u32;
+                lists[clouds.start as usize..(clouds.start + n) as usize].copy_from_slice(&r.list);
+                dirty_lists.push(clouds.start..clouds.start + n);
+            }
         }
+        if d2.sqrt() < r.radius_m {
+            in_cloud = in_cloud.max(inside_clouds(r, camera_m, settings, locks));
+        }
+        let (fade_kind, fade_progress) = fade_code(r.motion.fade);
+        out.push(GpuDrawBlock {
+            origin_rel: (-rel).as_vec3().to_array(),
+            first: total,
+            list_base: r.place.as_ref().map_or(0, |p| p.1.start),
+            list_len: r.list.len() as u32,
+            fade_kind,
+            fade_progress,
+        });
+        total += r.list_sprites;
+        stats.clouds_drawn += r.list.len() as u32;
     }
     locks.end();
     stats.sprites_drawn = total;
@@ -297,53 +322,200 @@ pub(super) fn main_view(
     in_cloud
 }
 
+/// Looks at every cloud of a block again: its clouds within the draw distance sorted back to
+/// front into its list, each stale order recomputed (Wang 6.1's thresholds), and how far and
+/// how long the camera may go before any of them needs it again.
+#[allow(clippy::too_many_arguments)]
+fn recheck(
+    r: &mut Resident,
+    camera_m: DVec3,
+    time_s: f64,
+    settings: &RenderSettings,
+    orders: &mut [u32],
+    dirty_orders: &mut Vec<std::ops::Range<u32>>,
+    stats: &mut FrameStats,
+    (scratch, keys): (&mut Vec<(usize, f64, f64)>, &mut SortKeys),
+) {
+    let cache = &settings.vertex_cache;
+    let draw_m = settings.clouds.draw_distance_m as f64;
+    let offset = r.motion.offset_m;
+    let fading = r.motion.fade != Fade::Steady;
+    let slope = cache.move_fraction as f64;
+    scratch.clear();
+    // Slack before a cloud crosses the draw distance.
+    let mut budget = f64::INFINITY;
+    for (ci, state) in r.clouds.iter().enumerate() {
+        let d = (state.centre_m + offset - camera_m).length();
+        let near_edge = (d - state.radius_m as f64).max(0.0);
+        if state.sprites > 0 {
+            budget = budget.min((near_edge - draw_m).abs());
+            if near_edge <= draw_m {
+                scratch.push((ci, d, near_edge));
+            }
+        }
+    }
+    scratch.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    r.list.clear();
+    let mut first = 0u32;
+    let mut nearest_edge = f64::INFINITY;
+    let mut oldest = f64::INFINITY;
+    for &(ci, _, near_edge) in scratch.iter() {
+        let state = &mut r.clouds[ci];
+        let rel = camera_m - (state.centre_m + offset);
+        // Stale by Wang's thresholds, or nearly (less than a third of its slack left): sorted
+        // now with the block's others, so that the block keeps a slack worth waiting for
+        // instead of coming back for one cloud every frame.
+        let stale = !cache.enabled
+            || state.ordered_at.is_none_or(|at| {
+                needs_recompute(at, fading, rel, time_s, near_edge, cache)
+                    || nearly_stale(at, fading, rel, time_s, near_edge, cache)
+            });
+        if stale {
+            let base = state.sprite_base as usize;
+            let slots = &mut orders[base..base + state.sprites as usize];
+            order_into(
+                &r.block.clouds[ci],
+                rel.as_vec3(),
+                state.sprite_base,
+                slots,
+                keys,
+            );
+            dirty_orders.push(state.sprite_base..state.sprite_base + state.sprites);
+            state.ordered_at = Some((rel, time_s));
+            stats.clouds_recomputed += 1;
+            stats.sprites_recomputed += state.sprites;
+        }
+        // What is left of its movement threshold, knowing that its distance (and with it the
+        // threshold) shrinks by at most what the camera moves.
+        let (at_rel, at_s) = state.ordered_at.unwrap_or((rel, time_s));
+        let limit = cache.min_move_m as f64 + slope * near_edge;
+        budget = budget.min((limit - (rel - at_rel).length()).max(0.0) / (1.0 + slope));
+        nearest_edge = nearest_edge.min(near_edge);
+        oldest = oldest.min(at_s);
+        r.list.push(GpuListCloud {
+            cloud: state.cloud_slot,
+            first,
+            order_base: state.sprite_base,
+            _pad: 0,
+        });
+        first += state.sprites;
+    }
+    r.list_sprites = first;
+    // The age threshold of the nearest cloud once the camera has used up the movement slack
+    // (the smallest any of them can have), from the oldest order.
+    let max_age_s = if fading {
+        cache.fading_max_age_s as f64
+    } else {
+        let edge = (nearest_edge - budget).max(0.0);
+        cache.max_age_s as f64 * (1.0 + edge / cache.time_distance_m as f64)
+    };
+    r.check = Some(BlockCheck {
+        camera_rel_m: camera_m - r.centre_m(),
+        move_budget_m: budget,
+        checked_s: time_s,
+        deadline_s: oldest + max_age_s,
+    });
+}
+
+/// The camera is within a block's radius: how far inside its clouds it is, and the facing locks
+/// of the sprites it is within half the radius of.
+fn inside_clouds(
+    r: &Resident,
+    camera_m: DVec3,
+    settings: &RenderSettings,
+    locks: &mut Locks,
+) -> f32 {
+    let mut in_cloud = 0.0f32;
+    let lock_fraction = settings.clouds.lock_radius_fraction;
+    for (state, cloud) in r.clouds.iter().zip(&r.block.clouds) {
+        let cam_local = (camera_m - (state.centre_m + r.motion.offset_m)).as_vec3();
+        if cam_local.length() >= state.radius_m {
+            continue;
+        }
+        in_cloud = in_cloud.max(in_cloud_factor(
+            state,
+            cam_local,
+            settings.in_cloud.ramp_fraction,
+        ));
+        if cloud.flat {
+            continue;
+        }
+        for (k, s) in cloud.sprites.iter().enumerate() {
+            let to_cam = cam_local - s.offset_m;
+            let radius = 0.5 * s.width_m.max(s.height_m);
+            if to_cam.length() < lock_fraction * radius {
+                let face = if s.upright {
+                    upright_facing(to_cam)
+                } else {
+                    facing_towards(to_cam.normalize_or(Vec3::Y))
+                };
+                locks.keep_or_lock(state.sprite_base + k as u32, face);
+            }
+        }
+    }
+    in_cloud
+}
+
 /// An impostor's view from `from_m` (no cache, no locks): the draw list of the blocks `ids`
-/// within `draw_m`, back to front, with every cloud's order computed afresh into `orders`.
-/// Returns the sprites.
+/// within `draw_m`, back to front, with each block's cloud list and every cloud's order
+/// computed afresh into `lists` and `orders`. Returns the sprites.
 pub(super) fn fresh_view(
     blocks: &Blocks,
     ids: &[u64],
     from_m: DVec3,
     draw_m: f64,
-    out: &mut Vec<GpuDrawCloud>,
+    out: &mut Vec<GpuDrawBlock>,
+    lists: &mut Vec<GpuListCloud>,
     orders: &mut Vec<u32>,
 ) -> u32 {
     out.clear();
+    lists.clear();
     orders.clear();
+    let mut total = 0u32;
     let mut cloud_order: Vec<(usize, f64)> = Vec::new();
     for (_, id) in blocks_back_to_front(blocks, ids, from_m) {
         let Some(r) = blocks.get(&id) else {
             continue;
         };
         let offset = r.motion.offset_m;
-        let (fade_kind, fade_progress) = fade_code(r.motion.fade);
         cloud_order.clear();
-        for (ci, (cloud, state)) in r.block.clouds.iter().zip(&r.clouds).enumerate() {
-            let d = (cloud.centre_m + offset - from_m).length();
-            if (d - state.radius_m as f64).max(0.0) <= draw_m && !cloud.sprites.is_empty() {
+        for (ci, state) in r.clouds.iter().enumerate() {
+            let d = (state.centre_m + offset - from_m).length();
+            if (d - state.radius_m as f64).max(0.0) <= draw_m && state.sprites > 0 {
                 cloud_order.push((ci, d));
             }
         }
         cloud_order.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+        let list_base = lists.len() as u32;
+        let mut first = 0u32;
         for &(ci, _) in &cloud_order {
             let (cloud, state) = (&r.block.clouds[ci], &r.clouds[ci]);
-            let rel = from_m - (cloud.centre_m + offset);
-            out.push(GpuDrawCloud {
-                centre_rel: (-rel).as_vec3().to_array(),
-                first: orders.len() as u32,
+            let rel = from_m - (state.centre_m + offset);
+            lists.push(GpuListCloud {
                 cloud: state.cloud_slot,
+                first,
                 order_base: orders.len() as u32,
-                fade_kind,
-                fade_progress,
+                _pad: 0,
             });
             orders.extend(
                 sprites_back_to_front(cloud, rel.as_vec3())
                     .into_iter()
                     .map(|(i, _)| state.sprite_base + i as u32),
             );
+            first += state.sprites;
         }
+        let (fade_kind, fade_progress) = fade_code(r.motion.fade);
+        out.push(GpuDrawBlock {
+            origin_rel: (r.centre_m() - from_m).as_vec3().to_array(),
+            first: total,
+            list_base,
+            list_len: cloud_order.len() as u32,
+            fade_kind,
+            fade_progress,
+        });
+        total += first;
     }
-    orders.len() as u32
+    total
 }
 
 #[cfg(test)]

@@ -1,6 +1,6 @@
 //! The structs the GPU reads, each with a WGSL twin of the same field names. Keep in sync with
-//! `shaders/shared/frame.wgsl` (`Frame`), `shaders/sprites.wgsl` (`Sprite`, `Cloud`, `DrawCloud`,
-//! `Lock`, `SpriteView`) and
+//! `shaders/shared/frame.wgsl` (`Frame`), `shaders/sprites.wgsl` (`Sprite`, `Cloud`, `DrawBlock`,
+//! `ListCloud`, `Lock`, `SpriteView`) and
 //! `shaders/terrain.wgsl` (`TerrainFrame`, `TerrainVertex`).
 
 use bytemuck::{Pod, Zeroable};
@@ -58,6 +58,8 @@ pub const SPRITE_UPRIGHT: u32 = 1 << 8;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuCloud {
+    /// xyz: centre, metres from its block's centre; w unused.
+    pub centre_block: [f32; 4],
     /// The five ambient colour levels, RGBA (Wang 5.1).
     pub level_rgba: [[f32; 4]; 5],
     /// Heights of levels 0..4, metres above mean sea level.
@@ -66,28 +68,44 @@ pub struct GpuCloud {
     /// w unused.
     pub level4_radius_flat: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuCloud>() == 112);
+const _: () = assert!(std::mem::size_of::<GpuCloud>() == 128);
 
-/// One cloud of a frame's draw list, back to front: where it is relative to the camera (f64 on
-/// the CPU, so nothing jitters far out) and where its sprite order lives. Keep in sync with
-/// `DrawCloud` in `shaders/sprites.wgsl`.
+/// One block of a frame's draw list, back to front: where it is relative to the camera (f64 on
+/// the CPU, so nothing jitters far out), where its clouds' list is, and its fade. Keep in sync
+/// with `DrawBlock` in `shaders/sprites.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuDrawCloud {
-    /// Cloud centre minus the camera position, metres.
-    pub centre_rel: [f32; 3],
+pub struct GpuDrawBlock {
+    /// Block centre (with its drift) minus the camera position, metres.
+    pub origin_rel: [f32; 3],
     /// Index of its first sprite in the frame's sequence of drawn sprites.
     pub first: u32,
-    /// Its slot in the cloud buffer.
-    pub cloud: u32,
-    /// Where its back-to-front sprite order starts in the bound order buffer.
-    pub order_base: u32,
+    /// Where its clouds' list starts in the bound list buffer.
+    pub list_base: u32,
+    /// Clouds in the list.
+    pub list_len: u32,
     /// 0 steady, 1 forming, 2 dissipating (Wang 4).
     pub fade_kind: u32,
     /// Progress of the formation or dissipation, 0..=1.
     pub fade_progress: f32,
 }
-const _: () = assert!(std::mem::size_of::<GpuDrawCloud>() == 32);
+const _: () = assert!(std::mem::size_of::<GpuDrawBlock>() == 32);
+
+/// One cloud of a block's list, back to front (kept until the camera has moved past the
+/// block's thresholds). Keep in sync with `ListCloud` in `shaders/sprites.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+pub struct GpuListCloud {
+    /// Its slot in the cloud buffer.
+    pub cloud: u32,
+    /// Index of its first sprite among its block's drawn sprites.
+    pub first: u32,
+    /// Where its back-to-front sprite order starts in the bound order buffer.
+    pub order_base: u32,
+    /// Unused.
+    pub _pad: u32,
+}
+const _: () = assert!(std::mem::size_of::<GpuListCloud>() == 16);
 
 /// Most facings locked at once (Wang 3.3); beyond it a sprite faces the camera.
 pub const MAX_LOCKS: usize = 128;
@@ -124,7 +142,7 @@ pub struct GpuSpriteView {
     /// x, y: sines of the upright fade start and end angles; z: lifecycle inner radius fraction;
     /// w: lifecycle outer start opacity.
     pub upright_lifecycle: [f32; 4],
-    /// x: clouds in the draw list; y: locks; zw unused.
+    /// x: blocks in the draw list; y: locks; zw unused.
     pub counts: [u32; 4],
     /// The locked facings.
     pub locks: [GpuLock; MAX_LOCKS],

@@ -28,6 +28,7 @@ pub mod output;
 mod pipeline;
 mod readback;
 mod resident;
+mod scatter;
 pub mod scene;
 pub mod settings;
 pub mod sky;

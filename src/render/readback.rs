@@ -36,6 +36,7 @@ pub(super) struct CornerSources<'a> {
     pub clouds: &'a wgpu::Buffer,
     pub view: &'a wgpu::Buffer,
     pub draws: &'a wgpu::Buffer,
+    pub lists: &'a wgpu::Buffer,
     pub orders: &'a wgpu::Buffer,
 }
 
@@ -52,9 +53,9 @@ pub(super) fn read_corners(
         return Ok(Vec::new());
     }
     let stage_buffers = device.limits().max_storage_buffers_per_shader_stage;
-    if stage_buffers < 5 {
+    if stage_buffers < 6 {
         return Err(RenderError::Device(format!(
-            "reading sprite corners back needs 5 storage buffers per shader stage, the device has {stage_buffers}"
+            "reading sprite corners back needs 6 storage buffers per shader stage, the device has {stage_buffers}"
         )));
     }
     let module = super::pipeline::shader(
@@ -101,7 +102,15 @@ pub(super) fn read_corners(
         group(0, &[]),
         group(1, &[(2, &out)]),
         group(2, &[(0, src.sprites), (1, src.clouds)]),
-        group(3, &[(0, src.view), (1, src.draws), (2, src.orders)]),
+        group(
+            3,
+            &[
+                (0, src.view),
+                (1, src.draws),
+                (2, src.lists),
+                (3, src.orders),
+            ],
+        ),
     ];
     let mut encoder = device.create_command_encoder(&Default::default());
     {

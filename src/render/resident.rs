@@ -12,11 +12,12 @@ use std::ops::Range;
 
 use glam::{DVec3, Vec3};
 
-use super::gpu_types::{GpuCloud, GpuSprite, SPRITE_UPRIGHT};
+use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_UPRIGHT};
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
 
-/// Bytes of GPU memory each sprite slot costs: its record, its order entry, six quad indices.
+/// Bytes of GPU memory each sprite slot costs: its record, its order entry, six quad indices
+/// (a cloud's record and list entry come on top, a hundredth of it for 30-sprite clouds).
 pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4 + 6 * 4;
 
 /// A cloud's bounds (computed once when its block arrives) and its order cache.
@@ -39,11 +40,29 @@ pub(super) struct CloudState {
     pub ordered_at: Option<(DVec3, f64)>,
 }
 
+/// When a block's cloud list and orders must be looked at again: the camera relative to the
+/// block then, how far it may move from there and until when, before any of its clouds passes
+/// its cache thresholds or the draw distance.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct BlockCheck {
+    pub camera_rel_m: DVec3,
+    pub move_budget_m: f64,
+    pub checked_s: f64,
+    pub deadline_s: f64,
+}
+
 /// A block the sky holds.
 #[derive(Debug, Clone)]
 pub(super) struct Resident {
     pub block: SkyBlock,
     pub motion: BlockMotion,
+    /// Radius of a sphere around the block's centre holding all its clouds, metres.
+    pub radius_m: f64,
+    /// Its drawn clouds, back to front, as last sorted (the GPU's copy is at its cloud slots of
+    /// the list buffer), and their sprites.
+    pub list: Vec<GpuListCloud>,
+    pub list_sprites: u32,
+    pub check: Option<BlockCheck>,
     /// Its slots, while it is on the GPU.
     pub place: Option<(Range<u32>, Range<u32>)>,
     /// Written to its slots yet.
@@ -55,7 +74,7 @@ pub(super) struct Resident {
 
 impl Resident {
     fn new(block: SkyBlock, motion: BlockMotion) -> Self {
-        let clouds = block
+        let clouds: Vec<CloudState> = block
             .clouds
             .iter()
             .map(|c| {
@@ -72,9 +91,17 @@ impl Resident {
                 }
             })
             .collect();
+        let radius_m = clouds
+            .iter()
+            .map(|c| (c.centre_m - block.centre_m).length() + c.radius_m as f64)
+            .fold(0.0, f64::max);
         Self {
             block,
             motion,
+            radius_m,
+            list: Vec::new(),
+            list_sprites: 0,
+            check: None,
             place: None,
             uploaded: false,
             near: true,
@@ -114,10 +141,11 @@ pub fn gpu_sprite(cloud: &SkyCloud, s: &super::scene::SkySprite) -> GpuSprite {
     }
 }
 
-/// The GPU record of a cloud.
-pub fn gpu_cloud(cloud: &SkyCloud) -> GpuCloud {
+/// The GPU record of a cloud of the block centred at `block_m`.
+pub fn gpu_cloud(cloud: &SkyCloud, block_m: DVec3) -> GpuCloud {
     let l = &cloud.colour_levels.0;
     GpuCloud {
+        centre_block: (cloud.centre_m - block_m).as_vec3().extend(0.0).to_array(),
         level_rgba: l.map(|level| level.rgba),
         level_height: [l[0].height_m, l[1].height_m, l[2].height_m, l[3].height_m],
         level4_radius_flat: [
@@ -141,6 +169,8 @@ pub(super) struct ResidentSet {
     pub cloud_buffer: wgpu::Buffer,
     /// The sky camera's per-cloud orders, at the clouds' sprite slots.
     pub order_buffer: wgpu::Buffer,
+    /// The sky camera's per-block cloud lists, at the blocks' cloud slots.
+    pub list_buffer: wgpu::Buffer,
     pub index_buffer: wgpu::Buffer,
     layout: wgpu::BindGroupLayout,
     /// Group 2 of the sprite passes: sprites and clouds.
@@ -148,6 +178,9 @@ pub(super) struct ResidentSet {
     /// A CPU copy of the order buffer; `dirty_orders` are the spans to write this frame.
     pub orders_cpu: Vec<u32>,
     pub dirty_orders: Vec<Range<u32>>,
+    /// The same for the cloud lists.
+    pub lists_cpu: Vec<GpuListCloud>,
+    pub dirty_lists: Vec<Range<u32>>,
     /// Counts buffer rebuilds: bind groups made with the old buffers must be made again.
     pub generation: u64,
 }
@@ -187,22 +220,24 @@ impl ResidentSet {
             entries: &[storage(0), storage(1)],
         });
         let sprites = FIRST_SPRITES.min(limit_sprites.max(1));
-        let (sprite_buffer, cloud_buffer, order_buffer, index_buffer, group) =
-            buffers(device, &layout, sprites, FIRST_CLOUDS);
+        let b = buffers(device, &layout, sprites, FIRST_CLOUDS);
         Self {
             device: device.clone(),
             blocks: HashMap::new(),
             sprite_slots: SlotRanges::new(sprites),
             cloud_slots: SlotRanges::new(FIRST_CLOUDS),
             limit_sprites,
-            sprite_buffer,
-            cloud_buffer,
-            order_buffer,
-            index_buffer,
+            sprite_buffer: b.sprites,
+            cloud_buffer: b.clouds,
+            order_buffer: b.orders,
+            list_buffer: b.lists,
+            index_buffer: b.indices,
             layout,
-            group,
+            group: b.group,
             orders_cpu: vec![0; sprites as usize],
             dirty_orders: Vec::new(),
+            lists_cpu: vec![GpuListCloud::default(); FIRST_CLOUDS as usize],
+            dirty_lists: Vec::new(),
             generation: 0,
         }
     }
@@ -217,6 +252,7 @@ impl ResidentSet {
         self.sprite_buffer.size()
             + self.cloud_buffer.size()
             + self.order_buffer.size()
+            + self.list_buffer.size()
             + self.index_buffer.size()
     }
 
@@ -315,6 +351,7 @@ impl ResidentSet {
         }
         r.place = Some((sprites, clouds));
         r.uploaded = false;
+        r.check = None;
         true
     }
 
@@ -341,18 +378,19 @@ impl ResidentSet {
         if sprites <= cap && clouds <= self.cloud_slots.capacity() {
             return false;
         }
-        let (s, c, o, i, g) = buffers(&self.device, &self.layout, sprites, clouds);
-        (
-            self.sprite_buffer,
-            self.cloud_buffer,
-            self.order_buffer,
-            self.index_buffer,
-            self.group,
-        ) = (s, c, o, i, g);
+        let b = buffers(&self.device, &self.layout, sprites, clouds);
+        self.sprite_buffer = b.sprites;
+        self.cloud_buffer = b.clouds;
+        self.order_buffer = b.orders;
+        self.list_buffer = b.lists;
+        self.index_buffer = b.indices;
+        self.group = b.group;
         self.sprite_slots = SlotRanges::new(sprites);
         self.cloud_slots = SlotRanges::new(clouds);
         self.orders_cpu = vec![0; sprites as usize];
         self.dirty_orders.clear();
+        self.lists_cpu = vec![GpuListCloud::default(); clouds as usize];
+        self.dirty_lists.clear();
         self.generation += 1;
         let mut placed: Vec<u64> = self
             .blocks
@@ -384,7 +422,7 @@ impl ResidentSet {
             clouds.clear();
             for cloud in &r.block.clouds {
                 sprites.extend(cloud.sprites.iter().map(|sp| gpu_sprite(cloud, sp)));
-                clouds.push(gpu_cloud(cloud));
+                clouds.push(gpu_cloud(cloud, r.block.centre_m));
             }
             let sprite_bytes = std::mem::size_of::<GpuSprite>() as u64;
             let cloud_bytes = std::mem::size_of::<GpuCloud>() as u64;
@@ -407,51 +445,19 @@ impl ResidentSet {
         }
         bytes
     }
-
-    /// Writes the orders changed this frame, nearby spans merged; returns the bytes.
-    pub fn upload_orders(&mut self, queue: &wgpu::Queue) -> u64 {
-        if self.dirty_orders.is_empty() {
-            return 0;
-        }
-        self.dirty_orders.sort_by_key(|r| r.start);
-        // Spans closer than this many slots go in one write: fewer calls for a few more bytes.
-        const MERGE_GAP: u32 = 2048;
-        let mut bytes = 0;
-        let mut spans = std::mem::take(&mut self.dirty_orders).into_iter();
-        let Some(mut run) = spans.next() else {
-            return 0;
-        };
-        let mut write = |run: &Range<u32>| {
-            let data = &self.orders_cpu[run.start as usize..run.end as usize];
-            queue.write_buffer(
-                &self.order_buffer,
-                run.start as u64 * 4,
-                bytemuck::cast_slice(data),
-            );
-            bytes += data.len() as u64 * 4;
-        };
-        for span in spans {
-            if span.start <= run.end + MERGE_GAP {
-                run.end = run.end.max(span.end);
-            } else {
-                write(&run);
-                run = span;
-            }
-        }
-        write(&run);
-        bytes
-    }
 }
 
-type Buffers = (
-    wgpu::Buffer,
-    wgpu::Buffer,
-    wgpu::Buffer,
-    wgpu::Buffer,
-    wgpu::BindGroup,
-);
+/// The resident buffers and the group of the two the sprite passes bind.
+struct Buffers {
+    sprites: wgpu::Buffer,
+    clouds: wgpu::Buffer,
+    orders: wgpu::Buffer,
+    lists: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    group: wgpu::BindGroup,
+}
 
-/// Sprite, cloud, order and quad-index buffers for `sprites` and `clouds` slots.
+/// Sprite, cloud, order, list and quad-index buffers for `sprites` and `clouds` slots.
 fn buffers(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
@@ -474,8 +480,6 @@ fn buffers(
         "sky.clouds",
         clouds as u64 * std::mem::size_of::<GpuCloud>() as u64,
     );
-    let order_buffer = storage("sky.orders", sprites as u64 * 4);
-    let index_buffer = quad_index_buffer(device, sprites);
     let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("sky.resident_group"),
         layout,
@@ -490,13 +494,17 @@ fn buffers(
             },
         ],
     });
-    (
-        sprite_buffer,
-        cloud_buffer,
-        order_buffer,
-        index_buffer,
+    Buffers {
+        sprites: sprite_buffer,
+        clouds: cloud_buffer,
+        orders: storage("sky.orders", sprites as u64 * 4),
+        lists: storage(
+            "sky.lists",
+            clouds as u64 * std::mem::size_of::<GpuListCloud>() as u64,
+        ),
+        indices: quad_index_buffer(device, sprites),
         group,
-    )
+    }
 }
 
 /// Index list for `sprites` quads of four corners (two triangles each): the vertex shader

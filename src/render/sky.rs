@@ -1,12 +1,14 @@
 //! [`Sky`]: the library object a host simulator embeds. Created once with the host's device,
 //! given clouds (uploaded to the GPU once per block), and each frame `prepare`d (CPU: sort blocks
 //! and clouds, the cached sprite orders, the draw list; uniforms) and `record`ed into the host's
-//! encoder. It draws into the host's colour target and reads the
-//! host's depth texture (never writes it): the sky gradient and sun where the host drew nothing,
-//! the cloud sprites with soft depth fades (Bahnassi), and in-cloud fog (Wang 7.1).
+//! encoder. It draws into the host's colour target and reads the host's depth texture (never
+//! writes it): the sky gradient and sun where the host drew nothing, the cloud sprites with soft
+//! depth fades (Bahnassi), and in-cloud fog (Wang 7.1).
 //!
-//! The host's depth texture needs `TEXTURE_BINDING` usage and must be drawn with the projection
-//! of [`Camera::projection`] (standard `[0, 1]` depth, near and far from the camera).
+//! The device needs 5 storage buffers per shader stage (WebGPU's default limit is 8) and vertex
+//! storage buffers. The host's depth texture needs `TEXTURE_BINDING` usage and must be drawn
+//! with the projection of [`Camera::projection`] (standard `[0, 1]` depth, near and far from
+//! the camera).
 
 use std::cell::Cell;
 use std::collections::HashSet;
@@ -17,14 +19,15 @@ use wgpu::util::DeviceExt;
 
 use super::RenderError;
 use super::camera::Camera;
-use super::draw_list::{Locks, OrderCopy, main_view};
-use super::gpu_types::{GpuDrawCloud, GpuFrame};
+use super::draw_list::{Copies, Locks, main_view};
+use super::gpu_types::{GpuDrawBlock, GpuFrame};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
 use super::pipeline::{PassDesc, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
+use super::scatter::Scatter;
 use super::scene::{BlockMotion, SkyBlock};
 use super::settings::RenderSettings;
-use super::sprite_view::{self, ViewBuffers, ViewLight};
+use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::{FrameStats, Lighting};
 use crate::clouds::{CloudsConfig, LifecycleConfig};
 use crate::shading::{SunPosition, TimeOfDay, TimeOfDayTable, hidden_above};
@@ -65,9 +68,10 @@ pub struct Sky {
     sprite_pipeline: wgpu::RenderPipeline,
     in_cloud_pipeline: wgpu::RenderPipeline,
     resident: ResidentSet,
+    scatter: Scatter,
     view_layout: wgpu::BindGroupLayout,
     view: ViewBuffers,
-    draws: Vec<GpuDrawCloud>,
+    draws: Vec<GpuDrawBlock>,
     locks: Locks,
     elapsed_s: f64,
     sprites_to_draw: u32,
@@ -98,6 +102,12 @@ impl Sky {
         queue: &wgpu::Queue,
         config: SkyConfig,
     ) -> Result<Self, RenderError> {
+        let stage_buffers = device.limits().max_storage_buffers_per_shader_stage;
+        if stage_buffers < 5 {
+            return Err(RenderError::Device(format!(
+                "the sky's sprites read 5 storage buffers in the vertex shader (WebGPU's default limit is 8); this device was created with {stage_buffers}"
+            )));
+        }
         let sheet = &config.sheet;
         if sheet.mips.is_empty() || sheet.size_px == 0 {
             return Err(RenderError::Sheet("the sprite sheet has no pixels".into()));
@@ -278,6 +288,7 @@ impl Sky {
             sprite_pipeline,
             in_cloud_pipeline,
             resident,
+            scatter: Scatter::new(device),
             view: ViewBuffers::new(device, false),
             view_layout,
             draws: Vec::new(),
@@ -430,12 +441,16 @@ impl Sky {
         &self,
         queue: &wgpu::Queue,
     ) -> Result<Vec<super::SpriteCorner>, RenderError> {
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.scatter.record(&mut encoder);
+        queue.submit([encoder.finish()]);
         let (view, draws) = self.view.buffers();
         let sources = super::readback::CornerSources {
             sprites: &self.resident.sprite_buffer,
             clouds: &self.resident.cloud_buffer,
             view,
             draws,
+            lists: &self.resident.list_buffer,
             orders: &self.resident.order_buffer,
         };
         super::readback::read_corners(&self.device, queue, &sources, self.sprites_to_draw)
@@ -497,6 +512,7 @@ impl Sky {
     pub fn gpu_buffer_bytes(&self) -> u64 {
         self.frame_buffer.size()
             + self.resident.gpu_bytes()
+            + self.scatter.gpu_bytes()
             + self.view.gpu_bytes()
             + self.ring.gpu_bytes()
     }
@@ -536,11 +552,14 @@ impl Sky {
         stats.blocks_left_out = left_out;
         self.ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
+        let resident = &mut self.resident;
         let in_cloud = main_view(
-            &mut self.resident.blocks,
-            OrderCopy {
-                slots: &mut self.resident.orders_cpu,
-                dirty: &mut self.resident.dirty_orders,
+            &mut resident.blocks,
+            Copies {
+                orders: &mut resident.orders_cpu,
+                dirty_orders: &mut resident.dirty_orders,
+                lists: &mut resident.lists_cpu,
+                dirty_lists: &mut resident.dirty_lists,
             },
             camera.position_m,
             self.elapsed_s,
@@ -549,7 +568,15 @@ impl Sky {
             &mut self.draws,
             &mut stats,
         );
-        upload_bytes += self.resident.upload_orders(queue);
+        let resident = &mut self.resident;
+        upload_bytes += self.scatter.prepare(
+            &self.device,
+            queue,
+            (&resident.orders_cpu, &resident.order_buffer),
+            &mut resident.dirty_orders,
+            (&resident.lists_cpu, &resident.list_buffer),
+            &mut resident.dirty_lists,
+        );
         let locks = self.locks.gpu();
         let light = ViewLight {
             lighting: &lighting,
@@ -565,9 +592,12 @@ impl Sky {
             &self.view_layout,
             &header,
             changed_locks,
-            &self.draws,
-            None,
-            Some((&self.resident.order_buffer, self.resident.generation)),
+            ViewData::Resident {
+                draws: &self.draws,
+                lists: &self.resident.list_buffer,
+                orders: &self.resident.order_buffer,
+                generation: self.resident.generation,
+            },
         );
         self.sprites_to_draw = stats.sprites_drawn;
         self.in_cloud = in_cloud;
@@ -640,6 +670,7 @@ impl Sky {
                 },
             ],
         });
+        self.scatter.record(encoder);
         self.ring.record_builds(
             encoder,
             &self.sheet_group,

@@ -1,11 +1,12 @@
 //! One view of the GPU-resident sprites (the sky's camera, or one impostor of the ring): its
-//! uniform (light, thresholds, locks), its draw list and, for an impostor, its own sprite
-//! orders; group 3 of the sprite passes. Buffers grow in powers of two and are rewritten only
+//! uniform (light, thresholds, locks), its draw list of blocks and, for an impostor, its own
+//! cloud lists and sprite orders (the sky's camera uses the resident ones); group 3 of the
+//! sprite passes. Buffers grow in powers of two and are rewritten only
 //! in the parts that changed.
 
 use glam::Vec3;
 
-use super::gpu_types::{GpuDrawCloud, GpuLock, GpuSpriteView, MAX_LOCKS};
+use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, GpuSpriteView, MAX_LOCKS};
 use super::settings::CloudSettings;
 use super::stats::Lighting;
 use crate::clouds::LifecycleConfig;
@@ -13,7 +14,7 @@ use crate::clouds::LifecycleConfig;
 /// Bytes of the view uniform before its lock table.
 const HEADER_BYTES: usize = std::mem::size_of::<GpuSpriteView>() - MAX_LOCKS * 48;
 
-/// The layout of group 3: view uniform, draw list, orders.
+/// The layout of group 3: view uniform, draw list, cloud lists, orders.
 pub(super) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
         binding,
@@ -32,6 +33,7 @@ pub(super) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             entry(0, wgpu::BufferBindingType::Uniform),
             entry(1, storage),
             entry(2, storage),
+            entry(3, storage),
         ],
     })
 }
@@ -44,7 +46,7 @@ pub(super) struct ViewLight<'a> {
     pub camera_z_m: f32,
 }
 
-/// The uniform of a view with `draws` clouds and `locks` locks (the table written apart).
+/// The uniform of a view with `draws` blocks and `locks` locks (the table written apart).
 pub(super) fn header(light: &ViewLight, draws: u32, locks: u32) -> GpuSpriteView {
     let ViewLight {
         lighting,
@@ -85,14 +87,65 @@ pub(super) fn header(light: &ViewLight, draws: u32, locks: u32) -> GpuSpriteView
 /// A view's buffers and bind group.
 pub(super) struct ViewBuffers {
     uniform: wgpu::Buffer,
-    draws: wgpu::Buffer,
-    draw_capacity: u64,
-    /// An impostor view's own orders (the sky's camera uses the resident order buffer).
-    orders: Option<wgpu::Buffer>,
-    order_capacity: u64,
+    draws: Grown,
+    /// An impostor view's own cloud lists and orders (the sky's camera uses the resident ones).
+    own: Option<(Grown, Grown)>,
     group: Option<wgpu::BindGroup>,
-    /// Which external order buffer the group was made with.
-    orders_generation: u64,
+    /// Which resident buffers the group was made with.
+    external_generation: u64,
+}
+
+/// A storage buffer that grows in powers of two.
+struct Grown {
+    buffer: wgpu::Buffer,
+    capacity_bytes: u64,
+    label: &'static str,
+}
+
+impl Grown {
+    fn new(device: &wgpu::Device, label: &'static str, bytes: u64) -> Self {
+        Self {
+            buffer: storage(device, label, bytes),
+            capacity_bytes: bytes,
+            label,
+        }
+    }
+
+    /// Makes room for `bytes`; true if the buffer was replaced.
+    fn reserve(&mut self, device: &wgpu::Device, bytes: u64) -> bool {
+        if bytes <= self.capacity_bytes {
+            return false;
+        }
+        self.capacity_bytes = bytes.next_power_of_two();
+        self.buffer = storage(device, self.label, self.capacity_bytes);
+        true
+    }
+
+    /// Writes `data` at the start; returns the bytes.
+    fn write<T: bytemuck::Pod>(&self, queue: &wgpu::Queue, data: &[T]) -> u64 {
+        if data.is_empty() {
+            return 0;
+        }
+        let bytes = bytemuck::cast_slice(data);
+        queue.write_buffer(&self.buffer, 0, bytes);
+        bytes.len() as u64
+    }
+}
+
+/// What a view writes besides its uniform: its draw list, and an impostor's own cloud lists and
+/// orders or, for the sky's camera, the resident list and order buffers (with their generation).
+pub(super) enum ViewData<'a> {
+    Own {
+        draws: &'a [GpuDrawBlock],
+        lists: &'a [GpuListCloud],
+        orders: &'a [u32],
+    },
+    Resident {
+        draws: &'a [GpuDrawBlock],
+        lists: &'a wgpu::Buffer,
+        orders: &'a wgpu::Buffer,
+        generation: u64,
+    },
 }
 
 fn storage(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
@@ -105,9 +158,8 @@ fn storage(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
 }
 
 impl ViewBuffers {
-    /// Buffers for a view; `own_orders` for an impostor view.
-    pub fn new(device: &wgpu::Device, own_orders: bool) -> Self {
-        let draw_capacity = 256;
+    /// Buffers for a view; `own` for an impostor view (its own lists and orders).
+    pub fn new(device: &wgpu::Device, own: bool) -> Self {
         Self {
             uniform: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sky.view"),
@@ -115,24 +167,30 @@ impl ViewBuffers {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
-            draws: storage(device, "sky.draws", draw_capacity * 32),
-            draw_capacity,
-            orders: own_orders.then(|| storage(device, "sky.view_orders", 1024 * 4)),
-            order_capacity: if own_orders { 1024 } else { 0 },
+            draws: Grown::new(device, "sky.draws", 256 * 32),
+            own: own.then(|| {
+                (
+                    Grown::new(device, "sky.view_lists", 1024 * 16),
+                    Grown::new(device, "sky.view_orders", 4096 * 4),
+                )
+            }),
             group: None,
-            orders_generation: u64::MAX,
+            external_generation: u64::MAX,
         }
     }
 
     /// Bytes of its buffers.
     pub fn gpu_bytes(&self) -> u64 {
-        self.uniform.size() + self.draws.size() + self.orders.as_ref().map_or(0, |b| b.size())
+        self.uniform.size()
+            + self.draws.buffer.size()
+            + self
+                .own
+                .as_ref()
+                .map_or(0, |(l, o)| l.buffer.size() + o.buffer.size())
     }
 
-    /// Writes the uniform (`locks`: the whole lock table too, else only the header), the draw
-    /// list and an impostor's own `orders`; `external` is the resident order buffer and its
-    /// generation for the sky's camera. Returns the bytes written.
-    #[allow(clippy::too_many_arguments)]
+    /// Writes the uniform (`locks`: the whole lock table too, else only the header) and `data`;
+    /// returns the bytes written.
     pub fn write(
         &mut self,
         device: &wgpu::Device,
@@ -140,51 +198,49 @@ impl ViewBuffers {
         layout: &wgpu::BindGroupLayout,
         view: &GpuSpriteView,
         locks: Option<&[GpuLock]>,
-        draws: &[GpuDrawCloud],
-        orders: Option<&[u32]>,
-        external: Option<(&wgpu::Buffer, u64)>,
+        data: ViewData,
     ) -> u64 {
         let mut regroup = self.group.is_none();
-        if draws.len() as u64 > self.draw_capacity {
-            self.draw_capacity = (draws.len() as u64).next_power_of_two();
-            self.draws = storage(device, "sky.draws", self.draw_capacity * 32);
-            regroup = true;
+        let draws = match &data {
+            ViewData::Own { draws, .. } | ViewData::Resident { draws, .. } => *draws,
+        };
+        regroup |= self.draws.reserve(device, draws.len() as u64 * 32);
+        let mut bytes = self.draws.write(queue, draws);
+        match (&data, &mut self.own) {
+            (ViewData::Own { lists, orders, .. }, Some((own_lists, own_orders))) => {
+                regroup |= own_lists.reserve(device, lists.len() as u64 * 16);
+                regroup |= own_orders.reserve(device, orders.len() as u64 * 4);
+                bytes += own_lists.write(queue, lists) + own_orders.write(queue, orders);
+            }
+            (ViewData::Resident { generation, .. }, None) => {
+                regroup |= *generation != self.external_generation;
+                self.external_generation = *generation;
+            }
+            _ => {}
         }
-        if let Some(orders) = orders
-            && orders.len() as u64 > self.order_capacity
-        {
-            self.order_capacity = (orders.len() as u64).next_power_of_two();
-            self.orders = Some(storage(device, "sky.view_orders", self.order_capacity * 4));
-            regroup = true;
-        }
-        if let Some((_, generation)) = external
-            && generation != self.orders_generation
-        {
-            self.orders_generation = generation;
-            regroup = true;
-        }
-        let order_buffer = external.map(|e| e.0).or(self.orders.as_ref());
-        if regroup && let Some(order_buffer) = order_buffer {
+        let (lists, orders) = match (&data, &self.own) {
+            (ViewData::Resident { lists, orders, .. }, _) => (*lists, *orders),
+            (_, Some((l, o))) => (&l.buffer, &o.buffer),
+            (ViewData::Own { .. }, None) => return bytes,
+        };
+        if regroup {
+            fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+                wgpu::BindGroupEntry {
+                    binding,
+                    resource: buffer.as_entire_binding(),
+                }
+            }
             self.group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("sky.view_group"),
                 layout,
                 entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: self.uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: self.draws.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: order_buffer.as_entire_binding(),
-                    },
+                    entry(0, &self.uniform),
+                    entry(1, &self.draws.buffer),
+                    entry(2, lists),
+                    entry(3, orders),
                 ],
             }));
         }
-        let mut bytes = 0;
         let header = &bytemuck::bytes_of(view)[..HEADER_BYTES];
         queue.write_buffer(&self.uniform, 0, header);
         bytes += header.len() as u64;
@@ -193,20 +249,12 @@ impl ViewBuffers {
             queue.write_buffer(&self.uniform, HEADER_BYTES as u64, table);
             bytes += table.len() as u64;
         }
-        if !draws.is_empty() {
-            queue.write_buffer(&self.draws, 0, bytemuck::cast_slice(draws));
-            bytes += draws.len() as u64 * 32;
-        }
-        if let (Some(orders), Some(buffer)) = (orders.filter(|o| !o.is_empty()), &self.orders) {
-            queue.write_buffer(buffer, 0, bytemuck::cast_slice(orders));
-            bytes += orders.len() as u64 * 4;
-        }
         bytes
     }
 
     /// The uniform and the draw list (for the corner read-back).
     pub fn buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
-        (&self.uniform, &self.draws)
+        (&self.uniform, &self.draws.buffer)
     }
 
     /// Group 3 of the sprite passes (after the first [`Self::write`]).

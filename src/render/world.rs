@@ -356,9 +356,7 @@ impl World {
             let fade = match fb.phase {
                 Phase::Steady => Fade::Steady,
                 Phase::Forming { .. } => Fade::Forming(progress(fb.phase, now, &lifecycle)),
-                Phase::Dissipating { .. } => {
-                    Fade::Dissipating(progress(fb.phase, now, &lifecycle))
-                }
+                Phase::Dissipating { .. } => Fade::Dissipating(progress(fb.phase, now, &lifecycle)),
                 Phase::Gone => Fade::Dissipating(1.0),
             };
             if fb.serial > newest {
@@ -384,7 +382,9 @@ impl World {
         // Every block of the field is in the sky; more there means some went.
         if living.in_sky.len() != count {
             living.seen.clear();
-            living.seen.extend(living.field.blocks().map(|(_, fb)| fb.serial));
+            living
+                .seen
+                .extend(living.field.blocks().map(|(_, fb)| fb.serial));
             let gone: Vec<u64> = living.in_sky.difference(&living.seen).copied().collect();
             for id in gone {
                 living.in_sky.remove(&id);

@@ -37,10 +37,10 @@ pub use layout::{
 use layout::{impostor_camera, in_sector};
 
 use super::draw_list::fresh_view;
-use super::gpu_types::{GpuDrawCloud, GpuFrame};
+use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud};
 use super::pipeline::{PassDesc, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
-use super::sprite_view::{self, ViewBuffers, ViewLight};
+use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
 
 const IMPOSTOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -81,7 +81,8 @@ pub struct ImpostorRing {
     slot_groups: Vec<wgpu::BindGroup>,
     slot_views: Vec<ViewBuffers>,
     view_layout: wgpu::BindGroupLayout,
-    draws: Vec<GpuDrawCloud>,
+    draws: Vec<GpuDrawBlock>,
+    lists: Vec<GpuListCloud>,
     orders: Vec<u32>,
     /// The ring pass's uniform (`GpuRing`).
     ring_uniform: wgpu::Buffer,
@@ -358,6 +359,7 @@ impl ImpostorRing {
             slot_groups,
             view_layout: shared.view_layout.clone(),
             draws: Vec::new(),
+            lists: Vec::new(),
             orders: Vec::new(),
             ring_uniform,
             shown: None,
@@ -433,11 +435,12 @@ impl ImpostorRing {
                 let in_far = far.is_some_and(|f| f.contains(&r.block.id));
                 r.near = !in_far;
                 far_count += in_far as u32;
-                if steady_shown && let Some(st) = shown {
-                    if is_far(r.centre_m(), st.centre_m, camera_m, &s) {
-                        far_now += 1;
-                        same &= in_far;
-                    }
+                if steady_shown
+                    && let Some(st) = shown
+                    && is_far(r.centre_m(), st.centre_m, camera_m, &s)
+                {
+                    far_now += 1;
+                    same &= in_far;
                 }
             }
         }
@@ -533,6 +536,7 @@ impl ImpostorRing {
                     centre,
                     self.settings.view_radius_m,
                     &mut self.draws,
+                    &mut self.lists,
                     &mut self.orders,
                 );
                 let light = ViewLight {
@@ -546,9 +550,11 @@ impl ImpostorRing {
                     &self.view_layout,
                     &header,
                     None,
-                    &self.draws,
-                    Some(&self.orders),
-                    None,
+                    ViewData::Own {
+                        draws: &self.draws,
+                        lists: &self.lists,
+                        orders: &self.orders,
+                    },
                 );
                 let cam = impostor_camera(i, centre, &self.settings);
                 let vp = cam.view_proj_relative();

@@ -1,0 +1,168 @@
+//! The sprite orders and cloud lists a frame changed, sent to the GPU as one patch and written
+//! into place there (`shaders/scatter.wgsl`): a queue write costs a few microseconds whatever
+//! its size, and a frame changes a hundred scattered orders. The patch is applied by the next
+//! `Sky::record` (or corner read-back); a frame prepared and never recorded keeps its patch for
+//! the next one, and past the size of the buffers themselves the whole buffers are written
+//! instead, so nothing grows however the sky is driven.
+
+use std::cell::Cell;
+use std::ops::Range;
+
+use super::gpu_types::GpuListCloud;
+
+const WGSL: &str = include_str!("../../shaders/scatter.wgsl");
+/// Workgroups per dispatch row.
+const ROW: u32 = 65_535;
+
+/// The patch being gathered and its GPU side.
+pub(super) struct Scatter {
+    pipeline: wgpu::ComputePipeline,
+    values: Vec<u32>,
+    /// `[dst, src, count, target]`: target 0 the orders, 1 the cloud lists (as words).
+    spans: Vec<[u32; 4]>,
+    patch: wgpu::Buffer,
+    span_buffer: wgpu::Buffer,
+    /// The bind group of the patch written.
+    group: Option<wgpu::BindGroup>,
+    /// Whether that patch went into a recorded frame (then the next one starts afresh).
+    applied: Cell<bool>,
+}
+
+fn storage(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+impl Scatter {
+    /// The pipeline and empty buffers.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("sky.scatter"),
+            source: wgpu::ShaderSource::Wgsl(WGSL.into()),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("sky.scatter"),
+            layout: None,
+            module: &module,
+            entry_point: Some("cs_scatter"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self {
+            pipeline,
+            values: Vec::new(),
+            spans: Vec::new(),
+            patch: storage(device, "sky.scatter_patch", 16 << 10),
+            span_buffer: storage(device, "sky.scatter_spans", 4 << 10),
+            group: None,
+            applied: Cell::new(true),
+        }
+    }
+
+    /// Bytes of its buffers.
+    pub fn gpu_bytes(&self) -> u64 {
+        self.patch.size() + self.span_buffer.size()
+    }
+
+    /// Gathers the changed spans of the orders and lists (their CPU copies) and writes the patch;
+    /// a patch not yet applied is kept and added to. Returns the bytes written.
+    #[allow(clippy::too_many_arguments)]
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (orders, order_buffer): (&[u32], &wgpu::Buffer),
+        dirty_orders: &mut Vec<Range<u32>>,
+        (lists, list_buffer): (&[GpuListCloud], &wgpu::Buffer),
+        dirty_lists: &mut Vec<Range<u32>>,
+    ) -> u64 {
+        if self.applied.replace(false) {
+            self.values.clear();
+            self.spans.clear();
+        }
+        self.group = None;
+        for r in dirty_orders.drain(..) {
+            self.push(0, r.start, &orders[r.start as usize..r.end as usize]);
+        }
+        let words = |l: &[GpuListCloud]| bytemuck::cast_slice::<GpuListCloud, u32>(l).to_vec();
+        for r in dirty_lists.drain(..) {
+            let part = words(&lists[r.start as usize..r.end as usize]);
+            self.push(1, r.start * 4, &part);
+        }
+        if self.spans.is_empty() {
+            return 0;
+        }
+        let whole = orders.len() + lists.len() * 4;
+        if self.values.len() > whole {
+            // Frames prepared and never drawn piled up more than the buffers hold: write them.
+            self.values.clear();
+            self.spans.clear();
+            queue.write_buffer(order_buffer, 0, bytemuck::cast_slice(orders));
+            queue.write_buffer(list_buffer, 0, bytemuck::cast_slice(lists));
+            return whole as u64 * 4;
+        }
+        let value_bytes = self.values.len() as u64 * 4;
+        let span_bytes = self.spans.len() as u64 * 16;
+        if value_bytes > self.patch.size() {
+            self.patch = storage(device, "sky.scatter_patch", value_bytes.next_power_of_two());
+        }
+        if span_bytes > self.span_buffer.size() {
+            let bytes = span_bytes.next_power_of_two();
+            self.span_buffer = storage(device, "sky.scatter_spans", bytes);
+        }
+        queue.write_buffer(&self.patch, 0, bytemuck::cast_slice(&self.values));
+        queue.write_buffer(&self.span_buffer, 0, bytemuck::cast_slice(&self.spans));
+        fn binding(binding: u32, buffer: &wgpu::Buffer, size: u64) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry {
+                binding,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer,
+                    offset: 0,
+                    size: std::num::NonZeroU64::new(size),
+                }),
+            }
+        }
+        self.group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sky.scatter"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &[
+                binding(0, &self.patch, value_bytes),
+                binding(1, &self.span_buffer, span_bytes),
+                binding(2, order_buffer, order_buffer.size()),
+                binding(3, list_buffer, list_buffer.size()),
+            ],
+        }));
+        value_bytes + span_bytes
+    }
+
+    fn push(&mut self, target: u32, dst: u32, data: &[u32]) {
+        if data.is_empty() {
+            return;
+        }
+        self.spans
+            .push([dst, self.values.len() as u32, data.len() as u32, target]);
+        self.values.extend_from_slice(data);
+    }
+
+    /// Records the patch's pass into `encoder` (before anything reads the orders), if there is
+    /// one; the next [`Self::prepare`] starts a new patch.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.applied.set(true);
+        let Some(group) = &self.group else {
+            return;
+        };
+        let n = self.spans.len() as u32;
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("sky.scatter"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, group, &[]);
+        // One workgroup a span, in rows of 65,535; the last row's extra groups find no span.
+        pass.dispatch_workgroups(n.min(ROW), n.div_ceil(ROW), 1);
+    }
+}
