@@ -13,6 +13,7 @@ fn weather(cloud_type: CloudType, oktas: f32, base_ft: f32, thickness_ft: f32) -
             thickness_ft,
         }],
         visibility_m: 9999.0,
+        obscuration: None,
         wind: Wind::default(),
         temperature_c: 10.0,
         dewpoint_c: 5.0,
