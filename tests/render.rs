@@ -956,7 +956,7 @@ fn ring_rebuilds_do_not_pop() {
     );
 }
 
-/// A fog report (Heathrow, 800 m in fog) hides the ground beyond its visibility: from 420 ft
+/// A fog report (Heathrow, 800 m in fog) hides the ground beyond its visibility: from about 80 ft
 /// above the runway, ground 1.6 to 4 km away (two to five visibilities) is one even fog colour, unlike
 /// the ground under the camera (within 300 m); under the same report with 10 km visibility and no fog the far
 /// ground looks like the near ground.
