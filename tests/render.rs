@@ -1042,3 +1042,87 @@ fn gpu_sprites_draw_the_frames_of_the_cpu_path() {
         );
     }
 }
+
+/// A fog report (Heathrow, 800 m in fog) hides the ground beyond its visibility: from about 80 ft
+/// above the runway, ground 1.6 to 4 km away (two to five visibilities) is one even fog colour, unlike
+/// the ground under the camera (within 300 m); under the same report with 10 km visibility and no fog the far
+/// ground looks like the near ground.
+#[test]
+fn a_fog_report_hides_the_ground_beyond_its_visibility() {
+    use exr::prelude::*;
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("fog-report");
+    std::fs::create_dir_all(&dir).unwrap();
+    let render = |name: &str, metar: &str| {
+        let weather = dir.join(format!("{name}.metar"));
+        std::fs::write(&weather, format!("{metar}\n")).unwrap();
+        let exr = dir.join(format!("{name}.exr"));
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_skycast"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .env("XDG_RUNTIME_DIR", "/tmp")
+            .args(["render", "--weather", weather.to_str().unwrap()])
+            .args([
+                "--at",
+                "51.4833,-0.45",
+                "--alt-ft",
+                "160",
+                "--heading",
+                "90",
+            ])
+            .args(["--pitch", "-20", "--size", "160x90"])
+            .args(["--time", "2025-01-28T11:00:00Z"])
+            .args(["--out", dir.join(format!("{name}.png")).to_str().unwrap()])
+            .args(["--exr", exr.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let layers = read_all_flat_layers_from_file(&exr).unwrap();
+        let channel = |n: &str| -> Vec<f32> {
+            let c = layers.layer_data[0]
+                .channel_data
+                .list
+                .iter()
+                .find(|c| c.name.to_string() == n)
+                .unwrap();
+            (0..c.sample_data.len())
+                .map(|i| c.sample_data.value_by_flat_index(i).to_f32())
+                .collect()
+        };
+        let (r, g, b, z) = (channel("R"), channel("G"), channel("B"), channel("Z"));
+        // (mean colour, largest distance from it) of the ground pixels within a depth range.
+        move |lo_m: f32, hi_m: f32| {
+            let px: Vec<Vec3> = (0..z.len())
+                .filter(|&i| z[i] >= lo_m && z[i] < hi_m)
+                .map(|i| Vec3::new(r[i], g[i], b[i]))
+                .collect();
+            assert!(px.len() > 50, "{} pixels at {lo_m}..{hi_m} m", px.len());
+            let mean = px.iter().copied().sum::<Vec3>() / px.len() as f32;
+            let spread = px.iter().map(|p| p.distance(mean)).fold(0.0f32, f32::max);
+            (mean, spread)
+        }
+    };
+    let fog = render("fog", "EGLL 281100Z 00000KT 0800 FG 04/04 Q1030");
+    let clear = render("clear", "EGLL 281100Z 00000KT 9999 04/04 Q1030");
+    let (fog_far, fog_far_spread) = fog(1_600.0, 4_000.0);
+    let (fog_near, _) = fog(0.0, 300.0);
+    let (clear_far, _) = clear(1_600.0, 4_000.0);
+    let (clear_near, _) = clear(0.0, 300.0);
+    // Beyond twice the visibility: one even colour, grey, far from the near ground's.
+    assert!(
+        fog_far_spread < 0.02,
+        "far ground in fog varies by {fog_far_spread}"
+    );
+    assert!(
+        fog_far.max_element() - fog_far.min_element() < 0.1,
+        "{fog_far}"
+    );
+    let fogged = fog_far.distance(fog_near);
+    let unfogged = clear_far.distance(clear_near);
+    assert!(
+        fogged > 2.0 * unfogged && fogged > 0.05,
+        "near/far ground differ by {fogged} in fog, {unfogged} in clear air"
+    );
+}

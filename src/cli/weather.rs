@@ -324,8 +324,19 @@ pub fn describe_block(at: &AtBlock) -> String {
         w.precipitation,
         w.ground_elevation_m
     );
+    if let Some(o) = w.obscuration {
+        let name = serde_json::to_value(o)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default();
+        let _ = writeln!(out, "  obscured by {name}");
+    }
     if w.layers.is_empty() {
         let _ = writeln!(out, "  no cloud");
+    } else {
+        let ceiling = skycast::weather::block::ceiling_ft(&w.layers, 5.0)
+            .map_or("none".to_string(), |c| format!("{c:.0} ft AGL"));
+        let _ = writeln!(out, "  ceiling {ceiling}");
     }
     for l in &w.layers {
         let source = serde_json::to_value(l.type_source)
@@ -334,10 +345,11 @@ pub fn describe_block(at: &AtBlock) -> String {
             .unwrap_or_default();
         let _ = writeln!(
             out,
-            "  {:<18} {:<11} {:.1} oktas, base {:.0} ft AGL, {:.0} ft thick",
+            "  {:<18} {:<11} {:.1} oktas ({:.1} seen from below), base {:.0} ft AGL, {:.0} ft thick",
             l.cloud_type.name(),
             source,
             l.coverage_oktas,
+            skycast::weather::block::cover_seen_from_below_oktas(&w.layers, l.base_ft_agl),
             l.base_ft_agl,
             l.thickness_ft
         );

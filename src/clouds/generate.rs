@@ -540,7 +540,7 @@ mod golden {
             [
                 "6ea2ffa12cd8ec62",
                 "656ebcbc069452f1",
-                "59cc129667aaccbe",
+                "388eb9e7de1536aa",
                 "5e9f9fbd940250a3"
             ]
         );

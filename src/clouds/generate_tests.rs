@@ -13,6 +13,7 @@ fn weather(cloud_type: CloudType, oktas: f32, base_ft: f32, thickness_ft: f32) -
             thickness_ft,
         }],
         visibility_m: 9999.0,
+        obscuration: None,
         wind: Wind::default(),
         temperature_c: 10.0,
         dewpoint_c: 5.0,
@@ -365,4 +366,49 @@ fn a_block_with_no_cloud_is_empty_and_cb_has_an_anvil() {
         spread(0.7, 1.01),
         spread(-0.2, 0.2)
     );
+}
+
+#[test]
+fn few_cb_is_one_or_two_isolated_cells_as_tall_as_the_weather_says() {
+    // FEW012CB at Timika: 2 oktas, tops at 35,000 ft over a 25 degree C surface.
+    let w = weather(CloudType::Cumulonimbus, 2.0, 1200.0, 33_800.0);
+    for i in 0..8 {
+        let index = BlockIndex::new(i, -2);
+        let block = generate_block(index, &w, 2003, types());
+        let cells = block.layers[0].clouds;
+        assert!((1..=2).contains(&cells), "block {i}: {cells} cells");
+        // Isolated cells: each tower's base (its lowest fifth) is at most 4 km across, the
+        // size of the block, while a layer would run on over the block's borders.
+        for c in &block.clouds {
+            let half_h = (block.layers[0].top_m - block.layers[0].base_m) / 2.0;
+            let base_radius = c
+                .sprites
+                .iter()
+                .filter(|s| s.offset_m[2] < -0.6 * half_h)
+                .map(|s| s.offset_m[0].hypot(s.offset_m[1]) + s.width_m / 2.0)
+                .fold(0.0f32, f32::max);
+            assert!(
+                base_radius < 2_000.0,
+                "block {i}: base radius {base_radius} m"
+            );
+        }
+        // The tops reach the weather's: the layer is not clamped under 25,000 ft, and the
+        // tallest sprite stands above 25,000 ft.
+        let ground = w.ground_elevation_m;
+        let top_ft = (block.layers[0].top_m - ground) as f64 / METRES_PER_FOOT;
+        assert!(top_ft > 34_000.0, "block {i}: top {top_ft} ft");
+        let highest = block
+            .clouds
+            .iter()
+            .flat_map(|c| {
+                c.sprites
+                    .iter()
+                    .map(move |s| c.centre_m.z + s.offset_m[2] as f64)
+            })
+            .fold(f64::MIN, f64::max);
+        assert!(
+            (highest - ground as f64) / METRES_PER_FOOT > 25_000.0,
+            "block {i}: highest sprite {highest} m"
+        );
+    }
 }

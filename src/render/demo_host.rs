@@ -152,8 +152,8 @@ impl DemoHost {
                 sun_dir: sun.direction_enu().as_vec3(),
                 sun_rgb: light.directional_rgb,
                 ambient: light.ambient_percent * 0.35,
-                fog_rgb: self.sky.horizon_rgb(),
-                visibility_m,
+                fog_rgb: self.sky.fog().rgb,
+                visibility_m: visibility_m.min(self.sky.fog().distance_m),
             },
         );
         let mut encoder = self

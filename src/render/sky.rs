@@ -88,6 +88,8 @@ pub struct Sky {
     seen_light: TimeOfDay,
     /// The weather over the camera: its cloud layers and ground elevation, metres.
     overhead: (Vec<BlockLayer>, f32),
+    /// The fog settings and the weather over the camera they read (visibility, obscuration).
+    fog: (crate::shading::FogSettings, BlockWeather),
     ring: ImpostorRing,
 }
 
@@ -304,6 +306,13 @@ impl Sky {
             clear_light: light,
             seen_light: light,
             overhead: (Vec::new(), 0.0),
+            fog: (
+                Default::default(),
+                BlockWeather {
+                    visibility_m: f32::INFINITY,
+                    ..Default::default()
+                },
+            ),
             ring,
         })
     }
@@ -478,6 +487,13 @@ impl Sky {
     /// Until it is called the sky is taken as clear overhead.
     pub fn set_weather_overhead(&mut self, weather: &BlockWeather) {
         self.overhead = (weather.layers.clone(), weather.ground_elevation_m);
+        self.fog.1 = weather.clone();
+    }
+
+    /// The fog a host draws over its scene: the visibility and obscuration of the weather over
+    /// the camera ([`crate::shading::fog`]) under the last frame's horizon sky.
+    pub fn fog(&self) -> crate::shading::Fog {
+        self.fog.0.fog(&self.fog.1, self.seen_light.sky_horizon_rgb)
     }
 
     /// The fraction of the sky hidden above `altitude_m` by the weather overhead, 0..=1.
@@ -628,7 +644,14 @@ impl Sky {
                 self.settings.clouds.soft_depth_fade_m,
                 self.settings.in_cloud.visibility_m,
             ],
-            haze: [self.settings.clouds.haze_distance_m, 0.0, 0.0, 0.0],
+            haze: [
+                self.fog
+                    .0
+                    .haze_distance_m(&self.fog(), self.settings.clouds.haze_distance_m),
+                0.0,
+                0.0,
+                0.0,
+            ],
         };
         queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&frame));
         upload_bytes += std::mem::size_of::<GpuFrame>() as u64;

@@ -17,12 +17,15 @@
 //!   2001): the silver lining of a cloud between the camera and the sun.
 //! - [`cover`]: beyond Wang, the daylight under the clouds: how much of the sky the layers above
 //!   a point hide, and the grey, sunless light below a thick deck.
+//! - [`fog`]: the weather's visibility and obscuration as the fog a host draws (distance and
+//!   colour, Koschmieder's law) and the clouds' haze distance.
 //!
 //! Plain data only: no wgpu here. Units: metres, degrees, linear RGB in 0..=1.
 
 pub mod ambient;
 pub mod cover;
 pub mod directional;
+pub mod fog;
 pub mod scatter;
 pub mod sun;
 pub mod time_of_day;
@@ -30,6 +33,7 @@ pub mod time_of_day;
 pub use ambient::{ColourLevel, ColourLevels};
 pub use cover::{OvercastLight, hidden_above};
 pub use directional::{DirectionalMapping, directional_percent};
+pub use fog::{Fog, FogSettings};
 pub use scatter::ForwardScattering;
 pub use sun::{SunPosition, sun_position};
 pub use time_of_day::{TimeOfDay, TimeOfDaySample, TimeOfDayTable};

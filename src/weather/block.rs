@@ -71,12 +71,59 @@ pub struct BlockLayer {
     pub cloud_type: CloudType,
     /// Where the type came from.
     pub type_source: TypeSource,
-    /// Sky coverage, oktas 0..=8 (fractional after interpolation).
+    /// The layer's own sky coverage, oktas 0..=8 (fractional after interpolation): the share
+    /// of the sky its clouds fill. A METAR cover counts all cloud at and below its base (the
+    /// summation principle); the own coverages are such that the layers at and below a base,
+    /// overlapping at random, cover what the report gives there (see
+    /// [`cover_seen_from_below_oktas`]).
     pub coverage_oktas: f32,
     /// Cloud base, feet above ground.
     pub base_ft_agl: f32,
     /// Layer thickness base to top, feet.
     pub thickness_ft: f32,
+}
+
+/// What the report says obscures the view near the ground (present weather BR, FG, HZ, FU,
+/// DU/SA/DS/SS): with the visibility it sets the fog a host draws and the haze of the clouds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Obscuration {
+    /// `BR`: mist, water droplets, visibility 1,000 m and more.
+    Mist,
+    /// `FG` (also `FZFG`, `BCFG`, `PRFG`, `MIFG`): fog, visibility under 1,000 m where it lies.
+    Fog,
+    /// `HZ`: haze, dry particles.
+    Haze,
+    /// `FU`: smoke.
+    Smoke,
+    /// `DU`, `SA`, `DS`, `SS`: dust or sand, raised or in a storm.
+    Dust,
+}
+
+impl Obscuration {
+    /// The obscuration a present-weather phenomenon code names (`FG`, `BR`, ...), if any.
+    pub fn of_code(code: &str) -> Option<Self> {
+        match code {
+            "BR" => Some(Self::Mist),
+            "FG" => Some(Self::Fog),
+            "HZ" => Some(Self::Haze),
+            "FU" => Some(Self::Smoke),
+            "DU" | "SA" | "DS" | "SS" => Some(Self::Dust),
+            _ => None,
+        }
+    }
+
+    /// Which of two reported obscurations a report is drawn with: fog, then smoke, dust, haze,
+    /// mist (the one that hides most).
+    pub fn rank(self) -> u8 {
+        match self {
+            Self::Fog => 4,
+            Self::Smoke => 3,
+            Self::Dust => 2,
+            Self::Haze => 1,
+            Self::Mist => 0,
+        }
+    }
 }
 
 /// Surface wind; interpolated as a vector so opposite winds cancel instead of averaging direction.
@@ -103,6 +150,9 @@ pub struct BlockWeather {
     pub layers: Vec<BlockLayer>,
     /// Horizontal visibility, metres.
     pub visibility_m: f32,
+    /// What obscures the view near the ground, if the reports say (fog, mist, haze, ...).
+    #[serde(default)]
+    pub obscuration: Option<Obscuration>,
     /// Surface wind.
     pub wind: Wind,
     /// Air temperature, degrees Celsius.
@@ -115,9 +165,79 @@ pub struct BlockWeather {
     pub ground_elevation_m: f32,
 }
 
+/// The sky covered seen from below at `height_ft` AGL, oktas: the layers with their base at or
+/// under it, each covering its own coverage of the sky independently of the others (clouds of
+/// different layers overlap at random), so `8 (1 - prod(1 - own / 8))`. This is what a METAR
+/// cover reports at that layer's base (the summation principle).
+pub fn cover_seen_from_below_oktas(layers: &[BlockLayer], height_ft: f32) -> f32 {
+    let clear: f32 = layers
+        .iter()
+        .filter(|l| l.base_ft_agl <= height_ft)
+        .map(|l| 1.0 - (l.coverage_oktas / 8.0).clamp(0.0, 1.0))
+        .product();
+    8.0 * (1.0 - clear)
+}
+
+/// The own coverage, oktas, a layer needs so that the sky seen from below goes from
+/// `below_oktas` (the cover of the layers under it) to `total_oktas` at its base: the inverse of
+/// [`cover_seen_from_below_oktas`]. `None` when the sky below is already overcast (nothing
+/// more can be seen) or the total does not grow.
+pub fn own_coverage_oktas(below_oktas: f64, total_oktas: f64) -> Option<f64> {
+    let clear_below = 1.0 - below_oktas / 8.0;
+    if clear_below <= 1e-9 || total_oktas <= below_oktas {
+        return None;
+    }
+    Some(8.0 * (1.0 - (1.0 - total_oktas.min(8.0) / 8.0) / clear_below))
+}
+
+/// The ceiling, feet AGL: the lowest base where the sky seen from below is broken or overcast
+/// (at least `broken_oktas`, 5 for the 5/8 that BKN starts at); `None` when it never is.
+pub fn ceiling_ft(layers: &[BlockLayer], broken_oktas: f32) -> Option<f32> {
+    let mut bases: Vec<f32> = layers.iter().map(|l| l.base_ft_agl).collect();
+    bases.sort_by(f32::total_cmp);
+    bases
+        .into_iter()
+        .find(|&b| cover_seen_from_below_oktas(layers, b) >= broken_oktas - 1e-4)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn layer(coverage_oktas: f32, base_ft_agl: f32) -> BlockLayer {
+        BlockLayer {
+            cloud_type: CloudType::Stratocumulus,
+            type_source: TypeSource::HeightRule,
+            coverage_oktas,
+            base_ft_agl,
+            thickness_ft: 500.0,
+        }
+    }
+
+    #[test]
+    fn own_coverages_add_up_to_the_reported_covers_seen_from_below() {
+        // FEW008 SCT026 BKN045: 2, 4 and 6 oktas seen from below.
+        let few = own_coverage_oktas(0.0, 2.0).unwrap();
+        let sct = own_coverage_oktas(2.0, 4.0).unwrap();
+        let bkn = own_coverage_oktas(4.0, 6.0).unwrap();
+        assert!((few - 2.0).abs() < 1e-9 && (sct - 8.0 / 3.0).abs() < 1e-9 && bkn == 4.0);
+        let layers = [
+            layer(few as f32, 800.0),
+            layer(sct as f32, 2600.0),
+            layer(bkn as f32, 4500.0),
+        ];
+        for (base, cover) in [(800.0, 2.0), (2600.0, 4.0), (4500.0, 6.0)] {
+            let seen = cover_seen_from_below_oktas(&layers, base);
+            assert!((seen - cover).abs() < 1e-5, "{base}: {seen}");
+        }
+        assert_eq!(cover_seen_from_below_oktas(&layers, 700.0), 0.0);
+        assert_eq!(ceiling_ft(&layers, 5.0), Some(4500.0));
+        assert_eq!(ceiling_ft(&layers[..2], 5.0), None);
+        // Nothing more is seen above an overcast, and a cover that does not grow adds nothing.
+        assert_eq!(own_coverage_oktas(8.0, 8.0), None);
+        assert_eq!(own_coverage_oktas(6.0, 6.0), None);
+        assert_eq!(own_coverage_oktas(6.0, 8.0), Some(8.0));
+    }
 
     #[test]
     fn block_index_of_points_on_both_sides_of_the_origin() {

@@ -295,9 +295,11 @@ mod bulk_file_tests {
             .iter()
             .map(|l| (l.cloud_type, l.type_source))
             .collect();
+        // Every layer of its own, each with the type its remark gives.
         assert_eq!(
             types,
             [
+                (CloudType::Altocumulus, TypeSource::Remark),
                 (CloudType::Altocumulus, TypeSource::Remark),
                 (CloudType::Cirrus, TypeSource::Remark)
             ]

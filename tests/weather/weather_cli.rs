@@ -51,7 +51,7 @@ fn summarises_the_real_bulk_file() {
 }
 
 #[test]
-fn the_block_at_cork_is_a_reported_cumulonimbus() {
+fn the_block_at_cork_lists_every_reported_layer() {
     let o = skycast(&["weather", BULK, "--at", "51.848,-8.479", "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("one JSON object");
@@ -64,9 +64,36 @@ fn the_block_at_cork_is_a_reported_cumulonimbus() {
     let at = &v["at"];
     assert_eq!(at["block"]["i"], 0);
     let layers = at["weather"]["layers"].as_array().expect("layers");
-    // EICK: FEW006 SCT018CB BKN035, 6/5 C.
-    assert_eq!(layers[0]["cloud_type"], "cumulonimbus", "{at}");
-    assert_eq!(layers[0]["type_source"], "reported", "{at}");
+    // EICK: FEW006 SCT018CB BKN035, 6/5 C: three layers, the CB reported, its own type.
+    let got: Vec<(String, String, f64)> = layers
+        .iter()
+        .map(|l| {
+            (
+                l["cloud_type"].as_str().unwrap_or("").to_string(),
+                l["type_source"].as_str().unwrap_or("").to_string(),
+                l["base_ft_agl"].as_f64().unwrap_or(-1.0),
+            )
+        })
+        .collect();
+    let want = [
+        ("cumulus_humilis", "height_rule", 600.0),
+        ("cumulonimbus", "reported", 1800.0),
+        ("stratocumulus", "height_rule", 3500.0),
+    ];
+    assert_eq!(got.len(), want.len(), "{at}");
+    for ((t, s, b), (wt, ws, wb)) in got.iter().zip(want) {
+        assert_eq!((t.as_str(), s.as_str(), *b), (wt, ws, wb), "{at}");
+    }
+    for l in layers {
+        assert!(l["coverage_oktas"].as_f64().is_some_and(|c| c > 0.0), "{l}");
+        assert!(l["thickness_ft"].as_f64().is_some_and(|t| t > 0.0), "{l}");
+    }
+    // The CB grows to its type's height, not a cover's default thickness.
+    assert!(
+        layers[1]["thickness_ft"].as_f64().unwrap_or(0.0) > 20_000.0,
+        "{at}"
+    );
+    assert_eq!(at["weather"]["visibility_m"], 10000.0);
     let t = at["weather"]["temperature_c"]
         .as_f64()
         .expect("temperature");

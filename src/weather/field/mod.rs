@@ -7,18 +7,18 @@
 //! takes its nearest station's values.
 //!
 //! Two triangulations: the cloud field holds the stations that say something about the sky
-//! (layers, CAVOK/NSC/NCD/SKC/CLR as zero coverage, VV, FG); the surface field holds every station
-//! (visibility, wind as a vector, temperature, dewpoint, precipitation, ground elevation). A value
-//! some neighbours do not report is interpolated over the neighbours that do (weights
-//! renormalised); with none, the configured default.
+//! (layers, CAVOK/NSC/NCD/SKC/CLR as a clear sky, VV); the surface field holds every station
+//! (visibility, obscuration, wind as a vector, temperature, dewpoint, precipitation, ground
+//! elevation). A value some neighbours do not report is interpolated over the neighbours that do
+//! (weights renormalised); with none, the configured default.
 //!
-//! Per band (fog, low < 6,500 ft, middle, high > 20,000 ft AGL) coverage is interpolated over all
-//! cloud stations (clear ones pull it down); base and thickness are weighted by weight x coverage,
-//! so clear stations do not drag bases. A reported CB (TCU) survives where the stations reporting
-//! it carry at least `convective.weight_min` of the natural-neighbour weight: near a CB station the
-//! layer stays a cumulonimbus instead of fading into its neighbours' stratocumulus. Layer types
-//! come from [`CloudTypeRule`]. Settings: `config/weather_field.toml`.
+//! Cloud layers: every reported layer is kept; the neighbours' layers are matched by height and
+//! blended by their weights, and the covers follow the summation principle (`layers`). A block
+//! that holds a station is sampled at the station, not at its centre, so it is that station's
+//! report. Layer types come from [`CloudTypeRule`], vertical extents from the settings.
+//! Settings: `config/weather_field.toml`.
 
+mod layers;
 mod rule;
 mod sample;
 mod settings;
@@ -26,7 +26,7 @@ mod settings;
 mod tests;
 
 pub use rule::{Band, CloudTypeRule, LayerFacts, Reported, Rule};
-pub use sample::{BandSample, StationSample};
+pub use sample::{LayerKind, StationLayer, StationSample};
 pub use settings::FieldSettings;
 
 use std::collections::HashMap;
@@ -34,8 +34,7 @@ use std::collections::HashMap;
 use glam::DVec2;
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 
-use super::block::{BlockIndex, BlockLayer, BlockWeather, TypeSource, Wind};
-use super::cloud_type::CloudType;
+use super::block::{BlockIndex, BlockLayer, BlockWeather, Obscuration, Wind};
 use super::files::PlacedReport;
 use super::frame::LocalFrame;
 use super::theme::Theme;
@@ -65,6 +64,9 @@ pub struct WeatherField {
     samples: Vec<StationSample>,
     surface: Tri,
     clouds: Tri,
+    /// Where each block that holds a station is sampled: at that station (a sky station first,
+    /// the one nearest the block centre).
+    station_in_block: HashMap<BlockIndex, DVec2>,
 }
 
 /// Natural-neighbour weights of a point: (sample index, weight), weights summing to 1.
@@ -151,13 +153,14 @@ impl WeatherField {
                 position: Point2::new(local.x, local.y),
                 index: samples.len(),
             };
-            if sample.bands.is_some() {
+            if sample.sky.is_some() {
                 cloud_sites.push(site);
             }
             surface_sites.push(site);
             samples.push(sample);
         }
         // The two triangulations are independent: build them side by side.
+        let station_in_block = stations_in_blocks(&cloud_sites, &surface_sites);
         let (surface, clouds) =
             rayon::join(|| triangulate(surface_sites), || triangulate(cloud_sites));
         Self {
@@ -167,6 +170,7 @@ impl WeatherField {
             samples,
             surface,
             clouds,
+            station_in_block,
         }
     }
 
@@ -185,9 +189,19 @@ impl WeatherField {
         self.clouds.num_vertices()
     }
 
-    /// The weather of a block, queried at its centre.
+    /// The weather of a block: queried at the station it holds (so the block is that station's
+    /// report), else at its centre.
     pub fn block_weather(&self, block: BlockIndex) -> BlockWeather {
-        self.weather_at(block.centre_m())
+        self.weather_at(self.block_sample_point_m(block))
+    }
+
+    /// Where [`Self::block_weather`] samples a block, local metres: the station in it (a sky
+    /// station first, then the one nearest the centre), else its centre.
+    pub fn block_sample_point_m(&self, block: BlockIndex) -> DVec2 {
+        self.station_in_block
+            .get(&block)
+            .copied()
+            .unwrap_or_else(|| block.centre_m())
     }
 
     /// The weather at a latitude/longitude.
@@ -208,10 +222,15 @@ impl WeatherField {
         let east = value(&|s| s.wind_kt.map(|v| v[0]), 0.0);
         let north = value(&|s| s.wind_kt.map(|v| v[1]), 0.0);
         let wind = wind_from_velocity_kt(east, north);
-        let layers = self.layers_at(point_m, precipitation, temperature_c - dewpoint_c);
+        let surface = layers::Surface {
+            precipitation,
+            temperature_c,
+            spread_c: temperature_c - dewpoint_c,
+        };
         BlockWeather {
-            layers,
+            layers: self.layers_at(point_m, surface),
             visibility_m: value(&|s| s.visibility_m, d.visibility_m) as f32,
+            obscuration: self.obscuration_at(&w),
             wind,
             temperature_c: temperature_c as f32,
             dewpoint_c: dewpoint_c as f32,
@@ -220,83 +239,56 @@ impl WeatherField {
         }
     }
 
-    fn layers_at(&self, point_m: DVec2, precipitation: f64, spread_c: f64) -> Vec<BlockLayer> {
+    fn layers_at(&self, point_m: DVec2, surface: layers::Surface) -> Vec<BlockLayer> {
         let w = weights(&self.clouds, point_m);
-        let mut layers = Vec::new();
-        for (i, band) in Band::ALL.into_iter().enumerate() {
-            let bands = |s: &StationSample| s.bands.map(|b| b[i]);
-            let mut coverage = 0.0;
-            let mut weighted_base = 0.0;
-            let mut weighted_thickness = 0.0;
-            let mut cb = 0.0;
-            let mut tower = 0.0;
-            let mut named: Vec<((CloudType, TypeSource), f64)> = Vec::new();
-            let mut unnamed_cloud_weight = 0.0;
-            for &(index, weight) in &w {
-                let Some(b) = bands(&self.samples[index]) else {
-                    continue;
-                };
-                coverage += weight * b.coverage_oktas;
-                weighted_base += weight * b.coverage_oktas * b.base_ft;
-                weighted_thickness += weight * b.coverage_oktas * b.thickness_ft;
-                if b.cb {
-                    cb += weight;
-                }
-                if b.cb || b.tcu {
-                    tower += weight;
-                }
-                match b.named {
-                    Some(t) => match named.iter_mut().find(|(n, _)| *n == t) {
-                        Some((_, total)) => *total += weight,
-                        None => named.push((t, weight)),
-                    },
-                    None if b.coverage_oktas > 0.0 => unnamed_cloud_weight += weight,
-                    None => {}
+        layers::blend(&w, &self.samples, &self.settings, &self.rule, surface)
+    }
+
+    /// The obscuration the neighbours reporting one carry the most weight for, if that weight
+    /// reaches `convective.weight_min` (as a reported CB must).
+    fn obscuration_at(&self, w: &Weights) -> Option<Obscuration> {
+        let mut tally: Vec<(Obscuration, f64)> = Vec::new();
+        for &(index, weight) in w {
+            if let Some(o) = self.samples[index].obscuration {
+                match tally.iter_mut().find(|(t, _)| *t == o) {
+                    Some((_, total)) => *total += weight,
+                    None => tally.push((o, weight)),
                 }
             }
-            // The named type carrying the most weight (the first named on ties). Where some
-            // cloudy neighbours name no type, a named type needs the same weight share as a CB.
-            let named_min = if unnamed_cloud_weight > 0.0 {
-                self.settings.convective.weight_min
-            } else {
-                0.0
-            };
-            let named = named
-                .into_iter()
-                .rev()
-                .max_by(|a, b| a.1.total_cmp(&b.1))
-                .filter(|(_, weight)| *weight > 0.0 && *weight >= named_min);
-            let min = self.settings.convective.weight_min;
-            let (reported_cb, reported_tcu) = (cb > 0.0 && cb >= min, tower > 0.0 && tower >= min);
-            if coverage < self.settings.layers.min_coverage_oktas || coverage <= 0.0 {
+        }
+        tally
+            .into_iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1).then(a.0.rank().cmp(&b.0.rank())))
+            .filter(|(_, weight)| *weight > 0.0 && *weight >= self.settings.convective.weight_min)
+            .map(|(o, _)| o)
+    }
+}
+
+/// The sample point of every block that holds a station: sky stations first, then any; of
+/// several, the one nearest the block centre.
+fn stations_in_blocks(cloud_sites: &[Site], surface_sites: &[Site]) -> HashMap<BlockIndex, DVec2> {
+    let mut out: HashMap<BlockIndex, DVec2> = HashMap::new();
+    for sites in [cloud_sites, surface_sites] {
+        let mut these: HashMap<BlockIndex, DVec2> = HashMap::new();
+        for site in sites {
+            let p = DVec2::new(site.position.x, site.position.y);
+            let block = BlockIndex::containing(p);
+            if out.contains_key(&block) {
                 continue;
             }
-            let (cloud_type, type_source) = if band != Band::Fog && reported_cb {
-                (self.rule.reported.cb, TypeSource::Reported)
-            } else if band != Band::Fog && reported_tcu {
-                (self.rule.reported.tcu, TypeSource::Reported)
-            } else if let Some((named, _)) = named {
-                named
-            } else {
-                let facts = LayerFacts {
-                    band,
-                    coverage_oktas: coverage,
-                    precipitation,
-                    spread_c,
-                };
-                (self.rule.height_rule_type(&facts), TypeSource::HeightRule)
-            };
-            layers.push(BlockLayer {
-                cloud_type,
-                type_source,
-                coverage_oktas: coverage.min(8.0) as f32,
-                base_ft_agl: (weighted_base / coverage) as f32,
-                thickness_ft: (weighted_thickness / coverage) as f32,
-            });
+            let centre = block.centre_m();
+            these
+                .entry(block)
+                .and_modify(|q| {
+                    if p.distance_squared(centre) < q.distance_squared(centre) {
+                        *q = p;
+                    }
+                })
+                .or_insert(p);
         }
-        layers.sort_by(|a, b| a.base_ft_agl.total_cmp(&b.base_ft_agl));
-        layers
+        out.extend(these);
     }
+    out
 }
 
 /// The triangulation of the sites (bulk loaded; a site spade rejects is left out).

@@ -1,54 +1,68 @@
-//! One station's values as the field interpolates them: per band coverage, base, thickness and
-//! CB/TCU flags, plus the surface values. Built from a [`PlacedReport`] with the settings.
+//! One station's values as the field interpolates them: every reported cloud layer (kind,
+//! base, the cover seen from below at its base, a type a remark or a theme names), plus the
+//! surface values. Built from a [`PlacedReport`] with the settings.
 //!
-//! Per band, the band's layers merge into one: coverage is the largest of its groups (METAR
-//! covers are cumulative, each group counts all cloud at and below it), the base is the lowest
-//! base (or the base of the band's lowest CB/TCU group, the cloud that will be drawn), the top the
-//! highest base plus that group's default thickness. VV is a fog layer as deep
-//! as the vertical visibility; FG in present weather a fog layer of the configured depth.
-//! CAVOK/NSC/NCD/SKC/CLR stations have zero coverage in every band; a station with no sky group at
-//! all has no cloud sample (it is left out of the cloud field).
-//!
-//! A band may also carry a named cloud type: from a cloud-type remark (`RMK SC4AC2`, the type of
-//! the band's lowest group the remark names) or from a weather theme, whose layers name theirs.
+//! Every group with a cover and a base is a layer of its own: nothing is merged. Its cover is the
+//! report's (FEW 2, SCT 4, BKN 6, OVC 8 oktas), which by the summation principle counts all cloud
+//! at and below its base; the field turns those covers into each layer's own coverage. A CB or
+//! TCU group is a convective layer; `//////CB` (no cover, no base) one of FEW at the configured
+//! base. VV is a fog layer on the ground, overcast, as deep as the vertical visibility. FG, BR,
+//! HZ, FU and DU/SA in present weather are an [`Obscuration`] (with the visibility, the fog a
+//! host draws), not a cloud layer. CAVOK/NSC/NCD/SKC/CLR stations have no layer but say the sky
+//! is clear; a station with no sky group at all has no cloud sample (it is left out of the cloud
+//! field).
 
-use crate::weather::block::TypeSource;
+use crate::weather::block::{Obscuration, TypeSource};
 use crate::weather::cloud_type::CloudType;
 use crate::weather::files::PlacedReport;
 use crate::weather::metar::{ConvectiveKind, Cover, Intensity, Report, SkyCode};
 use crate::weather::remarks::remark_types;
 use crate::weather::theme::{Precipitation as ThemePrecipitation, ThemeWeather};
 
-use super::rule::Band;
 use super::settings::FieldSettings;
 
 /// Precipitation phenomena of present weather.
 const PRECIPITATION: [&str; 9] = ["DZ", "RA", "SN", "SG", "IC", "PL", "GR", "GS", "UP"];
 
-/// One band of one station.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct BandSample {
-    /// Coverage, oktas; 0 when the band is clear.
-    pub coverage_oktas: f64,
-    /// Lowest base in the band, feet AGL (meaningless when coverage is 0).
+/// What a layer is; layers of neighbouring stations blend only with layers of the same kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum LayerKind {
+    /// The sky obscured from the ground up (VV, or a theme's fog).
+    Fog,
+    /// A layer of cloud without CB/TCU.
+    Plain,
+    /// Cumulonimbus reported (`CB`).
+    Cb,
+    /// Towering cumulus reported (`TCU`).
+    Tcu,
+}
+
+/// One reported layer of one station.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StationLayer {
+    /// What it is.
+    pub kind: LayerKind,
+    /// Base, feet AGL.
     pub base_ft: f64,
-    /// Base to top, feet.
-    pub thickness_ft: f64,
-    /// A CB was reported in the band.
-    pub cb: bool,
-    /// A TCU was reported in the band.
-    pub tcu: bool,
-    /// The cloud type a remark or a theme names for the band, and which of the two.
+    /// The cover seen from below at the base, oktas: the report's cover, which counts all cloud
+    /// at and below the base (the summation principle).
+    pub cover_below_oktas: f64,
+    /// Base to top when the source says (a theme's layer, a VV depth), feet.
+    pub thickness_ft: Option<f64>,
+    /// The cloud type a remark or a theme names for the layer, and which of the two.
     pub named: Option<(CloudType, TypeSource)>,
 }
 
 /// One station's values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StationSample {
-    /// Per band (fog, low, middle, high); `None` when the report says nothing about the sky.
-    pub bands: Option<[BandSample; 4]>,
+    /// The layers, lowest base first; `None` when the report says nothing about the sky, empty
+    /// when it says the sky is clear.
+    pub sky: Option<Vec<StationLayer>>,
     /// Visibility, metres.
     pub visibility_m: Option<f64>,
+    /// What obscures the view (the heaviest of the present-weather groups).
+    pub obscuration: Option<Obscuration>,
     /// Wind as the velocity the air moves with, knots east/north.
     pub wind_kt: Option<[f64; 2]>,
     /// Temperature, degrees C.
@@ -59,21 +73,6 @@ pub struct StationSample {
     pub precipitation: f64,
     /// Station elevation, metres.
     pub elevation_m: Option<f64>,
-}
-
-/// The band index of a base.
-pub fn band_of(base_ft: f64, settings: &FieldSettings) -> Band {
-    if base_ft < settings.bands.low_top_ft {
-        Band::Low
-    } else if base_ft > settings.bands.high_base_ft {
-        Band::High
-    } else {
-        Band::Middle
-    }
-}
-
-fn index(band: Band) -> usize {
-    Band::ALL.iter().position(|&b| b == band).unwrap_or(0)
 }
 
 impl StationSample {
@@ -97,8 +96,9 @@ impl StationSample {
             r.visibility_m.map(f64::from)
         };
         Some(Self {
-            bands: sky_bands(r, settings),
+            sky: sky_layers(r, settings),
             visibility_m,
+            obscuration: obscuration(r),
             wind_kt,
             temperature_c: r.temperature_c.map(f64::from),
             dewpoint_c: r.dewpoint_c.map(f64::from),
@@ -107,34 +107,36 @@ impl StationSample {
         })
     }
 
-    /// The sample of one place of a weather theme: its layers keep the types they name.
+    /// The sample of one place of a weather theme: its layers keep the types, covers and
+    /// thicknesses they name (a theme's cover is the layer's own; the cover seen from below at
+    /// each base is what the layers at and below it make together).
     pub fn of_theme(weather: &ThemeWeather, settings: &FieldSettings) -> Self {
-        let mut bands = [BandSample::default(); 4];
-        for layer in &weather.layers {
-            let band = if layer.cloud_type == CloudType::Fog {
-                Band::Fog
-            } else {
-                band_of(f64::from(layer.base_ft_agl), settings)
-            };
-            let b = &mut bands[index(band)];
-            let coverage = f64::from(layer.coverage_oktas);
-            // Two theme layers in one band: the band is drawn as the one covering more sky.
-            if coverage > b.coverage_oktas {
-                *b = BandSample {
-                    coverage_oktas: coverage,
-                    base_ft: f64::from(layer.base_ft_agl),
-                    thickness_ft: f64::from(layer.thickness_ft),
-                    cb: false,
-                    tcu: false,
-                    named: Some((layer.cloud_type, TypeSource::Theme)),
-                };
-            }
-        }
+        let mut layers: Vec<_> = weather.layers.iter().collect();
+        layers.sort_by(|a, b| a.base_ft_agl.total_cmp(&b.base_ft_agl));
+        let mut clear = 1.0;
+        let sky = layers
+            .into_iter()
+            .map(|l| {
+                clear *= 1.0 - (f64::from(l.coverage_oktas) / 8.0).clamp(0.0, 1.0);
+                StationLayer {
+                    kind: if l.cloud_type == CloudType::Fog {
+                        LayerKind::Fog
+                    } else {
+                        LayerKind::Plain
+                    },
+                    base_ft: f64::from(l.base_ft_agl),
+                    cover_below_oktas: 8.0 * (1.0 - clear),
+                    thickness_ft: Some(f64::from(l.thickness_ft)),
+                    named: Some((l.cloud_type, TypeSource::Theme)),
+                }
+            })
+            .collect();
         let p = &settings.precipitation;
         let wind = weather.wind;
         Self {
-            bands: Some(bands),
+            sky: Some(sky),
             visibility_m: Some(f64::from(weather.visibility_m)),
+            obscuration: None,
             wind_kt: Some(wind_velocity_kt(
                 f64::from(wind.from_deg),
                 f64::from(wind.speed_kt),
@@ -149,6 +151,18 @@ impl StationSample {
             },
             elevation_m: Some(f64::from(weather.ground_elevation_m)),
         }
+    }
+
+    /// The cover seen from below at `height_ft` by this station's report, oktas: the largest
+    /// cover of its layers based at or under it (the summation principle; a report whose covers
+    /// shrink upwards is read as the largest below).
+    pub fn cover_below_oktas(&self, height_ft: f64) -> f64 {
+        self.sky
+            .iter()
+            .flatten()
+            .filter(|l| l.base_ft <= height_ft)
+            .map(|l| l.cover_below_oktas)
+            .fold(0.0, f64::max)
     }
 }
 
@@ -176,80 +190,59 @@ pub fn precipitation(r: &Report, settings: &FieldSettings) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn has_fog(r: &Report) -> bool {
+/// The obscuration of the report's present weather (not in the vicinity), the heaviest first.
+pub fn obscuration(r: &Report) -> Option<Obscuration> {
     r.weather
         .iter()
-        .any(|w| w.intensity != Intensity::Vicinity && w.phenomena.iter().any(|p| p == "FG"))
+        .filter(|w| w.intensity != Intensity::Vicinity)
+        .flat_map(|w| w.phenomena.iter())
+        .filter_map(|p| Obscuration::of_code(p))
+        .max_by_key(|o| o.rank())
 }
 
-/// Per-band samples, or `None` when the report has no sky statement at all.
-fn sky_bands(r: &Report, settings: &FieldSettings) -> Option<[BandSample; 4]> {
-    let fog = has_fog(r);
-    if !r.cavok && r.sky.is_none() && r.clouds.is_empty() && !fog {
+/// The report's layers, lowest base first; `None` when it has no sky statement at all.
+fn sky_layers(r: &Report, settings: &FieldSettings) -> Option<Vec<StationLayer>> {
+    if !r.cavok && r.sky.is_none() && r.clouds.is_empty() {
         return None;
     }
-    let mut bands = [BandSample::default(); 4];
-    let mut top_ft = [0.0f64; 4];
-    let mut convective_base_ft: [Option<f64>; 4] = [None; 4];
-    if fog {
-        let f = &mut bands[index(Band::Fog)];
-        f.coverage_oktas = 8.0;
-        f.thickness_ft = settings.fog.thickness_ft;
-    }
     let named = remark_types(&r.clouds, &r.remarks);
+    let mut layers = Vec::with_capacity(r.clouds.len());
     for (g, named) in r.clouds.iter().zip(named) {
+        let named = named.map(|t| (t, TypeSource::Remark));
         if g.cover == Some(Cover::Vv) {
-            if let Some(t) = named {
-                bands[index(Band::Fog)].named = Some((t, TypeSource::Remark));
-            }
-            let f = &mut bands[index(Band::Fog)];
-            f.coverage_oktas = 8.0;
-            f.base_ft = 0.0;
-            let depth = g.base_ft.map_or(settings.fog.thickness_ft, f64::from);
-            f.thickness_ft = f.thickness_ft.max(depth);
+            layers.push(StationLayer {
+                kind: LayerKind::Fog,
+                base_ft: 0.0,
+                cover_below_oktas: settings.oktas.ovc,
+                thickness_ft: Some(g.base_ft.map_or(settings.fog.thickness_ft, f64::from)),
+                named,
+            });
             continue;
         }
-        let band = g
-            .base_ft
-            .map_or(Band::Low, |b| band_of(f64::from(b), settings));
-        let i = index(band);
-        let b = &mut bands[i];
-        if let (None, Some(t)) = (b.named, named) {
-            b.named = Some((t, TypeSource::Remark));
-        }
-        match g.kind {
-            Some(ConvectiveKind::Cb) => b.cb = true,
-            Some(ConvectiveKind::Tcu) => b.tcu = true,
-            None => {}
-        }
-        let (Some(cover), Some(base)) = (g.cover, g.base_ft) else {
-            continue;
+        let kind = match g.kind {
+            Some(ConvectiveKind::Cb) => LayerKind::Cb,
+            Some(ConvectiveKind::Tcu) => LayerKind::Tcu,
+            None => LayerKind::Plain,
         };
-        let base = f64::from(base);
-        if g.kind.is_some() {
-            convective_base_ft[i] = Some(convective_base_ft[i].map_or(base, |c| c.min(base)));
-        }
-        let first = b.coverage_oktas == 0.0;
-        b.coverage_oktas = b.coverage_oktas.max(settings.oktas.get(cover));
-        b.base_ft = if first { base } else { b.base_ft.min(base) };
-        top_ft[i] = top_ft[i].max(base + settings.thickness_ft.get(cover));
-        b.thickness_ft = top_ft[i] - b.base_ft;
+        let (cover, base) = match (g.cover, g.base_ft) {
+            (Some(cover), Some(base)) => (settings.oktas.get(cover), f64::from(base)),
+            // A reported CB/TCU without cover or base (`//////CB`) is still drawn.
+            (None, None) if kind != LayerKind::Plain => {
+                (settings.oktas.few, settings.convective.unknown_base_ft)
+            }
+            (None, Some(base)) if kind != LayerKind::Plain => (settings.oktas.few, f64::from(base)),
+            _ => continue,
+        };
+        layers.push(StationLayer {
+            kind,
+            base_ft: base,
+            cover_below_oktas: cover,
+            thickness_ft: None,
+            named,
+        });
     }
-    for (b, (base, top)) in bands.iter_mut().zip(convective_base_ft.iter().zip(top_ft)) {
-        if let Some(base) = *base {
-            b.base_ft = base;
-            b.thickness_ft = top - base;
-        }
-    }
-    // A reported CB/TCU without cover or base (`//////CB`) still gets a layer to be drawn in.
-    for b in &mut bands[1..] {
-        if (b.cb || b.tcu) && b.coverage_oktas == 0.0 {
-            b.coverage_oktas = settings.oktas.few;
-            b.base_ft = settings.convective.unknown_base_ft;
-            b.thickness_ft = settings.thickness_ft.few;
-        }
-    }
-    Some(bands)
+    layers.sort_by(|a, b| a.base_ft.total_cmp(&b.base_ft));
+    Some(layers)
 }
 
 #[cfg(test)]
@@ -283,9 +276,9 @@ mod tests {
     }
 
     #[test]
-    fn layers_merge_per_band() {
+    fn every_group_is_a_layer_of_its_own() {
         let s = FieldSettings::default();
-        // SCT028 BKN033 OVC050 FEW250 (KIKT, with a cirrus added).
+        // SCT028 BKN033TCU OVC050 FEW250 (KIKT, with a TCU and a cirrus added).
         let r = Report {
             clouds: vec![
                 group(Some(Cover::Sct), Some(2800), None),
@@ -295,54 +288,46 @@ mod tests {
             ],
             ..Report::default()
         };
-        let bands = StationSample::of(&placed(r), &s).unwrap().bands.unwrap();
-        let low = bands[1];
-        assert_eq!(low.coverage_oktas, 8.0);
-        // The TCU group's base, not the SCT028 below it.
-        assert_eq!(low.base_ft, 3300.0);
-        assert_eq!(low.thickness_ft, 5000.0 + 1500.0 - 3300.0);
-        assert!(low.tcu && !low.cb);
-        assert_eq!(bands[2].coverage_oktas, 0.0);
-        assert_eq!(bands[3].coverage_oktas, 2.0);
-        assert_eq!(bands[3].base_ft, 25000.0);
-        assert_eq!(bands[0].coverage_oktas, 0.0);
-    }
-
-    #[test]
-    fn a_convective_group_sets_its_band_base() {
-        let s = FieldSettings::default();
-        // EICK: FEW006 SCT018CB BKN035.
-        let r = Report {
-            clouds: vec![
-                group(Some(Cover::Few), Some(600), None),
-                group(Some(Cover::Sct), Some(1800), Some(ConvectiveKind::Cb)),
-                group(Some(Cover::Bkn), Some(3500), None),
-            ],
-            ..Report::default()
+        let sky = StationSample::of(&placed(r), &s).unwrap().sky.unwrap();
+        let got: Vec<(LayerKind, f64, f64)> = sky
+            .iter()
+            .map(|l| (l.kind, l.base_ft, l.cover_below_oktas))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                (LayerKind::Plain, 2800.0, 4.0),
+                (LayerKind::Tcu, 3300.0, 6.0),
+                (LayerKind::Plain, 5000.0, 8.0),
+                (LayerKind::Plain, 25000.0, 2.0),
+            ]
+        );
+        let sample = StationSample {
+            sky: Some(sky),
+            ..StationSample::of(&placed(Report::default()), &s).unwrap()
         };
-        let low = StationSample::of(&placed(r), &s).unwrap().bands.unwrap()[1];
-        assert!(low.cb);
-        assert_eq!(low.coverage_oktas, 6.0);
-        assert_eq!(low.base_ft, 1800.0);
-        assert_eq!(low.thickness_ft, 3500.0 + 1500.0 - 1800.0);
+        // The FEW250 under an overcast: the sky seen from below stays overcast.
+        assert_eq!(sample.cover_below_oktas(30000.0), 8.0);
+        assert_eq!(sample.cover_below_oktas(3000.0), 4.0);
+        assert_eq!(sample.cover_below_oktas(2000.0), 0.0);
     }
 
     #[test]
-    fn clear_codes_are_zero_and_no_sky_group_is_no_sample() {
+    fn clear_codes_are_no_layer_and_no_sky_group_is_no_sample() {
         let s = FieldSettings::default();
         let cavok = Report {
             cavok: true,
             ..Report::default()
         };
         let sample = StationSample::of(&placed(cavok), &s).unwrap();
-        assert_eq!(sample.bands, Some([BandSample::default(); 4]));
+        assert_eq!(sample.sky, Some(vec![]));
         assert_eq!(sample.visibility_m, Some(10000.0));
         let nothing = Report {
             visibility_m: Some(5000.0),
             ..Report::default()
         };
         let sample = StationSample::of(&placed(nothing), &s).unwrap();
-        assert_eq!(sample.bands, None);
+        assert_eq!(sample.sky, None);
         assert_eq!(sample.visibility_m, Some(5000.0));
         let nil = Report {
             sky: Some(SkyCode::Nil),
@@ -352,18 +337,25 @@ mod tests {
     }
 
     #[test]
-    fn vv_and_fg_are_fog_and_cb_without_base_is_kept() {
+    fn vv_is_fog_fg_is_an_obscuration_and_cb_without_base_is_kept() {
         let s = FieldSettings::default();
+        let weather = |intensity, phenomena: &[&str]| PresentWeather {
+            intensity,
+            descriptor: None,
+            phenomena: phenomena.iter().map(|p| p.to_string()).collect(),
+        };
         let r = Report {
             clouds: vec![
                 group(Some(Cover::Vv), Some(200), None),
                 group(None, None, Some(ConvectiveKind::Cb)),
             ],
-            weather: vec![PresentWeather {
-                intensity: Intensity::Heavy,
-                descriptor: Some("TS".to_string()),
-                phenomena: vec!["RA".to_string()],
-            }],
+            weather: vec![
+                PresentWeather {
+                    descriptor: Some("TS".to_string()),
+                    ..weather(Intensity::Heavy, &["RA"])
+                },
+                weather(Intensity::Moderate, &["BR"]),
+            ],
             wind: Some(WindGroup {
                 dir_deg: Some(270),
                 speed_kt: Some(10.0),
@@ -372,24 +364,35 @@ mod tests {
             ..Report::default()
         };
         let sample = StationSample::of(&placed(r), &s).unwrap();
-        let bands = sample.bands.unwrap();
-        assert_eq!(bands[0].coverage_oktas, 8.0);
-        assert_eq!(bands[0].thickness_ft, 200.0);
-        assert!(bands[1].cb);
-        assert_eq!(bands[1].coverage_oktas, 2.0);
-        assert_eq!(bands[1].base_ft, 3000.0);
+        let sky = sample.sky.unwrap();
+        assert_eq!(sky[0].kind, LayerKind::Fog);
+        assert_eq!((sky[0].base_ft, sky[0].cover_below_oktas), (0.0, 8.0));
+        assert_eq!(sky[0].thickness_ft, Some(200.0));
+        assert_eq!(sky[1].kind, LayerKind::Cb);
+        assert_eq!((sky[1].base_ft, sky[1].cover_below_oktas), (3000.0, 2.0));
         assert_eq!(sample.precipitation, 1.0);
+        assert_eq!(sample.obscuration, Some(Obscuration::Mist));
         // From 270: the air moves east.
         let w = sample.wind_kt.unwrap();
         assert!((w[0] - 10.0).abs() < 1e-9 && w[1].abs() < 1e-9);
+        // Fog in the vicinity says nothing about the station; fog at it hides more than mist.
         let mist = Report {
-            weather: vec![PresentWeather {
-                intensity: Intensity::Vicinity,
-                descriptor: None,
-                phenomena: vec!["FG".to_string()],
-            }],
+            weather: vec![weather(Intensity::Vicinity, &["FG"])],
             ..Report::default()
         };
-        assert_eq!(StationSample::of(&placed(mist), &s).unwrap().bands, None);
+        let sample = StationSample::of(&placed(mist), &s).unwrap();
+        assert_eq!((sample.sky, sample.obscuration), (None, None));
+        let fog = Report {
+            weather: vec![
+                weather(Intensity::Moderate, &["BR"]),
+                weather(Intensity::Moderate, &["FG"]),
+            ],
+            clouds: vec![group(Some(Cover::Bkn), Some(200), None)],
+            ..Report::default()
+        };
+        let sample = StationSample::of(&placed(fog), &s).unwrap();
+        assert_eq!(sample.obscuration, Some(Obscuration::Fog));
+        // FG is not a cloud layer: the BKN002 is the only one.
+        assert_eq!(sample.sky.unwrap().len(), 1);
     }
 }

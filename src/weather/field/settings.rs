@@ -1,5 +1,6 @@
-//! The field's settings, `config/weather_field.toml`: altitude bands, METAR cover to oktas,
-//! default thickness per cover, fog, CB/TCU survival, precipitation and fall-back values.
+//! The field's settings, `config/weather_field.toml`: the bands of the type rule, METAR cover to
+//! oktas, default thickness per cover, vertical extent by cloud type, fog, CB/TCU survival, how
+//! layers of neighbouring stations blend, precipitation and fall-back values.
 
 use std::path::Path;
 
@@ -15,12 +16,14 @@ const BUILTIN: &str = include_str!("../../../config/weather_field.toml");
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FieldSettings {
-    /// Altitude band limits.
+    /// Altitude band limits (they choose the type rule; layers are never merged by band).
     pub bands: Bands,
     /// Oktas per METAR cover.
     pub oktas: PerCover,
     /// Thickness per cover, feet.
     pub thickness_ft: PerCover,
+    /// Vertical extent by cloud type.
+    pub extent: Extent,
     /// Fog layers.
     pub fog: Fog,
     /// CB/TCU survival through interpolation.
@@ -69,6 +72,68 @@ impl PerCover {
     }
 }
 
+/// Vertical extent by cloud type: where the type, not the cover, decides how tall a layer is.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Extent {
+    /// Cumulonimbus tops (anvil included), feet AGL: the first at or below the cold end of
+    /// `convective_top_by_temperature_c`, the second at or above its warm end.
+    pub cumulonimbus_top_ft: [f64; 2],
+    /// Towering cumulus (cumulus congestus) tops, feet AGL, as for the cumulonimbus.
+    pub congestus_top_ft: [f64; 2],
+    /// Surface temperatures, degrees C, between which convective tops rise from the first to the
+    /// second of their range (a warmer surface, a higher tropopause).
+    pub convective_top_by_temperature_c: [f64; 2],
+    /// Fair-weather cumulus (humilis, mediocris) thickness, feet: the first at or below the first
+    /// temperature-dewpoint spread of `fair_weather_cumulus_by_spread_c`, the second at or above
+    /// the second.
+    pub fair_weather_cumulus_thickness_ft: [f64; 2],
+    /// Spreads, degrees C, between which fair-weather cumulus thickens.
+    pub fair_weather_cumulus_by_spread_c: [f64; 2],
+    /// Stratus thickness, feet.
+    pub stratus_thickness_ft: f64,
+}
+
+impl Extent {
+    /// Top of a cumulonimbus over a surface at `temperature_c`, feet AGL.
+    pub fn cumulonimbus_top_ft(&self, temperature_c: f64) -> f64 {
+        lerp_by(
+            self.cumulonimbus_top_ft,
+            self.convective_top_by_temperature_c,
+            temperature_c,
+        )
+    }
+
+    /// Top of a towering cumulus over a surface at `temperature_c`, feet AGL.
+    pub fn congestus_top_ft(&self, temperature_c: f64) -> f64 {
+        lerp_by(
+            self.congestus_top_ft,
+            self.convective_top_by_temperature_c,
+            temperature_c,
+        )
+    }
+
+    /// Thickness of fair-weather cumulus at a temperature-dewpoint spread, feet.
+    pub fn fair_weather_cumulus_thickness_ft(&self, spread_c: f64) -> f64 {
+        lerp_by(
+            self.fair_weather_cumulus_thickness_ft,
+            self.fair_weather_cumulus_by_spread_c,
+            spread_c,
+        )
+    }
+}
+
+/// `values[0]` at or below `by[0]`, `values[1]` at or above `by[1]`, linear between.
+fn lerp_by(values: [f64; 2], by: [f64; 2], x: f64) -> f64 {
+    let t = if by[1] > by[0] {
+        ((x - by[0]) / (by[1] - by[0])).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    let t = if t.is_finite() { t } else { 0.0 };
+    values[0] + (values[1] - values[0]) * t
+}
+
 /// Fog layers.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -87,12 +152,21 @@ pub struct Convective {
     pub unknown_base_ft: f64,
 }
 
-/// Which layers are kept.
+/// How the layers of neighbouring stations blend, and which are kept.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Layers {
     /// Least interpolated coverage of a kept layer, oktas.
     pub min_coverage_oktas: f64,
+    /// Layers of different stations whose bases lie within the larger of this, feet ...
+    pub blend_within_ft: f64,
+    /// ... and this fraction of the base are one layer between the stations.
+    pub blend_within_fraction: f64,
+    /// Least own coverage of a reported layer that adds no cover seen from below (`BKN010
+    /// BKN020`), oktas: it is still drawn, seen through the gaps of the one below.
+    pub min_added_oktas: f64,
+    /// Least thickness of a layer squeezed under the next base, feet.
+    pub min_thickness_ft: f64,
 }
 
 /// Precipitation intensity 0..=1 per present-weather intensity.
@@ -145,6 +219,40 @@ impl FieldSettings {
                 "must be above 0 and at most bands.high_base_ft",
             ));
         }
+        let e = &self.extent;
+        for (field, range) in [
+            ("extent.cumulonimbus_top_ft", e.cumulonimbus_top_ft),
+            ("extent.congestus_top_ft", e.congestus_top_ft),
+            (
+                "extent.fair_weather_cumulus_thickness_ft",
+                e.fair_weather_cumulus_thickness_ft,
+            ),
+            (
+                "extent.convective_top_by_temperature_c",
+                e.convective_top_by_temperature_c,
+            ),
+            (
+                "extent.fair_weather_cumulus_by_spread_c",
+                e.fair_weather_cumulus_by_spread_c,
+            ),
+        ] {
+            if !(range[0].is_finite() && range[1].is_finite() && range[0] <= range[1]) {
+                return Err(bad(
+                    field,
+                    "must be two finite numbers, the first at most the second",
+                ));
+            }
+        }
+        let l = &self.layers;
+        if !(l.blend_within_ft >= 0.0 && (0.0..1.0).contains(&l.blend_within_fraction)) {
+            return Err(bad(
+                "layers.blend_within_fraction",
+                "must be within 0..1 (and layers.blend_within_ft at least 0)",
+            ));
+        }
+        if !(0.0..=8.0).contains(&l.min_added_oktas) {
+            return Err(bad("layers.min_added_oktas", "must be within 0..=8"));
+        }
         if !(0.0..=1.0).contains(&self.convective.weight_min) {
             return Err(bad("convective.weight_min", "must be within 0..=1"));
         }
@@ -172,6 +280,35 @@ mod tests {
         assert_eq!(s.oktas.get(Cover::Bkn), 6.0);
         assert_eq!(s.bands.low_top_ft, 6500.0);
         assert_eq!(s.bands.high_base_ft, 20000.0);
+        let e = s.extent;
+        assert_eq!(e.cumulonimbus_top_ft(-10.0), 25_000.0);
+        assert_eq!(e.cumulonimbus_top_ft(40.0), 40_000.0);
+        assert!((e.congestus_top_ft(15.0) - 16_000.0).abs() < 1e-9);
+        let (thin, thick) = (
+            e.fair_weather_cumulus_thickness_ft(1.0),
+            e.fair_weather_cumulus_thickness_ft(20.0),
+        );
+        assert!(thin < thick, "{thin} {thick}");
+    }
+
+    #[test]
+    fn a_reversed_extent_range_names_its_line() {
+        let text = BUILTIN.replace(
+            "cumulonimbus_top_ft = [25000.0, 40000.0]",
+            "cumulonimbus_top_ft = [40000.0, 25000.0]",
+        );
+        let err = FieldSettings::parse(&text, Path::new("f.toml")).unwrap_err();
+        let line = BUILTIN
+            .lines()
+            .position(|l| l.starts_with("cumulonimbus_top_ft"))
+            .unwrap()
+            + 1;
+        assert!(
+            err.to_string().starts_with(&format!(
+                "f.toml:{line}: field `extent.cumulonimbus_top_ft`"
+            )),
+            "{err}"
+        );
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Interpolation properties of the field, on hand-built reports.
 
 use super::*;
+use crate::weather::block::TypeSource;
 use crate::weather::cloud_type::CloudType;
 use crate::weather::files::Position;
 use crate::weather::metar::{CloudGroup, ConvectiveKind, Cover, Report, ReportTime, WindGroup};
@@ -269,10 +270,11 @@ fn on_the_real_bulk_file_every_cb_station_keeps_its_cb() {
         &FieldSettings::default(),
         &CloudTypeRule::default(),
     );
-    // 4,877 placed reports; some share coordinates and some are NIL: 4,856 stations, 4,497 of
-    // them with something to say about the sky.
+    // 4,877 placed reports; some share coordinates and some are NIL: 4,856 stations, 4,496 of
+    // them with something to say about the sky (fog without a sky group is an obscuration, not
+    // a sky statement).
     assert_eq!(f.station_count(), 4_856);
-    assert_eq!(f.cloud_station_count(), 4_497);
+    assert_eq!(f.cloud_station_count(), 4_496);
     let mut checked = 0;
     for p in &file.reports {
         let has_cb = p
@@ -330,4 +332,103 @@ fn collinear_stations_fall_back_to_the_nearest() {
     assert_eq!(w.temperature_c, 1.0);
     assert_eq!(w.layers[0].cloud_type, CloudType::Stratus);
     assert!(f.weather_at_lat_lon(50.9, LON0).layers.is_empty());
+}
+
+/// Two stations 1 degree of longitude apart on the 50th parallel.
+fn pair(west: Vec<CloudGroup>, east: Vec<CloudGroup>) -> WeatherField {
+    field(&[
+        station(LAT0, 7.5, 1, report(west, 10.0, 270)),
+        station(LAT0, 8.5, 2, report(east, 10.0, 270)),
+        // Far corners, clear, so the two are inside the hull.
+        station(48.0, 6.0, 3, cavok(10.0)),
+        station(52.0, 10.0, 4, cavok(10.0)),
+        station(48.0, 10.0, 5, cavok(10.0)),
+        station(52.0, 6.0, 6, cavok(10.0)),
+    ])
+}
+
+#[test]
+fn layers_at_similar_heights_blend_and_a_layer_one_station_has_fades() {
+    let f = pair(
+        vec![layer(Cover::Sct, 2400, None), layer(Cover::Bkn, 9000, None)],
+        vec![layer(Cover::Sct, 2800, None)],
+    );
+    let at = |lon: f64| f.weather_at_lat_lon(LAT0, lon).layers;
+    // At each station its own report.
+    let west = at(7.5);
+    assert_eq!(west.len(), 2, "{west:?}");
+    assert_eq!((west[0].base_ft_agl, west[1].base_ft_agl), (2400.0, 9000.0));
+    let east = at(8.5);
+    assert_eq!(east.len(), 1, "{east:?}");
+    // Between them the SCT layers are one, its base between the two, and the BKN layer only
+    // the western station has thins out towards the east.
+    let mut last_base = 2400.0;
+    let mut last_upper = 8.0;
+    for lon in [7.7, 7.9, 8.1, 8.3] {
+        let layers = at(lon);
+        let low: Vec<_> = layers.iter().filter(|l| l.base_ft_agl < 5000.0).collect();
+        assert_eq!(low.len(), 1, "{lon}: {layers:?}");
+        assert!(low[0].base_ft_agl >= last_base, "{lon}: {layers:?}");
+        assert!(
+            (low[0].coverage_oktas - 4.0).abs() < 0.5,
+            "{lon}: {layers:?}"
+        );
+        last_base = low[0].base_ft_agl;
+        let upper = layers
+            .iter()
+            .find(|l| l.base_ft_agl > 5000.0)
+            .map_or(0.0, |l| l.coverage_oktas);
+        assert!(upper < last_upper, "{lon}: {layers:?}");
+        last_upper = upper;
+    }
+    assert!(last_base > 2400.0 && last_base <= 2800.0);
+    assert!(last_upper < 2.0, "{last_upper}");
+}
+
+#[test]
+fn a_block_that_holds_a_station_is_its_report() {
+    let f = field(&square());
+    for (lat, lon) in [(49.5, 7.3), (50.0, 8.0), (50.5, 8.7)] {
+        let block = f.frame().block_of(lat, lon);
+        let at_station = f.weather_at_lat_lon(lat, lon);
+        assert_eq!(f.block_weather(block), at_station, "{lat},{lon}");
+        assert_ne!(f.block_sample_point_m(block), block.centre_m());
+    }
+}
+
+#[test]
+fn covers_follow_the_summation_principle_and_tops_the_type() {
+    use crate::weather::block::{ceiling_ft, cover_seen_from_below_oktas};
+    // FEW008 SCT026 BKN045 (Dublin) next to FEW020CB BKN025 over a warm surface.
+    let dublin = vec![
+        layer(Cover::Few, 800, None),
+        layer(Cover::Sct, 2600, None),
+        layer(Cover::Bkn, 4500, None),
+    ];
+    let cb = vec![
+        layer(Cover::Few, 2000, Some(ConvectiveKind::Cb)),
+        layer(Cover::Bkn, 2500, None),
+    ];
+    let f = pair(dublin, cb);
+    let layers = f.weather_at_lat_lon(LAT0, 7.5).layers;
+    let seen: Vec<f32> = layers
+        .iter()
+        .map(|l| cover_seen_from_below_oktas(&layers, l.base_ft_agl))
+        .collect();
+    assert_eq!(layers.len(), 3);
+    for (got, want) in seen.iter().zip([2.0, 4.0, 6.0]) {
+        assert!((got - want).abs() < 1e-4, "{seen:?}");
+    }
+    assert_eq!(ceiling_ft(&layers, 5.0), Some(4500.0));
+    // The lower layers stop under the next base.
+    assert!(layers[0].thickness_ft <= 1800.0 && layers[1].thickness_ft <= 1900.0);
+    let layers = f.weather_at_lat_lon(LAT0, 8.5).layers;
+    assert_eq!(layers.len(), 2, "{layers:?}");
+    let (cells, deck) = (layers[0], layers[1]);
+    assert_eq!(cells.cloud_type, CloudType::Cumulonimbus);
+    assert_eq!(cells.coverage_oktas, 2.0);
+    // 10 degrees C: a third of the way from 25,000 to 40,000 ft.
+    assert!((cells.base_ft_agl + cells.thickness_ft - 30_000.0).abs() < 1.0);
+    assert_eq!(deck.cloud_type, CloudType::Stratocumulus);
+    assert!((cover_seen_from_below_oktas(&layers, 2500.0) - 6.0).abs() < 1e-4);
 }
