@@ -15,11 +15,15 @@
 
 // Keep in sync with `GpuSprite` in src/render/gpu_types.rs.
 struct Sprite {
-    offset_width: vec4<f32>,
-    group_height: vec4<f32>,
-    rotation_rad: f32,
-    alpha_morph: f32,
-    radius_fraction: f32,
+    offset: vec3<f32>,
+    // Width and height, half floats.
+    size: u32,
+    // The shading group centre's x and y, half floats.
+    group_xy: u32,
+    // Low: the group centre's z (half float); high: the rotation, a turn in 65,536 steps.
+    group_z_rotation: u32,
+    // Low: alpha_morph; high: radius fraction (16-bit fractions).
+    morph_radius: u32,
     bits: u32,
 };
 
@@ -240,9 +244,16 @@ fn sprite_corner(vi: u32) -> Corner {
     let s = sprites[slot];
     let flat_radius = clouds[entry.cloud].level4_radius_flat;
     let centre_rel = b.origin_rel + clouds[entry.cloud].centre_block.xyz;
-    let offset = s.offset_width.xyz;
-    let width = s.offset_width.w;
-    let height = s.group_height.w;
+    let offset = s.offset;
+    let size = unpack2x16float(s.size);
+    let width = size.x;
+    let height = size.y;
+    let group = vec3<f32>(
+        unpack2x16float(s.group_xy),
+        unpack2x16float(s.group_z_rotation & 0xffffu).x,
+    );
+    let rotation = f32(s.group_z_rotation >> 16u) * (6.283185307 / 65536.0);
+    let morph_radius = unpack2x16unorm(s.morph_radius);
     let cam_local = -centre_rel;
     let to_cam = cam_local - offset;
     let radius = 0.5 * max(width, height);
@@ -266,11 +277,11 @@ fn sprite_corner(vi: u32) -> Corner {
         let lock = view.forward_lock;
         alpha *= clamp((cos_angle - lock.w) / max(lock.z - lock.w, 1e-4), 0.0, 1.0);
     }
-    let morph = s.alpha_morph * lifecycle_alpha(b.fade_kind, b.fade_progress, s.radius_fraction);
+    let morph = morph_radius.x * lifecycle_alpha(b.fade_kind, b.fade_progress, morph_radius.y);
     o.visible = alpha > 0.0 && morph > 0.0;
 
     let corner = vec2<f32>(f32(corner_id & 1u), 1.0 - f32(corner_id >> 1u));
-    let sc = vec2<f32>(sin(s.rotation_rad), cos(s.rotation_rad));
+    let sc = vec2<f32>(sin(rotation), cos(rotation));
     let right = face.right * sc.y + face.up * sc.x;
     let up = face.up * sc.y - face.right * sc.x;
     let p = offset + right * ((corner.x - 0.5) * width) + up * ((corner.y - 0.5) * height);
@@ -281,7 +292,7 @@ fn sprite_corner(vi: u32) -> Corner {
     let ambient = level_colour(entry.cloud, height_msl);
     let view_dir = normalize_or(p - cam_local, vec3<f32>(0.0));
     let rim = length(p) / flat_radius.y;
-    let group_dir = normalize_or(p - s.group_height.xyz, vec3<f32>(0.0));
+    let group_dir = normalize_or(p - group, vec3<f32>(0.0));
     let sun = normalize_or(view.sun_dir_camera_z.xyz, vec3<f32>(0.0));
     let directional = (directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim))
         * light.rgb;

@@ -211,7 +211,8 @@ impl DemoHost {
     }
 
     /// The most sprites the sky can hold on the GPU on this device: its sprite records
-    /// ([`GpuSprite`]) in one storage buffer, six quad indices each in one index buffer.
+    /// ([`GpuSprite`]) in one storage buffer, and as many drawn at once, six quad indices each in
+    /// one index buffer.
     pub fn max_sprites(&self) -> u64 {
         let limits = self.gpu.device.limits();
         let records = limits

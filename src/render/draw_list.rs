@@ -473,6 +473,7 @@ pub(super) fn fresh_view(
     orders.clear();
     let mut total = 0u32;
     let mut cloud_order: Vec<(usize, f64)> = Vec::new();
+    let mut keys = SortKeys::new();
     for (_, id) in blocks_back_to_front(blocks, ids, from_m) {
         let Some(r) = blocks.get(&id) else {
             continue;
@@ -497,10 +498,14 @@ pub(super) fn fresh_view(
                 order_base: orders.len() as u32,
                 _pad: 0,
             });
-            orders.extend(
-                sprites_back_to_front(cloud, rel.as_vec3())
-                    .into_iter()
-                    .map(|(i, _)| state.sprite_base + i as u32),
+            let at = orders.len();
+            orders.resize(at + cloud.sprites.len(), 0);
+            order_into(
+                cloud,
+                rel.as_vec3(),
+                state.sprite_base,
+                &mut orders[at..],
+                &mut keys,
             );
             first += state.sprites;
         }

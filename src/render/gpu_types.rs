@@ -31,24 +31,29 @@ pub struct GpuFrame {
 const _: () = assert!(std::mem::size_of::<GpuFrame>() == 240);
 
 /// One sprite as it lives on the GPU from the moment its block arrives until the block goes
-/// (written once, never per frame). Keep in sync with `Sprite` in `shaders/sprites.wgsl`.
+/// (written once, never per frame), packed into 32 bytes: at a million sprites within 100 km
+/// every byte is a megabyte. Keep in sync with `Sprite` in `shaders/sprites.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuSprite {
-    /// xyz: centre, metres from the cloud centre (east, north, up); w: width, metres.
-    pub offset_width: [f32; 4],
-    /// xyz: its shading group's centre, metres from the cloud centre; w: height, metres.
-    pub group_height: [f32; 4],
-    /// Rotation in the sprite plane, radians.
-    pub rotation_rad: f32,
-    /// Formation / dissipation factor of the sprite itself, 0..=1 (multiplied by the block's fade).
-    pub alpha_morph: f32,
-    /// Distance from the cloud centre over the cloud radius (which sprites fade first, Wang 4).
-    pub radius_fraction: f32,
+    /// Centre, metres from the cloud centre (east, north, up).
+    pub offset: [f32; 3],
+    /// Width and height, metres, as two half floats (about a metre at 2 km).
+    pub size: u32,
+    /// Its shading group's centre, metres from the cloud centre, as half floats: x and y here,
+    /// z in the low half of `group_z_rotation`.
+    pub group_xy: u32,
+    /// Low half: the group centre's z (half float); high half: the rotation in the sprite
+    /// plane, a turn in 65,536 steps.
+    pub group_z_rotation: u32,
+    /// Low half: its own fixed transparency factor (`alpha_morph`); high half: its distance from
+    /// the cloud centre over the cloud radius (which sprites fade first, Wang 4); both 0..=1 in
+    /// 65,535 steps.
+    pub morph_radius: u32,
     /// Bits 0..4: sheet cell; bit 8: upright (cylindrical billboard).
     pub bits: u32,
 }
-const _: () = assert!(std::mem::size_of::<GpuSprite>() == 48);
+const _: () = assert!(std::mem::size_of::<GpuSprite>() == 32);
 
 /// The `bits` flag of an upright sprite.
 pub const SPRITE_UPRIGHT: u32 = 1 << 8;

@@ -16,9 +16,10 @@ use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_UPRIGHT};
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
 
-/// Bytes of GPU memory each sprite slot costs: its record, its order entry, six quad indices
-/// (a cloud's record and list entry come on top, a hundredth of it for 30-sprite clouds).
-pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4 + 6 * 4;
+/// Bytes of GPU memory each sprite slot costs: its record and its order entry (a cloud's record
+/// and list entry come on top, about a twentieth of it for 30-sprite clouds; the quad indices
+/// are for the sprites drawn, not held).
+pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4;
 
 /// A cloud's bounds (computed once when its block arrives) and its order cache.
 #[derive(Debug, Clone)]
@@ -124,6 +125,18 @@ impl Resident {
     }
 }
 
+/// Two values as the low and high halves of a `u32` (WGSL's `pack2x16float`).
+fn halves(low: f32, high: f32) -> u32 {
+    let h = |v: f32| half::f16::from_f32(v).to_bits() as u32;
+    h(low) | (h(high) << 16)
+}
+
+/// Two values in 0..=1 as 16-bit fractions (WGSL's `pack2x16unorm`).
+fn fractions(low: f32, high: f32) -> u32 {
+    let u = |v: f32| (v.clamp(0.0, 1.0) * 65_535.0).round() as u32;
+    u(low) | (u(high) << 16)
+}
+
 /// The GPU record of a sprite.
 pub fn gpu_sprite(cloud: &SkyCloud, s: &super::scene::SkySprite) -> GpuSprite {
     let group = cloud
@@ -131,12 +144,14 @@ pub fn gpu_sprite(cloud: &SkyCloud, s: &super::scene::SkySprite) -> GpuSprite {
         .get(s.group as usize)
         .copied()
         .unwrap_or(Vec3::ZERO);
+    let turns = s.rotation_deg.rem_euclid(360.0) / 360.0;
+    let rotation = ((turns * 65_536.0).round() as u32) & 0xffff;
     GpuSprite {
-        offset_width: s.offset_m.extend(s.width_m).to_array(),
-        group_height: group.extend(s.height_m).to_array(),
-        rotation_rad: s.rotation_deg.to_radians(),
-        alpha_morph: s.alpha_morph,
-        radius_fraction: s.radius_fraction,
+        offset: s.offset_m.to_array(),
+        size: halves(s.width_m, s.height_m),
+        group_xy: halves(group.x, group.y),
+        group_z_rotation: (half::f16::from_f32(group.z).to_bits() as u32) | (rotation << 16),
+        morph_radius: fractions(s.alpha_morph, s.radius_fraction),
         bits: (s.cell as u32).min(15) | if s.upright { SPRITE_UPRIGHT } else { 0 },
     }
 }
@@ -171,7 +186,6 @@ pub(super) struct ResidentSet {
     pub order_buffer: wgpu::Buffer,
     /// The sky camera's per-block cloud lists, at the blocks' cloud slots.
     pub list_buffer: wgpu::Buffer,
-    pub index_buffer: wgpu::Buffer,
     layout: wgpu::BindGroupLayout,
     /// Group 2 of the sprite passes: sprites and clouds.
     pub group: wgpu::BindGroup,
@@ -196,9 +210,8 @@ impl ResidentSet {
         let storage_max = limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
-        let by_device = (storage_max / std::mem::size_of::<GpuSprite>() as u64)
-            .min(limits.max_buffer_size / 24)
-            .min(u32::MAX as u64 / 6);
+        let by_device =
+            (storage_max / std::mem::size_of::<GpuSprite>() as u64).min(u32::MAX as u64 / 6);
         let by_budget = if budget_bytes == 0 {
             u64::MAX
         } else {
@@ -231,7 +244,6 @@ impl ResidentSet {
             cloud_buffer: b.clouds,
             order_buffer: b.orders,
             list_buffer: b.lists,
-            index_buffer: b.indices,
             layout,
             group: b.group,
             orders_cpu: vec![0; sprites as usize],
@@ -253,7 +265,6 @@ impl ResidentSet {
             + self.cloud_buffer.size()
             + self.order_buffer.size()
             + self.list_buffer.size()
-            + self.index_buffer.size()
     }
 
     /// Adds or replaces a block (uploaded by the next [`Self::place_and_upload`]).
@@ -356,7 +367,7 @@ impl ResidentSet {
     }
 
     /// Grows the buffers so that block `id` fits, if the limits allow: every block is placed
-    /// and written again (rare: the capacity doubles each time).
+    /// and written again (rare: the capacity grows by a quarter more than needed each time).
     fn grow_for(&mut self, id: u64) -> bool {
         let Some(r) = self.blocks.get(&id) else {
             return false;
@@ -367,14 +378,16 @@ impl ResidentSet {
         if need_sprites > self.limit_sprites || (need_sprites <= cap && cap >= self.limit_sprites) {
             return false;
         }
-        let sprites = need_sprites
-            .max(cap.saturating_mul(2))
-            .next_power_of_two()
+        // A quarter more than needed, in steps of 4,096: memory stays near what is held, and
+        // a growing field regrows a few times on its way up.
+        let grown = |need: u32, cap: u32| {
+            let want = need.max(cap) as u64 * 5 / 4;
+            (want.div_ceil(4096) * 4096).min(u32::MAX as u64) as u32
+        };
+        let sprites = grown(need_sprites, cap)
             .min(self.limit_sprites)
             .max(need_sprites);
-        let clouds = need_clouds
-            .max(self.cloud_slots.capacity().saturating_mul(2))
-            .next_power_of_two();
+        let clouds = grown(need_clouds, self.cloud_slots.capacity());
         if sprites <= cap && clouds <= self.cloud_slots.capacity() {
             return false;
         }
@@ -383,7 +396,6 @@ impl ResidentSet {
         self.cloud_buffer = b.clouds;
         self.order_buffer = b.orders;
         self.list_buffer = b.lists;
-        self.index_buffer = b.indices;
         self.group = b.group;
         self.sprite_slots = SlotRanges::new(sprites);
         self.cloud_slots = SlotRanges::new(clouds);
@@ -453,11 +465,10 @@ struct Buffers {
     clouds: wgpu::Buffer,
     orders: wgpu::Buffer,
     lists: wgpu::Buffer,
-    indices: wgpu::Buffer,
     group: wgpu::BindGroup,
 }
 
-/// Sprite, cloud, order, list and quad-index buffers for `sprites` and `clouds` slots.
+/// Sprite, cloud, order and list buffers for `sprites` and `clouds` slots.
 fn buffers(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
@@ -502,7 +513,6 @@ fn buffers(
             "sky.lists",
             clouds as u64 * std::mem::size_of::<GpuListCloud>() as u64,
         ),
-        indices: quad_index_buffer(device, sprites),
         group,
     }
 }

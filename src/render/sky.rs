@@ -23,7 +23,7 @@ use super::draw_list::{Copies, Locks, main_view};
 use super::gpu_types::{GpuDrawBlock, GpuFrame};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
 use super::pipeline::{PassDesc, pipeline, premultiplied_over};
-use super::resident::ResidentSet;
+use super::resident::{ResidentSet, quad_index_buffer};
 use super::scatter::Scatter;
 use super::scene::{BlockMotion, SkyBlock};
 use super::settings::RenderSettings;
@@ -68,6 +68,8 @@ pub struct Sky {
     sprite_pipeline: wgpu::RenderPipeline,
     in_cloud_pipeline: wgpu::RenderPipeline,
     resident: ResidentSet,
+    /// Quad indices for this many sprites (the most one draw needs so far).
+    quads: (wgpu::Buffer, u32),
     scatter: Scatter,
     view_layout: wgpu::BindGroupLayout,
     view: ViewBuffers,
@@ -290,6 +292,7 @@ impl Sky {
             sprite_pipeline,
             in_cloud_pipeline,
             resident,
+            quads: (quad_index_buffer(device, 4096), 4096),
             scatter: Scatter::new(device),
             view: ViewBuffers::new(device, false),
             view_layout,
@@ -528,6 +531,7 @@ impl Sky {
     pub fn gpu_buffer_bytes(&self) -> u64 {
         self.frame_buffer.size()
             + self.resident.gpu_bytes()
+            + self.quads.0.size()
             + self.scatter.gpu_bytes()
             + self.view.gpu_bytes()
             + self.ring.gpu_bytes()
@@ -662,8 +666,15 @@ impl Sky {
             camera_m: camera.position_m,
         };
         upload_bytes += self.ring.prepare_builds(queue, &ring_frame, &mut stats);
+        // Quad indices for the largest draw of the frame (the sprites, an impostor's sector).
+        let most = stats.sprites_drawn.max(self.ring.most_sprites_pending());
+        if most > self.quads.1 {
+            let sprites = most.next_power_of_two();
+            self.quads = (quad_index_buffer(&self.device, sprites), sprites);
+        }
         stats.upload_bytes = upload_bytes;
-        stats.sprite_gpu_bytes = self.resident.gpu_bytes() + self.view.gpu_bytes();
+        stats.sprite_gpu_bytes =
+            self.resident.gpu_bytes() + self.quads.0.size() + self.view.gpu_bytes();
         stats.field_us = std::mem::take(&mut self.field_us);
         stats.cpu_update_us =
             start.elapsed().as_micros() as u64 + std::mem::take(&mut self.pending_us);
@@ -698,7 +709,7 @@ impl Sky {
             encoder,
             &self.sheet_group,
             &self.resident.group,
-            &self.resident.index_buffer,
+            &self.quads.0,
         );
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sky"),
@@ -727,10 +738,7 @@ impl Sky {
             pass.set_bind_group(1, &self.sheet_group, &[]);
             pass.set_bind_group(2, &self.resident.group, &[]);
             pass.set_bind_group(3, view_group, &[]);
-            pass.set_index_buffer(
-                self.resident.index_buffer.slice(..),
-                wgpu::IndexFormat::Uint32,
-            );
+            pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..self.sprites_to_draw * 6, 0, 0..1);
         }
         if self.in_cloud > 0.0 {

@@ -620,6 +620,11 @@ impl ImpostorRing {
         bytes
     }
 
+    /// The most sprites one of this frame's impostor renders draws.
+    pub(super) fn most_sprites_pending(&self) -> u32 {
+        self.pending.iter().map(|p| p.2).max().unwrap_or(0)
+    }
+
     /// Records this frame's impostor renders (their own passes, before the sky pass), from the
     /// resident sprites (`resident`: group 2; `indices`: the quad index buffer).
     pub(super) fn record_builds(
