@@ -17,6 +17,7 @@ const ROW: u32 = 65_535;
 /// The patch being gathered and its GPU side.
 pub(super) struct Scatter {
     pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
     values: Vec<u32>,
     /// `[dst, src, count, target]`: target 0 the orders, 1 the cloud lists (as words).
     spans: Vec<[u32; 4]>,
@@ -53,6 +54,7 @@ impl Scatter {
             cache: None,
         });
         Self {
+            layout: pipeline.get_bind_group_layout(0),
             pipeline,
             values: Vec::new(),
             spans: Vec::new(),
@@ -128,7 +130,7 @@ impl Scatter {
         }
         self.group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sky.scatter"),
-            layout: &self.pipeline.get_bind_group_layout(0),
+            layout: &self.layout,
             entries: &[
                 binding(0, &self.patch, value_bytes),
                 binding(1, &self.span_buffer, span_bytes),
