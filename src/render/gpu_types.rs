@@ -55,6 +55,51 @@ pub struct GpuSprite {
 }
 const _: () = assert!(std::mem::size_of::<GpuSprite>() == 32);
 
+/// One corner of a sprite as the build pass makes it each frame, relative to the camera. Keep in
+/// sync with `BuiltCorner` in `shaders/sprite_build.wgsl` and `VertexIn` in
+/// `shaders/sprites.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuSpriteVertex {
+    /// xyz: position relative to the camera, metres; w: 1 drawn, 0 faded out.
+    pub position_visible: [f32; 4],
+    /// Texture coordinate on the sheet.
+    pub uv: [f32; 2],
+    /// Padding to 16 bytes.
+    pub _pad: [f32; 2],
+    /// Wang 5.3 vertex colour `(C_amb + C_dir)` and alpha (ambient alpha times the fades).
+    pub colour: [f32; 4],
+}
+const _: () = assert!(std::mem::size_of::<GpuSpriteVertex>() == 48);
+
+impl GpuSpriteVertex {
+    /// The buffer layout (offsets of uv and colour match the struct).
+    pub fn layout() -> wgpu::VertexBufferLayout<'static> {
+        const ATTRS: [wgpu::VertexAttribute; 3] = [
+            wgpu::VertexAttribute {
+                format: wgpu::VertexFormat::Float32x4,
+                offset: 0,
+                shader_location: 0,
+            },
+            wgpu::VertexAttribute {
+                format: wgpu::VertexFormat::Float32x2,
+                offset: 16,
+                shader_location: 1,
+            },
+            wgpu::VertexAttribute {
+                format: wgpu::VertexFormat::Float32x4,
+                offset: 32,
+                shader_location: 2,
+            },
+        ];
+        wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<GpuSpriteVertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &ATTRS,
+        }
+    }
+}
+
 /// The `bits` flag of an upright sprite.
 pub const SPRITE_UPRIGHT: u32 = 1 << 8;
 
@@ -129,8 +174,9 @@ pub struct GpuLock {
     pub sprite: u32,
 }
 
-/// What the sprite vertex shader needs besides the sprites: light, thresholds, the locks.
-/// One per view (the sky's camera, each impostor's). Keep in sync with `SpriteView` in
+/// What the build pass needs besides the sprites: light, thresholds, the locks. One per view (the
+/// sky's camera, each impostor's). Nothing in it bounds a loop (the counts are in the draw list's
+/// header): lavapipe folds such uniforms into the shader and would compile it every frame. Keep in sync with `SpriteView` in
 /// `shaders/sprites.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
@@ -147,12 +193,10 @@ pub struct GpuSpriteView {
     /// x, y: sines of the upright fade start and end angles; z: lifecycle inner radius fraction;
     /// w: lifecycle outer start opacity.
     pub upright_lifecycle: [f32; 4],
-    /// x: blocks in the draw list; y: locks; zw unused.
-    pub counts: [u32; 4],
     /// The locked facings.
     pub locks: [GpuLock; MAX_LOCKS],
 }
-const _: () = assert!(std::mem::size_of::<GpuSpriteView>() == 96 + 48 * MAX_LOCKS);
+const _: () = assert!(std::mem::size_of::<GpuSpriteView>() == 80 + 48 * MAX_LOCKS);
 
 /// Per-frame uniform of the demo terrain. Keep in sync with `shaders/terrain.wgsl`.
 #[repr(C)]

@@ -18,6 +18,7 @@
 //! Positions are f64 on the CPU and camera-relative f32 on the GPU. Units: metres, degrees,
 //! linear RGB.
 
+mod build;
 pub mod camera;
 pub mod demo_host;
 pub mod draw_list;

@@ -220,7 +220,7 @@ impl ResidentSet {
         let limit_sprites = by_device.min(by_budget) as u32;
         let storage = |b: u32| wgpu::BindGroupLayoutEntry {
             binding: b,
-            visibility: wgpu::ShaderStages::VERTEX,
+            visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Buffer {
                 ty: wgpu::BufferBindingType::Storage { read_only: true },
                 has_dynamic_offset: false,

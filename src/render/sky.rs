@@ -5,8 +5,8 @@
 //! writes it): the sky gradient and sun where the host drew nothing, the cloud sprites with soft
 //! depth fades (Bahnassi), and in-cloud fog (Wang 7.1).
 //!
-//! The device needs 5 storage buffers per shader stage (WebGPU's default limit is 8) and vertex
-//! storage buffers. The host's depth texture needs `TEXTURE_BINDING` usage and must be drawn
+//! The device needs 6 storage buffers per shader stage (WebGPU's default limit is 8) and compute
+//! shaders. The host's depth texture needs `TEXTURE_BINDING` usage and must be drawn
 //! with the projection of [`Camera::projection`] (standard `[0, 1]` depth, near and far from
 //! the camera).
 
@@ -18,9 +18,10 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use super::RenderError;
+use super::build::SpriteBuild;
 use super::camera::Camera;
 use super::draw_list::{Copies, Locks, main_view};
-use super::gpu_types::{GpuDrawBlock, GpuFrame};
+use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuSpriteVertex};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
 use super::pipeline::{PassDesc, pipeline, premultiplied_over};
 use super::resident::{ResidentSet, quad_index_buffer};
@@ -71,6 +72,7 @@ pub struct Sky {
     /// Quad indices for this many sprites (the most one draw needs so far).
     quads: (wgpu::Buffer, u32),
     scatter: Scatter,
+    build: SpriteBuild,
     view_layout: wgpu::BindGroupLayout,
     view: ViewBuffers,
     draws: Vec<GpuDrawBlock>,
@@ -107,9 +109,9 @@ impl Sky {
         config: SkyConfig,
     ) -> Result<Self, RenderError> {
         let stage_buffers = device.limits().max_storage_buffers_per_shader_stage;
-        if stage_buffers < 5 {
+        if stage_buffers < 6 {
             return Err(RenderError::Device(format!(
-                "the sky's sprites read 5 storage buffers in the vertex shader (WebGPU's default limit is 8); this device was created with {stage_buffers}"
+                "the sky builds its sprites in a compute pass reading 6 storage buffers (WebGPU's default limit is 8); this device was created with {stage_buffers}"
             )));
         }
         let sheet = &config.sheet;
@@ -224,13 +226,9 @@ impl Sky {
         let format = config.colour_format;
         let resident = ResidentSet::new(device, 0);
         let view_layout = sprite_view::layout(device);
+        let build = SpriteBuild::new(device, &view_layout, resident.layout());
         let frame_only = [Some(&frame_layout)];
-        let sprite_groups = [
-            Some(&frame_layout),
-            Some(&sheet_layout),
-            Some(resident.layout()),
-            Some(&view_layout),
-        ];
+        let sprite_groups = [Some(&frame_layout), Some(&sheet_layout)];
         let over = Some(premultiplied_over());
         let sky_pipeline = pipeline(
             device,
@@ -252,7 +250,7 @@ impl Sky {
                 vs: "vs_sprite",
                 fs: "fs_sprite",
                 bind_groups: &sprite_groups,
-                buffers: &[],
+                buffers: &[Some(GpuSpriteVertex::layout())],
                 targets: &[(format, over)],
             },
         );
@@ -277,7 +275,6 @@ impl Sky {
                 colour_format: format,
                 frame_layout: &frame_layout,
                 sheet_layout: &sheet_layout,
-                resident_layout: resident.layout(),
                 view_layout: &view_layout,
             },
         );
@@ -294,6 +291,7 @@ impl Sky {
             resident,
             quads: (quad_index_buffer(device, 4096), 4096),
             scatter: Scatter::new(device),
+            build,
             view: ViewBuffers::new(device, false),
             view_layout,
             draws: Vec::new(),
@@ -447,25 +445,29 @@ impl Sky {
     }
 
     /// The corners of the last prepared frame's sprites, four per sprite in drawing order, as
-    /// the vertex shader builds them (position relative to the camera, colour, drawn or not):
-    /// for tests and tools. Runs the shader's corner code in a compute pass and waits.
+    /// the build pass makes them for the draw (position relative to the camera, colour, drawn or
+    /// not): for tests and tools. Runs the frame's patch and build passes and waits.
     pub fn read_back_corners(
         &self,
         queue: &wgpu::Queue,
     ) -> Result<Vec<super::SpriteCorner>, RenderError> {
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.scatter.record(&mut encoder);
-        queue.submit([encoder.finish()]);
-        let (view, draws) = self.view.buffers();
-        let sources = super::readback::CornerSources {
-            sprites: &self.resident.sprite_buffer,
-            clouds: &self.resident.cloud_buffer,
-            view,
-            draws,
-            lists: &self.resident.list_buffer,
-            orders: &self.resident.order_buffer,
-        };
-        super::readback::read_corners(&self.device, queue, &sources, self.sprites_to_draw)
+        if let Some(view_group) = self.view.group() {
+            self.build.record(
+                &mut encoder,
+                view_group,
+                &self.resident.group,
+                self.sprites_to_draw,
+            );
+        }
+        super::readback::read_corners(
+            &self.device,
+            queue,
+            encoder,
+            self.build.vertices(),
+            self.sprites_to_draw,
+        )
     }
 
     /// CPU time of the last [`Self::record`], microseconds.
@@ -532,6 +534,7 @@ impl Sky {
         self.frame_buffer.size()
             + self.resident.gpu_bytes()
             + self.quads.0.size()
+            + self.build.gpu_bytes()
             + self.scatter.gpu_bytes()
             + self.view.gpu_bytes()
             + self.ring.gpu_bytes()
@@ -604,7 +607,7 @@ impl Sky {
             lifecycle: &self.lifecycle,
             camera_z_m: camera.position_m.z as f32,
         };
-        let header = sprite_view::header(&light, self.draws.len() as u32, locks.len() as u32);
+        let header = sprite_view::header(&light);
         let changed_locks = self.locks.take_changed().then_some(&locks[..]);
         upload_bytes += self.view.write(
             &self.device,
@@ -613,6 +616,12 @@ impl Sky {
             &header,
             changed_locks,
             ViewData::Resident {
+                counts: [
+                    self.draws.len() as u32,
+                    locks.len() as u32,
+                    stats.sprites_drawn,
+                    0,
+                ],
                 draws: &self.draws,
                 lists: &self.resident.list_buffer,
                 orders: &self.resident.order_buffer,
@@ -666,15 +675,19 @@ impl Sky {
             camera_m: camera.position_m,
         };
         upload_bytes += self.ring.prepare_builds(queue, &ring_frame, &mut stats);
-        // Quad indices for the largest draw of the frame (the sprites, an impostor's sector).
+        // Quad indices and built corners for the largest draw of the frame (the sprites, an
+        // impostor's sector).
         let most = stats.sprites_drawn.max(self.ring.most_sprites_pending());
         if most > self.quads.1 {
             let sprites = most.next_power_of_two();
             self.quads = (quad_index_buffer(&self.device, sprites), sprites);
         }
+        self.build.reserve(&self.device, most);
         stats.upload_bytes = upload_bytes;
-        stats.sprite_gpu_bytes =
-            self.resident.gpu_bytes() + self.quads.0.size() + self.view.gpu_bytes();
+        stats.sprite_gpu_bytes = self.resident.gpu_bytes()
+            + self.quads.0.size()
+            + self.build.gpu_bytes()
+            + self.view.gpu_bytes();
         stats.field_us = std::mem::take(&mut self.field_us);
         stats.cpu_update_us =
             start.elapsed().as_micros() as u64 + std::mem::take(&mut self.pending_us);
@@ -708,9 +721,18 @@ impl Sky {
         self.ring.record_builds(
             encoder,
             &self.sheet_group,
+            &self.build,
             &self.resident.group,
             &self.quads.0,
         );
+        if let Some(view_group) = self.view.group() {
+            self.build.record(
+                encoder,
+                view_group,
+                &self.resident.group,
+                self.sprites_to_draw,
+            );
+        }
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sky"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -731,13 +753,10 @@ impl Sky {
         pass.set_pipeline(&self.sky_pipeline);
         pass.draw(0..3, 0..1);
         self.ring.draw(&mut pass);
-        if self.sprites_to_draw > 0
-            && let Some(view_group) = self.view.group()
-        {
+        if self.sprites_to_draw > 0 && self.view.group().is_some() {
             pass.set_pipeline(&self.sprite_pipeline);
             pass.set_bind_group(1, &self.sheet_group, &[]);
-            pass.set_bind_group(2, &self.resident.group, &[]);
-            pass.set_bind_group(3, view_group, &[]);
+            pass.set_vertex_buffer(0, self.build.vertices().slice(..));
             pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..self.sprites_to_draw * 6, 0, 0..1);
         }

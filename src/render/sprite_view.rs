@@ -18,7 +18,7 @@ const HEADER_BYTES: usize = std::mem::size_of::<GpuSpriteView>() - MAX_LOCKS * 4
 pub(super) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
         binding,
-        visibility: wgpu::ShaderStages::VERTEX,
+        visibility: wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Buffer {
             ty,
             has_dynamic_offset: false,
@@ -46,8 +46,8 @@ pub(super) struct ViewLight<'a> {
     pub camera_z_m: f32,
 }
 
-/// The uniform of a view with `draws` blocks and `locks` locks (the table written apart).
-pub(super) fn header(light: &ViewLight, draws: u32, locks: u32) -> GpuSpriteView {
+/// The uniform of a view (its lock table written apart).
+pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
     let ViewLight {
         lighting,
         clouds,
@@ -74,7 +74,6 @@ pub(super) fn header(light: &ViewLight, draws: u32, locks: u32) -> GpuSpriteView
             lifecycle.inner_radius_fraction.max(1e-4),
             lifecycle.outer_start_opacity,
         ],
-        counts: [draws, locks, 0, 0],
         locks: [GpuLock {
             right: [0.0; 4],
             up: [0.0; 4],
@@ -132,15 +131,18 @@ impl Grown {
     }
 }
 
-/// What a view writes besides its uniform: its draw list, and an impostor's own cloud lists and
-/// orders or, for the sky's camera, the resident list and order buffers (with their generation).
+/// What a view writes besides its uniform: its draw list (after a header of its counts: blocks,
+/// locks, sprites), and an impostor's own cloud lists and orders or, for the sky's camera, the
+/// resident list and order buffers (with their generation).
 pub(super) enum ViewData<'a> {
     Own {
+        counts: [u32; 4],
         draws: &'a [GpuDrawBlock],
         lists: &'a [GpuListCloud],
         orders: &'a [u32],
     },
     Resident {
+        counts: [u32; 4],
         draws: &'a [GpuDrawBlock],
         lists: &'a wgpu::Buffer,
         orders: &'a wgpu::Buffer,
@@ -201,11 +203,18 @@ impl ViewBuffers {
         data: ViewData,
     ) -> u64 {
         let mut regroup = self.group.is_none();
-        let draws = match &data {
-            ViewData::Own { draws, .. } | ViewData::Resident { draws, .. } => *draws,
+        let (counts, draws) = match &data {
+            ViewData::Own { counts, draws, .. } | ViewData::Resident { counts, draws, .. } => {
+                (*counts, *draws)
+            }
         };
-        regroup |= self.draws.reserve(device, draws.len() as u64 * 32);
-        let mut bytes = self.draws.write(queue, draws);
+        regroup |= self.draws.reserve(device, 16 + draws.len() as u64 * 32);
+        queue.write_buffer(&self.draws.buffer, 0, bytemuck::bytes_of(&counts));
+        let mut bytes = 16;
+        if !draws.is_empty() {
+            queue.write_buffer(&self.draws.buffer, 16, bytemuck::cast_slice(draws));
+            bytes += draws.len() as u64 * 32;
+        }
         match (&data, &mut self.own) {
             (ViewData::Own { lists, orders, .. }, Some((own_lists, own_orders))) => {
                 regroup |= own_lists.reserve(device, lists.len() as u64 * 16);
@@ -252,12 +261,7 @@ impl ViewBuffers {
         bytes
     }
 
-    /// The uniform and the draw list (for the corner read-back).
-    pub fn buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
-        (&self.uniform, &self.draws.buffer)
-    }
-
-    /// Group 3 of the sprite passes (after the first [`Self::write`]).
+    /// The view's group of the build pass (after the first [`Self::write`]).
     pub fn group(&self) -> Option<&wgpu::BindGroup> {
         self.group.as_ref()
     }

@@ -36,8 +36,9 @@ pub use layout::{
 };
 use layout::{impostor_camera, in_sector};
 
+use super::build::SpriteBuild;
 use super::draw_list::fresh_view;
-use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud};
+use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuSpriteVertex};
 use super::pipeline::{PassDesc, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
@@ -124,9 +125,7 @@ pub struct RingShared<'a> {
     pub frame_layout: &'a wgpu::BindGroupLayout,
     /// Group 1 of the sprite pass (sheet and sampler).
     pub sheet_layout: &'a wgpu::BindGroupLayout,
-    /// Group 2 of the sprite pass (the resident sprites and clouds).
-    pub resident_layout: &'a wgpu::BindGroupLayout,
-    /// Group 3 of the sprite pass (a view: uniform, draw list, orders).
+    /// The build pass's group of a view (uniform, draw list, cloud lists, orders).
     pub view_layout: &'a wgpu::BindGroupLayout,
 }
 
@@ -181,13 +180,8 @@ impl ImpostorRing {
                 wgsl: &format!("{SPRITES_WGSL}\n{IMPOSTOR_SPRITES_WGSL}"),
                 vs: "vs_sprite",
                 fs: "fs_sprite_impostor",
-                bind_groups: &[
-                    Some(shared.frame_layout),
-                    Some(shared.sheet_layout),
-                    Some(shared.resident_layout),
-                    Some(shared.view_layout),
-                ],
-                buffers: &[],
+                bind_groups: &[Some(shared.frame_layout), Some(shared.sheet_layout)],
+                buffers: &[Some(GpuSpriteVertex::layout())],
                 targets: &[(IMPOSTOR_FORMAT, over), (DEPTH_FORMAT, over)],
             },
         );
@@ -543,7 +537,7 @@ impl ImpostorRing {
                     camera_z_m: centre.z as f32,
                     ..*view
                 };
-                let header = sprite_view::header(&light, self.draws.len() as u32, 0);
+                let header = sprite_view::header(&light);
                 bytes += self.slot_views[i].write(
                     &self.device,
                     queue,
@@ -551,6 +545,7 @@ impl ImpostorRing {
                     &header,
                     None,
                     ViewData::Own {
+                        counts: [self.draws.len() as u32, 0, sprites, 0],
                         draws: &self.draws,
                         lists: &self.lists,
                         orders: &self.orders,
@@ -625,16 +620,22 @@ impl ImpostorRing {
         self.pending.iter().map(|p| p.2).max().unwrap_or(0)
     }
 
-    /// Records this frame's impostor renders (their own passes, before the sky pass), from the
-    /// resident sprites (`resident`: group 2; `indices`: the quad index buffer).
+    /// Records this frame's impostor renders (their own passes, before the sky pass): each
+    /// sector's corners built from the resident sprites (`resident`) by `build`, then drawn
+    /// (`indices`: the quad index buffer).
     pub(super) fn record_builds(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         sheet: &wgpu::BindGroup,
+        build: &SpriteBuild,
         resident: &wgpu::BindGroup,
         indices: &wgpu::Buffer,
     ) {
         for &(r, i, sprites) in &self.pending {
+            let view = self.slot_views[i].group();
+            if let Some(view) = view {
+                build.record(encoder, view, resident, sprites);
+            }
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("ring.impostor"),
                 color_attachments: &[&self.views[r][i], &self.depth_views[r][i]].map(|view| {
@@ -653,14 +654,11 @@ impl ImpostorRing {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            if sprites > 0
-                && let Some(view) = self.slot_views[i].group()
-            {
+            if sprites > 0 && view.is_some() {
                 pass.set_pipeline(&self.sprite_pipeline);
                 pass.set_bind_group(0, &self.slot_groups[i], &[]);
                 pass.set_bind_group(1, sheet, &[]);
-                pass.set_bind_group(2, resident, &[]);
-                pass.set_bind_group(3, view, &[]);
+                pass.set_vertex_buffer(0, build.vertices().slice(..));
                 pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..sprites * 6, 0, 0..1);
             }

@@ -1,0 +1,324 @@
+// Pass `sky.sprite_build` (compute): builds the corners of a frame's sprites from the
+// GPU-resident sprites into a vertex buffer the draw reads (`sprites.wgsl`). The sprites live on
+// the GPU (written once per block); each frame the CPU sends only the draw list (one entry per
+// block, back to front, its centre relative to the camera) and the cloud lists and sprite orders
+// that changed. Each invocation builds one corner: the sprite's facing (camera facing, upright
+// cylindrical base sprites, flat cirrus, the facing lock of Wang 3.3 with its angle fade), Wang's
+// equation (3) shading (ambient colour levels by height, directional shading groups), the
+// forward-scattering rim, and the formation / dissipation fade of Wang 4. Built in a compute
+// pass, not in the vertex shader: on the software rasteriser storage buffers read by a vertex
+// shader cost memory every draw, and a compute pass runs on every core.
+
+// Keep in sync with `GpuSprite` in src/render/gpu_types.rs.
+struct Sprite {
+    offset: vec3<f32>,
+    // Width and height, half floats.
+    size: u32,
+    // The shading group centre's x and y, half floats.
+    group_xy: u32,
+    // Low: the group centre's z (half float); high: the rotation, a turn in 65,536 steps.
+    group_z_rotation: u32,
+    // Low: alpha_morph; high: radius fraction (16-bit fractions).
+    morph_radius: u32,
+    bits: u32,
+};
+
+// Keep in sync with `GpuCloud`.
+struct Cloud {
+    centre_block: vec4<f32>,
+    level_rgba: array<vec4<f32>, 5>,
+    level_height: vec4<f32>,
+    level4_radius_flat: vec4<f32>,
+};
+
+// Keep in sync with `GpuDrawBlock`.
+struct DrawBlock {
+    origin_rel: vec3<f32>,
+    first: u32,
+    list_base: u32,
+    list_len: u32,
+    fade_kind: u32,
+    fade_progress: f32,
+};
+
+// Keep in sync with `GpuListCloud`.
+struct ListCloud {
+    cloud: u32,
+    first: u32,
+    order_base: u32,
+    pad: u32,
+};
+
+// Keep in sync with `GpuLock`.
+struct Lock {
+    right: vec4<f32>,
+    up: vec4<f32>,
+    normal: vec3<f32>,
+    sprite: u32,
+};
+
+// Keep in sync with `GpuSpriteView` (MAX_LOCKS).
+struct SpriteView {
+    sun_dir_camera_z: vec4<f32>,
+    directional_ambient: vec4<f32>,
+    mapping_g: vec4<f32>,
+    forward_lock: vec4<f32>,
+    upright_lifecycle: vec4<f32>,
+    locks: array<Lock, 128>,
+};
+
+@group(0) @binding(0) var<uniform> view: SpriteView;
+// The frame's counts (blocks, locks, sprites) and its blocks. The counts bound loops, so they
+// live here and not in the uniform: a software rasteriser that folds uniforms used as loop
+// bounds into the shader (lavapipe does) would compile the shader again every frame.
+struct Draws {
+    counts: vec4<u32>,
+    blocks: array<DrawBlock>,
+};
+
+@group(0) @binding(1) var<storage, read> draws: Draws;
+@group(0) @binding(2) var<storage, read> lists: array<ListCloud>;
+@group(0) @binding(3) var<storage, read> orders: array<u32>;
+@group(1) @binding(0) var<storage, read> sprites: array<Sprite>;
+@group(1) @binding(1) var<storage, read> clouds: array<Cloud>;
+
+// One built corner. Keep in sync with `GpuSpriteVertex` in src/render/gpu_types.rs.
+struct BuiltCorner {
+    // xyz: metres from the camera; w: 1 drawn, 0 not (faded out).
+    position_visible: vec4<f32>,
+    uv: vec2<f32>,
+    pad: vec2<f32>,
+    colour: vec4<f32>,
+};
+
+@group(2) @binding(0) var<storage, read_write> built: array<BuiltCorner>;
+
+struct Facing {
+    right: vec3<f32>,
+    up: vec3<f32>,
+    normal: vec3<f32>,
+};
+
+fn normalize_or(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
+    let l = length(v);
+    return select(fallback, v / l, l > 0.0);
+}
+
+// Right/up axes facing a viewer along `normal`, world up kept up (east when straight above).
+// Same as `facing_towards` in src/render/draw_list.rs (the CPU's copy starts a lock).
+fn facing_towards(normal: vec3<f32>) -> Facing {
+    let r = cross(vec3<f32>(0.0, 0.0, 1.0), normal);
+    let right = select(vec3<f32>(1.0, 0.0, 0.0), normalize(r), dot(r, r) > 1e-6);
+    return Facing(right, normalize_or(cross(normal, right), vec3<f32>(0.0)), normal);
+}
+
+// An upright sprite turns only about the vertical, so its bottom edge stays level.
+fn upright_facing(to_cam: vec3<f32>) -> Facing {
+    let normal = normalize_or(vec3<f32>(to_cam.xy, 0.0), vec3<f32>(0.0, 1.0, 0.0));
+    let right = normalize_or(cross(vec3<f32>(0.0, 0.0, 1.0), normal), vec3<f32>(1.0, 0.0, 0.0));
+    return Facing(right, vec3<f32>(0.0, 0.0, 1.0), normal);
+}
+
+// Wang 5.1: the ambient colour of the cloud's five levels at a height above mean sea level.
+fn level_colour(ci: u32, h: f32) -> vec4<f32> {
+    let c = clouds[ci];
+    var heights = array<f32, 5>(
+        c.level_height.x, c.level_height.y, c.level_height.z, c.level_height.w,
+        c.level4_radius_flat.x,
+    );
+    if (h <= heights[0]) {
+        return clouds[ci].level_rgba[0];
+    }
+    for (var i = 0u; i < 4u; i++) {
+        let lo = heights[i];
+        let hi = heights[i + 1u];
+        if (h <= hi) {
+            let span = hi - lo;
+            let a_v = select(0.0, (hi - h) / span, span > 0.0);
+            return clouds[ci].level_rgba[i] * a_v + clouds[ci].level_rgba[i + 1u] * (1.0 - a_v);
+        }
+    }
+    return clouds[ci].level_rgba[4];
+}
+
+// Wang 5.2's biased mapping of dot(vertex - group centre, sun) to Cmin / Cmedian / Cmax.
+fn directional_percent(dot_sun: f32) -> f32 {
+    let d = clamp(dot_sun, -1.0, 1.0);
+    let m = view.mapping_g;
+    return select(m.y + (m.z - m.y) * d, m.y + (m.y - m.x) * d, d < 0.0);
+}
+
+// Light scattered forward towards the eye: a Henyey-Greenstein lobe, strongest on the rim.
+fn forward_percent(view_dir: vec3<f32>, rim: f32) -> f32 {
+    let g = view.mapping_g.w;
+    let cos_sun = clamp(dot(view_dir, view.sun_dir_camera_z.xyz), -1.0, 1.0);
+    let lobe = pow((1.0 - g) * (1.0 - g) / (1.0 + g * g - 2.0 * g * cos_sun), 1.5);
+    let r = clamp(rim, 0.0, 1.0);
+    return view.forward_lock.x * lobe * r * r * r * r;
+}
+
+// Wang 4: forming, the inner sprites fade in first; dissipating, the outer ones go first.
+// Same as src/clouds/lifecycle.rs.
+fn lifecycle_alpha(kind: u32, progress: f32, radius_fraction: f32) -> f32 {
+    let inner_fraction = view.upright_lifecycle.z;
+    let p = clamp(progress, 0.0, 1.0);
+    if (kind == 1u) {
+        if (radius_fraction <= inner_fraction) {
+            return min(p / 0.5, 1.0);
+        }
+        let start = 0.5 * view.upright_lifecycle.w;
+        return clamp((p - start) / (1.0 - start), 0.0, 1.0);
+    }
+    if (kind == 2u) {
+        if (radius_fraction > inner_fraction) {
+            return 1.0 - min(p / 0.5, 1.0);
+        }
+        let s = max((p - 0.5) / 0.5, 0.0);
+        return 1.0 - min(s * (1.0 + radius_fraction / inner_fraction), 1.0);
+    }
+    return 1.0;
+}
+
+// The sheet's texture coordinate of a corner of cell `cell` (a small inset keeps mips apart).
+fn cell_uv(cell: u32, corner: vec2<f32>) -> vec2<f32> {
+    let c = min(cell, 15u);
+    let inset = 1.0 / 64.0;
+    let uv = vec2<f32>(f32(c % 4u), f32(c / 4u)) + vec2<f32>(inset) + corner * (1.0 - 2.0 * inset);
+    return uv * 0.25;
+}
+
+// The block of the draw list holding the frame's sprite `k`: the last whose `first` is <= k.
+fn block_of(k: u32) -> u32 {
+    var lo = 0u;
+    var hi = draws.counts.x;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (draws.blocks[mid].first <= k) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// The cloud of a block's list holding its sprite `k`: the last whose `first` is <= k.
+fn cloud_of(b: DrawBlock, k: u32) -> u32 {
+    var lo = b.list_base;
+    var hi = b.list_base + b.list_len;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (lists[mid].first <= k) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// The locked facing of sprite `slot`, or `fallback` if it has none.
+fn locked_facing(slot: u32, fallback: Facing) -> Facing {
+    for (var i = 0u; i < draws.counts.y; i++) {
+        let l = view.locks[i];
+        if (l.sprite == slot) {
+            return Facing(l.right.xyz, l.up.xyz, l.normal);
+        }
+    }
+    return fallback;
+}
+
+// One corner as the vertex shader builds it, relative to the camera.
+struct Corner {
+    rel_m: vec3<f32>,
+    visible: bool,
+    uv: vec2<f32>,
+    colour: vec4<f32>,
+};
+
+// Corner `vi % 4` of the frame's sprite `vi / 4` (in drawing order).
+fn sprite_corner(vi: u32) -> Corner {
+    var o: Corner;
+    let k = vi / 4u;
+    let corner_id = vi % 4u;
+    let b = draws.blocks[block_of(k)];
+    let in_block = k - b.first;
+    let entry = lists[cloud_of(b, in_block)];
+    let slot = orders[entry.order_base + (in_block - entry.first)];
+    let s = sprites[slot];
+    let flat_radius = clouds[entry.cloud].level4_radius_flat;
+    let centre_rel = b.origin_rel + clouds[entry.cloud].centre_block.xyz;
+    let offset = s.offset;
+    let size = unpack2x16float(s.size);
+    let width = size.x;
+    let height = size.y;
+    let group = vec3<f32>(
+        unpack2x16float(s.group_xy),
+        unpack2x16float(s.group_z_rotation & 0xffffu).x,
+    );
+    let rotation = f32(s.group_z_rotation >> 16u) * (6.283185307 / 65536.0);
+    let morph_radius = unpack2x16unorm(s.morph_radius);
+    let cam_local = -centre_rel;
+    let to_cam = cam_local - offset;
+    let radius = 0.5 * max(width, height);
+
+    // Facing: camera facing, upright (fading seen from steeply above or below), flat, or locked.
+    var face = facing_towards(normalize_or(to_cam, vec3<f32>(0.0, 1.0, 0.0)));
+    var alpha = 1.0;
+    if ((s.bits & 256u) != 0u) {
+        face = upright_facing(to_cam);
+        let sin_elevation = abs(to_cam.z / max(length(to_cam), 1e-3));
+        let fade = view.upright_lifecycle;
+        alpha = 1.0 - clamp((sin_elevation - fade.x) / max(fade.y - fade.x, 1e-4), 0.0, 1.0);
+    }
+    if (flat_radius.z > 0.5) {
+        face = Facing(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+    } else if (length(to_cam) < view.forward_lock.y * radius) {
+        // Wang 3.3: inside half the radius the facing stays as it was when the camera came in;
+        // the sprite fades as the angle between that facing and the camera grows.
+        face = locked_facing(slot, face);
+        let cos_angle = abs(dot(face.normal, normalize_or(to_cam, face.normal)));
+        let lock = view.forward_lock;
+        alpha *= clamp((cos_angle - lock.w) / max(lock.z - lock.w, 1e-4), 0.0, 1.0);
+    }
+    let morph = morph_radius.x * lifecycle_alpha(b.fade_kind, b.fade_progress, morph_radius.y);
+    o.visible = alpha > 0.0 && morph > 0.0;
+
+    let corner = vec2<f32>(f32(corner_id & 1u), 1.0 - f32(corner_id >> 1u));
+    let sc = vec2<f32>(sin(rotation), cos(rotation));
+    let right = face.right * sc.y + face.up * sc.x;
+    let up = face.up * sc.y - face.right * sc.x;
+    let p = offset + right * ((corner.x - 0.5) * width) + up * ((corner.y - 0.5) * height);
+
+    // Wang eq. (3): (ambient + directional) x alpha_morph; the texture is the fragment's.
+    let light = view.directional_ambient;
+    let height_msl = view.sun_dir_camera_z.w + centre_rel.z + p.z;
+    let ambient = level_colour(entry.cloud, height_msl);
+    let view_dir = normalize_or(p - cam_local, vec3<f32>(0.0));
+    let rim = length(p) / flat_radius.y;
+    let group_dir = normalize_or(p - group, vec3<f32>(0.0));
+    let sun = normalize_or(view.sun_dir_camera_z.xyz, vec3<f32>(0.0));
+    let directional = (directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim))
+        * light.rgb;
+    o.colour = vec4<f32>(ambient.rgb * light.w + directional, ambient.a * morph * alpha);
+    // Texture v runs down the sheet: the top of the sprite is v = 0.
+    o.uv = cell_uv(s.bits & 15u, vec2<f32>(corner.x, 1.0 - corner.y));
+    o.rel_m = centre_rel + p;
+    return o;
+}
+
+// Corner `id % 4` of the frame's sprite `id / 4` (rows of 65,535 x 64 invocations).
+@compute @workgroup_size(64)
+fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
+    let vi = id.x + id.y * (65535u * 64u);
+    if (vi >= draws.counts.z * 4u) {
+        return;
+    }
+    let c = sprite_corner(vi);
+    built[vi] = BuiltCorner(
+        vec4<f32>(c.rel_m, select(0.0, 1.0, c.visible)),
+        c.uv,
+        vec2<f32>(0.0),
+        c.colour,
+    );
+}
