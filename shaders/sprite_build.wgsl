@@ -92,6 +92,11 @@ struct BuiltCorner {
 };
 
 @group(2) @binding(0) var<storage, read_write> built: array<BuiltCorner>;
+// x: the chunk's first sprite (a chunk of at most CHUNK sprites is built, then drawn).
+@group(2) @binding(1) var<uniform> chunk: vec4<u32>;
+
+// Keep in sync with `CHUNK` in src/render/build.rs.
+const CHUNK: u32 = 65536u;
 
 struct Facing {
     right: vec3<f32>,
@@ -307,15 +312,16 @@ fn sprite_corner(vi: u32) -> Corner {
     return o;
 }
 
-// Corner `id % 4` of the frame's sprite `id / 4` (rows of 65,535 x 64 invocations).
+// Corner `id % 4` of the chunk's sprite `id / 4` (rows of 65,535 x 64 invocations).
 @compute @workgroup_size(64)
 fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
-    let vi = id.x + id.y * (65535u * 64u);
-    if (vi >= draws.counts.z * 4u) {
+    let local = id.x + id.y * (65535u * 64u);
+    let vi = chunk.x * 4u + local;
+    if (local >= CHUNK * 4u || vi >= draws.counts.z * 4u) {
         return;
     }
     let c = sprite_corner(vi);
-    built[vi] = BuiltCorner(
+    built[local] = BuiltCorner(
         vec4<f32>(c.rel_m, select(0.0, 1.0, c.visible)),
         c.uv,
         vec2<f32>(0.0),

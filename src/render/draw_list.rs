@@ -257,14 +257,10 @@ pub(super) fn main_view(
 ) -> f32 {
     let mut order: Vec<(f64, &mut Resident)> = blocks
         .values_mut()
-        .filter(|r| r.near && r.place.is_some())
+        .filter(|r| r.near && r.uploaded)
         .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
         .collect();
     order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.block.id.cmp(&b.1.block.id)));
-    let mut in_cloud = 0.0f32;
-    let mut total = 0u32;
-    out.clear();
-    locks.begin();
     let Copies {
         orders,
         dirty_orders,
@@ -272,7 +268,9 @@ pub(super) fn main_view(
         dirty_lists,
     } = copies;
     let (mut scratch, mut keys) = (Vec::new(), Vec::new());
-    for (d2, r) in order {
+    // Looked at again nearest first, so that the frame's sorting budget goes to what is near.
+    let mut budget = settings.vertex_cache.max_sorted_sprites_per_frame;
+    for (_, r) in order.iter_mut().rev() {
         let rel = camera_m - r.centre_m();
         let fresh = settings.vertex_cache.enabled
             && r.check.is_some_and(|c| {
@@ -283,11 +281,10 @@ pub(super) fn main_view(
         if !fresh {
             recheck(
                 r,
-                camera_m,
-                time_s,
+                (camera_m, time_s),
                 settings,
-                orders,
-                dirty_orders,
+                (orders, dirty_orders),
+                &mut budget,
                 stats,
                 (&mut scratch, &mut keys),
             );
@@ -297,6 +294,13 @@ pub(super) fn main_view(
                 dirty_lists.push(clouds.start..clouds.start + n);
             }
         }
+    }
+    let mut in_cloud = 0.0f32;
+    let mut total = 0u32;
+    out.clear();
+    locks.begin();
+    for (d2, r) in order {
+        let rel = camera_m - r.centre_m();
         if d2.sqrt() < r.radius_m {
             in_cloud = in_cloud.max(inside_clouds(r, camera_m, settings, locks));
         }
@@ -325,14 +329,14 @@ pub(super) fn main_view(
 /// Looks at every cloud of a block again: its clouds within the draw distance sorted back to
 /// front into its list, each stale order recomputed (Wang 6.1's thresholds), and how far and
 /// how long the camera may go before any of them needs it again.
-#[allow(clippy::too_many_arguments)]
+/// Clouds past the frame's sorting `budget` (sprites) keep their order; their block comes back
+/// the next frame.
 fn recheck(
     r: &mut Resident,
-    camera_m: DVec3,
-    time_s: f64,
+    (camera_m, time_s): (DVec3, f64),
     settings: &RenderSettings,
-    orders: &mut [u32],
-    dirty_orders: &mut Vec<std::ops::Range<u32>>,
+    (orders, dirty_orders): (&mut [u32], &mut Vec<std::ops::Range<u32>>),
+    budget_sprites: &mut u32,
     stats: &mut FrameStats,
     (scratch, keys): (&mut Vec<(usize, f64, f64)>, &mut SortKeys),
 ) {
@@ -370,7 +374,12 @@ fn recheck(
                 needs_recompute(at, fading, rel, time_s, near_edge, cache)
                     || nearly_stale(at, fading, rel, time_s, near_edge, cache)
             });
-        if stale {
+        let afford = state.sprites <= *budget_sprites;
+        if stale && !afford {
+            // Over the frame's budget: drawn in its last order, looked at again next frame.
+            budget = 0.0;
+        } else if stale {
+            *budget_sprites = budget_sprites.saturating_sub(state.sprites);
             let base = state.sprite_base as usize;
             let slots = &mut orders[base..base + state.sprites as usize];
             order_into(

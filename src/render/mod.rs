@@ -6,12 +6,14 @@
 //! it).
 //!
 //! - `resident`, `slots`: the sprites and clouds on the GPU, each block in slots it keeps.
-//! - `draw_list`: per frame on the CPU: blocks and clouds back to front, each cloud's sprite
-//!   order recomputed only when Wang's cache thresholds say (6.1), the facing locks (3.3), the
-//!   draw list. `sprite_view`: a view's uniform, draw list and orders on the GPU.
-//! - `sky`: pipelines and passes: sky gradient and sun, sprites (built, faced and shaded by the
-//!   vertex shader, Wang 3.3 and 5) with soft depth fades (Bahnassi), in-cloud fog (Wang 7.1).
-//!   Shaders in `shaders/*.wgsl`, structs with twins in `gpu_types`.
+//! - `draw_list`: per frame on the CPU: the near blocks back to front, each block's cloud list
+//!   and each cloud's sprite order recomputed only when Wang's cache thresholds say (6.1), the
+//!   facing locks (3.3), the draw list. `sprite_view`: a view's uniform, draw list, lists and
+//!   orders on the GPU. `scatter`: the changed lists and orders sent as one patch. `build`: the
+//!   compute pass that makes the sprites' corners (facing, Wang 5 shading, fades) for the draw.
+//! - `sky`: pipelines and passes: sky gradient and sun, sprites with soft depth fades
+//!   (Bahnassi), in-cloud fog (Wang 7.1). Shaders in `shaders/*.wgsl`, structs with twins in
+//!   `gpu_types`. `readback`: the built corners read back for tests and tools.
 //! - `terrain`, `headless`, `output`: the demo host (height-field ground with fog, an offscreen
 //!   device and target on any adapter, lavapipe included) and PNG / EXR output.
 //!

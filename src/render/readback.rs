@@ -18,28 +18,29 @@ pub struct SpriteCorner {
     pub colour: Vec4,
 }
 
-/// Finishes `encoder` (which builds the corners into `vertices`) with a copy of the first
-/// `sprites` sprites' corners, runs it and reads them back, four per sprite in drawing order.
+/// A buffer for `sprites` sprites' corners to be copied into and read back.
+pub(super) fn read_buffer(device: &wgpu::Device, sprites: u32) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("sky.sprite_corners_read"),
+        size: (sprites as u64 * 4 * std::mem::size_of::<GpuSpriteVertex>() as u64).max(16),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    })
+}
+
+/// Runs `encoder` (which copies `sprites` sprites' corners into `read`) and reads them back,
+/// four per sprite in drawing order.
 pub(super) fn read_corners(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
-    mut encoder: wgpu::CommandEncoder,
-    vertices: &wgpu::Buffer,
+    encoder: wgpu::CommandEncoder,
+    read: &wgpu::Buffer,
     sprites: u32,
 ) -> Result<Vec<SpriteCorner>, RenderError> {
-    let bytes = sprites as u64 * 4 * std::mem::size_of::<GpuSpriteVertex>() as u64;
-    if bytes == 0 {
-        queue.submit([encoder.finish()]);
+    queue.submit([encoder.finish()]);
+    if sprites == 0 {
         return Ok(Vec::new());
     }
-    let read = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("sky.sprite_corners_read"),
-        size: bytes,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    encoder.copy_buffer_to_buffer(vertices, 0, &read, 0, bytes);
-    queue.submit([encoder.finish()]);
     read.map_async(wgpu::MapMode::Read, .., |_| {});
     device
         .poll(wgpu::PollType::wait_indefinitely())
@@ -48,7 +49,7 @@ pub(super) fn read_corners(
         .get_mapped_range(..)
         .map_err(|e| RenderError::Device(e.to_string()))?;
     let corners: &[GpuSpriteVertex] = bytemuck::cast_slice(&view);
-    Ok(corners
+    Ok(corners[..sprites as usize * 4]
         .iter()
         .map(|c| {
             let p = c.position_visible;

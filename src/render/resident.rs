@@ -287,9 +287,16 @@ impl ResidentSet {
     }
 
     /// Places every block not on the GPU yet (growing the buffers where the limits allow;
-    /// past them the farthest from `camera_m` are left out) and writes the new ones. Returns
-    /// the bytes written and the blocks left out.
-    pub fn place_and_upload(&mut self, queue: &wgpu::Queue, camera_m: DVec3) -> (u64, u32) {
+    /// past them the farthest from `camera_m` are left out) and writes the new ones, nearest
+    /// first, up to `budget_sprites` sprites (all of them after the buffers grew: everything is
+    /// written again then). Returns the bytes written and the blocks left out.
+    pub fn place_and_upload(
+        &mut self,
+        queue: &wgpu::Queue,
+        camera_m: DVec3,
+        budget_sprites: u32,
+    ) -> (u64, u32) {
+        let generation = self.generation;
         let mut waiting: Vec<(f64, u64)> = self
             .blocks
             .values()
@@ -304,7 +311,12 @@ impl ResidentSet {
         }
         // Blocks that did not fit, and any a nearer one took the place of.
         let left_out = self.blocks.values().filter(|r| r.place.is_none()).count() as u32;
-        (self.upload(queue), left_out)
+        let budget = if self.generation != generation {
+            u32::MAX
+        } else {
+            budget_sprites
+        };
+        (self.upload(queue, camera_m, budget), left_out)
     }
 
     /// Places one block: in free slots, else after growing, else in place of farther ones.
@@ -350,6 +362,11 @@ impl ResidentSet {
             self.sprite_slots.release(sprites);
             return false;
         };
+        // Until its first sort a cloud is drawn in its sprites' own order.
+        for slot in sprites.clone() {
+            self.orders_cpu[slot as usize] = slot;
+        }
+        self.dirty_orders.push(sprites.clone());
         let Some(r) = self.blocks.get_mut(&id) else {
             return true;
         };
@@ -420,16 +437,26 @@ impl ResidentSet {
         true
     }
 
-    /// Writes every placed block not written yet; returns the bytes.
-    fn upload(&mut self, queue: &wgpu::Queue) -> u64 {
+    /// Writes placed blocks not written yet, nearest first, until `budget` sprites are written
+    /// (at least one block); returns the bytes.
+    fn upload(&mut self, queue: &wgpu::Queue, camera_m: DVec3, budget: u32) -> u64 {
         let mut bytes = 0;
         let mut sprites: Vec<GpuSprite> = Vec::new();
         let mut clouds: Vec<GpuCloud> = Vec::new();
-        for r in self.blocks.values_mut() {
-            let Some((s, c)) = &r.place else { continue };
-            if r.uploaded {
-                continue;
+        let mut todo: Vec<(f64, &mut Resident)> = self
+            .blocks
+            .values_mut()
+            .filter(|r| r.place.is_some() && !r.uploaded)
+            .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
+            .collect();
+        todo.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.block.id.cmp(&b.1.block.id)));
+        let mut written = 0u32;
+        for (_, r) in todo {
+            if written >= budget {
+                break;
             }
+            let Some((s, c)) = &r.place else { continue };
+            written = written.saturating_add(s.end - s.start);
             sprites.clear();
             clouds.clear();
             for cloud in &r.block.clouds {

@@ -90,6 +90,23 @@ pub struct VertexCacheSettings {
     pub time_distance_m: f32,
     /// Age threshold while a cloud forms or dissipates, seconds.
     pub fading_max_age_s: f32,
+    /// Most sprites re-sorted in one frame; past it stale clouds keep their order until a later
+    /// frame (nearest clouds first), so a frame where many clouds come near at once (the ring
+    /// handing blocks back) does not stall.
+    #[serde(default = "default_sorted_sprites")]
+    pub max_sorted_sprites_per_frame: u32,
+    /// Most sprites of newly arrived blocks uploaded in one frame (nearest blocks first; the
+    /// others are drawn from a later frame on).
+    #[serde(default = "default_uploaded_sprites")]
+    pub max_uploaded_sprites_per_frame: u32,
+}
+
+fn default_sorted_sprites() -> u32 {
+    8192
+}
+
+fn default_uploaded_sprites() -> u32 {
+    32768
 }
 
 /// All renderer settings.
@@ -145,6 +162,8 @@ impl Default for RenderSettings {
                 max_age_s: 2.0,
                 time_distance_m: 2000.0,
                 fading_max_age_s: 0.25,
+                max_sorted_sprites_per_frame: default_sorted_sprites(),
+                max_uploaded_sprites_per_frame: default_uploaded_sprites(),
             },
             impostors: Default::default(),
         })

@@ -18,7 +18,7 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use super::RenderError;
-use super::build::SpriteBuild;
+use super::build::{CHUNK, SpriteBuild, chunks};
 use super::camera::Camera;
 use super::draw_list::{Copies, Locks, main_view};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuSpriteVertex};
@@ -453,21 +453,23 @@ impl Sky {
     ) -> Result<Vec<super::SpriteCorner>, RenderError> {
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.scatter.record(&mut encoder);
+        let read = super::readback::read_buffer(&self.device, self.sprites_to_draw);
+        let corner_bytes = 4 * std::mem::size_of::<GpuSpriteVertex>() as u64;
         if let Some(view_group) = self.view.group() {
-            self.build.record(
-                &mut encoder,
-                view_group,
-                &self.resident.group,
-                self.sprites_to_draw,
-            );
+            for (chunk, first, sprites) in chunks(self.sprites_to_draw) {
+                let group = &self.resident.group;
+                self.build
+                    .record(&mut encoder, view_group, group, (chunk, sprites));
+                encoder.copy_buffer_to_buffer(
+                    self.build.vertices(),
+                    0,
+                    &read,
+                    first as u64 * corner_bytes,
+                    sprites as u64 * corner_bytes,
+                );
+            }
         }
-        super::readback::read_corners(
-            &self.device,
-            queue,
-            encoder,
-            self.build.vertices(),
-            self.sprites_to_draw,
-        )
+        super::readback::read_corners(&self.device, queue, encoder, &read, self.sprites_to_draw)
     }
 
     /// CPU time of the last [`Self::record`], microseconds.
@@ -571,7 +573,11 @@ impl Sky {
             forward: self.time_of_day.forward_scattering,
         };
         let mut stats = FrameStats::default();
-        let (mut upload_bytes, left_out) = self.resident.place_and_upload(queue, camera.position_m);
+        let (mut upload_bytes, left_out) = self.resident.place_and_upload(
+            queue,
+            camera.position_m,
+            self.settings.vertex_cache.max_uploaded_sprites_per_frame,
+        );
         stats.blocks_left_out = left_out;
         self.ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
@@ -677,7 +683,10 @@ impl Sky {
         upload_bytes += self.ring.prepare_builds(queue, &ring_frame, &mut stats);
         // Quad indices and built corners for the largest draw of the frame (the sprites, an
         // impostor's sector).
-        let most = stats.sprites_drawn.max(self.ring.most_sprites_pending());
+        let most = stats
+            .sprites_drawn
+            .max(self.ring.most_sprites_pending())
+            .min(CHUNK);
         if most > self.quads.1 {
             let sprites = most.next_power_of_two();
             self.quads = (quad_index_buffer(&self.device, sprites), sprites);
@@ -725,14 +734,53 @@ impl Sky {
             &self.resident.group,
             &self.quads.0,
         );
-        if let Some(view_group) = self.view.group() {
-            self.build.record(
-                encoder,
-                view_group,
-                &self.resident.group,
-                self.sprites_to_draw,
-            );
+        // The sky, the ring, the sprites a chunk at a time (each built just before it is
+        // drawn; one pass when they fit one chunk), the in-cloud fog.
+        let view_group = self.view.group().filter(|_| self.sprites_to_draw > 0);
+        let parts: Vec<(u32, u32, u32)> = view_group
+            .map(|_| chunks(self.sprites_to_draw).collect())
+            .unwrap_or_default();
+        if parts.len() <= 1
+            && let (Some(group), Some(&(c, _, n))) = (view_group, parts.first())
+        {
+            self.build
+                .record(encoder, group, &self.resident.group, (c, n));
         }
+        let mut pass = self.sky_pass(encoder, colour_view, &frame_group);
+        pass.set_pipeline(&self.sky_pipeline);
+        pass.draw(0..3, 0..1);
+        self.ring.draw(&mut pass);
+        for &(c, _, n) in &parts {
+            if parts.len() > 1 {
+                drop(pass);
+                if let Some(group) = view_group {
+                    self.build
+                        .record(encoder, group, &self.resident.group, (c, n));
+                }
+                pass = self.sky_pass(encoder, colour_view, &frame_group);
+            }
+            pass.set_pipeline(&self.sprite_pipeline);
+            pass.set_bind_group(1, &self.sheet_group, &[]);
+            pass.set_vertex_buffer(0, self.build.vertices().slice(..));
+            pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..n * 6, 0, 0..1);
+        }
+        if self.in_cloud > 0.0 {
+            pass.set_pipeline(&self.in_cloud_pipeline);
+            pass.draw(0..3, 0..1);
+        }
+        drop(pass);
+        self.recorded.set(true);
+        self.record_us.set(start.elapsed().as_micros() as u64);
+    }
+
+    /// A pass over the host's colour (kept), with the frame's group 0 bound.
+    fn sky_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        colour_view: &wgpu::TextureView,
+        frame_group: &wgpu::BindGroup,
+    ) -> wgpu::RenderPass<'e> {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sky"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -749,23 +797,7 @@ impl Sky {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(0, &frame_group, &[]);
-        pass.set_pipeline(&self.sky_pipeline);
-        pass.draw(0..3, 0..1);
-        self.ring.draw(&mut pass);
-        if self.sprites_to_draw > 0 && self.view.group().is_some() {
-            pass.set_pipeline(&self.sprite_pipeline);
-            pass.set_bind_group(1, &self.sheet_group, &[]);
-            pass.set_vertex_buffer(0, self.build.vertices().slice(..));
-            pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..self.sprites_to_draw * 6, 0, 0..1);
-        }
-        if self.in_cloud > 0.0 {
-            pass.set_pipeline(&self.in_cloud_pipeline);
-            pass.draw(0..3, 0..1);
-        }
-        drop(pass);
-        self.recorded.set(true);
-        self.record_us.set(start.elapsed().as_micros() as u64);
+        pass.set_bind_group(0, frame_group, &[]);
+        pass
     }
 }

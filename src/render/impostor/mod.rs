@@ -36,7 +36,7 @@ pub use layout::{
 };
 use layout::{impostor_camera, in_sector};
 
-use super::build::SpriteBuild;
+use super::build::{SpriteBuild, chunks};
 use super::draw_list::fresh_view;
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuSpriteVertex};
 use super::pipeline::{PassDesc, pipeline, premultiplied_over};
@@ -632,35 +632,45 @@ impl ImpostorRing {
         indices: &wgpu::Buffer,
     ) {
         for &(r, i, sprites) in &self.pending {
-            let view = self.slot_views[i].group();
-            if let Some(view) = view {
-                build.record(encoder, view, resident, sprites);
-            }
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("ring.impostor"),
-                color_attachments: &[&self.views[r][i], &self.depth_views[r][i]].map(|view| {
-                    Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })
-                }),
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if sprites > 0 && view.is_some() {
-                pass.set_pipeline(&self.sprite_pipeline);
-                pass.set_bind_group(0, &self.slot_groups[i], &[]);
-                pass.set_bind_group(1, sheet, &[]);
-                pass.set_vertex_buffer(0, build.vertices().slice(..));
-                pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..sprites * 6, 0, 0..1);
+            let view = self.slot_views[i].group().filter(|_| sprites > 0);
+            let parts: Vec<(u32, u32, u32)> = chunks(sprites).collect();
+            // The impostor is cleared, then its sprites drawn a chunk at a time.
+            for k in 0..parts.len().max(1) {
+                let part = parts.get(k).copied();
+                if let (Some(view), Some((c, _, n))) = (view, part) {
+                    build.record(encoder, view, resident, (c, n));
+                }
+                let load = if k == 0 {
+                    wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+                } else {
+                    wgpu::LoadOp::Load
+                };
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("ring.impostor"),
+                    color_attachments: &[&self.views[r][i], &self.depth_views[r][i]].map(|view| {
+                        Some(wgpu::RenderPassColorAttachment {
+                            view,
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations {
+                                load,
+                                store: wgpu::StoreOp::Store,
+                            },
+                        })
+                    }),
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                if let (Some(_), Some((_, _, n))) = (view, part) {
+                    pass.set_pipeline(&self.sprite_pipeline);
+                    pass.set_bind_group(0, &self.slot_groups[i], &[]);
+                    pass.set_bind_group(1, sheet, &[]);
+                    pass.set_vertex_buffer(0, build.vertices().slice(..));
+                    pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(0..n * 6, 0, 0..1);
+                }
             }
         }
     }
