@@ -233,19 +233,9 @@ fn locked_facing(slot: u32, fallback: Facing) -> Facing {
     return fallback;
 }
 
-// One corner as the vertex shader builds it, relative to the camera.
-struct Corner {
-    rel_m: vec3<f32>,
-    visible: bool,
-    uv: vec2<f32>,
-    colour: vec4<f32>,
-};
-
-// Corner `vi % 4` of the frame's sprite `vi / 4` (in drawing order).
-fn sprite_corner(vi: u32) -> Corner {
-    var o: Corner;
-    let k = vi / 4u;
-    let corner_id = vi % 4u;
+// Builds the four corners of the frame's sprite `k` (in drawing order) into `built[at..at + 4]`:
+// what the corners share (finding the sprite, its facing, lock and fades) is done once.
+fn build_sprite(k: u32, at: u32) {
     let b = draws.blocks[block_of(k)];
     let in_block = k - b.first;
     let entry = lists[cloud_of(b, in_block)];
@@ -287,44 +277,48 @@ fn sprite_corner(vi: u32) -> Corner {
         alpha *= clamp((cos_angle - lock.w) / max(lock.z - lock.w, 1e-4), 0.0, 1.0);
     }
     let morph = morph_radius.x * lifecycle_alpha(b.fade_kind, b.fade_progress, morph_radius.y);
-    o.visible = alpha > 0.0 && morph > 0.0;
+    if (!(alpha > 0.0 && morph > 0.0)) {
+        // Faded out: the draw puts its corners outside the clip volume.
+        for (var c = 0u; c < 4u; c++) {
+            built[at + c].position_visible = vec4<f32>(0.0);
+        }
+        return;
+    }
 
-    let corner = vec2<f32>(f32(corner_id & 1u), 1.0 - f32(corner_id >> 1u));
     let sc = vec2<f32>(sin(rotation), cos(rotation));
     let right = face.right * sc.y + face.up * sc.x;
     let up = face.up * sc.y - face.right * sc.x;
-    let p = offset + right * ((corner.x - 0.5) * width) + up * ((corner.y - 0.5) * height);
-
-    // Wang eq. (3): (ambient + directional) x alpha_morph; the texture is the fragment's.
     let light = view.directional_ambient;
-    let height_msl = view.sun_dir_camera_z.w + centre_rel.z + p.z;
-    let ambient = level_colour(entry.cloud, height_msl);
-    let view_dir = normalize_or(p - cam_local, vec3<f32>(0.0));
-    let rim = length(p) / flat_radius.y;
-    let group_dir = normalize_or(p - group, vec3<f32>(0.0));
     let sun = normalize_or(view.sun_dir_camera_z.xyz, vec3<f32>(0.0));
-    let directional = (directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim))
-        * light.rgb;
-    o.colour = vec4<f32>(ambient.rgb * light.w + directional, ambient.a * morph * alpha);
-    // Texture v runs down the sheet: the top of the sprite is v = 0.
-    o.uv = cell_uv(s.bits & 15u, vec2<f32>(corner.x, 1.0 - corner.y));
-    o.rel_m = centre_rel + p;
-    return o;
+    let cell = s.bits & 15u;
+    for (var c = 0u; c < 4u; c++) {
+        let corner = vec2<f32>(f32(c & 1u), 1.0 - f32(c >> 1u));
+        let p = offset + right * ((corner.x - 0.5) * width) + up * ((corner.y - 0.5) * height);
+        // Wang eq. (3): (ambient + directional) x alpha_morph; the texture is the fragment's.
+        let height_msl = view.sun_dir_camera_z.w + centre_rel.z + p.z;
+        let ambient = level_colour(entry.cloud, height_msl);
+        let view_dir = normalize_or(p - cam_local, vec3<f32>(0.0));
+        let rim = length(p) / flat_radius.y;
+        let group_dir = normalize_or(p - group, vec3<f32>(0.0));
+        let directional = (directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim))
+            * light.rgb;
+        // Texture v runs down the sheet: the top of the sprite is v = 0.
+        built[at + c] = BuiltCorner(
+            vec4<f32>(centre_rel + p, 1.0),
+            cell_uv(cell, vec2<f32>(corner.x, 1.0 - corner.y)),
+            vec2<f32>(0.0),
+            vec4<f32>(ambient.rgb * light.w + directional, ambient.a * morph * alpha),
+        );
+    }
 }
 
-// Corner `id % 4` of the chunk's sprite `id / 4` (rows of 65,535 x 64 invocations).
+// Sprite `id` of the chunk (rows of 65,535 x 64 invocations), its four corners.
 @compute @workgroup_size(64)
 fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
     let local = id.x + id.y * (65535u * 64u);
-    let vi = chunk.x * 4u + local;
-    if (local >= CHUNK * 4u || vi >= draws.counts.z * 4u) {
+    let k = chunk.x + local;
+    if (local >= CHUNK || k >= draws.counts.z) {
         return;
     }
-    let c = sprite_corner(vi);
-    built[local] = BuiltCorner(
-        vec4<f32>(c.rel_m, select(0.0, 1.0, c.visible)),
-        c.uv,
-        vec2<f32>(0.0),
-        c.colour,
-    );
+    build_sprite(k, local * 4u);
 }

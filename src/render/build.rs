@@ -144,7 +144,7 @@ impl SpriteBuild {
         if sprites == 0 {
             return;
         }
-        let groups = (sprites * 4).div_ceil(GROUP);
+        let groups = sprites.div_ceil(GROUP);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("sky.sprite_build"),
             timestamp_writes: None,

@@ -32,8 +32,8 @@ pub struct DemoHost {
     timer: Option<GpuTimer>,
 }
 
-/// Three timestamps: before the frame's passes, between the ground and the sky, after; where the
-/// device has timestamp queries.
+/// Five timestamps: around the sky's own submission from `prepare`, then before the frame's
+/// passes, between the ground and the sky, after; where the device has timestamp queries.
 struct GpuTimer {
     queries: wgpu::QuerySet,
     resolve: wgpu::Buffer,
@@ -51,12 +51,12 @@ impl GpuTimer {
         let queries = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("host.frame_time"),
             ty: wgpu::QueryType::Timestamp,
-            count: 3,
+            count: 5,
         });
         let buffer = |label, usage| {
             gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: 24,
+                size: 40,
                 usage,
                 mapped_at_creation: false,
             })
@@ -75,20 +75,28 @@ impl GpuTimer {
         })
     }
 
-    /// Milliseconds of the ground and of the sky passes of the last submitted frame (waits
-    /// for it).
+    /// Writes timestamp `index` in a submission of its own (around the sky's `prepare`, which
+    /// submits the sky's own work).
+    fn stamp(&self, gpu: &HeadlessGpu, index: u32) {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        encoder.write_timestamp(&self.queries, index);
+        gpu.queue.submit([encoder.finish()]);
+    }
+
+    /// Milliseconds of the ground and of the sky (its own submission from `prepare` and its
+    /// passes in the frame) of the last submitted frame (waits for it).
     fn read_ms(&self, gpu: &HeadlessGpu) -> Option<[f64; 2]> {
         self.read.map_async(wgpu::MapMode::Read, .., |_| {});
         gpu.device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
-        let ticks: [u64; 3] = {
+        let t: Vec<u64> = {
             let view = self.read.get_mapped_range(..).ok()?;
-            let t =
-                |i: usize| u64::from_le_bytes(view[i * 8..i * 8 + 8].try_into().unwrap_or([0; 8]));
-            [t(0), t(1), t(2)]
+            (0..5)
+                .map(|i| u64::from_le_bytes(view[i * 8..i * 8 + 8].try_into().unwrap_or([0; 8])))
+                .collect()
         };
         self.read.unmap();
         let ms = |a: u64, b: u64| b.saturating_sub(a) as f64 * self.period_ns as f64 / 1.0e6;
-        Some([ms(ticks[0], ticks[1]), ms(ticks[1], ticks[2])])
+        Some([ms(t[2], t[3]), ms(t[0], t[1]) + ms(t[3], t[4])])
     }
 }
 
@@ -143,7 +151,13 @@ impl DemoHost {
         dt_s: f64,
         visibility_m: f32,
     ) -> FrameStats {
+        if let Some(t) = &self.timer {
+            t.stamp(&self.gpu, 0);
+        }
         let mut stats = self.sky.prepare(&self.gpu.queue, camera, sun, dt_s);
+        if let Some(t) = &self.timer {
+            t.stamp(&self.gpu, 1);
+        }
         let light = self.sky.light();
         self.terrain.prepare(
             &self.gpu.queue,
@@ -163,7 +177,7 @@ impl DemoHost {
                 label: Some("host.frame"),
             });
         if let Some(t) = &self.timer {
-            encoder.write_timestamp(&t.queries, 0);
+            encoder.write_timestamp(&t.queries, 2);
         }
         self.terrain.record(
             &mut encoder,
@@ -171,7 +185,7 @@ impl DemoHost {
             &self.target.depth_view,
         );
         if let Some(t) = &self.timer {
-            encoder.write_timestamp(&t.queries, 1);
+            encoder.write_timestamp(&t.queries, 3);
         }
         self.sky.record(
             &mut encoder,
@@ -180,9 +194,9 @@ impl DemoHost {
         );
         stats.record_us = self.sky.last_record_us();
         if let Some(t) = &self.timer {
-            encoder.write_timestamp(&t.queries, 2);
-            encoder.resolve_query_set(&t.queries, 0..3, &t.resolve, 0);
-            encoder.copy_buffer_to_buffer(&t.resolve, 0, &t.read, 0, 24);
+            encoder.write_timestamp(&t.queries, 4);
+            encoder.resolve_query_set(&t.queries, 0..5, &t.resolve, 0);
+            encoder.copy_buffer_to_buffer(&t.resolve, 0, &t.read, 0, 40);
         }
         self.gpu.queue.submit([encoder.finish()]);
         stats

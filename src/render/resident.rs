@@ -383,31 +383,38 @@ impl ResidentSet {
         true
     }
 
-    /// Grows the buffers so that block `id` fits, if the limits allow: every block is placed
-    /// and written again (rare: the capacity grows by a quarter more than needed each time).
+    /// Grows (or only packs) the buffers so that block `id` fits, if the limits allow: every
+    /// block is placed and written again (rare: a buffer that grows gets a quarter more than it
+    /// needs).
     fn grow_for(&mut self, id: u64) -> bool {
         let Some(r) = self.blocks.get(&id) else {
             return false;
         };
-        let need_sprites = self.sprite_slots.used() + r.sprite_count();
-        let need_clouds = self.cloud_slots.used() + r.block.clouds.len() as u32;
-        let cap = self.sprite_slots.capacity();
-        if need_sprites > self.limit_sprites || (need_sprites <= cap && cap >= self.limit_sprites) {
+        let (n_sprites, n_clouds) = (r.sprite_count(), r.block.clouds.len() as u32);
+        let need_sprites = self.sprite_slots.used() + n_sprites;
+        let need_clouds = self.cloud_slots.used() + n_clouds;
+        if need_sprites > self.limit_sprites {
             return false;
         }
-        // A quarter more than needed, in steps of 4,096: memory stays near what is held, and
-        // a growing field regrows a few times on its way up.
-        let grown = |need: u32, cap: u32| {
-            let want = need.max(cap) as u64 * 5 / 4;
-            (want.div_ceil(4096) * 4096).min(u32::MAX as u64) as u32
+        // What does not fit grows to a quarter more than is needed, in steps of 4,096; a
+        // buffer with room enough but in pieces keeps its size and is only packed again.
+        let grown = |fits: bool, need: u32, cap: u32| {
+            if fits {
+                return cap;
+            }
+            let want = (need as u64 * 5 / 4).div_ceil(4096) * 4096;
+            want.min(u32::MAX as u64).max(cap as u64) as u32
         };
-        let sprites = grown(need_sprites, cap)
+        let cap = self.sprite_slots.capacity();
+        let sprite_fits = self.sprite_slots.fits(n_sprites);
+        let cloud_fits = self.cloud_slots.fits(n_clouds);
+        if sprite_fits && cloud_fits {
+            return false;
+        }
+        let sprites = grown(sprite_fits, need_sprites, cap)
             .min(self.limit_sprites)
             .max(need_sprites);
-        let clouds = grown(need_clouds, self.cloud_slots.capacity());
-        if sprites <= cap && clouds <= self.cloud_slots.capacity() {
-            return false;
-        }
+        let clouds = grown(cloud_fits, need_clouds, self.cloud_slots.capacity());
         let b = buffers(&self.device, &self.layout, sprites, clouds);
         self.sprite_buffer = b.sprites;
         self.cloud_buffer = b.clouds;

@@ -33,6 +33,11 @@ impl SlotRanges {
         self.capacity - self.free.iter().map(|r| r.end - r.start).sum::<u32>()
     }
 
+    /// Whether a range of `len` slots is free.
+    pub fn fits(&self, len: u32) -> bool {
+        len == 0 || self.free.iter().any(|r| r.end - r.start >= len)
+    }
+
     /// A range of `len` slots, if one is free (`len` 0 gives an empty range).
     pub fn allocate(&mut self, len: u32) -> Option<Range<u32>> {
         if len == 0 {
@@ -78,6 +83,7 @@ mod tests {
         let c = s.allocate(30).unwrap();
         assert_eq!((a.clone(), b.clone(), c.clone()), (0..30, 30..60, 60..90));
         assert_eq!(s.allocate(11), None, "only 10 left");
+        assert!(s.fits(10) && !s.fits(11));
         assert_eq!(s.used(), 90);
         s.release(b);
         // A 30-slot hole: a 20 fits in it, first fit.
