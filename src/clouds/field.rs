@@ -192,6 +192,8 @@ pub struct CloudField {
     wind_m_s: DVec2,
     slots: BTreeMap<BlockIndex, Slot>,
     next_serial: u64,
+    /// Counts changes to which generations exist (added, gone).
+    membership: u64,
 }
 
 impl CloudField {
@@ -217,6 +219,7 @@ impl CloudField {
             wind_m_s: DVec2::ZERO,
             slots: BTreeMap::new(),
             next_serial: 0,
+            membership: 0,
         }
     }
 
@@ -253,8 +256,12 @@ impl CloudField {
         }
         // Blocks a block beyond the rim leave the field.
         let keep = radius + BLOCK_SIZE_M;
+        let before = self.slots.len();
         self.slots
             .retain(|index, _| index.centre_m().distance_squared(air_centre) <= keep * keep);
+        if self.slots.len() != before {
+            self.membership += 1;
+        }
         self.take_finished();
     }
 
@@ -283,6 +290,7 @@ impl CloudField {
                 }
             }
             self.next_serial += 1;
+            self.membership += 1;
             slot.generations.push(FieldBlock {
                 block: done.block,
                 phase,
@@ -303,7 +311,11 @@ impl CloudField {
             for g in &mut slot.generations {
                 g.phase = phase_at(g.phase, now, &lifecycle);
             }
+            let before = slot.generations.len();
             slot.generations.retain(|g| g.phase != Phase::Gone);
+            if slot.generations.len() != before {
+                self.membership += 1;
+            }
         }
         self.take_finished();
     }
@@ -312,6 +324,12 @@ impl CloudField {
     /// [`Self::update`] does after asking).
     pub fn poll(&mut self) {
         self.take_finished();
+    }
+
+    /// Counts changes to which generations exist (one added, one gone): while it stays the same,
+    /// [`Self::blocks`] holds the same generations.
+    pub fn membership(&self) -> u64 {
+        self.membership
     }
 
     /// The lifecycle settings the field fades with.

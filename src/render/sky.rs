@@ -84,9 +84,8 @@ pub struct Sky {
     pending_us: u64,
     field_us: u64,
     record_us: Cell<u64>,
-    /// Whether this frame's corners were built in `prepare`'s own submission (they fit one
-    /// chunk); else `record` builds them a chunk at a time between its draws.
-    built: bool,
+    /// Whether the last prepared frame was recorded (if not, its writes are flushed).
+    recorded: Cell<bool>,
     /// The time-of-day light of the last frame, clear sky: what the clouds are lit with.
     clear_light: TimeOfDay,
     /// `clear_light` under the cloud cover over the camera: the sky colours and the host's light.
@@ -304,7 +303,7 @@ impl Sky {
             pending_us: 0,
             field_us: 0,
             record_us: Cell::new(0),
-            built: false,
+            recorded: Cell::new(true),
             clear_light: light,
             seen_light: light,
             overhead: (Vec::new(), 0.0),
@@ -545,10 +544,9 @@ impl Sky {
 
     /// CPU work of a frame: advances time by `dt_s`, uploads blocks that arrived, sorts blocks
     /// and clouds, recomputes the sprite orders Wang's cache says are stale, and writes the draw
-    /// list and this frame's uniforms (only what changed goes to the GPU), and submits the GPU
-    /// work that does not need the host's targets (the patch of changed orders, impostor
-    /// renders, the sprites' corners): nothing piles up however the host drives it, a frame
-    /// prepared and never recorded included.
+    /// list and this frame's uniforms (only what changed goes to the GPU); impostor renders go in
+    /// a submission of their own. A frame prepared and never recorded is flushed by the next
+    /// prepare, so nothing piles up however the host drives it.
     pub fn prepare(
         &mut self,
         queue: &wgpu::Queue,
@@ -557,6 +555,10 @@ impl Sky {
         dt_s: f64,
     ) -> FrameStats {
         let start = Instant::now();
+        if !self.recorded.replace(false) {
+            // The last frame's writes never reached a submit: send them, so they are freed.
+            queue.submit([]);
+        }
         self.elapsed_s += dt_s.max(0.0);
         self.clear_light = self.time_of_day.at(sun.elevation_deg as f32);
         self.seen_light = self.clear_light.under_cover(
@@ -691,37 +693,25 @@ impl Sky {
         }
         self.build.reserve(&self.device, most);
         stats.upload_bytes = upload_bytes;
-        // The frame's GPU work that does not need the host's targets goes in a submission of
-        // its own, ahead of the host's: the patch, impostor renders and the corners (when they
-        // fit one chunk). The software rasteriser runs it before the host's ground instead of
-        // stopping between the ground and the sky for it, and the frame's writes are always
-        // submitted, so a frame prepared and never recorded leaves nothing behind.
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("sky.prepare"),
-            });
-        self.scatter.record(&mut encoder);
-        self.ring.record_builds(
-            &mut encoder,
-            &self.sheet_group,
-            &self.build,
-            &self.resident.group,
-            &self.quads.0,
-        );
-        self.built = false;
-        if let Some(group) = self.view.group()
-            && self.sprites_to_draw <= CHUNK
-        {
-            self.build.record(
+        // Impostor renders (8 frames of a rebuild) need no host target: they go in a submission
+        // of the sky's own, ahead of the host's frame, with the patch of changed orders they
+        // read.
+        if self.ring.has_pending() {
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("sky.impostors"),
+                });
+            self.scatter.record(&mut encoder);
+            self.ring.record_builds(
                 &mut encoder,
-                group,
+                &self.sheet_group,
+                &self.build,
                 &self.resident.group,
-                (0, self.sprites_to_draw),
+                &self.quads.0,
             );
-            self.built = true;
+            queue.submit([encoder.finish()]);
         }
-        queue.submit([encoder.finish()]);
         stats.sprite_gpu_bytes = self.resident.gpu_bytes()
             + self.quads.0.size()
             + self.build.gpu_bytes()
@@ -755,18 +745,27 @@ impl Sky {
                 },
             ],
         });
-        // The sky, the ring, the sprites (built in `prepare` when they fit one chunk, else a
-        // chunk at a time, each built just before it is drawn), the in-cloud fog.
+        // The patch of changed orders, then the sky, the ring, the sprites a chunk at a time
+        // (each built just before it is drawn; one pass when they fit one chunk), the in-cloud
+        // fog.
+        self.scatter.record(encoder);
         let view_group = self.view.group().filter(|_| self.sprites_to_draw > 0);
         let parts: Vec<(u32, u32, u32)> = view_group
             .map(|_| chunks(self.sprites_to_draw).collect())
             .unwrap_or_default();
+        if parts.len() == 1
+            && let Some(group) = view_group
+        {
+            let (c, _, n) = parts[0];
+            self.build
+                .record(encoder, group, &self.resident.group, (c, n));
+        }
         let mut pass = self.sky_pass(encoder, colour_view, &frame_group);
         pass.set_pipeline(&self.sky_pipeline);
         pass.draw(0..3, 0..1);
         self.ring.draw(&mut pass);
         for &(c, _, n) in &parts {
-            if !self.built {
+            if parts.len() > 1 {
                 drop(pass);
                 if let Some(group) = view_group {
                     self.build
@@ -785,6 +784,7 @@ impl Sky {
             pass.draw(0..3, 0..1);
         }
         drop(pass);
+        self.recorded.set(true);
         self.record_us.set(start.elapsed().as_micros() as u64);
     }
 

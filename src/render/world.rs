@@ -113,8 +113,9 @@ pub struct LivingClouds {
     asked: Option<(BlockIndex, BlockIndex, u64)>,
     in_sky: HashSet<u64>,
     seen: HashSet<u64>,
-    /// The newest generation handed to the sky.
+    /// The newest generation handed to the sky, and the field's membership count then.
     newest_serial: u64,
+    membership: Option<u64>,
     /// Generations forming or dissipating this frame and the last.
     fading: Vec<u64>,
     was_fading: Vec<u64>,
@@ -304,6 +305,7 @@ impl World {
                 in_sky: HashSet::new(),
                 seen: HashSet::new(),
                 newest_serial: 0,
+                membership: None,
                 fading: Vec::new(),
                 was_fading: Vec::new(),
             });
@@ -345,6 +347,13 @@ impl World {
         let now = living.field.time_s();
         let lifecycle = *living.field.lifecycle();
         let sky_before_us = sky.pending_cpu_us();
+        // Nothing came, went, forms or dissipates: only the drift changed.
+        if living.membership == Some(living.field.membership()) && living.was_fading.is_empty() {
+            sky.set_drift(offset_m);
+            sky.add_field_cpu_us(start.elapsed().as_micros() as u64);
+            return Ok(());
+        }
+        living.membership = Some(living.field.membership());
         // Generations are handed over when they appear (serials only grow) and when they go;
         // per frame only the drift (one value) and the fades of the blocks forming or
         // dissipating change.

@@ -615,6 +615,11 @@ impl ImpostorRing {
         bytes
     }
 
+    /// Whether this frame renders impostors.
+    pub(super) fn has_pending(&self) -> bool {
+        !self.pending.is_empty()
+    }
+
     /// The most sprites one of this frame's impostor renders draws.
     pub(super) fn most_sprites_pending(&self) -> u32 {
         self.pending.iter().map(|p| p.2).max().unwrap_or(0)
