@@ -162,6 +162,16 @@ pub fn weather_changed(a: &BlockWeather, b: &BlockWeather) -> bool {
         })
 }
 
+impl Slot {
+    /// Its generations forming or dissipating.
+    fn unsettled(&self) -> usize {
+        self.generations
+            .iter()
+            .filter(|g| g.phase != Phase::Steady)
+            .count()
+    }
+}
+
 /// One generation of clouds in a block, with where it is in its life.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FieldBlock {
@@ -194,6 +204,8 @@ pub struct CloudField {
     next_serial: u64,
     /// Counts changes to which generations exist (added, gone).
     membership: u64,
+    /// Generations forming or dissipating: while none are, advancing time touches no block.
+    unsettled: usize,
 }
 
 impl CloudField {
@@ -220,6 +232,7 @@ impl CloudField {
             slots: BTreeMap::new(),
             next_serial: 0,
             membership: 0,
+            unsettled: 0,
         }
     }
 
@@ -257,8 +270,15 @@ impl CloudField {
         // Blocks a block beyond the rim leave the field.
         let keep = radius + BLOCK_SIZE_M;
         let before = self.slots.len();
-        self.slots
-            .retain(|index, _| index.centre_m().distance_squared(air_centre) <= keep * keep);
+        let mut unsettled_gone = 0;
+        self.slots.retain(|index, slot| {
+            let kept = index.centre_m().distance_squared(air_centre) <= keep * keep;
+            if !kept {
+                unsettled_gone += slot.unsettled();
+            }
+            kept
+        });
+        self.unsettled -= unsettled_gone;
         if self.slots.len() != before {
             self.membership += 1;
         }
@@ -285,9 +305,15 @@ impl CloudField {
                 Phase::Forming { since_s: now }
             };
             for g in &mut slot.generations {
+                if g.phase == Phase::Steady {
+                    self.unsettled += 1;
+                }
                 if !matches!(g.phase, Phase::Dissipating { .. }) {
                     g.phase = Phase::Dissipating { since_s: now };
                 }
+            }
+            if phase != Phase::Steady {
+                self.unsettled += 1;
             }
             self.next_serial += 1;
             self.membership += 1;
@@ -307,14 +333,18 @@ impl CloudField {
         self.drift_m += self.wind_m_s * dt_s;
         let now = self.time_s;
         let lifecycle = self.config.lifecycle;
-        for slot in self.slots.values_mut() {
-            for g in &mut slot.generations {
-                g.phase = phase_at(g.phase, now, &lifecycle);
-            }
-            let before = slot.generations.len();
-            slot.generations.retain(|g| g.phase != Phase::Gone);
-            if slot.generations.len() != before {
-                self.membership += 1;
+        if self.unsettled > 0 {
+            for slot in self.slots.values_mut() {
+                let before = slot.unsettled();
+                for g in &mut slot.generations {
+                    g.phase = phase_at(g.phase, now, &lifecycle);
+                }
+                let len = slot.generations.len();
+                slot.generations.retain(|g| g.phase != Phase::Gone);
+                if slot.generations.len() != len {
+                    self.membership += 1;
+                }
+                self.unsettled -= before - slot.unsettled();
             }
         }
         self.take_finished();
