@@ -45,9 +45,9 @@ pictures: vulkan
 	$(FRAME) --weather $(METARS) --at 29.4270,-98.6080 --alt-ft 5000 --heading 40 --pitch -3 --out tests/pictures/frames/approach_above_deck.png
 	$(FRAME) --weather $(METARS) --at 29.4800,-98.5480 --alt-ft 3300 --heading 40 --pitch -3 --out tests/pictures/frames/approach_in_deck.png
 	$(FRAME) --weather $(METARS) --at 29.5230,-98.5000 --alt-ft 1500 --heading 40 --pitch 10 --out tests/pictures/frames/approach_below_deck.png
-	$(FRAME) --weather $(METARS) --at 53.43,-6.10 --alt-ft 700 --heading 280 --pitch 12 --out tests/pictures/airports/dublin_approach.png
-	$(FRAME) --weather $(METARS) --at -4.62,136.887 --alt-ft 900 --heading 0 --pitch 8 --out tests/pictures/airports/timika_cb.png
-	$(FRAME) --weather weather/themes/low_stratus_and_fog.toml --at 28.5,-81.45 --time 2025-01-27T13:30:00Z --alt-ft 150 --heading 90 --pitch 3 --out tests/pictures/airports/fog_morning.png
+	$(FRAME) --weather $(METARS) --at 53.43,-6.10 --time 2025-01-27T14:00:00Z --alt-ft 700 --heading 280 --pitch 12 --out tests/pictures/airports/dublin_approach.png
+	$(FRAME) --weather $(METARS) --at -4.80,136.887 --alt-ft 900 --heading 0 --pitch 14 --out tests/pictures/airports/timika_cb.png
+	$(FRAME) --weather weather/themes/low_stratus_and_fog.toml --at 28.5,-81.45 --time 2025-01-27T13:30:00Z --alt-ft 450 --heading 90 --pitch -4 --out tests/pictures/airports/fog_morning.png
 
 # Runs every cargo-fuzz target for FUZZ_SECONDS each (see fuzz/README.md); needs cargo-fuzz.
 FUZZ_SECONDS ?= 120
