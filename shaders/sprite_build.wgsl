@@ -96,7 +96,7 @@ struct BuiltCorner {
 @group(2) @binding(1) var<uniform> chunk: vec4<u32>;
 
 // Keep in sync with `CHUNK` in src/render/build.rs.
-const CHUNK: u32 = 65536u;
+const CHUNK: u32 = 32768u;
 
 struct Facing {
     right: vec3<f32>,

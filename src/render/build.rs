@@ -8,10 +8,10 @@
 use super::gpu_types::GpuSpriteVertex;
 
 const WGSL: &str = include_str!("../../shaders/sprite_build.wgsl");
-/// Most sprites built and drawn at once (12.6 MB of corners). Keep in sync with `CHUNK` in
+/// Most sprites built and drawn at once (6.3 MB of corners). Keep in sync with `CHUNK` in
 /// `shaders/sprite_build.wgsl`.
-pub(super) const CHUNK: u32 = 65_536;
-/// Most chunks of one view (16.7 million sprites).
+pub(super) const CHUNK: u32 = 32_768;
+/// Most chunks of one view (8.4 million sprites).
 const MAX_CHUNKS: u32 = 256;
 /// Bytes between the chunks' uniforms (the dynamic offset alignment every device accepts).
 const CHUNK_STRIDE: u64 = 256;

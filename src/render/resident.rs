@@ -384,7 +384,7 @@ impl ResidentSet {
     }
 
     /// Grows (or only packs) the buffers so that block `id` fits, if the limits allow: every
-    /// block is placed and written again (rare: a buffer that grows gets a quarter more than it
+    /// block is placed and written again (rare: a buffer that grows gets a sixteenth more than it
     /// needs).
     fn grow_for(&mut self, id: u64) -> bool {
         let Some(r) = self.blocks.get(&id) else {
@@ -396,13 +396,13 @@ impl ResidentSet {
         if need_sprites > self.limit_sprites {
             return false;
         }
-        // What does not fit grows to a quarter more than is needed, in steps of 4,096; a
+        // What does not fit grows to a sixteenth more than is needed, in steps of 4,096; a
         // buffer with room enough but in pieces keeps its size and is only packed again.
         let grown = |fits: bool, need: u32, cap: u32| {
             if fits {
                 return cap;
             }
-            let want = (need as u64 * 5 / 4).div_ceil(4096) * 4096;
+            let want = (need as u64 * 17 / 16).div_ceil(4096) * 4096;
             want.min(u32::MAX as u64).max(cap as u64) as u32
         };
         let cap = self.sprite_slots.capacity();
