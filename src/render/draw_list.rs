@@ -115,43 +115,34 @@ impl Locks {
     }
 }
 
-/// Wang 6.1's thresholds: they grow with the cloud's distance; fading clouds age out sooner.
-fn needs_recompute(
-    ordered_at: (DVec3, f64),
-    fading: bool,
-    camera_rel_m: DVec3,
-    time_s: f64,
-    near_edge_m: f64,
-    cache: &VertexCacheSettings,
-) -> bool {
-    let moved_m = (camera_rel_m - ordered_at.0).length();
+/// Wang 6.1's thresholds for a cloud `near_edge_m` away: how far the camera may move relative
+/// to it and how long it may wait, metres and seconds; they grow with the distance, and fading
+/// clouds age out sooner.
+fn thresholds(fading: bool, near_edge_m: f64, cache: &VertexCacheSettings) -> (f64, f64) {
     let move_limit_m = cache.min_move_m as f64 + cache.move_fraction as f64 * near_edge_m;
     let max_age_s = if fading {
         cache.fading_max_age_s as f64
     } else {
         cache.max_age_s as f64 * (1.0 + near_edge_m / cache.time_distance_m as f64)
     };
-    moved_m > move_limit_m || time_s - ordered_at.1 > max_age_s || time_s < ordered_at.1
+    (move_limit_m, max_age_s)
 }
 
-/// Whether less than a third of a cloud's movement or age threshold is left.
-fn nearly_stale(
-    ordered_at: (DVec3, f64),
-    fading: bool,
+/// Whether more than `share` of a cloud's movement or age threshold is used up since its order
+/// was computed (or time ran backwards): with `share` 1 Wang's rule that the order is stale.
+fn used_up(
+    (ordered_at, fading): ((DVec3, f64), bool),
     camera_rel_m: DVec3,
     time_s: f64,
     near_edge_m: f64,
     cache: &VertexCacheSettings,
+    share: f64,
 ) -> bool {
-    const LEFT: f64 = 1.0 / 3.0;
+    let (move_limit_m, max_age_s) = thresholds(fading, near_edge_m, cache);
     let moved_m = (camera_rel_m - ordered_at.0).length();
-    let move_limit_m = cache.min_move_m as f64 + cache.move_fraction as f64 * near_edge_m;
-    let max_age_s = if fading {
-        cache.fading_max_age_s as f64
-    } else {
-        cache.max_age_s as f64 * (1.0 + near_edge_m / cache.time_distance_m as f64)
-    };
-    moved_m > (1.0 - LEFT) * move_limit_m || time_s - ordered_at.1 > (1.0 - LEFT) * max_age_s
+    moved_m > share * move_limit_m
+        || time_s - ordered_at.1 > share * max_age_s
+        || time_s < ordered_at.1
 }
 
 /// How far inside the cloud's core box the camera is: 0 outside, rising to 1 over `ramp` of the
@@ -370,10 +361,9 @@ fn recheck(
         // now with the block's others, so that the block keeps a slack worth waiting for
         // instead of coming back for one cloud every frame.
         let stale = !cache.enabled
-            || state.ordered_at.is_none_or(|at| {
-                needs_recompute(at, fading, rel, time_s, near_edge, cache)
-                    || nearly_stale(at, fading, rel, time_s, near_edge, cache)
-            });
+            || state
+                .ordered_at
+                .is_none_or(|at| used_up((at, fading), rel, time_s, near_edge, cache, 2.0 / 3.0));
         let afford = state.sprites <= *budget_sprites;
         if stale && !afford {
             // Over the frame's budget: drawn in its last order, looked at again next frame.
@@ -397,7 +387,7 @@ fn recheck(
         // What is left of its movement threshold, knowing that its distance (and with it the
         // threshold) shrinks by at most what the camera moves.
         let (at_rel, at_s) = state.ordered_at.unwrap_or((rel, time_s));
-        let limit = cache.min_move_m as f64 + slope * near_edge;
+        let (limit, _) = thresholds(fading, near_edge, cache);
         budget = budget.min((limit - (rel - at_rel).length()).max(0.0) / (1.0 + slope));
         nearest_edge = nearest_edge.min(near_edge);
         oldest = oldest.min(at_s);
@@ -412,12 +402,7 @@ fn recheck(
     r.list_sprites = first;
     // The age threshold of the nearest cloud once the camera has used up the movement slack
     // (the smallest any of them can have), from the oldest order.
-    let max_age_s = if fading {
-        cache.fading_max_age_s as f64
-    } else {
-        let edge = (nearest_edge - budget).max(0.0);
-        cache.max_age_s as f64 * (1.0 + edge / cache.time_distance_m as f64)
-    };
+    let (_, max_age_s) = thresholds(fading, (nearest_edge - budget).max(0.0), cache);
     r.check = Some(BlockCheck {
         camera_rel_m: camera_m - r.centre_m(),
         move_budget_m: budget,

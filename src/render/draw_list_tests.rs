@@ -12,17 +12,17 @@ fn the_order_ages_and_moves_out_by_distance_and_sooner_while_fading() {
     let at = (DVec3::new(0.0, -1000.0, 0.0), 10.0);
     // 1 km from its edge: 5 m + 2% = 25 m of movement, 2 s x 1.5 = 3 s of age.
     let moved = |m: f64| DVec3::new(m, -1000.0, 0.0);
-    assert!(!needs_recompute(at, false, moved(24.0), 10.0, 1000.0, &c));
-    assert!(needs_recompute(at, false, moved(26.0), 10.0, 1000.0, &c));
-    assert!(!needs_recompute(at, false, moved(0.0), 12.9, 1000.0, &c));
-    assert!(needs_recompute(at, false, moved(0.0), 13.1, 1000.0, &c));
+    assert!(!used_up((at, false), moved(24.0), 10.0, 1000.0, &c, 1.0));
+    assert!(used_up((at, false), moved(26.0), 10.0, 1000.0, &c, 1.0));
+    assert!(!used_up((at, false), moved(0.0), 12.9, 1000.0, &c, 1.0));
+    assert!(used_up((at, false), moved(0.0), 13.1, 1000.0, &c, 1.0));
     // 10 km out the same 26 m keeps the order (limit 205 m).
-    assert!(!needs_recompute(at, false, moved(26.0), 10.0, 10_000.0, &c));
+    assert!(!used_up((at, false), moved(26.0), 10.0, 10_000.0, &c, 1.0));
     // Fading: every 0.25 s whatever the distance.
-    assert!(needs_recompute(at, true, moved(0.0), 10.3, 10_000.0, &c));
-    assert!(!needs_recompute(at, true, moved(0.0), 10.2, 10_000.0, &c));
+    assert!(used_up((at, true), moved(0.0), 10.3, 10_000.0, &c, 1.0));
+    assert!(!used_up((at, true), moved(0.0), 10.2, 10_000.0, &c, 1.0));
     // Time running backwards (a new flight in the same sky) recomputes.
-    assert!(needs_recompute(at, false, moved(0.0), 9.0, 1000.0, &c));
+    assert!(used_up((at, false), moved(0.0), 9.0, 1000.0, &c, 1.0));
 }
 
 #[test]

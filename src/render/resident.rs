@@ -493,6 +493,16 @@ impl ResidentSet {
     }
 }
 
+/// A storage buffer the queue writes into, of at least 16 bytes.
+pub(super) fn storage_buffer(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
 /// The resident buffers and the group of the two the sprite passes bind.
 struct Buffers {
     sprites: wgpu::Buffer,
@@ -509,14 +519,7 @@ fn buffers(
     sprites: u32,
     clouds: u32,
 ) -> Buffers {
-    let storage = |label, size: u64| {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: size.max(16),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
-    };
+    let storage = |label, size| storage_buffer(device, label, size);
     let sprite_buffer = storage(
         "sky.sprites",
         sprites as u64 * std::mem::size_of::<GpuSprite>() as u64,

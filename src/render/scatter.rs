@@ -9,6 +9,7 @@ use std::cell::Cell;
 use std::ops::Range;
 
 use super::gpu_types::GpuListCloud;
+use super::resident::storage_buffer;
 
 const WGSL: &str = include_str!("../../shaders/scatter.wgsl");
 /// Workgroups per dispatch row.
@@ -27,15 +28,6 @@ pub(super) struct Scatter {
     group: Option<wgpu::BindGroup>,
     /// Whether that patch went into a recorded frame (then the next one starts afresh).
     applied: Cell<bool>,
-}
-
-fn storage(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: bytes.max(16),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
 }
 
 impl Scatter {
@@ -58,8 +50,8 @@ impl Scatter {
             pipeline,
             values: Vec::new(),
             spans: Vec::new(),
-            patch: storage(device, "sky.scatter_patch", 16 << 10),
-            span_buffer: storage(device, "sky.scatter_spans", 4 << 10),
+            patch: storage_buffer(device, "sky.scatter_patch", 16 << 10),
+            span_buffer: storage_buffer(device, "sky.scatter_spans", 4 << 10),
             group: None,
             applied: Cell::new(true),
         }
@@ -110,11 +102,12 @@ impl Scatter {
         let value_bytes = self.values.len() as u64 * 4;
         let span_bytes = self.spans.len() as u64 * 16;
         if value_bytes > self.patch.size() {
-            self.patch = storage(device, "sky.scatter_patch", value_bytes.next_power_of_two());
+            self.patch =
+                storage_buffer(device, "sky.scatter_patch", value_bytes.next_power_of_two());
         }
         if span_bytes > self.span_buffer.size() {
             let bytes = span_bytes.next_power_of_two();
-            self.span_buffer = storage(device, "sky.scatter_spans", bytes);
+            self.span_buffer = storage_buffer(device, "sky.scatter_spans", bytes);
         }
         queue.write_buffer(&self.patch, 0, bytemuck::cast_slice(&self.values));
         queue.write_buffer(&self.span_buffer, 0, bytemuck::cast_slice(&self.spans));

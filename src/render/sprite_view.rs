@@ -7,6 +7,7 @@
 use glam::Vec3;
 
 use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, GpuSpriteView, MAX_LOCKS};
+use super::resident::storage_buffer;
 use super::settings::CloudSettings;
 use super::stats::Lighting;
 use crate::clouds::LifecycleConfig;
@@ -104,7 +105,7 @@ struct Grown {
 impl Grown {
     fn new(device: &wgpu::Device, label: &'static str, bytes: u64) -> Self {
         Self {
-            buffer: storage(device, label, bytes),
+            buffer: storage_buffer(device, label, bytes),
             capacity_bytes: bytes,
             label,
         }
@@ -116,7 +117,7 @@ impl Grown {
             return false;
         }
         self.capacity_bytes = bytes.next_power_of_two();
-        self.buffer = storage(device, self.label, self.capacity_bytes);
+        self.buffer = storage_buffer(device, self.label, self.capacity_bytes);
         true
     }
 
@@ -148,15 +149,6 @@ pub(super) enum ViewData<'a> {
         orders: &'a wgpu::Buffer,
         generation: u64,
     },
-}
-
-fn storage(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: bytes.max(16),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
 }
 
 impl ViewBuffers {
