@@ -459,7 +459,7 @@ impl ResidentSet {
         todo.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.block.id.cmp(&b.1.block.id)));
         let mut written = 0u32;
         for (_, r) in todo {
-            if written >= budget {
+            if written > 0 && written >= budget {
                 break;
             }
             let Some((s, c)) = &r.place else { continue };

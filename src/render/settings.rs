@@ -196,6 +196,21 @@ impl RenderSettings {
                 ));
             }
         }
+        let budgets = [
+            (
+                "vertex_cache.max_sorted_sprites_per_frame",
+                s.vertex_cache.max_sorted_sprites_per_frame,
+            ),
+            (
+                "vertex_cache.max_uploaded_sprites_per_frame",
+                s.vertex_cache.max_uploaded_sprites_per_frame,
+            ),
+        ];
+        for (field, value) in budgets {
+            if value == 0 {
+                return Err(ConfigError::at_key(path, text, field, "must be at least 1"));
+            }
+        }
         if let Some((field, message)) = s.impostors.invalid_field() {
             return Err(ConfigError::at_key(path, text, field, message));
         }
@@ -265,10 +280,32 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("clouds.upright_fade_end_deg"), "{err}");
+        let text = DEFAULT_RENDER_TOML.replace(
+            "max_sorted_sprites_per_frame = 8192",
+            "max_sorted_sprites_per_frame = 0",
+        );
+        let err = RenderSettings::from_toml_str(&text, "r.toml")
+            .unwrap_err()
+            .to_string();
+        let line = line_of_key(
+            DEFAULT_RENDER_TOML,
+            "vertex_cache.max_sorted_sprites_per_frame",
+        )
+        .unwrap();
+        assert!(
+            err.starts_with(&format!(
+                "r.toml:{line}: field `vertex_cache.max_sorted_sprites_per_frame`"
+            )),
+            "{err}"
+        );
         // Files written before the upright fade existed still load, with its defaults.
         let old = DEFAULT_RENDER_TOML
             .lines()
-            .filter(|l| !l.starts_with("upright_fade"))
+            .filter(|l| {
+                !l.starts_with("upright_fade")
+                    && !l.starts_with("max_sorted")
+                    && !l.starts_with("max_uploaded")
+            })
             .collect::<Vec<_>>()
             .join("\n");
         let s = RenderSettings::from_toml_str(&old, "old.toml").unwrap();
