@@ -124,26 +124,22 @@ fn upright_facing(to_cam: vec3<f32>) -> Facing {
     return Facing(right, vec3<f32>(0.0, 0.0, 1.0), normal);
 }
 
-// Wang 5.1: the ambient colour of the cloud's five levels at a height above mean sea level.
-fn level_colour(ci: u32, h: f32) -> vec4<f32> {
-    let c = clouds[ci];
-    var heights = array<f32, 5>(
-        c.level_height.x, c.level_height.y, c.level_height.z, c.level_height.w,
-        c.level4_radius_flat.x,
-    );
-    if (h <= heights[0]) {
-        return clouds[ci].level_rgba[0];
-    }
-    for (var i = 0u; i < 4u; i++) {
-        let lo = heights[i];
-        let hi = heights[i + 1u];
-        if (h <= hi) {
-            let span = hi - lo;
-            let a_v = select(0.0, (hi - h) / span, span > 0.0);
-            return clouds[ci].level_rgba[i] * a_v + clouds[ci].level_rgba[i + 1u] * (1.0 - a_v);
-        }
-    }
-    return clouds[ci].level_rgba[4];
+// Wang 5.1: the ambient colour of the cloud's five levels at a height above mean sea level:
+// piecewise linear between the levels (heights ascending), held beyond the first and the last.
+// Written as a chain of mixes, each level's weight clamped, with no loop or indexed array: the
+// software rasteriser runs it on every lane at once.
+fn level_colour(c: Cloud, h: f32) -> vec4<f32> {
+    let heights = vec4<f32>(c.level_height.yzw, c.level4_radius_flat.x);
+    let lows = c.level_height;
+    let spans = heights - lows;
+    let t = select(vec4<f32>(1.0), clamp((h - lows) / spans, vec4<f32>(0.0), vec4<f32>(1.0)),
+        spans > vec4<f32>(0.0));
+    // A level is reached once h passes its height, even where a span is zero.
+    let w = select(t, vec4<f32>(0.0), vec4<f32>(h) <= lows);
+    var colour = mix(c.level_rgba[0], c.level_rgba[1], w.x);
+    colour = mix(colour, c.level_rgba[2], w.y);
+    colour = mix(colour, c.level_rgba[3], w.z);
+    return mix(colour, c.level_rgba[4], w.w);
 }
 
 // Wang 5.2's biased mapping of dot(vertex - group centre, sun) to Cmin / Cmedian / Cmax.
@@ -157,7 +153,8 @@ fn directional_percent(dot_sun: f32) -> f32 {
 fn forward_percent(view_dir: vec3<f32>, rim: f32) -> f32 {
     let g = view.mapping_g.w;
     let cos_sun = clamp(dot(view_dir, view.sun_dir_camera_z.xyz), -1.0, 1.0);
-    let lobe = pow((1.0 - g) * (1.0 - g) / (1.0 + g * g - 2.0 * g * cos_sun), 1.5);
+    let base = (1.0 - g) * (1.0 - g) / (1.0 + g * g - 2.0 * g * cos_sun);
+    let lobe = base * sqrt(base);
     let r = clamp(rim, 0.0, 1.0);
     return view.forward_lock.x * lobe * r * r * r * r;
 }
@@ -241,8 +238,9 @@ fn build_sprite(k: u32, at: u32) {
     let entry = lists[cloud_of(b, in_block)];
     let slot = orders[entry.order_base + (in_block - entry.first)];
     let s = sprites[slot];
-    let flat_radius = clouds[entry.cloud].level4_radius_flat;
-    let centre_rel = b.origin_rel + clouds[entry.cloud].centre_block.xyz;
+    let cloud = clouds[entry.cloud];
+    let flat_radius = cloud.level4_radius_flat;
+    let centre_rel = b.origin_rel + cloud.centre_block.xyz;
     let offset = s.offset;
     let size = unpack2x16float(s.size);
     let width = size.x;
@@ -296,7 +294,7 @@ fn build_sprite(k: u32, at: u32) {
         let p = offset + right * ((corner.x - 0.5) * width) + up * ((corner.y - 0.5) * height);
         // Wang eq. (3): (ambient + directional) x alpha_morph; the texture is the fragment's.
         let height_msl = view.sun_dir_camera_z.w + centre_rel.z + p.z;
-        let ambient = level_colour(entry.cloud, height_msl);
+        let ambient = level_colour(cloud, height_msl);
         let view_dir = normalize_or(p - cam_local, vec3<f32>(0.0));
         let rim = length(p) / flat_radius.y;
         let group_dir = normalize_or(p - group, vec3<f32>(0.0));

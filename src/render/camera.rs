@@ -5,7 +5,7 @@
 //! `world - position_m` (as f32) to clip space, so nothing jitters far from the origin.
 //! Depth is the standard WebGPU `[0, 1]` range, near plane at 0.
 
-use glam::{DVec3, Mat4, Vec3};
+use glam::{DVec3, Mat4, Vec3, Vec4};
 
 /// A camera in the local east-north-up frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,6 +53,45 @@ impl Camera {
     pub fn view_proj_relative(&self) -> Mat4 {
         self.projection() * self.view_relative()
     }
+
+    /// The view volume, camera-relative, for culling whole blocks before any of their sprites
+    /// is built or drawn.
+    pub fn frustum_relative(&self) -> Frustum {
+        Frustum::from_view_proj(self.view_proj_relative())
+    }
+}
+
+/// The side and far planes of a view volume (camera-relative metres), each `n . p + d >= 0`
+/// inside with `n` of unit length. The near plane is left out: whatever contains the camera is
+/// in view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frustum {
+    planes: [Vec4; 5],
+}
+
+impl Frustum {
+    /// The planes of a projection-times-view matrix with WebGPU's `[0, 1]` depth (Gribb and
+    /// Hartmann's extraction from the matrix's rows).
+    pub fn from_view_proj(m: Mat4) -> Self {
+        let (r0, r1, r2, r3) = (m.row(0), m.row(1), m.row(2), m.row(3));
+        let unit = |p: Vec4| p / p.truncate().length().max(f32::MIN_POSITIVE);
+        Self {
+            planes: [
+                unit(r3 + r0),
+                unit(r3 - r0),
+                unit(r3 + r1),
+                unit(r3 - r1),
+                unit(r3 - r2),
+            ],
+        }
+    }
+
+    /// Whether any of the sphere at `centre` (camera-relative) of `radius` may be in view.
+    pub fn sees_sphere(&self, centre: Vec3, radius: f32) -> bool {
+        self.planes
+            .iter()
+            .all(|p| p.truncate().dot(centre) + p.w >= -radius)
+    }
 }
 
 #[cfg(test)]
@@ -84,5 +123,22 @@ mod tests {
         assert!(above.y / above.w > 0.0 && left.x / left.w < 0.0);
         // clip.w is the view depth, which the shaders use as linear depth.
         assert!((ahead.w - 100.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn the_frustum_sees_what_is_ahead_and_what_holds_the_camera_and_nothing_behind() {
+        let f = cam().frustum_relative();
+        // Ahead, and a sphere just off the edge of the view that still reaches into it.
+        assert!(f.sees_sphere(Vec3::new(5000.0, 0.0, 0.0), 10.0));
+        // 60 degrees up at 1 km is outside the 30-degree half-angle; its 1 m sphere too,
+        // a sphere reaching back across the top plane is seen.
+        let high = Vec3::new(500.0, 0.0, 866.0);
+        assert!(!f.sees_sphere(high, 1.0));
+        assert!(f.sees_sphere(high, 600.0));
+        // Behind the camera, and beyond the far plane.
+        assert!(!f.sees_sphere(Vec3::new(-3000.0, 0.0, 0.0), 2000.0));
+        assert!(!f.sees_sphere(Vec3::new(12_000.0, 0.0, 0.0), 1000.0));
+        // A block holding the camera is always seen, whatever its radius beyond zero.
+        assert!(f.sees_sphere(Vec3::new(-1.0, 0.5, 0.0), 2.0));
     }
 }

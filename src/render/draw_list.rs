@@ -16,6 +16,7 @@ use std::collections::HashMap;
 
 use glam::{DVec3, Vec3};
 
+use super::camera::Frustum;
 use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, MAX_LOCKS};
 use super::resident::{BlockCheck, CloudState, Resident};
 use super::scene::{Fade, SkyCloud};
@@ -231,24 +232,27 @@ pub(super) struct Copies<'a> {
     pub dirty_lists: &'a mut Vec<std::ops::Range<u32>>,
 }
 
-/// The sky camera's frame: fills `out` with the draw list of the blocks marked near and placed,
-/// looks again at the blocks whose slack is used up (re-sorting their clouds, recomputing the
+/// The sky camera's frame: fills `out` with the draw list of the blocks marked near, placed and
+/// in view (`frustum`: nothing of a block wholly outside it is built or drawn), looks again at the blocks whose slack is used up (re-sorting their clouds, recomputing the
 /// orders the cache says are stale, into `copies`, marked dirty), updates `locks`, and counts
 /// into `stats`. Returns how far inside a cloud the camera is, 0..=1.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn main_view(
     blocks: &mut Blocks,
     copies: Copies,
-    camera_m: DVec3,
+    (camera_m, frustum): (DVec3, &Frustum),
     time_s: f64,
     settings: &RenderSettings,
     locks: &mut Locks,
     out: &mut Vec<GpuDrawBlock>,
     stats: &mut FrameStats,
 ) -> f32 {
+    // A block out of view is not looked at again either: its slack check catches up with the
+    // camera the frame it comes into view.
     let mut order: Vec<(f64, &mut Resident)> = blocks
         .values_mut()
         .filter(|r| r.near && r.uploaded)
+        .filter(|r| frustum.sees_sphere((r.centre_m() - camera_m).as_vec3(), r.radius_m as f32))
         .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
         .collect();
     order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.block.id.cmp(&b.1.block.id)));

@@ -41,7 +41,7 @@ pub mod stats;
 pub mod terrain;
 pub mod world;
 
-pub use camera::Camera;
+pub use camera::{Camera, Frustum};
 pub use demo_host::{DemoHost, ground_from_field};
 pub use headless::{Frame, HeadlessGpu, OffscreenTarget};
 pub use readback::SpriteCorner;

@@ -590,7 +590,7 @@ impl Sky {
                 lists: &mut resident.lists_cpu,
                 dirty_lists: &mut resident.dirty_lists,
             },
-            camera.position_m,
+            (camera.position_m, &camera.frustum_relative()),
             self.elapsed_s,
             &self.settings,
             &mut self.locks,
