@@ -63,7 +63,7 @@ fn cruise() -> Cruise {
         18,
         world.ground(),
         SkyConfig {
-            colour_format: headless::COLOUR_FORMAT,
+            targets: headless::TARGETS,
             settings: Default::default(),
             time_of_day: TimeOfDayTable::default(),
             sheet: world.sheet(),

@@ -117,7 +117,8 @@ fn ring_sample(
 
 @fragment
 fn fs_impostor(i: RingOut) -> @location(0) vec4<f32> {
-    let far = frame.inv_view_proj * vec4<f32>(i.ndc, 1.0, 1.0);
+    // A point on the pixel's ray (depth 0.5 is finite under any projection, reversed or not).
+    let far = frame.inv_view_proj * vec4<f32>(i.ndc, 0.5, 1.0);
     let dir = normalize(far.xyz / far.w);
     let w = ring.old_centre_weight.w;
     let before = ring_sample(

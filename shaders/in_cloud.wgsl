@@ -16,7 +16,7 @@ fn vs_in_cloud(@builtin(vertex_index) vi: u32) -> FogOut {
 @fragment
 fn fs_in_cloud(i: FogOut) -> @location(0) vec4<f32> {
     let d = scene_depth_at(i.position.xy);
-    let dist_m = select(linear_depth_m(d), 1.0e9, d >= 1.0);
+    let dist_m = select(linear_depth_m(d), 1.0e9, is_background(d));
     let density = 1.0 - exp(-dist_m / frame.params.w);
     let alpha = clamp(density * frame.in_cloud_rgba.a, 0.0, 1.0);
     return vec4<f32>(frame.in_cloud_rgba.rgb * alpha, alpha);

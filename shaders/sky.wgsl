@@ -16,10 +16,11 @@ fn vs_sky(@builtin(vertex_index) vi: u32) -> SkyOut {
 
 @fragment
 fn fs_sky(i: SkyOut) -> @location(0) vec4<f32> {
-    if (scene_depth_at(i.position.xy) < 1.0) {
+    if (!is_background(scene_depth_at(i.position.xy))) {
         discard;
     }
-    let far = frame.inv_view_proj * vec4<f32>(i.ndc, 1.0, 1.0);
+    // A point on the pixel's ray (depth 0.5 is finite under any projection, reversed or not).
+    let far = frame.inv_view_proj * vec4<f32>(i.ndc, 0.5, 1.0);
     let dir = normalize(far.xyz / far.w);
     var c = sky_colour(dir);
     let cos_sun = dot(dir, frame.sun_dir.xyz);

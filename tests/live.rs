@@ -102,7 +102,7 @@ impl Flight {
             H,
             world.ground(),
             SkyConfig {
-                colour_format: skycast::render::headless::COLOUR_FORMAT,
+                targets: skycast::render::headless::TARGETS,
                 settings: RenderSettings::default(),
                 time_of_day: TimeOfDayTable::default(),
                 sheet: world.sheet(),

@@ -123,7 +123,7 @@ fn sun() -> SunPosition {
 
 fn sky_config(settings: RenderSettings) -> SkyConfig {
     SkyConfig {
-        colour_format: headless::COLOUR_FORMAT,
+        targets: headless::TARGETS,
         settings,
         time_of_day: TimeOfDayTable::default(),
         sheet: puff_sheet(),

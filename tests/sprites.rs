@@ -24,7 +24,7 @@ fn host(table: TimeOfDayTable) -> DemoHost {
         36,
         &ground,
         SkyConfig {
-            colour_format: headless::COLOUR_FORMAT,
+            targets: headless::TARGETS,
             settings: RenderSettings::default(),
             time_of_day: table,
             sheet,

@@ -7,21 +7,30 @@ struct Frame {
     sky_zenith_rgb: vec4<f32>,
     sky_horizon_rgb: vec4<f32>,
     in_cloud_rgba: vec4<f32>,
-    // near_m, far_m, soft_depth_fade_m, in_cloud_visibility_m
+    // x: the host's background depth (1 standard Z, 0 reversed), y unused, soft_depth_fade_m,
+    // in_cloud_visibility_m
     params: vec4<f32>,
     // x: haze distance, metres
     haze: vec4<f32>,
+    // The host projection's depth to metres: -(a d + b) / (c d + e) for (a, b, c, e).
+    depth_to_view: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 // The host's depth, read only. Bound as an unfilterable float texture (works on Vulkan and GL).
 @group(0) @binding(1) var scene_depth: texture_2d<f32>;
 
-// Metres from the camera plane of a [0, 1] perspective depth value.
+// Metres from the camera plane of a depth value of the host's projection (standard or
+// reversed Z, finite or infinite far plane).
 fn linear_depth_m(d: f32) -> f32 {
-    let near = frame.params.x;
-    let far = frame.params.y;
-    return near * far / (far - d * (far - near));
+    let k = frame.depth_to_view;
+    let w = k.z * d + k.w;
+    return select(1.0e9, -(k.x * d + k.y) / w, abs(w) > 1.0e-12);
+}
+
+// Whether the host drew nothing at a pixel (its depth is still the cleared far value).
+fn is_background(d: f32) -> bool {
+    return d == frame.params.x;
 }
 
 fn scene_depth_at(frag_xy: vec2<f32>) -> f32 {

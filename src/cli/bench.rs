@@ -218,7 +218,7 @@ fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> any
         setup.size.1,
         world.ground(),
         SkyConfig {
-            colour_format: skycast::render::headless::COLOUR_FORMAT,
+            targets: skycast::render::headless::TARGETS,
             settings,
             time_of_day: setup.table.clone(),
             sheet: world.sheet(),

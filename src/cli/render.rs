@@ -197,7 +197,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         args.size.1,
         world.ground(),
         SkyConfig {
-            colour_format: skycast::render::headless::COLOUR_FORMAT,
+            targets: skycast::render::headless::TARGETS,
             settings,
             time_of_day: table,
             sheet,

@@ -59,30 +59,29 @@ impl Camera {
     pub fn frustum_relative(&self) -> Frustum {
         Frustum::from_view_proj(self.view_proj_relative())
     }
+
+    /// The camera as the sky takes a host's view: position and matrices.
+    pub fn sky_view(&self) -> super::targets::SkyView {
+        self.into()
+    }
 }
 
-/// The side and far planes of a view volume (camera-relative metres), each `n . p + d >= 0`
-/// inside with `n` of unit length. The near plane is left out: whatever contains the camera is
-/// in view.
+/// The four side planes of a view volume (camera-relative metres), each `n . p + d >= 0`
+/// inside with `n` of unit length. The near and far planes are left out: whatever contains the
+/// camera is in view, and a host's far plane may be at infinity (reversed Z).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Frustum {
-    planes: [Vec4; 5],
+    planes: [Vec4; 4],
 }
 
 impl Frustum {
-    /// The planes of a projection-times-view matrix with WebGPU's `[0, 1]` depth (Gribb and
-    /// Hartmann's extraction from the matrix's rows).
+    /// The side planes of a projection-times-view matrix (Gribb and Hartmann's extraction from
+    /// the matrix's rows).
     pub fn from_view_proj(m: Mat4) -> Self {
-        let (r0, r1, r2, r3) = (m.row(0), m.row(1), m.row(2), m.row(3));
+        let (r0, r1, r3) = (m.row(0), m.row(1), m.row(3));
         let unit = |p: Vec4| p / p.truncate().length().max(f32::MIN_POSITIVE);
         Self {
-            planes: [
-                unit(r3 + r0),
-                unit(r3 - r0),
-                unit(r3 + r1),
-                unit(r3 - r1),
-                unit(r3 - r2),
-            ],
+            planes: [unit(r3 + r0), unit(r3 - r0), unit(r3 + r1), unit(r3 - r1)],
         }
     }
 
@@ -135,9 +134,8 @@ mod tests {
         let high = Vec3::new(500.0, 0.0, 866.0);
         assert!(!f.sees_sphere(high, 1.0));
         assert!(f.sees_sphere(high, 600.0));
-        // Behind the camera, and beyond the far plane.
+        // Behind the camera.
         assert!(!f.sees_sphere(Vec3::new(-3000.0, 0.0, 0.0), 2000.0));
-        assert!(!f.sees_sphere(Vec3::new(12_000.0, 0.0, 0.0), 1000.0));
         // A block holding the camera is always seen, whatever its radius beyond zero.
         assert!(f.sees_sphere(Vec3::new(-1.0, 0.5, 0.0), 2.0));
     }

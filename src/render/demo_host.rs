@@ -115,7 +115,7 @@ impl DemoHost {
             &gpu.device,
             &gpu.queue,
             SkyConfig {
-                colour_format: headless::COLOUR_FORMAT,
+                targets: headless::TARGETS,
                 ..sky
             },
         )?;

@@ -23,12 +23,15 @@ pub struct GpuFrame {
     pub sky_horizon_rgb: [f32; 4],
     /// rgb: in-cloud fog colour; a: how far inside a cloud the camera is, 0..=1.
     pub in_cloud_rgba: [f32; 4],
-    /// near_m, far_m, soft_depth_fade_m, in_cloud_visibility_m.
+    /// The host's background depth (1 standard Z, 0 reversed), unused, soft_depth_fade_m,
+    /// in_cloud_visibility_m.
     pub params: [f32; 4],
     /// x: distance at which sprites have faded 63% into the horizon haze, metres; yzw unused.
     pub haze: [f32; 4],
+    /// The host projection's depth to metres along the view axis ([`super::SkyView::depth_to_view`]).
+    pub depth_to_view: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuFrame>() == 240);
+const _: () = assert!(std::mem::size_of::<GpuFrame>() == 256);
 
 /// One sprite as it lives on the GPU from the moment its block arrives until the block goes
 /// (written once, never per frame), packed into 32 bytes: at a million sprites within 100 km

@@ -8,6 +8,13 @@ use super::RenderError;
 pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The depth format of the offscreen target.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The off-screen targets as the sky sees them: standard Z, one sample.
+pub const TARGETS: super::HostTargets = super::HostTargets {
+    colour_format: COLOUR_FORMAT,
+    depth_format: DEPTH_FORMAT,
+    reversed_z: false,
+    sample_count: 1,
+};
 
 /// The apt line that installs the software Vulkan driver.
 pub const INSTALL_HINT: &str = "sudo apt-get install -y mesa-vulkan-drivers libvulkan1";

@@ -38,6 +38,7 @@ pub mod sky;
 mod slots;
 mod sprite_view;
 pub mod stats;
+pub mod targets;
 pub mod terrain;
 pub mod world;
 
@@ -50,6 +51,7 @@ pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite}
 pub use settings::RenderSettings;
 pub use sky::{Sky, SkyConfig, SpriteSheet};
 pub use stats::{FrameStats, Lighting};
+pub use targets::{HostTargets, SkyView};
 pub use terrain::{HeightField, Terrain, TerrainLight};
 
 /// Errors of the renderer.
@@ -89,6 +91,9 @@ pub enum RenderError {
     /// The sprite sheet's pixel data does not match its size.
     #[error("sprite sheet: {0}")]
     Sheet(String),
+    /// The host's targets are ones the sky cannot draw into or read.
+    #[error("host targets: {0}")]
+    Targets(String),
     /// An output file could not be written.
     #[error("{path}: {message}")]
     Output {

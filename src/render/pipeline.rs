@@ -6,11 +6,20 @@
 /// The structs and helpers every sky pass shares.
 const SHARED_WGSL: &str = include_str!("../../shaders/shared/frame.wgsl");
 
-/// A shader module of `shaders/shared/frame.wgsl` followed by `pass_wgsl`.
-pub(super) fn shader(device: &wgpu::Device, label: &str, pass_wgsl: &str) -> wgpu::ShaderModule {
+/// The shared WGSL's binding of the host's depth, single-sampled.
+const SINGLE_DEPTH: &str = "var scene_depth: texture_2d<f32>;";
+
+/// A shader module of `shaders/shared/frame.wgsl` followed by `pass_wgsl`; a pass drawn into
+/// `samples` samples a pixel reads a depth texture of as many.
+fn shader(device: &wgpu::Device, label: &str, pass_wgsl: &str, samples: u32) -> wgpu::ShaderModule {
+    let shared = if samples > 1 {
+        SHARED_WGSL.replace(SINGLE_DEPTH, "var scene_depth: texture_multisampled_2d<f32>;")
+    } else {
+        SHARED_WGSL.to_string()
+    };
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(format!("{SHARED_WGSL}\n{pass_wgsl}").into()),
+        source: wgpu::ShaderSource::Wgsl(format!("{shared}\n{pass_wgsl}").into()),
     })
 }
 
@@ -44,11 +53,14 @@ pub(super) struct PassDesc<'a> {
     pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
     /// Colour targets: format and blending.
     pub targets: &'a [(wgpu::TextureFormat, Option<wgpu::BlendState>)],
+    /// Samples a pixel of the targets (the host's MSAA count, or 1); the host's depth the pass
+    /// reads has as many.
+    pub samples: u32,
 }
 
 /// Builds the pipeline `desc` describes.
 pub(super) fn pipeline(device: &wgpu::Device, desc: &PassDesc) -> wgpu::RenderPipeline {
-    let module = shader(device, desc.label, desc.wgsl);
+    let module = shader(device, desc.label, desc.wgsl, desc.samples);
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(desc.label),
         bind_group_layouts: desc.bind_groups,
@@ -79,7 +91,10 @@ pub(super) fn pipeline(device: &wgpu::Device, desc: &PassDesc) -> wgpu::RenderPi
             ..Default::default()
         },
         depth_stencil: None,
-        multisample: Default::default(),
+        multisample: wgpu::MultisampleState {
+            count: desc.samples,
+            ..Default::default()
+        },
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some(desc.fs),

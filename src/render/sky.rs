@@ -19,7 +19,6 @@ use wgpu::util::DeviceExt;
 
 use super::RenderError;
 use super::build::{CHUNK, SpriteBuild, chunks};
-use super::camera::Camera;
 use super::draw_list::{Copies, Locks, main_view};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuSpriteVertex};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
@@ -30,6 +29,7 @@ use super::scene::{BlockMotion, SkyBlock};
 use super::settings::RenderSettings;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::{FrameStats, Lighting};
+use super::targets::{self, HostTargets, SkyView};
 use crate::clouds::{CloudsConfig, LifecycleConfig};
 use crate::shading::{SunPosition, TimeOfDay, TimeOfDayTable, hidden_above};
 use crate::weather::{BlockLayer, BlockWeather};
@@ -46,14 +46,40 @@ pub struct SpriteSheet {
 /// What the sky is created with.
 #[derive(Debug, Clone)]
 pub struct SkyConfig {
-    /// Format of the host's colour target (linear formats get linear colours).
-    pub colour_format: wgpu::TextureFormat,
+    /// The host's colour and depth targets: formats, standard or reversed Z, samples.
+    pub targets: HostTargets,
     /// Renderer settings (`config/render.toml`).
     pub settings: RenderSettings,
     /// Time-of-day table (`config/time_of_day.toml`).
     pub time_of_day: TimeOfDayTable,
     /// The sprite texture sheet.
     pub sheet: SpriteSheet,
+}
+
+impl SkyConfig {
+    /// The shipped settings, time-of-day table and sprite sheet for `targets`: nothing read
+    /// from files.
+    pub fn new(targets: HostTargets) -> Self {
+        Self {
+            targets,
+            settings: RenderSettings::default(),
+            time_of_day: TimeOfDayTable::default(),
+            sheet: SpriteSheet::generated(),
+        }
+    }
+}
+
+impl SpriteSheet {
+    /// The clouds stage's procedural 16-texture sheet (Wang 2003 figure 6), with its mips.
+    pub fn generated() -> Self {
+        let sheet = crate::clouds::TextureSheet::generate();
+        Self {
+            size_px: sheet.level_size_px(0),
+            mips: (0..sheet.level_count())
+                .map(|l| sheet.level(l).to_vec())
+                .collect(),
+        }
+    }
 }
 
 /// The sky subsystem: pipelines, the GPU-resident clouds, their sprite orders and the ring.
@@ -64,6 +90,7 @@ pub struct Sky {
     lifecycle: LifecycleConfig,
     frame_buffer: wgpu::Buffer,
     frame_layout: wgpu::BindGroupLayout,
+    targets: HostTargets,
     sheet_group: wgpu::BindGroup,
     sky_pipeline: wgpu::RenderPipeline,
     sprite_pipeline: wgpu::RenderPipeline,
@@ -108,6 +135,7 @@ impl Sky {
         queue: &wgpu::Queue,
         config: SkyConfig,
     ) -> Result<Self, RenderError> {
+        config.targets.validate()?;
         let stage_buffers = device.limits().max_storage_buffers_per_shader_stage;
         if stage_buffers < 6 {
             return Err(RenderError::Device(format!(
@@ -162,31 +190,10 @@ impl Sky {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sky.frame_layout"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-            ],
-        });
+        let samples = config.targets.sample_count;
+        let frame_layout = targets::frame_layout(device, samples > 1);
+        // The impostor renders draw into the ring's own single-sample textures.
+        let ring_frame_layout = targets::frame_layout(device, false);
         let sheet_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sky.sheet_layout"),
             entries: &[
@@ -223,7 +230,7 @@ impl Sky {
                 },
             ],
         });
-        let format = config.colour_format;
+        let format = config.targets.colour_format;
         let resident = ResidentSet::new(device, 0);
         let view_layout = sprite_view::layout(device);
         let build = SpriteBuild::new(device, &view_layout, resident.layout());
@@ -240,6 +247,7 @@ impl Sky {
                 bind_groups: &frame_only,
                 buffers: &[],
                 targets: &[(format, None)],
+                samples,
             },
         );
         let sprite_pipeline = pipeline(
@@ -252,6 +260,7 @@ impl Sky {
                 bind_groups: &sprite_groups,
                 buffers: &[Some(GpuSpriteVertex::layout())],
                 targets: &[(format, over)],
+                samples,
             },
         );
         let in_cloud_pipeline = pipeline(
@@ -264,6 +273,7 @@ impl Sky {
                 bind_groups: &frame_only,
                 buffers: &[],
                 targets: &[(format, over)],
+                samples,
             },
         );
         let light = config.time_of_day.at(45.0);
@@ -272,8 +282,9 @@ impl Sky {
             queue,
             config.settings.impostors,
             &RingShared {
-                colour_format: format,
-                frame_layout: &frame_layout,
+                targets: config.targets,
+                frame_layout: &ring_frame_layout,
+                host_frame_layout: &frame_layout,
                 sheet_layout: &sheet_layout,
                 view_layout: &view_layout,
             },
@@ -284,6 +295,7 @@ impl Sky {
             time_of_day: config.time_of_day,
             frame_buffer,
             frame_layout,
+            targets: config.targets,
             sheet_group,
             sky_pipeline,
             sprite_pipeline,
@@ -550,11 +562,12 @@ impl Sky {
     pub fn prepare(
         &mut self,
         queue: &wgpu::Queue,
-        camera: &Camera,
+        view: impl Into<SkyView>,
         sun: &SunPosition,
         dt_s: f64,
     ) -> FrameStats {
         let start = Instant::now();
+        let camera: SkyView = view.into();
         if !self.recorded.replace(false) {
             // The last frame's writes never reached a submit: send them, so they are freed.
             queue.submit([]);
@@ -590,7 +603,7 @@ impl Sky {
                 lists: &mut resident.lists_cpu,
                 dirty_lists: &mut resident.dirty_lists,
             },
-            (camera.position_m, &camera.frustum_relative()),
+            (camera.position_m, &camera.frustum()),
             self.elapsed_s,
             &self.settings,
             &mut self.locks,
@@ -638,7 +651,7 @@ impl Sky {
         self.in_cloud = in_cloud;
         stats.in_cloud = in_cloud;
 
-        let view_proj = camera.view_proj_relative();
+        let view_proj = camera.view_proj();
         let sun_cfg = &self.settings.sun;
         // In-cloud fog: the ambient of a mid-grey cloud at this time of day plus some sun.
         let fog_rgb = Vec3::splat(0.8) * self.clear_light.ambient_percent
@@ -658,8 +671,8 @@ impl Sky {
             sky_horizon_rgb: self.seen_light.sky_horizon_rgb.extend(1.0).to_array(),
             in_cloud_rgba: fog_rgb.extend(in_cloud).to_array(),
             params: [
-                camera.near_m,
-                camera.far_m,
+                self.targets.background_depth(),
+                0.0,
                 self.settings.clouds.soft_depth_fade_m,
                 self.settings.in_cloud.visibility_m,
             ],
@@ -671,6 +684,7 @@ impl Sky {
                 0.0,
                 0.0,
             ],
+            depth_to_view: camera.depth_to_view(),
         };
         queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&frame));
         upload_bytes += std::mem::size_of::<GpuFrame>() as u64;

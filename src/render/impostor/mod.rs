@@ -119,10 +119,12 @@ pub(super) struct RingFrame<'a> {
 
 /// The layouts and resources of the sky the ring shares.
 pub struct RingShared<'a> {
-    /// Format of the host colour target.
-    pub colour_format: wgpu::TextureFormat,
-    /// Group 0 of the sky passes (frame uniform and scene depth).
+    /// The host's colour and depth targets (the ring's quads are drawn into them).
+    pub targets: super::targets::HostTargets,
+    /// Group 0 of the impostor renders (frame uniform, a single-sample scene depth).
     pub frame_layout: &'a wgpu::BindGroupLayout,
+    /// Group 0 of the passes into the host's targets (its depth, multisampled or not).
+    pub host_frame_layout: &'a wgpu::BindGroupLayout,
     /// Group 1 of the sprite pass (sheet and sampler).
     pub sheet_layout: &'a wgpu::BindGroupLayout,
     /// The build pass's group of a view (uniform, draw list, cloud lists, orders).
@@ -183,6 +185,7 @@ impl ImpostorRing {
                 bind_groups: &[Some(shared.frame_layout), Some(shared.sheet_layout)],
                 buffers: &[Some(GpuSpriteVertex::layout())],
                 targets: &[(IMPOSTOR_FORMAT, over), (DEPTH_FORMAT, over)],
+                samples: 1,
             },
         );
         let quad_pipeline = pipeline(
@@ -192,9 +195,10 @@ impl ImpostorRing {
                 wgsl: QUAD_WGSL,
                 vs: "vs_impostor",
                 fs: "fs_impostor",
-                bind_groups: &[Some(shared.frame_layout), Some(&tex_layout)],
+                bind_groups: &[Some(shared.host_frame_layout), Some(&tex_layout)],
                 buffers: &[],
-                targets: &[(shared.colour_format, over)],
+                targets: &[(shared.targets.colour_format, over)],
+                samples: shared.targets.sample_count,
             },
         );
         let rings = if settings.enabled { 2 } else { 0 };
@@ -557,12 +561,9 @@ impl ImpostorRing {
                     view_proj: vp.to_cols_array_2d(),
                     inv_view_proj: vp.inverse().to_cols_array_2d(),
                     in_cloud_rgba: [0.0; 4],
-                    params: [
-                        cam.near_m,
-                        cam.far_m,
-                        template.params[2],
-                        template.params[3],
-                    ],
+                    // Its own standard-Z view over a scene of nothing (a depth of 1 everywhere).
+                    params: [1.0, 0.0, template.params[2], template.params[3]],
+                    depth_to_view: cam.sky_view().depth_to_view(),
                     ..*template
                 };
                 queue.write_buffer(&self.slot_frames[i], 0, bytemuck::bytes_of(&frame));

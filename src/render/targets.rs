@@ -1,0 +1,226 @@
+//! The host's side of the frame, on the host's terms: the targets the sky draws into (colour
+//! format, depth format, standard or reversed Z, sample count) and the view it draws from (the
+//! host's own view and projection matrices). The sky never writes the host's depth; it reads it
+//! as a texture to fade clouds into terrain, so it must know how the host's depth encodes
+//! distance: [`SkyView::depth_to_view`] works that out from the host's projection, whatever its
+//! convention (standard or reversed, finite or infinite far plane).
+
+use glam::{DMat4, DVec3, Mat4};
+
+use super::RenderError;
+use super::camera::{Camera, Frustum};
+
+/// What the host's colour and depth targets are. The defaults are a single-sample
+/// `Rgba8UnormSrgb` colour target over a standard-Z `Depth32Float` depth.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HostTargets {
+    /// Format of the colour target the sky draws into.
+    pub colour_format: wgpu::TextureFormat,
+    /// Format of the host's depth texture (created with `TEXTURE_BINDING`; a view of a
+    /// depth-stencil format must select the depth aspect).
+    pub depth_format: wgpu::TextureFormat,
+    /// Reversed Z: the host clears depth to 0 and nearer is larger (common in flight simulators
+    /// for their long view ranges).
+    pub reversed_z: bool,
+    /// Samples per pixel of the colour and depth targets (1 or 4, MSAA).
+    pub sample_count: u32,
+}
+
+impl Default for HostTargets {
+    fn default() -> Self {
+        Self {
+            colour_format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            depth_format: wgpu::TextureFormat::Depth32Float,
+            reversed_z: false,
+            sample_count: 1,
+        }
+    }
+}
+
+impl HostTargets {
+    /// Checks what the sky can draw into and read: one clear error for anything else.
+    pub fn validate(&self) -> Result<(), RenderError> {
+        use wgpu::TextureFormat as F;
+        let depth_ok = matches!(
+            self.depth_format,
+            F::Depth32Float | F::Depth24Plus | F::Depth16Unorm | F::Depth24PlusStencil8
+        ) || self.depth_format == F::Depth32FloatStencil8;
+        if !depth_ok {
+            return Err(RenderError::Targets(format!(
+                "depth format {:?} cannot be read by the sky (use Depth32Float, Depth24Plus, Depth16Unorm or a depth-stencil format's depth aspect)",
+                self.depth_format
+            )));
+        }
+        if self.colour_format.is_depth_stencil_format() {
+            return Err(RenderError::Targets(format!(
+                "colour format {:?} is a depth format",
+                self.colour_format
+            )));
+        }
+        if !matches!(self.sample_count, 1 | 4) {
+            return Err(RenderError::Targets(format!(
+                "sample count {} (the sky draws into 1 or 4 samples a pixel)",
+                self.sample_count
+            )));
+        }
+        Ok(())
+    }
+
+    /// The depth value the host clears to: where nothing was drawn.
+    pub fn background_depth(&self) -> f32 {
+        if self.reversed_z { 0.0 } else { 1.0 }
+    }
+}
+
+/// Where the sky is seen from this frame: the camera's position in the sky's east-north-up frame
+/// (f64 metres, z above mean sea level) and the host's own matrices.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkyView {
+    /// Camera position, metres east, north and above mean sea level.
+    pub position_m: DVec3,
+    /// The host's view matrix for camera-relative east-north-up positions: the rotation from
+    /// (east, north, up) axes to the host's view space (its translation is ignored). A host
+    /// whose world is y-up multiplies its view by the axis swap.
+    pub view: Mat4,
+    /// The host's projection matrix, clip depth in WebGPU's `[0, 1]`, standard or reversed.
+    pub projection: Mat4,
+}
+
+impl SkyView {
+    /// Projection times view for camera-relative positions.
+    pub fn view_proj(&self) -> Mat4 {
+        self.projection * self.view_rotation()
+    }
+
+    /// The view with its translation dropped: the sky works camera-relative.
+    fn view_rotation(&self) -> Mat4 {
+        let mut v = self.view;
+        v.w_axis = glam::Vec4::W;
+        v
+    }
+
+    /// The view volume, for culling whole blocks.
+    pub fn frustum(&self) -> Frustum {
+        Frustum::from_view_proj(self.view_proj())
+    }
+
+    /// How a depth value `d` of the host's projection becomes metres along the view axis:
+    /// `-(a d + b) / (c d + e)` for `[a, b, c, e]` (the inverse projection's z and w rows; exact
+    /// for any perspective projection, reversed or infinite included).
+    pub fn depth_to_view(&self) -> [f32; 4] {
+        let inv: DMat4 = self.projection.as_dmat4().inverse();
+        [
+            inv.z_axis.z as f32,
+            inv.w_axis.z as f32,
+            inv.z_axis.w as f32,
+            inv.w_axis.w as f32,
+        ]
+    }
+}
+
+impl From<&Camera> for SkyView {
+    fn from(camera: &Camera) -> Self {
+        Self {
+            position_m: camera.position_m,
+            view: camera.view_relative(),
+            projection: camera.projection(),
+        }
+    }
+}
+
+impl From<Camera> for SkyView {
+    fn from(camera: Camera) -> Self {
+        Self::from(&camera)
+    }
+}
+
+/// The host's depth as the sky's passes read it (group 0, binding 1): an unfilterable float
+/// texture, multisampled when the host's targets are.
+pub(super) fn frame_layout(device: &wgpu::Device, multisampled: bool) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(if multisampled {
+            "sky.frame_layout_msaa"
+        } else {
+            "sky.frame_layout"
+        }),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled,
+                },
+                count: None,
+            },
+        ],
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn linear(view: &SkyView, d: f32) -> f32 {
+        let [a, b, c, e] = view.depth_to_view();
+        -(a * d + b) / (c * d + e)
+    }
+
+    #[test]
+    fn depth_becomes_metres_for_standard_reversed_and_infinite_projections() {
+        let camera = Camera {
+            position_m: DVec3::ZERO,
+            heading_deg: 0.0,
+            pitch_deg: 0.0,
+            fov_y_deg: 60.0,
+            aspect: 1.5,
+            near_m: 1.0,
+            far_m: 100_000.0,
+        };
+        let fov = 60f32.to_radians();
+        let reversed = glam::camera::rh::proj::directx::perspective(fov, 1.5, 100_000.0, 1.0);
+        let infinite = glam::camera::rh::proj::directx::perspective_infinite_reverse(fov, 1.5, 1.0);
+        for projection in [camera.projection(), reversed, infinite] {
+            let view = SkyView {
+                projection,
+                ..SkyView::from(&camera)
+            };
+            for metres in [2.0f32, 150.0, 3_000.0, 40_000.0] {
+                let clip = projection * glam::Vec4::new(0.0, 0.0, -metres, 1.0);
+                let back = linear(&view, clip.z / clip.w);
+                // Within what an f32 depth holds: standard Z at 40 km with a 1 m near plane
+                // keeps about 40 m.
+                assert!(
+                    (back - metres).abs() < metres * 2.5e-3,
+                    "{metres} m came back as {back}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn targets_the_sky_cannot_use_are_refused_with_a_reason() {
+        assert!(HostTargets::default().validate().is_ok());
+        let msaa8 = HostTargets {
+            sample_count: 8,
+            ..Default::default()
+        };
+        assert!(msaa8.validate().unwrap_err().to_string().contains("sample count 8"));
+        let stencil = HostTargets {
+            depth_format: wgpu::TextureFormat::Stencil8,
+            ..Default::default()
+        };
+        assert!(stencil.validate().is_err());
+    }
+}
