@@ -61,7 +61,7 @@ fn cruise() -> Cruise {
     let mut host = DemoHost::new(
         32,
         18,
-        world.ground(),
+        &skycast::render::demo_ground(world.field(), &Default::default()),
         SkyConfig {
             targets: headless::TARGETS,
             settings: Default::default(),

@@ -11,7 +11,7 @@ use glam::DVec3;
 use skycast::clouds::CloudsConfig;
 use skycast::clouds::field::weather_changed;
 use skycast::render::world::{World, WorldSettings};
-use skycast::render::{DemoHost, Frame, RenderSettings, SkyConfig};
+use skycast::render::{DemoHost, Frame, GroundSettings, RenderSettings, SkyConfig, demo_ground};
 use skycast::shading::{SunPosition, TimeOfDayTable};
 use skycast::weather::live::{LiveChange, LiveWeather, Prepare};
 use skycast::weather::{
@@ -85,8 +85,6 @@ const SUN: SunPosition = SunPosition {
 impl Flight {
     fn new(field: WeatherField, radius_m: f64, formation_s: f32) -> Flight {
         let settings = WorldSettings {
-            ground_size_m: 60_000.0,
-            ground_samples: 65,
             cloud_radius_m: radius_m,
             ..WorldSettings::default()
         };
@@ -97,10 +95,15 @@ impl Flight {
         world.set_clouds_config(clouds);
         // Blocks arrive in the frame they are queued, so each run draws the same frames.
         world.set_synchronous_clouds(true);
+        let ground = GroundSettings {
+            size_m: 60_000.0,
+            samples: 65,
+            ..GroundSettings::default()
+        };
         let host = DemoHost::new(
             W,
             H,
-            world.ground(),
+            &demo_ground(world.field(), &ground),
             SkyConfig {
                 targets: skycast::render::headless::TARGETS,
                 settings: RenderSettings::default(),

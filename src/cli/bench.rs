@@ -29,7 +29,7 @@ use clap::Args;
 use glam::{DVec2, DVec3};
 use skycast::clouds::{CloudTypes, generate_block};
 use skycast::render::world::{World, WorldSettings};
-use skycast::render::{DemoHost, RenderSettings, SkyConfig};
+use skycast::render::{DemoHost, GroundSettings, RenderSettings, SkyConfig, demo_ground};
 use skycast::shading::{TimeOfDayTable, sun_position};
 use skycast::weather::{
     BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, METRES_PER_FOOT, StationTable,
@@ -213,10 +213,11 @@ enum Flown {
 fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> anyhow::Result<Flown> {
     let mut settings = setup.settings;
     settings.impostors.enabled = impostors;
+    let ground = demo_ground(world.field(), &GroundSettings::default());
     let mut host = DemoHost::new(
         setup.size.0,
         setup.size.1,
-        world.ground(),
+        &ground,
         SkyConfig {
             targets: skycast::render::headless::TARGETS,
             settings,
@@ -228,7 +229,7 @@ fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> any
         "{} ({:?})",
         host.gpu.adapter_info.name, host.gpu.adapter_info.backend
     );
-    let alt_m = world.ground().height_at_m(DVec2::ZERO) + CRUISE_FT_AGL * METRES_PER_FOOT;
+    let alt_m = ground.height_at_m(DVec2::ZERO) + CRUISE_FT_AGL * METRES_PER_FOOT;
     let sun = sun_position(setup.unix_s, at.0, at.1);
     let visibility_m = world.visibility_m();
     let step_m = PATH_LENGTH_M / (setup.frames - 1) as f64;

@@ -90,7 +90,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let start_unix_s = time_or_default(args.time)?;
     let mut world = world_at(&loaded, lat, lon);
-    args.elevation.apply(&mut world)?;
+    let ground = args.elevation.ground(&world)?;
     if let Some(path) = &args.clouds {
         world.set_clouds_config(CloudsConfig::load(path)?);
     }
@@ -129,7 +129,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let mut host = DemoHost::new(
         args.size.0,
         args.size.1,
-        world.ground(),
+        &ground,
         SkyConfig {
             targets: skycast::render::headless::TARGETS,
             settings,

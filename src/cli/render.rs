@@ -7,7 +7,9 @@ use std::path::PathBuf;
 use clap::Args;
 use glam::DVec2;
 use skycast::render::world::{World, WorldSettings};
-use skycast::render::{DemoHost, HeightField, RenderSettings, SkyConfig};
+use skycast::render::{
+    DemoHost, GroundSettings, HeightField, RenderSettings, SkyConfig, demo_ground,
+};
 use skycast::shading::{TimeOfDayTable, sun_position};
 use skycast::weather::{LocalFrame, METRES_PER_FOOT};
 
@@ -81,21 +83,27 @@ pub struct ElevationArgs {
 }
 
 impl ElevationArgs {
-    /// Puts the elevation file, when given, under `world`.
-    pub fn apply(&self, world: &mut World) -> anyhow::Result<()> {
+    /// The ground under `world`: the elevation file when given, else the demo ground of its
+    /// weather (the stations' elevations). Cloud bases stay above the weather's ground, so a
+    /// mountain of the file higher than that reaches into the clouds.
+    pub fn ground(&self, world: &World) -> anyhow::Result<HeightField> {
         let (Some(path), Some(size_km), Some((min_m, max_m))) = (
             &self.elevation,
             self.elevation_size_km,
             self.elevation_range_m,
         ) else {
-            return Ok(());
+            return Ok(demo_ground(world.field(), &GroundSettings::default()));
         };
         if !(1.0..=1000.0).contains(&size_km) {
             anyhow::bail!("--elevation-size-km {size_km} is outside 1..=1000");
         }
-        let ground = HeightField::from_png16(path, DVec2::ZERO, size_km * 1000.0, min_m, max_m)?;
-        world.set_ground(ground);
-        Ok(())
+        Ok(HeightField::from_png16(
+            path,
+            DVec2::ZERO,
+            size_km * 1000.0,
+            min_m,
+            max_m,
+        )?)
     }
 }
 
@@ -190,12 +198,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let unix_s = time_or_default(args.time)?;
     let mut world = world_at(&loaded, lat, lon);
-    args.elevation.apply(&mut world)?;
+    let ground = args.elevation.ground(&world)?;
     let sheet = world.sheet();
     let mut host = DemoHost::new(
         args.size.0,
         args.size.1,
-        world.ground(),
+        &ground,
         SkyConfig {
             targets: skycast::render::headless::TARGETS,
             settings,
@@ -213,7 +221,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if let Some(exr) = &args.exr {
         frame.write_exr(exr, camera.near_m, camera.far_m)?;
     }
-    let ground_m = world.ground().height_at_m(glam::DVec2::ZERO);
+    let ground_m = ground.height_at_m(glam::DVec2::ZERO);
     println!(
         "{}: {}x{} on {} ({:?}); sun elevation {:.1} deg, azimuth {:.1} deg; camera {:.0} ft MSL, {:.0} ft above the ground; {} clouds, {} sprites; CPU update {} us",
         args.out.display(),

@@ -249,6 +249,39 @@ impl DemoHost {
     }
 }
 
+/// The demo ground's extent: what `render`, `fly` and `bench` draw under the sky.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GroundSettings {
+    /// Side of the square of ground around the origin, metres.
+    pub size_m: f64,
+    /// Samples per side.
+    pub samples: u32,
+    /// Procedural relief on top of the station elevations, metres.
+    pub relief_m: f64,
+}
+
+impl Default for GroundSettings {
+    fn default() -> Self {
+        Self {
+            size_m: 130_000.0,
+            samples: 257,
+            relief_m: 40.0,
+        }
+    }
+}
+
+/// The demo ground around the field's origin: the stations' elevations plus gentle relief, so
+/// a METAR base above ground lands above this ground.
+pub fn demo_ground(field: &WeatherField, settings: &GroundSettings) -> HeightField {
+    ground_from_field(
+        field,
+        DVec2::ZERO,
+        settings.size_m,
+        settings.samples,
+        settings.relief_m,
+    )
+}
+
 /// Ground around `centre_m` (`size_m` square, `samples` per side) at the field's interpolated
 /// station elevations plus `relief_m` of procedural relief. The field is sampled on a coarser
 /// grid (every 4th sample) and interpolated; it changes slowly.

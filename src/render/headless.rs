@@ -17,7 +17,7 @@ pub const TARGETS: super::HostTargets = super::HostTargets {
 };
 
 /// The apt line that installs the software Vulkan driver.
-pub const INSTALL_HINT: &str = "sudo apt-get install -y mesa-vulkan-drivers libvulkan1";
+pub use super::INSTALL_HINT;
 
 /// A device and queue with no window.
 pub struct HeadlessGpu {

@@ -14,19 +14,25 @@
 //! - `sky`: pipelines and passes: sky gradient and sun, sprites with soft depth fades
 //!   (Bahnassi), in-cloud fog (Wang 7.1). Shaders in `shaders/*.wgsl`, structs with twins in
 //!   `gpu_types`. `readback`: the built corners read back for tests and tools.
-//! - `terrain`, `headless`, `output`: the demo host (height-field ground with fog, an offscreen
-//!   device and target on any adapter, lavapipe included) and PNG / EXR output.
+//! - `targets`: the host's targets and view on its terms (formats, reversed Z, MSAA, its own
+//!   matrices).
+//! - `demo_host`, `terrain`, `headless`, `output` (feature `demo`): the demo host (height-field
+//!   ground with fog, an offscreen device and target on any adapter, lavapipe included) and
+//!   PNG / EXR output.
 //!
 //! Positions are f64 on the CPU and camera-relative f32 on the GPU. Units: metres, degrees,
 //! linear RGB.
 
 mod build;
 pub mod camera;
+#[cfg(feature = "demo")]
 pub mod demo_host;
 pub mod draw_list;
 pub mod gpu_types;
+#[cfg(feature = "demo")]
 pub mod headless;
 pub mod impostor;
+#[cfg(feature = "demo")]
 pub mod output;
 mod pipeline;
 mod readback;
@@ -39,11 +45,14 @@ mod slots;
 mod sprite_view;
 pub mod stats;
 pub mod targets;
+#[cfg(feature = "demo")]
 pub mod terrain;
 pub mod world;
 
 pub use camera::{Camera, Frustum};
-pub use demo_host::{DemoHost, ground_from_field};
+#[cfg(feature = "demo")]
+pub use demo_host::{DemoHost, GroundSettings, demo_ground, ground_from_field};
+#[cfg(feature = "demo")]
 pub use headless::{Frame, HeadlessGpu, OffscreenTarget};
 pub use readback::SpriteCorner;
 pub use resident::BYTES_PER_SPRITE;
@@ -52,7 +61,11 @@ pub use settings::RenderSettings;
 pub use sky::{Sky, SkyConfig, SpriteSheet};
 pub use stats::{FrameStats, Lighting};
 pub use targets::{HostTargets, SkyView};
+#[cfg(feature = "demo")]
 pub use terrain::{HeightField, Terrain, TerrainLight};
+
+/// How to install a software Vulkan driver where there is no GPU (Debian, Ubuntu).
+pub const INSTALL_HINT: &str = "sudo apt-get install -y mesa-vulkan-drivers libvulkan1";
 
 /// Errors of the renderer.
 #[derive(Debug, thiserror::Error)]
@@ -61,7 +74,7 @@ pub enum RenderError {
     /// No graphics adapter at all (no GPU and no software driver).
     #[error(
         "no graphics adapter found ({0}); skycast renders on any GPU or on Mesa's software Vulkan driver, install it with: {hint}",
-        hint = headless::INSTALL_HINT
+        hint = INSTALL_HINT
     )]
     NoAdapter(String),
     /// The adapter refused a device, or a device operation failed.

@@ -13,7 +13,10 @@ const SINGLE_DEPTH: &str = "var scene_depth: texture_2d<f32>;";
 /// `samples` samples a pixel reads a depth texture of as many.
 fn shader(device: &wgpu::Device, label: &str, pass_wgsl: &str, samples: u32) -> wgpu::ShaderModule {
     let shared = if samples > 1 {
-        SHARED_WGSL.replace(SINGLE_DEPTH, "var scene_depth: texture_multisampled_2d<f32>;")
+        SHARED_WGSL.replace(
+            SINGLE_DEPTH,
+            "var scene_depth: texture_multisampled_2d<f32>;",
+        )
     } else {
         SHARED_WGSL.to_string()
     };

@@ -216,7 +216,13 @@ mod tests {
             sample_count: 8,
             ..Default::default()
         };
-        assert!(msaa8.validate().unwrap_err().to_string().contains("sample count 8"));
+        assert!(
+            msaa8
+                .validate()
+                .unwrap_err()
+                .to_string()
+                .contains("sample count 8")
+        );
         let stencil = HostTargets {
             depth_format: wgpu::TextureFormat::Stencil8,
             ..Default::default()

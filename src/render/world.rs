@@ -1,6 +1,5 @@
-//! The demo world: what the CLI, the flights and the benchmarks draw. Weather reports go in; the
-//! weather field, the ground that agrees with it (station elevations) and the cloud blocks around
-//! the camera come out, the blocks converted to [`SkyBlock`]s for the [`super::Sky`].
+//! The world of clouds a sky shows: weather reports go in as a weather field; the cloud blocks
+//! around the camera come out, converted to [`SkyBlock`]s for the [`super::Sky`].
 //!
 //! Blocks are generated on demand (a pure function of block index, block weather and seed) and
 //! kept, so a flight regenerates nothing it has seen. A living world hands the sky its changes
@@ -14,31 +13,23 @@ use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
 use super::RenderError;
-use super::demo_host::ground_from_field;
 use super::scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite};
 use super::sky::{Sky, SpriteSheet};
-use super::terrain::HeightField;
 use crate::clouds::lifecycle::{Phase, progress};
 use crate::clouds::{
-    Cloud, CloudField, CloudTypes, CloudsConfig, TextureSheet, field::FieldBlock,
-    field::weather_changed, generate_block,
+    Cloud, CloudField, CloudTypes, CloudsConfig, field::FieldBlock, field::weather_changed,
+    generate_block,
 };
 use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
 use crate::weather::{BlockIndex, BlockWeather};
 use std::sync::Arc;
 
-/// Settings of the demo world (`render` and `fly` use the defaults; `bench` widens the cloud
-/// radius to its view radius).
+/// Settings of the world (`render` and `fly` use the defaults; `bench` widens the cloud radius
+/// to its view radius).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WorldSettings {
-    /// Side of the square of ground around the origin, metres.
-    pub ground_size_m: f64,
-    /// Ground samples per side.
-    pub ground_samples: u32,
-    /// Procedural relief on top of the station elevations, metres.
-    pub relief_m: f64,
     /// Blocks whose centre lies within this horizontal distance of the camera get clouds, metres.
     pub cloud_radius_m: f64,
     /// Seed of the cloud generation.
@@ -48,9 +39,6 @@ pub struct WorldSettings {
 impl Default for WorldSettings {
     fn default() -> Self {
         Self {
-            ground_size_m: 130_000.0,
-            ground_samples: 257,
-            relief_m: 40.0,
             // As far as sprites are drawn (`draw_distance_m`): from altitude a deck that ended
             // at 24 km showed its edge; beyond the 20 km ring radius they are impostors.
             cloud_radius_m: 60_000.0,
@@ -93,16 +81,6 @@ impl From<&Cloud> for SkyCloud {
     }
 }
 
-/// The clouds stage's texture sheet as the renderer's [`SpriteSheet`].
-pub fn sprite_sheet(sheet: &TextureSheet) -> SpriteSheet {
-    SpriteSheet {
-        size_px: sheet.level_size_px(0),
-        mips: (0..sheet.level_count())
-            .map(|l| sheet.level(l).to_vec())
-            .collect(),
-    }
-}
-
 /// The clouds stage's living field (background generation, drift, formation and dissipation)
 /// as a [`World`] flies through it, and which of its generations the sky holds.
 pub struct LivingClouds {
@@ -121,10 +99,9 @@ pub struct LivingClouds {
     was_fading: Vec<u64>,
 }
 
-/// Weather field, ground and cloud blocks around a reference point.
+/// Weather field and cloud blocks around a reference point.
 pub struct World {
     field: WeatherField,
-    ground: HeightField,
     types: CloudTypes,
     settings: WorldSettings,
     blocks: HashMap<BlockIndex, SkyBlock>,
@@ -136,18 +113,10 @@ pub struct World {
 }
 
 impl World {
-    /// Builds the ground for `field` (whose frame origin is the world's centre).
+    /// The world of `field` (whose frame origin is the world's centre).
     pub fn new(field: WeatherField, settings: &WorldSettings) -> Self {
-        let ground = ground_from_field(
-            &field,
-            DVec2::ZERO,
-            settings.ground_size_m,
-            settings.ground_samples,
-            settings.relief_m,
-        );
         Self {
             field,
-            ground,
             types: CloudTypes::builtin(),
             settings: *settings,
             blocks: HashMap::new(),
@@ -180,7 +149,7 @@ impl World {
     /// Takes a new weather field (built off the frame thread, e.g. by a
     /// [`LiveWeather`](crate::weather::live::LiveWeather)'s prepare) without stopping: the living
     /// clouds of every block whose weather changed dissipate while the new ones form; unchanged
-    /// blocks stay as they are. The ground is kept (its elevations do not change with weather).
+    /// blocks stay as they are.
     pub fn set_field(&mut self, field: WeatherField) {
         let old = std::mem::replace(&mut self.field, field);
         self.field_version += 1;
@@ -199,21 +168,9 @@ impl World {
         self.living.as_ref().map(|l| &l.field)
     }
 
-    /// Replaces the ground (a real elevation model, say) before the host is built from it.
-    /// Cloud bases stay above the weather field's ground (the stations' elevations), so a
-    /// mountain higher than that reaches into the clouds.
-    pub fn set_ground(&mut self, ground: HeightField) {
-        self.ground = ground;
-    }
-
-    /// The ground.
-    pub fn ground(&self) -> &HeightField {
-        &self.ground
-    }
-
     /// The texture sheet of the clouds stage.
     pub fn sheet(&self) -> SpriteSheet {
-        sprite_sheet(&TextureSheet::generate())
+        SpriteSheet::generated()
     }
 
     /// Horizontal visibility at the origin, metres. METAR caps visibility at 10 km (9999) or
