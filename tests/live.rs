@@ -162,7 +162,7 @@ impl Flight {
         } else {
             self.host
                 .sky
-                .prepare(&self.host.gpu.queue, &camera, &SUN, dt_s);
+                .prepare(&self.host.gpu.queue, camera, &SUN, dt_s);
             None
         };
         self.time_s += dt_s;

@@ -80,7 +80,7 @@ fn camera(host: &DemoHost, at: DVec3) -> Camera {
 /// Prepares a frame from `at` at sky time step `dt_s` and reads its corners back.
 fn corners(host: &mut DemoHost, at: DVec3, dt_s: f64) -> Vec<SpriteCorner> {
     let cam = camera(host, at);
-    host.sky.prepare(&host.gpu.queue, &cam, &SUN, dt_s);
+    host.sky.prepare(&host.gpu.queue, cam, &SUN, dt_s);
     host.sky
         .read_back_corners(&host.gpu.queue)
         .expect("corners read back")
@@ -100,7 +100,7 @@ fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
     let cam = DVec3::new(0.0, 0.0, 1000.0);
     let at = |host: &DemoHost, p: DVec3| camera(host, p);
     let c0 = at(&host, cam);
-    let first = host.sky.prepare(&host.gpu.queue, &c0, &SUN, 0.0);
+    let first = host.sky.prepare(&host.gpu.queue, c0, &SUN, 0.0);
     assert_eq!(
         (
             first.clouds_drawn,
@@ -111,7 +111,7 @@ fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
     );
     let first_corners = host.sky.read_back_corners(&host.gpu.queue).unwrap();
     for frame in 1..30 {
-        let still = host.sky.prepare(&host.gpu.queue, &c0, &SUN, 1.0 / 30.0);
+        let still = host.sky.prepare(&host.gpu.queue, c0, &SUN, 1.0 / 30.0);
         assert_eq!(still.clouds_recomputed, 0, "frame {frame}");
         assert_eq!(still.cache_hit_rate, 1.0);
     }
@@ -121,7 +121,7 @@ fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
     );
     // Handing the same blocks again (as a host does when the block set changes) keeps them.
     host.sky.set_clouds(blocks());
-    let again = host.sky.prepare(&host.gpu.queue, &c0, &SUN, 0.0);
+    let again = host.sky.prepare(&host.gpu.queue, c0, &SUN, 0.0);
     assert_eq!(again.clouds_recomputed, 0);
     // Clouds drifting with the wind and a camera flying along with them: nothing moved
     // relative to each other, nothing re-sorts.
@@ -136,7 +136,7 @@ fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
     let along = at(&host, cam + drift);
     assert_eq!(
         host.sky
-            .prepare(&host.gpu.queue, &along, &SUN, 0.0)
+            .prepare(&host.gpu.queue, along, &SUN, 0.0)
             .clouds_recomputed,
         0
     );
@@ -145,21 +145,21 @@ fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
     let moved = at(&host, cam + DVec3::new(0.0, 300.0, 0.0));
     assert_eq!(
         host.sky
-            .prepare(&host.gpu.queue, &moved, &SUN, 0.0)
+            .prepare(&host.gpu.queue, moved, &SUN, 0.0)
             .clouds_recomputed,
         10
     );
     // 150 m more: past the threshold of the near clouds (about 90 m at 4 km) only, not of
     // the far ones (about 280 m at 14 km).
     let nudged = at(&host, cam + DVec3::new(0.0, 450.0, 0.0));
-    let stats = host.sky.prepare(&host.gpu.queue, &nudged, &SUN, 0.0);
+    let stats = host.sky.prepare(&host.gpu.queue, nudged, &SUN, 0.0);
     assert!(
         stats.clouds_recomputed > 0 && stats.clouds_recomputed < 10,
         "{stats:?}"
     );
     // Uncached, every frame re-sorts everything.
     host.sky.set_vertex_cache(false);
-    let stats = host.sky.prepare(&host.gpu.queue, &nudged, &SUN, 0.0);
+    let stats = host.sky.prepare(&host.gpu.queue, nudged, &SUN, 0.0);
     assert_eq!(stats.clouds_recomputed, 10);
 }
 
@@ -317,7 +317,7 @@ fn the_rim_of_a_cloud_against_the_sun_glows() {
             declination_deg: 0.0,
         };
         let c = camera(&host, cam);
-        host.sky.prepare(&host.gpu.queue, &c, &sun, 0.0);
+        host.sky.prepare(&host.gpu.queue, c, &sun, 0.0);
         host.sky
             .read_back_corners(&host.gpu.queue)
             .unwrap()
@@ -385,7 +385,7 @@ fn past_the_sprite_budget_the_farthest_blocks_are_left_out() {
     ]);
     let drawn_from = |host: &mut DemoHost, at: DVec3| {
         let c = camera(host, at);
-        let stats = host.sky.prepare(&host.gpu.queue, &c, &SUN, 0.1);
+        let stats = host.sky.prepare(&host.gpu.queue, c, &SUN, 0.1);
         let norths: Vec<f32> = host
             .sky
             .read_back_corners(&host.gpu.queue)

@@ -219,7 +219,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             written += 1;
             stats
         } else {
-            host.sky.prepare(&host.gpu.queue, &camera, &sun, dt_s)
+            host.sky.prepare(&host.gpu.queue, camera, &sun, dt_s)
         };
         let p = pose.position_m;
         csv.write_record([
