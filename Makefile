@@ -18,6 +18,9 @@ test: vulkan
 	cargo test --all-targets
 	cargo test --doc
 	RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
+	# A simulator embedding the library compiles none of the command line's crates.
+	cargo clippy --lib --no-default-features -- -D warnings
+	! cargo tree -e normal --no-default-features | grep -E '^[^a-z]*(clap|indicatif|env_logger|anyhow|exr) '
 
 # The live-weather soak test (ignored by default): one simulated hour, a weather change every
 # five minutes; fails if memory (RSS) or the renderer's GPU buffers grow after the first changes.

@@ -1,9 +1,46 @@
 //! skycast: a cloud and weather sky for flight simulators.
 //!
-//! Real weather reports go in (METAR, bulk weather files); clouds come out as 4 km x 4 km blocks
-//! of camera-facing sprites (Wang 2003), drawn with wgpu into the host's frame. Data flows one way,
-//! one module per stage: [`weather`] -> `clouds` -> [`shading`] -> `render` -> `flight`.
-//! Only `render` knows wgpu; every stage before it is plain data, testable without a device.
+//! Real weather reports go in (METAR, bulk weather files, themes); clouds come out as 4 km x 4 km
+//! blocks of camera-facing sprites (Wang 2003), drawn with wgpu into the host's own frame, on the
+//! host's terms: its device, its camera matrices, its depth (standard or reversed Z, MSAA).
+//!
+//! # Embedding
+//!
+//! One object, [`SkySystem`], built from the host's device, queue and targets:
+//!
+//! ```no_run
+//! # fn frame(device: &wgpu::Device, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder,
+//! #          colour: &wgpu::TextureView, depth: &wgpu::TextureView,
+//! #          view: glam::Mat4, projection: glam::Mat4) -> Result<(), skycast::SkyError> {
+//! use skycast::{HostCamera, HostPosition, HostTargets, SkySystem, Weather};
+//!
+//! let targets = HostTargets { reversed_z: true, ..HostTargets::default() };
+//! let mut sky = SkySystem::new(device, queue, targets, (34.0, -118.4))?;
+//! sky.set_weather(Weather::File("metars.cache.csv".as_ref()))?;
+//! // Every frame, after the host drew its scene into colour and depth:
+//! let camera = HostCamera {
+//!     position: HostPosition::LatLonAlt { lat_deg: 34.05, lon_deg: -118.3, alt_m: 1500.0 },
+//!     view,       // the host's view for east-north-up axes
+//!     projection, // the host's projection, as its depth convention has it
+//! };
+//! let (stats, _applied) = sky.update(queue, &camera, 1_738_015_200.0, 1.0 / 60.0)?;
+//! sky.record(encoder, colour, depth); // reads the host's depth, never writes it
+//! let light = sky.lighting();         // sun, ambient, horizon and fog for the host's scene
+//! # let _ = (stats, light); Ok(()) }
+//! ```
+//!
+//! `examples/host.rs` is a complete host (its own device, targets and ground) that the tests run
+//! with standard Z, reversed Z and 4x MSAA. A host that writes `default-features = false`
+//! compiles none of the command line's crates.
+//!
+//! # Stages
+//!
+//! Data flows one way, one module per stage: [`weather`] (reports, the weather field) ->
+//! [`clouds`] (cloud blocks, their lifecycle) -> [`shading`] (sun, light, fog) -> [`render`]
+//! (the only stage that uses wgpu: the sky on the GPU) -> [`flight`] ([`SkySystem`], the frame
+//! step; flight paths). Every stage before `render` is plain data, testable without a device.
+
+#![deny(missing_docs)]
 
 pub mod clouds;
 pub mod config;
@@ -11,3 +48,8 @@ pub mod flight;
 pub mod render;
 pub mod shading;
 pub mod weather;
+
+pub use flight::{
+    HostCamera, HostLighting, HostPosition, SkyError, SkySystem, SkySystemConfig, Weather,
+};
+pub use render::{FrameStats, HostTargets, Sky, SkyView};

@@ -1,4 +1,6 @@
-//! The flight stage: scripted camera paths for `skycast fly` and the benchmarks.
+//! The flight stage, the last before the command line: [`SkySystem`], the sky a simulator
+//! embeds (the frame step: live weather, the living clouds, the sun, the sky's frame), and
+//! scripted camera paths for `skycast fly` and the benchmarks.
 //!
 //! A flight path is a TOML file of timed waypoints (`config/flights/*.toml`): positions as
 //! latitude/longitude or local metres, altitude in feet above mean sea level, and a view given as
@@ -10,5 +12,9 @@
 
 mod path;
 mod spline;
+pub mod system;
 
 pub use path::{CameraPose, FlightPath, FlightPlan, View, Waypoint, WeatherEvent};
+pub use system::{
+    HostCamera, HostLighting, HostPosition, SkyError, SkySystem, SkySystemConfig, Weather,
+};

@@ -1,4 +1,5 @@
-//! [`Sky`]: the library object a host simulator embeds. Created once with the host's device,
+//! [`Sky`]: the sky's GPU side (the whole frame step around it is
+//! [`SkySystem`](crate::SkySystem)'s). Created once with the host's device,
 //! given clouds (uploaded to the GPU once per block), and each frame `prepare`d (CPU: sort blocks
 //! and clouds, the cached sprite orders, the draw list; uniforms) and `record`ed into the host's
 //! encoder. It draws into the host's colour target and reads the host's depth texture (never
@@ -6,9 +7,9 @@
 //! depth fades (Bahnassi), and in-cloud fog (Wang 7.1).
 //!
 //! The device needs 6 storage buffers per shader stage (WebGPU's default limit is 8) and compute
-//! shaders. The host's depth texture needs `TEXTURE_BINDING` usage and must be drawn
-//! with the projection of [`Camera::projection`] (standard `[0, 1]` depth, near and far from
-//! the camera).
+//! shaders. The host's depth texture needs `TEXTURE_BINDING` usage; it is read through the
+//! host's own projection ([`SkyView`]) in the convention its [`HostTargets`] name (standard or
+//! reversed Z, one sample or four).
 
 use std::cell::Cell;
 use std::collections::HashSet;

@@ -1,0 +1,330 @@
+//! [`SkySystem`]: the sky a simulator embeds, as one object. The host keeps it beside its own
+//! renderer: built from the host's device, queue and targets ([`HostTargets`]); given weather
+//! (a report file, bytes, a theme or a watched file); each frame given the host's camera as the
+//! host has it ([`HostCamera`]: position and its own view and projection), the UTC time and
+//! the frame's dt; then it records its passes into the host's encoder. Between them it runs the
+//! frame step: new weather switched in without a pop, the living clouds around the camera
+//! advanced and handed to the GPU (only what changed), the sky greyed under the weather
+//! overhead, the sun placed, the CPU share of the frame done ([`Sky::prepare`]).
+//!
+//! What the host needs to light and fog its own scene the same way comes back from
+//! [`SkySystem::lighting`].
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use glam::{DVec3, Mat4, Vec3};
+
+use crate::render::world::{World, WorldSettings};
+use crate::render::{FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView};
+use crate::shading::sun_position;
+use crate::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
+use crate::weather::live::{LiveChange, LiveWeather, Prepare};
+use crate::weather::{LocalFrame, StationTable, WeatherError, WeatherInput};
+
+/// Why the sky could not be built or given its weather.
+#[derive(Debug, thiserror::Error)]
+pub enum SkyError {
+    /// The device or the host's targets.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// A weather file, its bytes or the station table.
+    #[error(transparent)]
+    Weather(#[from] WeatherError),
+}
+
+/// How a [`SkySystem`] is set up. [`SkySystemConfig::new`] needs no files.
+#[derive(Debug, Clone)]
+pub struct SkySystemConfig {
+    /// The sky's look and the host's targets (formats, reversed Z, samples).
+    pub sky: SkyConfig,
+    /// Latitude and longitude, degrees, of the local frame's origin: the middle of the area
+    /// flown (positions in metres are east and north of it).
+    pub origin_lat_lon_deg: (f64, f64),
+    /// How far around the camera clouds live, and the seed they are generated from.
+    pub world: WorldSettings,
+    /// How the weather field is built from reports.
+    pub field: FieldSettings,
+    /// Which cloud type a reported layer is, where the report does not say.
+    pub rule: CloudTypeRule,
+    /// Places the reports of files that give no positions (NOAA's station table).
+    pub stations: Option<Arc<StationTable>>,
+}
+
+impl SkySystemConfig {
+    /// The shipped settings for `targets`, the local frame around `origin_lat_lon_deg`.
+    pub fn new(targets: HostTargets, origin_lat_lon_deg: (f64, f64)) -> Self {
+        Self {
+            sky: SkyConfig::new(targets),
+            origin_lat_lon_deg,
+            world: WorldSettings::default(),
+            field: FieldSettings::default(),
+            rule: CloudTypeRule::default(),
+            stations: None,
+        }
+    }
+}
+
+/// Weather for the sky.
+#[derive(Debug, Clone, Copy)]
+pub enum Weather<'a> {
+    /// A report file (the aviation weather service's `metars.cache.csv`, a NOAA cycle file,
+    /// one METAR a line) or a weather theme (`.toml`), read now.
+    File(&'a Path),
+    /// The same, already in memory; `name` tells a theme by its extension and names it in
+    /// errors.
+    Bytes {
+        /// The name of what the bytes are (a path or a file name).
+        name: &'a Path,
+        /// Its contents.
+        bytes: &'a [u8],
+    },
+    /// A file read now and again whenever it changes (read and built off the frame thread;
+    /// a change is applied `settle` after the last write, a broken file keeps the last good sky).
+    Watch {
+        /// The file.
+        path: &'a Path,
+        /// Quiet time after a write before the file is read.
+        settle: Duration,
+    },
+}
+
+/// Where the host's camera is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HostPosition {
+    /// Latitude and longitude in degrees, altitude in metres above mean sea level.
+    LatLonAlt {
+        /// Degrees north.
+        lat_deg: f64,
+        /// Degrees east.
+        lon_deg: f64,
+        /// Metres above mean sea level.
+        alt_m: f64,
+    },
+    /// Metres east and north of the origin, and above mean sea level.
+    Local(DVec3),
+}
+
+/// The host's camera this frame, as the host has it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HostCamera {
+    /// Where it is.
+    pub position: HostPosition,
+    /// The host's view matrix for east-north-up axes (its translation is ignored: the sky
+    /// works relative to the camera). A y-up host multiplies its view by the axis swap.
+    pub view: Mat4,
+    /// The host's projection, clip depth `[0, 1]`, standard or reversed as its targets say.
+    pub projection: Mat4,
+}
+
+/// What the host needs to light and fog its own scene like the sky (linear RGB).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HostLighting {
+    /// Unit vector towards the sun, east-north-up.
+    pub sun_direction: Vec3,
+    /// Direct sunlight colour, dimmed under cloud cover.
+    pub sun_rgb: Vec3,
+    /// Ambient light as a fraction of full daylight.
+    pub ambient: f32,
+    /// Sky colour straight up and at the horizon.
+    pub zenith_rgb: Vec3,
+    /// Sky colour at the horizon (what distant terrain fades into).
+    pub horizon_rgb: Vec3,
+    /// The visibility at the camera, metres: 95% fog at this distance.
+    pub fog_distance_m: f32,
+    /// The fog's colour at the camera (haze, mist, smoke, dust).
+    pub fog_rgb: Vec3,
+}
+
+/// The sky a simulator embeds. See the module docs.
+pub struct SkySystem {
+    sky: Sky,
+    world: World,
+    frame: LocalFrame,
+    live: LiveWeather<WeatherField>,
+    prepare_field: Prepare<WeatherField>,
+    stations: Option<Arc<StationTable>>,
+    /// Seconds of frames so far (the clock of weather changes).
+    clock_s: f64,
+    sun_direction: Vec3,
+}
+
+impl SkySystem {
+    /// The sky on the host's device for its `targets`, the local frame around
+    /// `origin_lat_lon_deg`; clear weather until [`Self::set_weather`].
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        targets: HostTargets,
+        origin_lat_lon_deg: (f64, f64),
+    ) -> Result<Self, SkyError> {
+        Self::with_config(
+            device,
+            queue,
+            SkySystemConfig::new(targets, origin_lat_lon_deg),
+        )
+    }
+
+    /// The sky with settings of its own (files loaded by the host, a wider cloud radius, ...).
+    pub fn with_config(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        config: SkySystemConfig,
+    ) -> Result<Self, SkyError> {
+        let (lat, lon) = config.origin_lat_lon_deg;
+        let frame = LocalFrame::new(lat, lon);
+        let (settings, rule) = (config.field.clone(), config.rule.clone());
+        let prepare_field: Prepare<WeatherField> =
+            Arc::new(move |input| input.field(LocalFrame::new(lat, lon), &settings, &rule));
+        let clear = WeatherField::build(frame, &[], &config.field, &config.rule);
+        Ok(Self {
+            sky: Sky::new(device, queue, config.sky)?,
+            world: World::new(clear, &config.world),
+            frame,
+            live: LiveWeather::new(),
+            prepare_field,
+            stations: config.stations,
+            clock_s: 0.0,
+            sun_direction: Vec3::Z,
+        })
+    }
+
+    /// Takes new weather. A file or bytes are read now (an error names file, line and field,
+    /// and the sky keeps its last good weather); a watched file is read off the frame thread and
+    /// applied by the frames that follow. The clouds of every block whose weather changed
+    /// dissipate while the new ones form.
+    pub fn set_weather(&mut self, weather: Weather) -> Result<(), SkyError> {
+        let stations = self.stations.as_deref();
+        let input = match weather {
+            Weather::File(path) => WeatherInput::load(path, stations)?,
+            Weather::Bytes { name, bytes } => WeatherInput::parse(name, bytes, stations)?,
+            Weather::Watch { path, settle } => {
+                self.live.watch(
+                    path,
+                    self.stations.clone(),
+                    settle,
+                    Arc::clone(&self.prepare_field),
+                )?;
+                return Ok(());
+            }
+        };
+        self.world.set_field((self.prepare_field)(input));
+        Ok(())
+    }
+
+    /// Schedules a weather file for `at_s` seconds of frames from now (a front passing in a
+    /// scripted flight): read and built off the frame thread, applied on the first frame at or
+    /// after its time.
+    pub fn schedule_weather(&mut self, path: &Path, at_s: f64) -> Result<(), SkyError> {
+        self.live.schedule(
+            self.clock_s + at_s,
+            path,
+            self.stations.clone(),
+            Arc::clone(&self.prepare_field),
+        )?;
+        Ok(())
+    }
+
+    /// The frame step, CPU side: applies weather that is ready, advances the living clouds by
+    /// `dt_s` around the camera and hands the sky what changed, places the sun for `utc_unix_s`,
+    /// and prepares the sky's frame. Returns the frame's stats (its CPU cost included) and the
+    /// files applied this frame. Call [`Self::record`] after it, in the frame's encoder.
+    pub fn update(
+        &mut self,
+        queue: &wgpu::Queue,
+        camera: &HostCamera,
+        utc_unix_s: f64,
+        dt_s: f64,
+    ) -> Result<(FrameStats, Vec<PathBuf>), SkyError> {
+        let start = Instant::now();
+        let dt_s = dt_s.max(0.0);
+        self.clock_s += dt_s;
+        let mut applied = Vec::new();
+        for change in self.live.poll(self.clock_s) {
+            match change {
+                LiveChange::Loaded { source, weather } => {
+                    self.world.set_field(weather);
+                    applied.push(source);
+                }
+                // Already logged with its file and line; the last good sky stays.
+                LiveChange::Rejected(_) => {}
+            }
+        }
+        self.sky
+            .add_field_cpu_us(start.elapsed().as_micros() as u64);
+        let position_m = match camera.position {
+            HostPosition::Local(p) => p,
+            HostPosition::LatLonAlt {
+                lat_deg,
+                lon_deg,
+                alt_m,
+            } => self.frame.to_local_m(lat_deg, lon_deg).extend(alt_m),
+        };
+        self.world.update_sky(&mut self.sky, position_m, dt_s)?;
+        self.sky
+            .set_weather_overhead(&self.world.weather_over(position_m));
+        let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
+        let sun = sun_position(utc_unix_s, lat, lon);
+        self.sun_direction = sun.direction_enu().as_vec3();
+        let view = SkyView {
+            position_m,
+            view: camera.view,
+            projection: camera.projection,
+        };
+        Ok((self.sky.prepare(queue, view, &sun, dt_s), applied))
+    }
+
+    /// Records the sky's passes into the host's encoder after the host drew its scene: the sky
+    /// behind everything, the clouds faded softly into the host's depth (read, never written),
+    /// the fog inside a cloud.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) {
+        self.sky.record(encoder, colour, depth);
+    }
+
+    /// The light and fog of the last [`Self::update`], for the host's own scene.
+    pub fn lighting(&self) -> HostLighting {
+        let light = self.sky.light();
+        let fog = self.sky.fog();
+        HostLighting {
+            sun_direction: self.sun_direction,
+            sun_rgb: light.directional_rgb,
+            ambient: light.ambient_percent,
+            zenith_rgb: light.sky_zenith_rgb,
+            horizon_rgb: light.sky_horizon_rgb,
+            fog_distance_m: fog.distance_m,
+            fog_rgb: fog.rgb,
+        }
+    }
+
+    /// The local frame: latitude/longitude to the metres positions are given in.
+    pub fn frame(&self) -> &LocalFrame {
+        &self.frame
+    }
+
+    /// The renderer underneath, for hosts that want its lower-level controls.
+    pub fn sky(&self) -> &Sky {
+        &self.sky
+    }
+
+    /// The renderer underneath, mutable.
+    pub fn sky_mut(&mut self) -> &mut Sky {
+        &mut self.sky
+    }
+
+    /// The weather field and the clouds built from it.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The weather field and clouds, mutable (e.g. synchronous generation for reproducible
+    /// frames).
+    pub fn world_mut(&mut self) -> &mut World {
+        &mut self.world
+    }
+}
