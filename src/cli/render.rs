@@ -178,11 +178,11 @@ pub fn load_look(
     time_of_day: Option<&PathBuf>,
 ) -> anyhow::Result<(RenderSettings, TimeOfDayTable)> {
     let settings = match render {
-        Some(p) => RenderSettings::from_path(p)?,
+        Some(p) => RenderSettings::load(p)?,
         None => RenderSettings::default(),
     };
     let table = match time_of_day {
-        Some(p) => TimeOfDayTable::from_path(p)?,
+        Some(p) => TimeOfDayTable::load(p)?,
         None => TimeOfDayTable::default(),
     };
     Ok((settings, table))

@@ -129,51 +129,16 @@ pub struct RenderSettings {
 }
 
 impl Default for RenderSettings {
+    /// The shipped `config/render.toml` (built in; a test checks that it parses).
     fn default() -> Self {
-        // The built-in text is tested to parse; the fallback is never reached in practice.
-        Self::from_toml_str(DEFAULT_RENDER_TOML, "config/render.toml (built in)").unwrap_or(Self {
-            camera: CameraSettings {
-                fov_y_deg: 60.0,
-                near_m: 2.0,
-                far_m: 160_000.0,
-            },
-            clouds: CloudSettings {
-                soft_depth_fade_m: 120.0,
-                lock_radius_fraction: 0.5,
-                lock_fade_start_deg: 20.0,
-                lock_fade_end_deg: 70.0,
-                upright_fade_start_deg: default_upright_fade_start_deg(),
-                upright_fade_end_deg: default_upright_fade_end_deg(),
-                draw_distance_m: 60_000.0,
-                haze_distance_m: 50_000.0,
-            },
-            in_cloud: InCloudSettings {
-                visibility_m: 70.0,
-                ramp_fraction: 0.35,
-            },
-            sun: SunSettings {
-                disc_radius_deg: 0.8,
-                glow_radius_deg: 12.0,
-            },
-            vertex_cache: VertexCacheSettings {
-                enabled: true,
-                move_fraction: 0.02,
-                min_move_m: 5.0,
-                max_age_s: 2.0,
-                time_distance_m: 2000.0,
-                fading_max_age_s: 0.25,
-                max_sorted_sprites_per_frame: default_sorted_sprites(),
-                max_uploaded_sprites_per_frame: default_uploaded_sprites(),
-            },
-            impostors: Default::default(),
-        })
+        Self::parse(DEFAULT_RENDER_TOML, Path::new("config/render.toml"))
+            .expect("the shipped config/render.toml is valid (tested)")
     }
 }
 
 impl RenderSettings {
-    /// Parses and checks settings; `source_name` names the file in errors.
-    pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self, ConfigError> {
-        let path = Path::new(source_name);
+    /// Parses and checks settings; `path` names the file in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
         let s: Self = parse_toml(text, path)?;
         let positive = [
             ("camera.near_m", s.camera.near_m),
@@ -238,10 +203,10 @@ impl RenderSettings {
     }
 
     /// Reads and checks a settings file.
-    pub fn from_path(path: &Path) -> Result<Self, ConfigError> {
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
         let text = std::fs::read_to_string(path)
             .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::from_toml_str(&text, &path.display().to_string())
+        Self::parse(&text, path)
     }
 }
 
@@ -252,7 +217,7 @@ mod tests {
 
     #[test]
     fn built_in_settings_parse() {
-        let s = RenderSettings::from_toml_str(DEFAULT_RENDER_TOML, "render.toml").unwrap();
+        let s = RenderSettings::parse(DEFAULT_RENDER_TOML, Path::new("render.toml")).unwrap();
         assert_eq!(s, RenderSettings::default());
         assert_eq!(s.clouds.lock_radius_fraction, 0.5);
     }
@@ -261,7 +226,7 @@ mod tests {
     fn bad_values_name_the_field() {
         let text =
             DEFAULT_RENDER_TOML.replace("soft_depth_fade_m = 120.0", "soft_depth_fade_m = -1.0");
-        let err = RenderSettings::from_toml_str(&text, "r.toml")
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
             .unwrap_err()
             .to_string();
         let line = line_of_key(DEFAULT_RENDER_TOML, "clouds.soft_depth_fade_m").unwrap();
@@ -270,13 +235,13 @@ mod tests {
             "{err}"
         );
         let text = DEFAULT_RENDER_TOML.replace("near_m = 2.0", "near_m = \"near\"");
-        let err = RenderSettings::from_toml_str(&text, "r.toml")
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
             .unwrap_err()
             .to_string();
         assert!(err.starts_with("r.toml:7: field `near_m`"), "{err}");
         let text = DEFAULT_RENDER_TOML
             .replace("upright_fade_end_deg = 35.0", "upright_fade_end_deg = 10.0");
-        let err = RenderSettings::from_toml_str(&text, "r.toml")
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
             .unwrap_err()
             .to_string();
         assert!(err.contains("clouds.upright_fade_end_deg"), "{err}");
@@ -284,7 +249,7 @@ mod tests {
             "max_sorted_sprites_per_frame = 8192",
             "max_sorted_sprites_per_frame = 0",
         );
-        let err = RenderSettings::from_toml_str(&text, "r.toml")
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
             .unwrap_err()
             .to_string();
         let line = line_of_key(
@@ -308,7 +273,7 @@ mod tests {
             })
             .collect::<Vec<_>>()
             .join("\n");
-        let s = RenderSettings::from_toml_str(&old, "old.toml").unwrap();
+        let s = RenderSettings::parse(&old, Path::new("old.toml")).unwrap();
         assert_eq!(s, RenderSettings::default());
     }
 }
