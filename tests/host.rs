@@ -10,8 +10,9 @@ mod host;
 use std::path::Path;
 
 use glam::DVec3;
-use skycast::render::world::{World, WorldSettings};
-use skycast::render::{Camera, DemoHost, GroundSettings, SkyConfig, demo_ground, headless};
+use skycast::demo::{DemoHost, GroundSettings, demo_ground, headless};
+use skycast::flight::world::{World, WorldSettings};
+use skycast::render::{Camera, SkyConfig};
 use skycast::shading::sun_position;
 use skycast::weather::{CloudTypeRule, FieldSettings, LocalFrame, WeatherInput};
 

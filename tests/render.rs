@@ -7,12 +7,11 @@ use std::path::PathBuf;
 
 use glam::{DVec2, DVec3, Vec3};
 use skycast::clouds::{CloudTypes, generate_block};
+use skycast::demo::terrain::HeightField;
+use skycast::demo::{DemoHost, Frame, headless};
+use skycast::flight::world::block_id;
 use skycast::render::square_sprite;
-use skycast::render::terrain::HeightField;
-use skycast::render::world::block_id;
-use skycast::render::{
-    Camera, DemoHost, Frame, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteSheet, headless,
-};
+use skycast::render::{Camera, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteSheet};
 use skycast::shading::{ColourLevels, SunPosition, TimeOfDayTable};
 use skycast::weather::{BlockIndex, BlockLayer, BlockWeather, CloudType, TypeSource};
 

@@ -28,8 +28,9 @@ use anyhow::Context;
 use clap::Args;
 use glam::{DVec2, DVec3};
 use skycast::clouds::{CloudTypes, generate_block};
-use skycast::render::world::{World, WorldSettings};
-use skycast::render::{DemoHost, GroundSettings, RenderSettings, SkyConfig, demo_ground};
+use skycast::demo::{DemoHost, GroundSettings, demo_ground};
+use skycast::flight::world::{World, WorldSettings};
+use skycast::render::{RenderSettings, SkyConfig};
 use skycast::shading::{TimeOfDayTable, sun_position};
 use skycast::weather::{
     BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, METRES_PER_FOOT, StationTable,
@@ -219,7 +220,7 @@ fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> any
         setup.size.1,
         &ground,
         SkyConfig {
-            targets: skycast::render::headless::TARGETS,
+            targets: skycast::demo::headless::TARGETS,
             settings,
             time_of_day: setup.table.clone(),
             sheet: world.sheet(),

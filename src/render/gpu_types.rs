@@ -230,3 +230,16 @@ pub struct GpuTerrainVertex {
     pub normal: [f32; 4],
 }
 const _: () = assert!(std::mem::size_of::<GpuTerrainVertex>() == 32);
+
+/// The impostor ring pass's uniform. Keep in sync with `Ring` in `shaders/impostor_quad.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuRing {
+    /// The shown ring's centre relative to the camera, metres; w: the crossfade weight.
+    pub old_centre_weight: [f32; 4],
+    /// The centre of the ring fading in (the shown one's when not fading), metres.
+    pub new_centre: [f32; 4],
+    /// Ring radius, half side of a quad, the old and new rings' mean far distance, metres.
+    pub size: [f32; 4],
+}
+const _: () = assert!(std::mem::size_of::<GpuRing>() == 48);

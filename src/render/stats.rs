@@ -25,6 +25,9 @@ pub struct FrameStats {
     /// lifecycle, the blocks handed over), microseconds, as reported to the sky with
     /// [`crate::render::Sky::add_field_cpu_us`].
     pub field_us: u64,
+    /// The host's weather step this frame (polling a watched file, switching in a new field;
+    /// never reading one), microseconds; part of `field_us`.
+    pub weather_us: u64,
     /// CPU time of the last [`crate::render::Sky::record`], microseconds (filled in by hosts that
     /// record after they prepare, like the demo host).
     pub record_us: u64,

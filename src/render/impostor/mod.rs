@@ -38,7 +38,7 @@ use layout::{impostor_camera, in_sector};
 
 use super::build::{SpriteBuild, chunks};
 use super::draw_list::fresh_view;
-use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuSpriteVertex};
+use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuRing, GpuSpriteVertex};
 use super::pipeline::{PassDesc, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
@@ -691,16 +691,4 @@ impl ImpostorRing {
         pass.set_bind_group(1, &self.quad_groups[old][new], &[]);
         pass.draw(0..3, 0..1);
     }
-}
-
-/// The ring pass's uniform. Keep in sync with `Ring` in `shaders/impostor_quad.wgsl`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct GpuRing {
-    /// The shown ring's centre relative to the camera, metres; w: the crossfade weight.
-    old_centre_weight: [f32; 4],
-    /// The centre of the ring fading in (the shown one's when not fading), metres.
-    new_centre: [f32; 4],
-    /// Ring radius, half side of a quad, the old and new rings' mean far distance, metres.
-    size: [f32; 4],
 }
