@@ -47,3 +47,18 @@ fn sky_colour(dir: vec3<f32>) -> vec3<f32> {
     c += frame.sun_rgb.rgb * glow * glow * 0.35;
     return c;
 }
+
+// What a cloud pass writes into the off-screen cloud target (src/render/cloud_target.rs):
+// premultiplied colour, and the clouds' distance in kilometres times alpha (R16Float), both
+// blended "over", so distance / alpha is the distance of what shows in the texel.
+struct CloudOut {
+    @location(0) colour: vec4<f32>,
+    @location(1) distance: vec4<f32>,
+};
+
+fn cloud_out(colour: vec4<f32>, distance_m: f32) -> CloudOut {
+    var o: CloudOut;
+    o.colour = colour;
+    o.distance = vec4<f32>(distance_m * 0.001 * colour.a, 0.0, 0.0, colour.a);
+    return o;
+}

@@ -1,9 +1,12 @@
-//! `skycast bench [--size WxH] [--frames N] [--out DIR]`: the frame-budget benchmark of issue 6
-//! (Wang 2003 section 6.3, figure 15). The three scenarios of `weather/scenarios/` (sparse,
-//! scattered, overcast: about 170 %, 200 % and 475 % block overdraw) are flown along the same
-//! straight path, a cruise due east at 5,000 ft above the scenario's station, each once with
-//! the impostor ring (far blocks in impostors) and once without (every block as sprites). Both
-//! runs see the same view: clouds out to the ring's view radius, sprites drawn that far.
+//! `skycast bench [--size WxH] [--frames N] [--cloud-scale S] [--out DIR]`: the frame-budget
+//! benchmark of issue 6 (Wang 2003 section 6.3, figure 15). The three scenarios of
+//! `weather/scenarios/` (sparse, scattered, overcast: about 170 %, 200 % and 475 % block
+//! overdraw) are flown along the same straight path, a cruise due east at 5,000 ft above the
+//! scenario's station, each with the impostor ring (far blocks in impostors) and without (every
+//! block as sprites), and each of those with the clouds drawn at the cloud scale S (default: the
+//! renderer settings' `[clouds] resolution_scale`) and at full resolution (scale 1), so one run
+//! compares both. All runs see the same view: clouds out to the ring's view radius, sprites
+//! drawn that far.
 //!
 //! The path is sampled, not flown frame by frame: `--frames` points 12 km apart / (N - 1). A
 //! real flight rebuilds the ring every 15% of its radius (3 km at 20 km: 25 s at 120 m/s, some
@@ -14,7 +17,7 @@
 //!
 //! Out: one table on standard output headed by the adapter's name (scenario, block overdraw,
 //! median and p95 of the steady frames' milliseconds, the median of the frames rendering an
-//! impostor, the off/on ratio of the medians, sprites drawn, the sky's CPU milliseconds (update
+//! impostor, the off/on ratio of the medians, the scale-1 over scale-S ratio, sprites drawn, the sky's CPU milliseconds (update
 //! and recording) and the GPU memory of the resident sprites, per scenario with impostors on
 //! and off); the same rows as `bench.csv`, every frame in
 //! `frames.csv`, and `frame_time.png`, steady frame time along the path. Frame time is
@@ -36,7 +39,7 @@ use skycast::weather::{
     WeatherInput,
 };
 
-use super::render::{load_look, parse_size, parse_time, time_or_default};
+use super::render::{load_look, parse_cloud_scale, parse_size, parse_time, time_or_default};
 use super::weather::DEFAULT_STATIONS;
 
 mod plot;
@@ -79,6 +82,10 @@ pub struct BenchArgs {
     /// Time-of-day table (default: the shipped config/time_of_day.toml).
     #[arg(long)]
     pub time_of_day: Option<PathBuf>,
+    /// Resolution the clouds are drawn at besides full resolution: 1, 1/2 or 1/4 (default: the
+    /// renderer settings' `[clouds] resolution_scale`); each scenario is run at both.
+    #[arg(long, value_parser = parse_cloud_scale)]
+    pub cloud_scale: Option<f32>,
     /// UTC time, RFC 3339 (default: the shipped weather file's time).
     #[arg(long, value_parser = parse_time)]
     pub time: Option<f64>,
@@ -99,13 +106,16 @@ struct FrameRecord {
     blocks_near: u32,
     blocks_far: u32,
     impostors_rebuilt: u32,
+    /// Bytes of the sky's off-screen cloud target (0 at scale 1).
+    cloud_target_bytes: u64,
 }
 
-/// One run: a scenario with impostors on or off.
+/// One run: a scenario with impostors on or off, the clouds at one resolution scale.
 struct Run {
     scenario: &'static str,
     overdraw: f64,
     impostors: bool,
+    cloud_scale: f32,
     frames: Vec<FrameRecord>,
     /// Sprites in view where the run could not be drawn (too many for the device).
     not_drawn: Option<u64>,
@@ -209,10 +219,16 @@ enum Flown {
     TooMany { sprites: u64, max_sprites: u64 },
 }
 
-/// Flies one run.
-fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> anyhow::Result<Flown> {
+/// Flies one run: the ring on or off, the clouds at `cloud_scale`.
+fn fly(
+    setup: &Setup,
+    world: &mut World,
+    at: (f64, f64),
+    (impostors, cloud_scale): (bool, f32),
+) -> anyhow::Result<Flown> {
     let mut settings = setup.settings;
     settings.impostors.enabled = impostors;
+    settings.clouds.resolution_scale = cloud_scale;
     let mut host = DemoHost::new(
         setup.size.0,
         setup.size.1,
@@ -293,6 +309,7 @@ fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> any
                 blocks_near: stats.blocks_near,
                 blocks_far: stats.blocks_far,
                 impostors_rebuilt: stats.impostors_rebuilt,
+                cloud_target_bytes: stats.cloud_target_bytes,
             });
             if steady {
                 break;
@@ -312,7 +329,16 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     if args.frames < 2 {
         anyhow::bail!("--frames {} is less than 2", args.frames);
     }
-    let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
+    let (settings, table) = load_look(
+        args.render_settings.as_ref(),
+        args.time_of_day.as_ref(),
+        args.cloud_scale,
+    )?;
+    // The chosen scale first, then full resolution to compare with.
+    let mut scales = vec![settings.clouds.resolution_scale];
+    if scales[0] != 1.0 {
+        scales.push(1.0);
+    }
     let unix_s = time_or_default(args.time)?;
     let stations =
         StationTable::load(&args.stations).context("station table (choose one with --stations)")?;
@@ -346,13 +372,17 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         let (mut world, at) =
             scenario_world(&args.scenarios, scenario, &stations, &world_settings)?;
         let overdraw = mean_overdraw(&world, world_settings.seed);
-        for impostors in [true, false] {
+        let runs_of_scenario = scales
+            .iter()
+            .flat_map(|&scale| [(true, scale), (false, scale)]);
+        for (impostors, cloud_scale) in runs_of_scenario {
             eprintln!(
-                "bench: {scenario}, impostors {}",
-                if impostors { "on" } else { "off" }
+                "bench: {scenario}, impostors {}, cloud scale {}",
+                if impostors { "on" } else { "off" },
+                scale_text(cloud_scale)
             );
             let mut not_drawn = None;
-            let frames = match fly(&setup, &mut world, at, impostors)? {
+            let frames = match fly(&setup, &mut world, at, (impostors, cloud_scale))? {
                 Flown::Frames {
                     frames,
                     adapter: name,
@@ -377,6 +407,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
                 scenario,
                 overdraw,
                 impostors,
+                cloud_scale,
                 frames,
                 not_drawn,
             });
@@ -400,11 +431,21 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// A scale as the table and the CSV files write it: 1, 1/2, 1/4.
+fn scale_text(scale: f32) -> String {
+    if scale >= 1.0 {
+        "1".to_string()
+    } else {
+        format!("1/{}", (1.0 / scale).round())
+    }
+}
+
 /// A row of the table and of `bench.csv`.
 struct Row {
     scenario: &'static str,
     overdraw_pct: f64,
     impostors: bool,
+    cloud_scale: f32,
     median_ms: f64,
     p95_ms: f64,
     /// Median of the sky's passes alone over the steady frames (NaN: no GPU timestamps).
@@ -415,6 +456,10 @@ struct Row {
     ratio: f64,
     /// The same for the sky's passes alone.
     sky_ratio: f64,
+    /// Median at scale 1 over median at this row's scale, same scenario and ring (1 at scale 1).
+    scale_ratio: f64,
+    /// The same for the sky's passes alone.
+    sky_scale_ratio: f64,
     sprites_drawn: f64,
     cpu_update_ms: f64,
     /// Median GPU memory of the resident sprites (records, orders, indices, draw list), MB.
@@ -426,9 +471,14 @@ struct Row {
 fn summary_rows(runs: &[Run]) -> Vec<Row> {
     runs.iter()
         .map(|r| {
-            let other = runs
-                .iter()
-                .find(|o| o.scenario == r.scenario && o.impostors != r.impostors);
+            let other = runs.iter().find(|o| {
+                o.scenario == r.scenario
+                    && o.cloud_scale == r.cloud_scale
+                    && o.impostors != r.impostors
+            });
+            let full = runs.iter().find(|o| {
+                o.scenario == r.scenario && o.impostors == r.impostors && o.cloud_scale == 1.0
+            });
             let (on, off) = match other {
                 Some(o) if r.impostors => (r, o),
                 Some(o) => (o, r),
@@ -439,10 +489,17 @@ fn summary_rows(runs: &[Run]) -> Vec<Row> {
                 Some(_) => (off.median_ms() / on.median_ms(), sky(off) / sky(on)),
                 None => (f64::NAN, f64::NAN),
             };
+            let (scale_ratio, sky_scale_ratio) = match full {
+                Some(f) => (f.median_ms() / r.median_ms(), sky(f) / sky(r)),
+                None => (f64::NAN, f64::NAN),
+            };
             Row {
                 scenario: r.scenario,
                 overdraw_pct: r.overdraw * 100.0,
                 impostors: r.impostors,
+                cloud_scale: r.cloud_scale,
+                scale_ratio,
+                sky_scale_ratio,
                 median_ms: r.median_ms(),
                 p95_ms: r.p95_ms(),
                 sky_ms: sky(r),
@@ -461,16 +518,19 @@ fn summary_rows(runs: &[Run]) -> Vec<Row> {
         .collect()
 }
 
-const HEADER: [&str; 13] = [
+const HEADER: [&str; 16] = [
     "scenario",
     "overdraw_pct",
     "impostors",
+    "cloud_scale",
     "median_ms",
     "p95_ms",
     "sky_ms",
     "rebuild_ms",
     "off_on_ratio",
     "sky_off_on_ratio",
+    "full_scale_ratio",
+    "sky_full_scale_ratio",
     "sprites_drawn",
     "cpu_update_ms",
     "sprite_gpu_mb",
@@ -487,16 +547,19 @@ fn print_table(adapter: &str, args: &BenchArgs, timing: &str, rows: &[Row]) {
         CRUISE_FT_AGL
     );
     println!(
-        "{:<10} {:>9} {:>9} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>10} {:>9} {:>9}",
+        "{:<10} {:>9} {:>9} {:>5} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>6} {:>7} {:>10} {:>9} {:>9}",
         "scenario",
         "overdraw",
         "impostors",
+        "scale",
         "median ms",
         "p95 ms",
         "sky ms",
         "rebuild ms",
         "off/on",
         "sky off/on",
+        "1/S",
+        "sky 1/S",
         "sprites",
         "cpu ms",
         "gpu MB"
@@ -510,16 +573,19 @@ fn print_table(adapter: &str, args: &BenchArgs, timing: &str, rows: &[Row]) {
     };
     for r in rows {
         println!(
-            "{:<10} {:>8.0}% {:>9} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>10.0} {:>9} {:>9.1}{}",
+            "{:<10} {:>8.0}% {:>9} {:>5} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>6} {:>7} {:>10.0} {:>9} {:>9.1}{}",
             r.scenario,
             r.overdraw_pct,
             if r.impostors { "on" } else { "off" },
+            scale_text(r.cloud_scale),
             ms(r.median_ms),
             ms(r.p95_ms),
             ms(r.sky_ms),
             ms(r.rebuild_ms),
             ms(r.ratio),
             ms(r.sky_ratio),
+            ms(r.scale_ratio),
+            ms(r.sky_scale_ratio),
             r.sprites_drawn,
             ms(r.cpu_update_ms),
             r.sprite_mb,
@@ -551,12 +617,15 @@ fn write_csv(path: &Path, adapter: &str, timing: &str, rows: &[Row]) -> anyhow::
             r.scenario.to_string(),
             format!("{:.0}", r.overdraw_pct),
             (if r.impostors { "on" } else { "off" }).to_string(),
+            r.cloud_scale.to_string(),
             ms(r.median_ms),
             ms(r.p95_ms),
             ms(r.sky_ms),
             ms(r.rebuild_ms),
             ms(r.ratio),
             ms(r.sky_ratio),
+            ms(r.scale_ratio),
+            ms(r.sky_scale_ratio),
             format!("{:.0}", r.sprites_drawn),
             ms(r.cpu_update_ms),
             format!("{:.1}", r.sprite_mb),
@@ -580,6 +649,7 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
     csv.write_record([
         "scenario",
         "impostors",
+        "cloud_scale",
         "frame",
         "steady",
         "distance_m",
@@ -592,12 +662,14 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
         "blocks_near",
         "blocks_far",
         "impostors_rebuilt",
+        "cloud_target_bytes",
     ])?;
     for run in runs {
         for (k, f) in run.frames.iter().enumerate() {
             csv.write_record([
                 run.scenario.to_string(),
                 (if run.impostors { "on" } else { "off" }).to_string(),
+                run.cloud_scale.to_string(),
                 k.to_string(),
                 (if f.steady { "yes" } else { "no" }).to_string(),
                 format!("{:.0}", f.distance_m),
@@ -614,6 +686,7 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
                 f.blocks_near.to_string(),
                 f.blocks_far.to_string(),
                 f.impostors_rebuilt.to_string(),
+                f.cloud_target_bytes.to_string(),
             ])?;
         }
     }
@@ -621,13 +694,25 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// One line a run: colour by scenario (lighter at full resolution when another scale is run),
+/// dashed without the impostor ring.
 fn runs_for_plot(runs: &[Run]) -> Vec<plot::Series> {
+    let several_scales = runs.iter().any(|r| r.cloud_scale != runs[0].cloud_scale);
     runs.iter()
         .map(|r| plot::Series {
-            colour: match r.scenario {
-                "sparse" => [40, 110, 220],
-                "scattered" => [30, 160, 60],
-                _ => [210, 50, 40],
+            label: format!(
+                "{}, ring {}, clouds at {}",
+                r.scenario,
+                if r.impostors { "on" } else { "off" },
+                scale_text(r.cloud_scale)
+            ),
+            colour: match (r.scenario, several_scales && r.cloud_scale == 1.0) {
+                ("sparse", false) => [40, 110, 220],
+                ("sparse", true) => [140, 180, 240],
+                ("scattered", false) => [30, 160, 60],
+                ("scattered", true) => [140, 210, 150],
+                (_, false) => [210, 50, 40],
+                (_, true) => [240, 150, 140],
             },
             dashed: !r.impostors,
             points: r.steady().map(|f| (f.distance_m, f.frame_ms)).collect(),

@@ -14,6 +14,8 @@
 //! - `sky`: pipelines and passes: sky gradient and sun, sprites with soft depth fades
 //!   (Bahnassi), in-cloud fog (Wang 7.1). Shaders in `shaders/*.wgsl`, structs with twins in
 //!   `gpu_types`. `readback`: the built corners read back for tests and tools.
+//! - `cloud_target`: below full resolution, the clouds drawn off-screen against the farthest
+//!   depth of each block of pixels and composited with a full-resolution depth fix-up.
 //! - `terrain`, `headless`, `output`: the demo host (height-field ground with fog, an offscreen
 //!   device and target on any adapter, lavapipe included) and PNG / EXR output.
 //!
@@ -22,6 +24,7 @@
 
 mod build;
 pub mod camera;
+pub mod cloud_target;
 pub mod demo_host;
 pub mod draw_list;
 pub mod gpu_types;
