@@ -9,37 +9,55 @@
 // the texel shows (stored distance / alpha): the fade the texel had at its block's farthest
 // depth is replaced by the fade at this pixel's depth. Where the pixel's depth is the block's,
 // the ratio is 1 and the upsample is untouched; on a ridge in front of the cloud it is 0, so the
-// cloud stops at the ridge's full-resolution edge. DIVISOR is put in front of this file when the
-// pipeline is built. Shared structs: shared/frame.wgsl (group 0 binds the host's depth).
+// cloud stops at the ridge's full-resolution edge. Where the host drew nothing, the pass also
+// draws the sky background (the sky pass is left out below full resolution). DIVISOR is put in
+// front of this file when the pipeline is built. Shared structs: shared/frame.wgsl (group 0 binds the host's depth).
 
 @group(1) @binding(0) var cloud_colour: texture_2d<f32>;
 @group(1) @binding(1) var cloud_distance: texture_2d<f32>;
 @group(1) @binding(2) var farthest_depth: texture_2d<f32>;
 @group(1) @binding(3) var cloud_sampler: sampler;
 
-@vertex
-fn vs_composite(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
-    return fullscreen_position(vi);
-}
+struct CompositeOut {
+    @builtin(position) position: vec4<f32>,
+    // The far-plane point of the pixel, homogeneous (see `background_along`).
+    @location(0) far: vec4<f32>,
+};
 
-// The soft depth fade of a cloud `cloud_m` from the camera plane in front of scene depth `d`.
-fn soft_fade(d: f32, cloud_m: f32) -> f32 {
-    return clamp((linear_depth_m(d) - cloud_m) / frame.params.z, 0.0, 1.0);
+@vertex
+fn vs_composite(@builtin(vertex_index) vi: u32) -> CompositeOut {
+    var o: CompositeOut;
+    o.position = fullscreen_position(vi);
+    o.far = far_point(o.position.xy);
+    return o;
 }
 
 @fragment
-fn fs_composite(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+fn fs_composite(i: CompositeOut) -> @location(0) vec4<f32> {
+    let position = i.position;
     // Texel i of the cloud target covers host pixels [i * DIVISOR, (i + 1) * DIVISOR).
     let low_size = vec2<f32>(textureDimensions(cloud_colour));
     let uv = position.xy / (low_size * f32(DIVISOR));
     let colour = textureSampleLevel(cloud_colour, cloud_sampler, uv, 0.0);
+    let d = scene_depth_at(position.xy);
+    if (d >= 1.0) {
+        // Where the host drew nothing this pass is also the sky background (one full-resolution
+        // pass instead of two): the clouds over it, opaque. Sky pixels are the farthest of their
+        // block, so their clouds need no fix-up.
+        return vec4<f32>(colour.rgb + (1.0 - colour.a) * background_along(i.far), 1.0);
+    }
     if (colour.a < 1.0 / 2048.0) {
         discard;
     }
+    // Every host pixel redoes the fade, not only those nearer than their block's farthest depth:
+    // on terrain in front of the clouds the bilinear upsample also brings in the neighbouring
+    // texels' clouds, drawn against the sky beside it.
+    let farthest = textureLoad(farthest_depth, vec2<i32>(position.xy) / DIVISOR, 0).r;
+    let here_m = linear_depth_m(d);
+    let farthest_m = linear_depth_m(farthest);
     let cloud_m = textureSampleLevel(cloud_distance, cloud_sampler, uv, 0.0).r * 1000.0 / colour.a;
-    let block = vec2<i32>(position.xy) / DIVISOR;
-    let drawn_with = soft_fade(textureLoad(farthest_depth, block, 0).r, cloud_m);
-    let here = soft_fade(scene_depth_at(position.xy), cloud_m);
+    let drawn_with = clamp((farthest_m - cloud_m) / frame.params.z, 0.0, 1.0);
+    let here = clamp((here_m - cloud_m) / frame.params.z, 0.0, 1.0);
     // Nothing of the cloud was left at the block's depth: it is hidden here too (a neighbour
     // texel's cloud must not bleed onto terrain in front of it).
     let keep = select(clamp(here / drawn_with, 0.0, 1.0), here, drawn_with < 1.0e-3);

@@ -48,6 +48,24 @@ fn sky_colour(dir: vec3<f32>) -> vec3<f32> {
     return c;
 }
 
+// The sky behind everything along a view ray: the gradient and the sun disc (`sky.wgsl`, and the
+// cloud composite below full resolution). `far` is the ray's point on the far plane in
+// homogeneous world coordinates (`far_point` of the pixel): the full-screen passes compute it
+// per vertex and let it be interpolated (exact: it is linear across the screen), which spares
+// each pixel a matrix product.
+fn background_along(far: vec4<f32>) -> vec3<f32> {
+    let dir = normalize(far.xyz / far.w);
+    let c = sky_colour(dir);
+    let cos_sun = dot(dir, frame.sun_dir.xyz);
+    let disc = smoothstep(frame.sun_dir.w - 0.00002, frame.sun_dir.w + 0.00002, cos_sun);
+    return mix(c, frame.sun_rgb.rgb * 4.0, disc * step(-0.01, dir.z));
+}
+
+// The far-plane point (homogeneous world coordinates) at normalised device coordinates `ndc`.
+fn far_point(ndc: vec2<f32>) -> vec4<f32> {
+    return frame.inv_view_proj * vec4<f32>(ndc, 1.0, 1.0);
+}
+
 // What a cloud pass writes into the off-screen cloud target (src/render/cloud_target.rs):
 // premultiplied colour, and the clouds' distance in kilometres times alpha (R16Float), both
 // blended "over", so distance / alpha is the distance of what shows in the texel.

@@ -781,18 +781,23 @@ impl Sky {
             self.build
                 .record(encoder, group, &self.resident.group, (c, n));
         }
-        let mut pass = self.sky_pass(encoder, colour_view, &frame_group);
-        pass.set_pipeline(&self.sky_pipeline);
-        pass.draw(0..3, 0..1);
-        // Below full resolution the clouds go to the cloud target (composited at the end).
+        // Below full resolution the clouds go to the cloud target, composited at the end with
+        // the sky background; at full resolution they are drawn over the sky in the host's colour.
         let offscreen = self
             .clouds
             .frame(&self.device, &self.frame_buffer, depth_view);
-        if let Some(target) = &offscreen {
-            drop(pass);
-            target.downsample(encoder, &frame_group);
-            pass = target.pass(encoder, true);
-        }
+        let mut pass = match &offscreen {
+            Some(target) => {
+                target.downsample(encoder, &frame_group);
+                target.pass(encoder, true)
+            }
+            None => {
+                let mut pass = self.sky_pass(encoder, colour_view, &frame_group);
+                pass.set_pipeline(&self.sky_pipeline);
+                pass.draw(0..3, 0..1);
+                pass
+            }
+        };
         let (sprite_pipeline, in_cloud_pipeline) = match &offscreen {
             Some(target) => (target.sprite_pipeline(), target.in_cloud_pipeline()),
             None => (&self.sprite_pipeline, &self.in_cloud_pipeline),
