@@ -5,8 +5,9 @@
 //! scenario's station, each with the impostor ring (far blocks in impostors) and without (every
 //! block as sprites), and each of those with the clouds drawn at the cloud scale S (default: the
 //! renderer settings' `[clouds] resolution_scale`) and at full resolution (scale 1), so one run
-//! compares both. All runs see the same view: clouds out to the ring's view radius, sprites
-//! drawn that far.
+//! compares both: the two scales fly side by side, one host each, both drawing each sample
+//! before the camera moves on, so load from elsewhere on a shared machine falls on both alike.
+//! All runs see the same view: clouds out to the ring's view radius, sprites drawn that far.
 //!
 //! The path is sampled, not flown frame by frame: `--frames` points 12 km apart / (N - 1). A
 //! real flight rebuilds the ring every 15% of its radius (3 km at 20 km: 25 s at 120 m/s, some
@@ -16,11 +17,13 @@
 //! a real flight's frames are.
 //!
 //! Out: one table on standard output headed by the adapter's name (scenario, block overdraw,
-//! median and p95 of the steady frames' milliseconds, the median of the frames rendering an
-//! impostor, the off/on ratio of the medians, the scale-1 over scale-S ratio, sprites drawn, the sky's CPU milliseconds (update
-//! and recording) and the GPU memory of the resident sprites, per scenario with impostors on
-//! and off); the same rows as `bench.csv`, every frame in
-//! `frames.csv`, and `frame_time.png`, steady frame time along the path. Frame time is
+//! ring on or off, cloud scale, median and p95 of the steady frames' milliseconds, the sky's
+//! passes alone, the median of the frames rendering an impostor, the off/on ratio of the
+//! medians, the scale-1 over scale-S ratio, sprites drawn, the sky's CPU milliseconds (update
+//! and recording) and the GPU memory of the resident sprites); the same rows as `bench.csv`,
+//! every frame in `frames.csv` (with its cloud scale and the cloud target's bytes), and
+//! `frame_time.png`, steady frame time along the path (plotters: axes with units, a legend
+//! naming each run's scenario, ring and scale). Frame time is
 //! the GPU time between timestamps around the frame's passes where the adapter has timestamp
 //! queries, else the wall time from submit to the end of the poll-wait; the table says which.
 
@@ -219,31 +222,40 @@ enum Flown {
     TooMany { sprites: u64, max_sprites: u64 },
 }
 
-/// Flies one run: the ring on or off, the clouds at `cloud_scale`.
+/// Flies the runs of one ring setting side by side, one host a cloud scale: at each sample
+/// every host draws its frames before the camera moves on, so a burst of load on a shared
+/// machine falls on all the scales alike and their ratio holds.
 fn fly(
     setup: &Setup,
     world: &mut World,
     at: (f64, f64),
-    (impostors, cloud_scale): (bool, f32),
-) -> anyhow::Result<Flown> {
-    let mut settings = setup.settings;
-    settings.impostors.enabled = impostors;
-    settings.clouds.resolution_scale = cloud_scale;
-    let mut host = DemoHost::new(
-        setup.size.0,
-        setup.size.1,
-        world.ground(),
-        SkyConfig {
-            colour_format: skycast::render::headless::COLOUR_FORMAT,
-            settings,
-            time_of_day: setup.table.clone(),
-            sheet: world.sheet(),
-        },
-    )?;
+    (impostors, scales): (bool, &[f32]),
+) -> anyhow::Result<Vec<Flown>> {
+    let mut hosts = Vec::new();
+    for &cloud_scale in scales {
+        let mut settings = setup.settings;
+        settings.impostors.enabled = impostors;
+        settings.clouds.resolution_scale = cloud_scale;
+        hosts.push(DemoHost::new(
+            setup.size.0,
+            setup.size.1,
+            world.ground(),
+            SkyConfig {
+                colour_format: skycast::render::headless::COLOUR_FORMAT,
+                settings,
+                time_of_day: setup.table.clone(),
+                sheet: world.sheet(),
+            },
+        )?);
+    }
+    let Some(first) = hosts.first() else {
+        return Ok(Vec::new());
+    };
     let adapter = format!(
         "{} ({:?})",
-        host.gpu.adapter_info.name, host.gpu.adapter_info.backend
+        first.gpu.adapter_info.name, first.gpu.adapter_info.backend
     );
+    let max_sprites = first.max_sprites();
     let alt_m = world.ground().height_at_m(DVec2::ZERO) + CRUISE_FT_AGL * METRES_PER_FOOT;
     let sun = sun_position(setup.unix_s, at.0, at.1);
     let visibility_m = world.visibility_m();
@@ -251,15 +263,12 @@ fn fly(
     let dt_s = step_m / SPEED_M_S;
     let position = |k: u32| DVec3::new(-PATH_LENGTH_M / 2.0 + k as f64 * step_m, 0.0, alt_m);
     let mut indices = Vec::new();
-    let mut records = Vec::new();
+    let mut records: Vec<Vec<FrameRecord>> = hosts.iter().map(|_| Vec::new()).collect();
     let mut timestamps = true;
     // Sample 0 is drawn twice: the first time (pipelines warming up, the whole ring built at
     // once) is not counted.
-    let mut warm_up = 0;
+    let mut warm_up = vec![0; hosts.len()];
     for (n, k) in std::iter::once(0).chain(0..setup.frames).enumerate() {
-        if n == 1 {
-            warm_up = records.len();
-        }
         let p = position(k);
         let now = world.block_indices(p);
         if now != indices {
@@ -269,59 +278,90 @@ fn fly(
                 .flat_map(|b| &b.clouds)
                 .map(|c| c.sprites.len() as u64)
                 .sum();
-            if !impostors && sprites > host.max_sprites() {
+            if !impostors && sprites > max_sprites {
                 // All of them as sprites do not fit the device's largest buffer.
-                return Ok(Flown::TooMany {
-                    sprites,
-                    max_sprites: host.max_sprites(),
-                });
+                return Ok(scales
+                    .iter()
+                    .map(|_| Flown::TooMany {
+                        sprites,
+                        max_sprites,
+                    })
+                    .collect());
             }
-            host.sky.set_clouds(blocks);
+            for host in &mut hosts {
+                host.sky.set_clouds(blocks.clone());
+            }
             indices = now;
         }
-        host.sky.set_weather_overhead(&world.weather_over(p));
-        let camera = host.camera(p, 90.0, PITCH_DEG);
-        // Draw until the ring is up to date here (8 rebuild frames and a crossfade at most, plus
-        // slack), then the frame is a steady one.
-        for _ in 0..64 {
-            let start = Instant::now();
-            let stats = host.draw(&camera, &sun, dt_s, visibility_m);
-            let (frame_ms, sky_ms) = match host.last_gpu_split_ms() {
-                Some([ground, sky]) => (ground + sky, sky),
-                None => {
-                    timestamps = false;
-                    host.wait_idle()?;
-                    // Submit to the end of the wait: the draw call minus its CPU update.
-                    let wall = start.elapsed().as_secs_f64() * 1e3;
-                    ((wall - stats.cpu_update_us as f64 / 1e3).max(0.0), f64::NAN)
-                }
-            };
-            let steady = stats.impostors_rebuilt == 0 && stats.crossfade_weight == 0.0;
-            records.push(FrameRecord {
-                steady,
-                distance_m: k as f64 * step_m,
-                frame_ms,
-                sky_ms,
-                cpu_update_ms: stats.sky_cpu_us() as f64 / 1e3,
-                upload_bytes: stats.upload_bytes,
-                sprite_gpu_bytes: stats.sprite_gpu_bytes,
-                sprites_drawn: stats.sprites_drawn,
-                blocks_near: stats.blocks_near,
-                blocks_far: stats.blocks_far,
-                impostors_rebuilt: stats.impostors_rebuilt,
-                cloud_target_bytes: stats.cloud_target_bytes,
-            });
-            if steady {
-                break;
+        let overhead = world.weather_over(p);
+        for ((host, records), warm_up) in hosts.iter_mut().zip(&mut records).zip(&mut warm_up) {
+            if n == 1 {
+                *warm_up = records.len();
             }
+            host.sky.set_weather_overhead(&overhead);
+            let distance_m = k as f64 * step_m;
+            timestamps &=
+                draw_to_steady(host, (p, distance_m), (&sun, dt_s, visibility_m), records)?;
         }
     }
-    records.drain(..warm_up);
-    Ok(Flown::Frames {
-        frames: records,
-        adapter,
-        timestamps,
-    })
+    Ok(records
+        .into_iter()
+        .zip(warm_up)
+        .map(|(mut frames, warm_up)| {
+            frames.drain(..warm_up);
+            Flown::Frames {
+                frames,
+                adapter: adapter.clone(),
+                timestamps,
+            }
+        })
+        .collect())
+}
+
+/// Draws frames at one sample until the ring is up to date there (8 rebuild frames and a
+/// crossfade at most, plus slack); the last is the steady one. False when the frames were timed
+/// by the wall clock (no GPU timestamps).
+fn draw_to_steady(
+    host: &mut DemoHost,
+    (p, distance_m): (DVec3, f64),
+    (sun, dt_s, visibility_m): (&skycast::shading::SunPosition, f64, f32),
+    records: &mut Vec<FrameRecord>,
+) -> anyhow::Result<bool> {
+    let camera = host.camera(p, 90.0, PITCH_DEG);
+    let mut timestamps = true;
+    for _ in 0..64 {
+        let start = Instant::now();
+        let stats = host.draw(&camera, sun, dt_s, visibility_m);
+        let (frame_ms, sky_ms) = match host.last_gpu_split_ms() {
+            Some([ground, sky]) => (ground + sky, sky),
+            None => {
+                timestamps = false;
+                host.wait_idle()?;
+                // Submit to the end of the wait: the draw call minus its CPU update.
+                let wall = start.elapsed().as_secs_f64() * 1e3;
+                ((wall - stats.cpu_update_us as f64 / 1e3).max(0.0), f64::NAN)
+            }
+        };
+        let steady = stats.impostors_rebuilt == 0 && stats.crossfade_weight == 0.0;
+        records.push(FrameRecord {
+            steady,
+            distance_m,
+            frame_ms,
+            sky_ms,
+            cpu_update_ms: stats.sky_cpu_us() as f64 / 1e3,
+            upload_bytes: stats.upload_bytes,
+            sprite_gpu_bytes: stats.sprite_gpu_bytes,
+            sprites_drawn: stats.sprites_drawn,
+            blocks_near: stats.blocks_near,
+            blocks_far: stats.blocks_far,
+            impostors_rebuilt: stats.impostors_rebuilt,
+            cloud_target_bytes: stats.cloud_target_bytes,
+        });
+        if steady {
+            break;
+        }
+    }
+    Ok(timestamps)
 }
 
 /// Runs `skycast bench`.
@@ -372,47 +412,60 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         let (mut world, at) =
             scenario_world(&args.scenarios, scenario, &stations, &world_settings)?;
         let overdraw = mean_overdraw(&world, world_settings.seed);
-        let runs_of_scenario = scales
-            .iter()
-            .flat_map(|&scale| [(true, scale), (false, scale)]);
-        for (impostors, cloud_scale) in runs_of_scenario {
+        for impostors in [true, false] {
             eprintln!(
-                "bench: {scenario}, impostors {}, cloud scale {}",
+                "bench: {scenario}, impostors {}, cloud scales {}",
                 if impostors { "on" } else { "off" },
-                scale_text(cloud_scale)
+                scales
+                    .iter()
+                    .map(|&s| scale_text(s))
+                    .collect::<Vec<_>>()
+                    .join(" and ")
             );
-            let mut not_drawn = None;
-            let frames = match fly(&setup, &mut world, at, (impostors, cloud_scale))? {
-                Flown::Frames {
+            let flown = fly(&setup, &mut world, at, (impostors, &scales))?;
+            for (flown, &cloud_scale) in flown.into_iter().zip(&scales) {
+                let mut not_drawn = None;
+                let frames = match flown {
+                    Flown::Frames {
+                        frames,
+                        adapter: name,
+                        timestamps: gpu,
+                    } => {
+                        adapter = name;
+                        timestamps &= gpu;
+                        frames
+                    }
+                    Flown::TooMany {
+                        sprites,
+                        max_sprites,
+                    } => {
+                        eprintln!(
+                            "bench: {scenario} without impostors: {sprites} sprites in view, this device draws at most {max_sprites} at once; not drawn (choose a smaller --view-km to compare)"
+                        );
+                        not_drawn = Some(sprites);
+                        Vec::new()
+                    }
+                };
+                runs.push(Run {
+                    scenario,
+                    overdraw,
+                    impostors,
+                    cloud_scale,
                     frames,
-                    adapter: name,
-                    timestamps: gpu,
-                } => {
-                    adapter = name;
-                    timestamps &= gpu;
-                    frames
-                }
-                Flown::TooMany {
-                    sprites,
-                    max_sprites,
-                } => {
-                    eprintln!(
-                        "bench: {scenario} without impostors: {sprites} sprites in view, this device draws at most {max_sprites} at once; not drawn (choose a smaller --view-km to compare)"
-                    );
-                    not_drawn = Some(sprites);
-                    Vec::new()
-                }
-            };
-            runs.push(Run {
-                scenario,
-                overdraw,
-                impostors,
-                cloud_scale,
-                frames,
-                not_drawn,
-            });
+                    not_drawn,
+                });
+            }
         }
     }
+    // In the table each scenario's rows go by scale, then ring on and off.
+    let scale_rank = |run: &Run| scales.iter().position(|&s| s == run.cloud_scale);
+    runs.sort_by_key(|r| {
+        (
+            SCENARIOS.iter().position(|&s| s == r.scenario),
+            scale_rank(r),
+            !r.impostors,
+        )
+    });
     let timing = if timestamps {
         "GPU timestamps"
     } else {
