@@ -89,6 +89,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         every: args.every,
         time: None,
         render_settings: None,
+        cloud_scale: None,
         time_of_day: None,
         watch: false,
         settle_ms: 500,

@@ -57,6 +57,10 @@ pub struct FlyArgs {
     /// Renderer settings (default: the shipped config/render.toml).
     #[arg(long)]
     pub render_settings: Option<PathBuf>,
+    /// Resolution the clouds are drawn at, a fraction of the frames': 1, 1/2 or 1/4 (default:
+    /// the renderer settings' `[clouds] resolution_scale`).
+    #[arg(long, value_parser = super::render::parse_cloud_scale)]
+    pub cloud_scale: Option<f32>,
     /// Time-of-day table (default: the shipped config/time_of_day.toml).
     #[arg(long)]
     pub time_of_day: Option<PathBuf>,
@@ -86,7 +90,11 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let plan = FlightPlan::load(&args.path)?;
     let (lat, lon) = plan.origin_lat_lon_deg;
     let flight = plan.place(&LocalFrame::new(lat, lon));
-    let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
+    let (settings, table) = load_look(
+        args.render_settings.as_ref(),
+        args.time_of_day.as_ref(),
+        args.cloud_scale,
+    )?;
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let start_unix_s = time_or_default(args.time)?;
     let field = loaded
@@ -151,6 +159,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "weather_applied",
         "written",
         "gpu_ms",
+        "cloud_scale",
+        "cloud_target_bytes",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
@@ -215,6 +225,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             applied,
             (write as u8).to_string(),
             gpu_ms,
+            stats.cloud_scale.to_string(),
+            stats.cloud_target_bytes.to_string(),
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);

@@ -51,6 +51,10 @@ pub struct RenderArgs {
     /// Renderer settings (default: the shipped config/render.toml).
     #[arg(long)]
     pub render_settings: Option<PathBuf>,
+    /// Resolution the clouds are drawn at, a fraction of the image's: 1, 1/2 or 1/4 (default:
+    /// the renderer settings' `[clouds] resolution_scale`).
+    #[arg(long, value_parser = parse_cloud_scale)]
+    pub cloud_scale: Option<f32>,
     /// Time-of-day table (default: the shipped config/time_of_day.toml).
     #[arg(long)]
     pub time_of_day: Option<PathBuf>,
@@ -156,6 +160,17 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((side(w)?, side(h)?))
 }
 
+/// Parses `--cloud-scale`: 1, 1/2 or 1/4 (or 0.5, 0.25).
+pub fn parse_cloud_scale(text: &str) -> Result<f32, String> {
+    let scale = match text.trim() {
+        "1" | "1.0" => 1.0,
+        "1/2" | "0.5" => 0.5,
+        "1/4" | "0.25" => 0.25,
+        _ => return Err(format!("`{text}` is not a cloud scale: 1, 1/2 or 1/4")),
+    };
+    Ok(scale)
+}
+
 /// The time a `--time` flag gives, or the shipped weather file's ([`DEFAULT_TIME`]), Unix seconds.
 pub fn time_or_default(time: Option<f64>) -> anyhow::Result<f64> {
     match time {
@@ -182,11 +197,15 @@ pub fn sky_config(
 pub fn load_look(
     render: Option<&PathBuf>,
     time_of_day: Option<&PathBuf>,
+    cloud_scale: Option<f32>,
 ) -> anyhow::Result<(RenderSettings, TimeOfDayTable)> {
-    let settings = match render {
+    let mut settings = match render {
         Some(p) => RenderSettings::load(p)?,
         None => RenderSettings::default(),
     };
+    if let Some(scale) = cloud_scale {
+        settings.clouds.resolution_scale = scale;
+    }
     let table = match time_of_day {
         Some(p) => TimeOfDayTable::load(p)?,
         None => TimeOfDayTable::default(),
@@ -200,7 +219,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if !(-2_000.0..=100_000.0).contains(&args.alt_ft) {
         anyhow::bail!("--alt-ft {} is outside -2000..=100000 feet", args.alt_ft);
     }
-    let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
+    let (settings, table) = load_look(
+        args.render_settings.as_ref(),
+        args.time_of_day.as_ref(),
+        args.cloud_scale,
+    )?;
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let unix_s = time_or_default(args.time)?;
     let field = loaded

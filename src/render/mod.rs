@@ -16,12 +16,15 @@
 //!   `gpu_types`. `readback`: the built corners read back for tests and tools.
 //! - `targets`: the host's targets and view on its terms (formats, reversed Z, MSAA, its own
 //!   matrices).
+//! - `cloud_target`: below full resolution, the clouds drawn off-screen against the farthest
+//!   depth of each block of pixels and composited with a full-resolution depth fix-up.
 //!
 //! Positions are f64 on the CPU and camera-relative f32 on the GPU. Units: metres, degrees,
 //! linear RGB.
 
 mod build;
 pub mod camera;
+pub mod cloud_target;
 pub mod draw_list;
 pub mod gpu_types;
 pub mod impostor;

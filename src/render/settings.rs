@@ -52,6 +52,15 @@ pub struct CloudSettings {
     pub draw_distance_m: f32,
     /// Distant sprites fade into the horizon haze: 63% at this distance, metres.
     pub haze_distance_m: f32,
+    /// Resolution of the off-screen target the clouds (sprites, impostor ring, in-cloud fog) are
+    /// drawn into, as a fraction of the host's: 1, 0.5 or 0.25 (1: straight into the host's
+    /// colour). See [`super::cloud_target`].
+    #[serde(default = "default_resolution_scale")]
+    pub resolution_scale: f32,
+}
+
+fn default_resolution_scale() -> f32 {
+    0.5
 }
 
 /// In-cloud fog settings (Wang 7.1).
@@ -176,6 +185,14 @@ impl RenderSettings {
                 return Err(ConfigError::at_key(path, text, field, "must be at least 1"));
             }
         }
+        if super::cloud_target::divisor_of(s.clouds.resolution_scale).is_none() {
+            return Err(ConfigError::at_key(
+                path,
+                text,
+                "clouds.resolution_scale",
+                format!("must be 1, 0.5 or 0.25, is {}", s.clouds.resolution_scale),
+            ));
+        }
         if let Some((field, message)) = s.impostors.invalid_field() {
             return Err(ConfigError::at_key(path, text, field, message));
         }
@@ -263,11 +280,22 @@ mod tests {
             )),
             "{err}"
         );
+        let text = DEFAULT_RENDER_TOML.replace("resolution_scale = 0.5", "resolution_scale = 0.3");
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
+            .unwrap_err()
+            .to_string();
+        let line = line_of_key(DEFAULT_RENDER_TOML, "clouds.resolution_scale").unwrap();
+        assert!(
+            err.starts_with(&format!("r.toml:{line}: field `clouds.resolution_scale`"))
+                && err.contains("must be 1, 0.5 or 0.25"),
+            "{err}"
+        );
         // Files written before the upright fade existed still load, with its defaults.
         let old = DEFAULT_RENDER_TOML
             .lines()
             .filter(|l| {
                 !l.starts_with("upright_fade")
+                    && !l.starts_with("resolution_scale")
                     && !l.starts_with("max_sorted")
                     && !l.starts_with("max_uploaded")
             })

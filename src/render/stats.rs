@@ -51,6 +51,12 @@ pub struct FrameStats {
     pub crossfade_weight: f32,
     /// Bytes of the ring's GPU textures and buffers.
     pub ring_gpu_bytes: u64,
+    /// Resolution of the clouds' off-screen target as a fraction of the host's (1: drawn
+    /// straight into the host's colour; `[clouds] resolution_scale`).
+    pub cloud_scale: f32,
+    /// Bytes of the off-screen cloud target's textures (colour, distance, farthest depth) at
+    /// the last recorded frame size; 0 at scale 1.
+    pub cloud_target_bytes: u64,
 }
 
 impl FrameStats {
