@@ -161,10 +161,11 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "gpu_ms",
         "cloud_scale",
         "cloud_target_bytes",
+        "in_cloud",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
-    let mut written = 0u32;
+    let (mut written, mut inside_cloud) = (0u32, 0u32);
     // On a terminal only (indicatif hides it when stderr is a file or a pipe).
     let progress = indicatif::ProgressBar::new(frames);
     if let Ok(style) = indicatif::ProgressStyle::with_template(
@@ -199,6 +200,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
                 gpu_ms = format!("{ms:.2}");
             }
             written += 1;
+            // Entirely inside a cloud: the frame is the in-cloud fog and nothing else.
+            inside_cloud += (stats.in_cloud >= 0.99) as u32;
         }
         let p = pose.position_m;
         csv.write_record([
@@ -227,6 +230,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             gpu_ms,
             stats.cloud_scale.to_string(),
             stats.cloud_target_bytes.to_string(),
+            format!("{:.2}", stats.in_cloud),
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);
@@ -234,7 +238,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     progress.finish();
     csv.flush()?;
     println!(
-        "{}: {written} frames and frames.csv ({frames} simulated at {} fps)",
+        "{}: {written} frames ({inside_cloud} of them entirely inside cloud) and frames.csv ({frames} simulated at {} fps)",
         args.out.display(),
         args.fps
     );
