@@ -64,6 +64,7 @@ impl From<&Cloud> for SkyCloud {
                     alpha_morph: s.alpha_morph,
                     radius_fraction: s.radius_fraction,
                     upright: s.upright,
+                    precipitation: s.precipitation,
                 })
                 .collect(),
             group_centres_m: c

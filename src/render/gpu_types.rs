@@ -105,6 +105,8 @@ impl GpuSpriteVertex {
 
 /// The `bits` flag of an upright sprite.
 pub const SPRITE_UPRIGHT: u32 = 1 << 8;
+/// `GpuSprite::bits`: falling rain or snow, drawn darker and greyer.
+pub const SPRITE_PRECIPITATION: u32 = 1 << 9;
 
 /// One cloud's shading constants on the GPU (written with its block). Keep in sync with
 /// `Cloud` in `shaders/sprites.wgsl`.
