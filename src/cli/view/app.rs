@@ -1,0 +1,476 @@
+//! The window and its frame loop (winit 0.30's `ApplicationHandler`): the window, surface and
+//! device made when the event loop resumes, then each redraw flies the aircraft, runs the demo
+//! host's frame step (the sky's `update`, ground, sky) and presents.
+
+use std::collections::HashSet;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use skycast::demo::{DemoHost, HeadlessGpu, HeightField};
+use skycast::flight::{SkySystemConfig, Weather};
+use skycast::weather::{METRES_PER_FOOT, WeatherField};
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, KeyEvent, MouseButton, WindowEvent};
+use winit::event_loop::ActiveEventLoop;
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::window::{Window, WindowId};
+
+use super::controls::{Aircraft, KEYS_HELP, Key, TIME_STEP_S};
+use super::present::PresentPass;
+use super::script::Press;
+
+/// Everything the viewer is started with (flags loaded and checked).
+pub struct Setup {
+    /// Window size, pixels.
+    pub size: (u32, u32),
+    /// Present at the display's refresh.
+    pub vsync: bool,
+    /// Quit after this many presented frames.
+    pub frames: Option<u64>,
+    /// Frames to write as PNG.
+    pub screenshots: Vec<(u64, PathBuf)>,
+    /// Scripted key presses.
+    pub presses: Vec<Press>,
+    /// UTC time of the first frame, Unix seconds.
+    pub start_unix_s: f64,
+    /// Where the flight starts.
+    pub aircraft: Aircraft,
+    /// The demo ground.
+    pub ground: HeightField,
+    /// The sky's settings.
+    pub config: SkySystemConfig,
+    /// The weather at the start.
+    pub field: WeatherField,
+    /// The weather file to watch and its settle time.
+    pub watch: Option<(PathBuf, Duration)>,
+}
+
+/// The window, its surface and the demo host drawing into it.
+struct Running {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    surface_config: wgpu::SurfaceConfiguration,
+    surface_view_format: wgpu::TextureFormat,
+    present: PresentPass,
+    host: DemoHost,
+}
+
+/// The viewer: the setup, then the running window; the first error ends the loop.
+pub struct Viewer {
+    setup: Setup,
+    running: Option<Running>,
+    field: Option<WeatherField>,
+    error: Option<anyhow::Error>,
+    held: HashSet<Key>,
+    dragging: Option<(f64, f64)>,
+    frame: u64,
+    last_frame: Option<Instant>,
+    clock_s: f64,
+    time_offset_s: f64,
+    frame_ms: Vec<f64>,
+    title_at: Option<Instant>,
+    screenshot_requested: bool,
+    screenshots_taken: u32,
+}
+
+impl Viewer {
+    /// A viewer that opens its window when the event loop starts.
+    pub fn new(mut setup: Setup) -> Self {
+        let field = Some(std::mem::replace(
+            &mut setup.field,
+            WeatherField::build(
+                skycast::weather::LocalFrame::new(0.0, 0.0),
+                &[],
+                &Default::default(),
+                &Default::default(),
+            ),
+        ));
+        Self {
+            setup,
+            running: None,
+            field,
+            error: None,
+            held: HashSet::new(),
+            dragging: None,
+            frame: 0,
+            last_frame: None,
+            clock_s: 0.0,
+            time_offset_s: 0.0,
+            frame_ms: Vec::new(),
+            title_at: None,
+            screenshot_requested: false,
+            screenshots_taken: 0,
+        }
+    }
+
+    /// After the loop: the error that ended it, or the frame rate on standard output.
+    pub fn finish(mut self) -> anyhow::Result<()> {
+        if let Some(err) = self.error.take() {
+            return Err(err);
+        }
+        // The first frame compiles the shaders and builds the clouds: left out of the rate.
+        let mut times: Vec<f64> = self.frame_ms.iter().skip(1).copied().collect();
+        times.sort_by(f64::total_cmp);
+        if let (Some(running), false) = (&self.running, times.is_empty()) {
+            let median_ms = times[times.len() / 2];
+            let (w, h) = (running.surface_config.width, running.surface_config.height);
+            println!(
+                "{} frames presented at {w}x{h} on {} ({:?}); median frame {median_ms:.1} ms, {:.1} fps",
+                self.frame,
+                running.host.gpu.adapter_info.name,
+                running.host.gpu.adapter_info.backend,
+                1000.0 / median_ms,
+            );
+        }
+        Ok(())
+    }
+
+    /// Makes the window, surface, device, ground and sky.
+    fn open(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<Running> {
+        let (width, height) = self.setup.size;
+        let attributes = Window::default_attributes()
+            .with_title("skycast view")
+            .with_inner_size(winit::dpi::PhysicalSize::new(width, height));
+        let window = Arc::new(
+            event_loop
+                .create_window(attributes)
+                .context("cannot open a window")?,
+        );
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let surface = instance
+            .create_surface(Arc::clone(&window))
+            .context("cannot draw into the window (no surface)")?;
+        let gpu = HeadlessGpu::with_instance(&instance, Some(&surface))?;
+        let caps = surface.get_capabilities(&gpu.adapter);
+        let format = *caps
+            .formats
+            .first()
+            .context("the adapter cannot present to this window")?;
+        // The present pass writes linear colour through an sRGB view, whatever the surface's
+        // own format, so the hardware encodes it as `render`'s PNG is encoded.
+        let surface_view_format = format.add_srgb_suffix();
+        let size = window.inner_size();
+        let surface_config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            color_space: wgpu::SurfaceColorSpace::Auto,
+            width: size.width.max(1),
+            height: size.height.max(1),
+            present_mode: if self.setup.vsync {
+                wgpu::PresentMode::AutoVsync
+            } else {
+                wgpu::PresentMode::AutoNoVsync
+            },
+            desired_maximum_frame_latency: 2,
+            alpha_mode: wgpu::CompositeAlphaMode::Auto,
+            view_formats: vec![surface_view_format],
+        };
+        surface.configure(&gpu.device, &surface_config);
+        let present = PresentPass::new(&gpu.device, surface_view_format);
+        let mut host = DemoHost::with_gpu(
+            gpu,
+            surface_config.width,
+            surface_config.height,
+            &self.setup.ground,
+            self.setup.config.clone(),
+        )?;
+        if let Some(field) = self.field.take() {
+            host.sky.set_weather_field(field);
+        }
+        if let Some((path, settle)) = &self.setup.watch {
+            host.sky.set_weather(Weather::Watch {
+                path,
+                settle: *settle,
+            })?;
+            eprintln!("watching {}", path.display());
+        }
+        Ok(Running {
+            window,
+            surface,
+            surface_config,
+            surface_view_format,
+            present,
+            host,
+        })
+    }
+
+    /// A key went down (`pressed`) or up, from the keyboard or the script.
+    fn key(&mut self, key: Key, pressed: bool, event_loop: &ActiveEventLoop) {
+        if !pressed {
+            self.held.remove(&key);
+            return;
+        }
+        self.held.insert(key);
+        match key {
+            Key::Plus => self.time_offset_s += TIME_STEP_S,
+            Key::Minus => self.time_offset_s -= TIME_STEP_S,
+            Key::F12 => self.screenshot_requested = true,
+            Key::H => println!("{KEYS_HELP}"),
+            Key::Escape => event_loop.exit(),
+            _ => self.setup.aircraft.press(key),
+        }
+    }
+
+    /// The scripted presses and releases of this frame.
+    fn run_script(&mut self, event_loop: &ActiveEventLoop) {
+        let frame = self.frame;
+        let events: Vec<(Key, bool)> = self
+            .setup
+            .presses
+            .iter()
+            .filter_map(|p| {
+                if p.from == frame {
+                    Some((p.key, true))
+                } else if p.until == frame {
+                    Some((p.key, false))
+                } else {
+                    None
+                }
+            })
+            .collect();
+        for (key, pressed) in events {
+            self.key(key, pressed, event_loop);
+        }
+    }
+
+    /// One frame: fly, step the sky, draw, screenshot, present.
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
+        self.run_script(event_loop);
+        let now = Instant::now();
+        // The first frame is the start pose, as `render` draws it (dt 0).
+        let dt_s = self
+            .last_frame
+            .map_or(0.0, |t| now.duration_since(t).as_secs_f64().min(0.25));
+        self.last_frame = Some(now);
+        let Some(running) = self.running.as_mut() else {
+            return Ok(());
+        };
+        let ground = &self.setup.ground;
+        self.setup
+            .aircraft
+            .advance(&self.held, dt_s, |p| ground.height_at_m(p.truncate()));
+        self.clock_s += dt_s;
+        let a = &self.setup.aircraft;
+        let camera = running
+            .host
+            .camera(a.position_m, a.heading_deg, a.pitch_deg);
+        let utc_unix_s = self.setup.start_unix_s + self.clock_s + self.time_offset_s;
+        let (stats, changes) = running.host.step(&camera, utc_unix_s, dt_s, true)?;
+        for change in changes {
+            match change {
+                Ok(path) => eprintln!("weather applied: {}", path.display()),
+                Err(why) => eprintln!("weather rejected, the last good sky stays: {why}"),
+            }
+        }
+        let mut shots: Vec<PathBuf> = self
+            .setup
+            .screenshots
+            .iter()
+            .filter(|(k, _)| *k == self.frame)
+            .map(|(_, p)| p.clone())
+            .collect();
+        if std::mem::take(&mut self.screenshot_requested) {
+            self.screenshots_taken += 1;
+            shots.push(PathBuf::from(format!(
+                "skycast-view-{}.png",
+                self.screenshots_taken
+            )));
+        }
+        if !shots.is_empty() {
+            let frame = running.host.target.read_back(&running.host.gpu)?;
+            for path in shots {
+                frame.write_png(&path)?;
+                eprintln!("screenshot: {}", path.display());
+            }
+        }
+        let presented = running.present_frame()?;
+        let frame_ms = now.elapsed().as_secs_f64() * 1000.0;
+        if presented {
+            self.frame_ms.push(frame_ms);
+            self.frame += 1;
+        }
+        // The title carries the figures, twice a second (a title change is a round trip).
+        if self
+            .title_at
+            .is_none_or(|t| t.elapsed() > Duration::from_millis(500))
+        {
+            self.title_at = Some(Instant::now());
+            let a = &self.setup.aircraft;
+            let (lat, lon) = running
+                .host
+                .sky
+                .frame()
+                .to_lat_lon_deg(a.position_m.truncate());
+            let agl_m = a.position_m.z - ground.height_at_m(a.position_m.truncate());
+            let time = jiff::Timestamp::from_millisecond((utc_unix_s * 1000.0) as i64)
+                .map(|t| t.strftime("%H:%MZ").to_string())
+                .unwrap_or_default();
+            running.window.set_title(&format!(
+                "skycast view  {lat:.4}, {lon:.4}  {:.0} ft MSL  {:.0} ft AGL  hdg {:.0}  {:.0} kt  {time}  {:.1} fps  sky CPU {:.1} ms  {} sprites  (H: keys)",
+                a.position_m.z / METRES_PER_FOOT,
+                agl_m / METRES_PER_FOOT,
+                a.heading_deg,
+                a.speed_mps * 1.943_844,
+                1000.0 / frame_ms.max(0.001),
+                stats.sky_cpu_us() as f64 / 1000.0,
+                stats.sprites_drawn,
+            ));
+        }
+        if self.setup.frames.is_some_and(|n| self.frame >= n) {
+            event_loop.exit();
+        }
+        Ok(())
+    }
+}
+
+impl Running {
+    /// Copies the drawn frame onto the surface and presents it; false when the surface had no
+    /// texture to give this time (resized, occluded), which the next frame retries.
+    fn present_frame(&mut self) -> anyhow::Result<bool> {
+        let texture = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return Ok(false);
+            }
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface
+                    .configure(&self.host.gpu.device, &self.surface_config);
+                return Ok(false);
+            }
+            wgpu::CurrentSurfaceTexture::Validation => {
+                anyhow::bail!("the window's surface rejected the frame (a wgpu validation error)")
+            }
+        };
+        let view = texture.texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(self.surface_view_format),
+            ..Default::default()
+        });
+        let device = &self.host.gpu.device;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("view.present"),
+        });
+        self.present
+            .record(device, &mut encoder, &self.host.target.colour_view, &view);
+        self.host.gpu.queue.submit([encoder.finish()]);
+        self.window.pre_present_notify();
+        self.host.gpu.queue.present(texture);
+        Ok(true)
+    }
+
+    /// The window's new size: the surface and the off-screen frame follow.
+    fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
+        if width == 0 || height == 0 {
+            return Ok(());
+        }
+        self.surface_config.width = width;
+        self.surface_config.height = height;
+        self.surface
+            .configure(&self.host.gpu.device, &self.surface_config);
+        self.host.resize(width, height)?;
+        Ok(())
+    }
+}
+
+/// The viewer's key for a key of the keyboard.
+fn key_for(code: KeyCode) -> Option<Key> {
+    Some(match code {
+        KeyCode::KeyW => Key::W,
+        KeyCode::KeyS => Key::S,
+        KeyCode::KeyA => Key::A,
+        KeyCode::KeyD => Key::D,
+        KeyCode::KeyQ => Key::Q,
+        KeyCode::KeyE => Key::E,
+        KeyCode::PageUp => Key::PageUp,
+        KeyCode::PageDown => Key::PageDown,
+        KeyCode::ShiftLeft | KeyCode::ShiftRight => Key::Shift,
+        KeyCode::Equal | KeyCode::NumpadAdd => Key::Plus,
+        KeyCode::Minus | KeyCode::NumpadSubtract => Key::Minus,
+        KeyCode::Digit1 => Key::Slow,
+        KeyCode::Digit2 => Key::Fast,
+        KeyCode::Digit0 => Key::Stop,
+        KeyCode::F12 => Key::F12,
+        KeyCode::KeyH => Key::H,
+        KeyCode::Escape => Key::Escape,
+        _ => return None,
+    })
+}
+
+impl ApplicationHandler for Viewer {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.running.is_some() {
+            return;
+        }
+        match self.open(event_loop) {
+            Ok(running) => {
+                running.window.request_redraw();
+                self.running = Some(running);
+            }
+            Err(err) => {
+                self.error = Some(err);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let result = match event {
+            WindowEvent::CloseRequested => {
+                event_loop.exit();
+                Ok(())
+            }
+            WindowEvent::Resized(size) => self
+                .running
+                .as_mut()
+                .map_or(Ok(()), |r| r.resize(size.width, size.height)),
+            WindowEvent::KeyboardInput {
+                event:
+                    KeyEvent {
+                        physical_key: PhysicalKey::Code(code),
+                        state,
+                        repeat: false,
+                        ..
+                    },
+                ..
+            } => {
+                if let Some(key) = key_for(code) {
+                    self.key(key, state == ElementState::Pressed, event_loop);
+                }
+                Ok(())
+            }
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => {
+                // The drag starts at the next cursor position.
+                self.dragging = (state == ElementState::Pressed).then_some((f64::NAN, f64::NAN));
+                Ok(())
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                if let Some((x, y)) = self.dragging {
+                    if x.is_finite() {
+                        self.setup.aircraft.look(position.x - x, position.y - y);
+                    }
+                    self.dragging = Some((position.x, position.y));
+                }
+                Ok(())
+            }
+            WindowEvent::RedrawRequested => {
+                let result = self.redraw(event_loop);
+                if let Some(r) = &self.running {
+                    r.window.request_redraw();
+                }
+                result
+            }
+            _ => Ok(()),
+        };
+        if let Err(err) = result {
+            self.error = Some(err);
+            event_loop.exit();
+        }
+    }
+}
