@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use skycast::demo::{DemoHost, HeadlessGpu, HeightField};
 use skycast::flight::{SkySystemConfig, Weather};
+use skycast::render::FrameStats;
 use skycast::weather::{METRES_PER_FOOT, WeatherField};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, KeyEvent, MouseButton, WindowEvent};
@@ -18,8 +19,13 @@ use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 use super::controls::{Aircraft, KEYS_HELP, Key, TIME_STEP_S};
+use super::figures::Figures;
+use super::overlay::{self, OverlayImage};
 use super::present::PresentPass;
 use super::script::Press;
+
+/// Metres per second in a knot.
+const KNOT_MPS: f64 = 0.514_444;
 
 /// Everything the viewer is started with (flags loaded and checked).
 pub struct Setup {
@@ -55,6 +61,8 @@ struct Running {
     surface_view_format: wgpu::TextureFormat,
     present: PresentPass,
     host: DemoHost,
+    overlay: OverlayImage,
+    overlay_view: wgpu::TextureView,
 }
 
 /// The viewer: the setup, then the running window; the first error ends the loop.
@@ -70,7 +78,9 @@ pub struct Viewer {
     clock_s: f64,
     time_offset_s: f64,
     frame_ms: Vec<f64>,
-    title_at: Option<Instant>,
+    overlay_at: Option<Instant>,
+    fps: f64,
+    show_keys: bool,
     screenshot_requested: bool,
     screenshots_taken: u32,
 }
@@ -99,7 +109,9 @@ impl Viewer {
             clock_s: 0.0,
             time_offset_s: 0.0,
             frame_ms: Vec::new(),
-            title_at: None,
+            overlay_at: None,
+            fps: 0.0,
+            show_keys: false,
             screenshot_requested: false,
             screenshots_taken: 0,
         }
@@ -187,6 +199,8 @@ impl Viewer {
             })?;
             eprintln!("watching {}", path.display());
         }
+        let overlay = OverlayImage::from_lines(&[]);
+        let overlay_view = overlay::upload(&host.gpu.device, &host.gpu.queue, &overlay);
         Ok(Running {
             window,
             surface,
@@ -194,6 +208,8 @@ impl Viewer {
             surface_view_format,
             present,
             host,
+            overlay,
+            overlay_view,
         })
     }
 
@@ -208,7 +224,10 @@ impl Viewer {
             Key::Plus => self.time_offset_s += TIME_STEP_S,
             Key::Minus => self.time_offset_s -= TIME_STEP_S,
             Key::F12 => self.screenshot_requested = true,
-            Key::H => println!("{KEYS_HELP}"),
+            Key::H => {
+                self.show_keys = !self.show_keys;
+                self.overlay_at = None;
+            }
             Key::Escape => event_loop.exit(),
             _ => self.setup.aircraft.press(key),
         }
@@ -233,6 +252,40 @@ impl Viewer {
             .collect();
         for (key, pressed) in events {
             self.key(key, pressed, event_loop);
+        }
+    }
+
+    /// The overlay's figures of this frame.
+    fn figures(
+        setup: &Setup,
+        fps: f64,
+        running: &Running,
+        stats: &FrameStats,
+        utc_unix_s: f64,
+    ) -> Figures {
+        let a = &setup.aircraft;
+        let (lat_deg, lon_deg) = running
+            .host
+            .sky
+            .frame()
+            .to_lat_lon_deg(a.position_m.truncate());
+        let ground_m = setup.ground.height_at_m(a.position_m.truncate());
+        Figures {
+            lat_deg,
+            lon_deg,
+            msl_ft: a.position_m.z / METRES_PER_FOOT,
+            agl_ft: (a.position_m.z - ground_m) / METRES_PER_FOOT,
+            heading_deg: a.heading_deg,
+            pitch_deg: a.pitch_deg,
+            speed_kt: a.speed_mps / KNOT_MPS,
+            utc_unix_s,
+            fps,
+            sky_cpu_ms: stats.sky_cpu_us() as f64 / 1000.0,
+            gpu_ms: running.host.last_gpu_ms(),
+            sprites: stats.sprites_drawn,
+            clouds: stats.clouds_drawn,
+            impostor_blocks: stats.blocks_far,
+            weather: running.host.sky.world().weather_over(a.position_m),
         }
     }
 
@@ -265,59 +318,50 @@ impl Viewer {
                 Err(why) => eprintln!("weather rejected, the last good sky stays: {why}"),
             }
         }
-        let mut shots: Vec<PathBuf> = self
+        if dt_s > 0.0 {
+            self.fps = 0.9 * self.fps + 0.1 / dt_s;
+        }
+        // The figures four times a second (the GPU time waits for the frame), the keys on H.
+        if self
+            .overlay_at
+            .is_none_or(|t| t.elapsed() > Duration::from_millis(250))
+        {
+            self.overlay_at = Some(Instant::now());
+            let mut lines =
+                Self::figures(&self.setup, self.fps, running, &stats, utc_unix_s).lines();
+            if self.show_keys {
+                lines.extend(KEYS_HELP.lines().map(str::to_string));
+            }
+            running.set_overlay(OverlayImage::from_lines(&lines));
+        }
+        let shots: Vec<PathBuf> = self
             .setup
             .screenshots
             .iter()
             .filter(|(k, _)| *k == self.frame)
             .map(|(_, p)| p.clone())
             .collect();
-        if std::mem::take(&mut self.screenshot_requested) {
-            self.screenshots_taken += 1;
-            shots.push(PathBuf::from(format!(
-                "skycast-view-{}.png",
-                self.screenshots_taken
-            )));
-        }
         if !shots.is_empty() {
+            // The sky's frame as `render` writes it, no overlay (what tests compare).
             let frame = running.host.target.read_back(&running.host.gpu)?;
             for path in shots {
                 frame.write_png(&path)?;
                 eprintln!("screenshot: {}", path.display());
             }
         }
-        let presented = running.present_frame()?;
-        let frame_ms = now.elapsed().as_secs_f64() * 1000.0;
-        if presented {
-            self.frame_ms.push(frame_ms);
-            self.frame += 1;
+        if std::mem::take(&mut self.screenshot_requested) {
+            // What the window shows, overlay included.
+            self.screenshots_taken += 1;
+            let path = PathBuf::from(format!("skycast-view-{}.png", self.screenshots_taken));
+            let mut frame = running.host.target.read_back(&running.host.gpu)?;
+            running.overlay.composite(&mut frame);
+            frame.write_png(&path)?;
+            eprintln!("screenshot: {}", path.display());
         }
-        // The title carries the figures, twice a second (a title change is a round trip).
-        if self
-            .title_at
-            .is_none_or(|t| t.elapsed() > Duration::from_millis(500))
-        {
-            self.title_at = Some(Instant::now());
-            let a = &self.setup.aircraft;
-            let (lat, lon) = running
-                .host
-                .sky
-                .frame()
-                .to_lat_lon_deg(a.position_m.truncate());
-            let agl_m = a.position_m.z - ground.height_at_m(a.position_m.truncate());
-            let time = jiff::Timestamp::from_millisecond((utc_unix_s * 1000.0) as i64)
-                .map(|t| t.strftime("%H:%MZ").to_string())
-                .unwrap_or_default();
-            running.window.set_title(&format!(
-                "skycast view  {lat:.4}, {lon:.4}  {:.0} ft MSL  {:.0} ft AGL  hdg {:.0}  {:.0} kt  {time}  {:.1} fps  sky CPU {:.1} ms  {} sprites  (H: keys)",
-                a.position_m.z / METRES_PER_FOOT,
-                agl_m / METRES_PER_FOOT,
-                a.heading_deg,
-                a.speed_mps * 1.943_844,
-                1000.0 / frame_ms.max(0.001),
-                stats.sky_cpu_us() as f64 / 1000.0,
-                stats.sprites_drawn,
-            ));
+        let presented = running.present_frame()?;
+        if presented {
+            self.frame_ms.push(now.elapsed().as_secs_f64() * 1000.0);
+            self.frame += 1;
         }
         if self.setup.frames.is_some_and(|n| self.frame >= n) {
             event_loop.exit();
@@ -327,6 +371,12 @@ impl Viewer {
 }
 
 impl Running {
+    /// Shows `overlay` from the next present on.
+    fn set_overlay(&mut self, overlay: OverlayImage) {
+        self.overlay_view = overlay::upload(&self.host.gpu.device, &self.host.gpu.queue, &overlay);
+        self.overlay = overlay;
+    }
+
     /// Copies the drawn frame onto the surface and presents it; false when the surface had no
     /// texture to give this time (resized, occluded), which the next frame retries.
     fn present_frame(&mut self) -> anyhow::Result<bool> {
@@ -353,8 +403,8 @@ impl Running {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("view.present"),
         });
-        self.present
-            .record(device, &mut encoder, &self.host.target.colour_view, &view);
+        let inputs = (&self.host.target.colour_view, &self.overlay_view);
+        self.present.record(device, &mut encoder, inputs, &view);
         self.host.gpu.queue.submit([encoder.finish()]);
         self.window.pre_present_notify();
         self.host.gpu.queue.present(texture);

@@ -38,7 +38,7 @@ pub enum Key {
     Stop,
     /// PNG screenshot of the current frame.
     F12,
-    /// The keys, printed.
+    /// The keys on screen, or not.
     H,
     /// Quit.
     Escape,
@@ -73,11 +73,11 @@ pub const KEYS: [(Key, &str, &str); 17] = [
         "F12",
         "PNG screenshot of the current frame (skycast-view-N.png)",
     ),
-    (Key::H, "H", "print these keys"),
+    (Key::H, "H", "show or hide these keys"),
     (Key::Escape, "Escape", "quit"),
 ];
 
-/// The keys as `--help` and H print them.
+/// The keys as `--help` and the overlay (H) list them.
 pub const KEYS_HELP: &str = "\
 Keys (mouse: drag with the left button to look around):
   W / S              faster / slower (hold)
@@ -87,7 +87,7 @@ Keys (mouse: drag with the left button to look around):
   1 / 2 / 0          cloud close-up speed (20 m/s) / cross-country (600 m/s) / stop
   + / -              time of day +30 / -30 minutes
   F12                PNG screenshot of the current frame (skycast-view-N.png)
-  H                  print these keys
+  H                  show or hide these keys
   Escape             quit";
 
 impl Key {

@@ -2,8 +2,9 @@
 //! window to fly through. The viewer is one more host of the library: the demo host's device
 //! (made able to present to the window), its ground and its [`skycast::SkySystem`] draw each
 //! frame off-screen exactly as `skycast render` does; a present pass shows it on the window's
-//! surface (sRGB, vsync by default). The window title carries the figures: position, MSL and
-//! AGL, speed, time, frames per second, the sky's CPU milliseconds and its sprites.
+//! surface (sRGB, vsync by default) with an overlay of figures over it: position, MSL and AGL,
+//! speed, time, the weather at the aircraft, frames per second, the sky's CPU and GPU
+//! milliseconds, sprites; H adds the keys.
 //!
 //! Without a display (no X server) it says so and names `render` and `fly`, exit status 2.
 
@@ -21,6 +22,8 @@ use super::weather::{DEFAULT_STATIONS, load};
 
 mod app;
 mod controls;
+mod figures;
+mod overlay;
 mod present;
 mod script;
 

@@ -1,6 +1,7 @@
 //! The present pass: the demo host's off-screen frame (linear `Rgba16Float`, the pixels
 //! `skycast render` writes) drawn onto the window's surface through an sRGB view, so what the
-//! window shows and what `render` saves are the same picture. Shader: `shaders/view_present.wgsl`.
+//! window shows and what `render` saves are the same picture; the overlay is blended over it
+//! there. Shader: `shaders/view_present.wgsl`.
 
 /// The pipeline that copies the frame onto the surface.
 pub struct PresentPass {
@@ -15,16 +16,7 @@ impl PresentPass {
             device.create_shader_module(wgpu::include_wgsl!("../../../shaders/view_present.wgsl"));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("view.present_layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            }],
+            entries: &[texture_entry(0), texture_entry(1)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("view.present"),
@@ -55,21 +47,28 @@ impl PresentPass {
         Self { pipeline, layout }
     }
 
-    /// Records the copy of `frame` (same size as the surface) onto `surface_view`.
+    /// Records the copy of `frame` (same size as the surface) with `overlay` over it onto
+    /// `surface_view`.
     pub fn record(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &wgpu::TextureView,
+        (frame, overlay): (&wgpu::TextureView, &wgpu::TextureView),
         surface_view: &wgpu::TextureView,
     ) {
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("view.present_group"),
             layout: &self.layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(frame),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(frame),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(overlay),
+                },
+            ],
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("view.present"),
@@ -90,5 +89,19 @@ impl PresentPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &group, &[]);
         pass.draw(0..3, 0..1);
+    }
+}
+
+/// A texture the fragment stage reads texel by texel.
+fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
     }
 }
