@@ -224,6 +224,12 @@ impl Viewer {
             Key::Plus => self.time_offset_s += TIME_STEP_S,
             Key::Minus => self.time_offset_s -= TIME_STEP_S,
             Key::F12 => self.screenshot_requested = true,
+            Key::V => {
+                if let Some(running) = self.running.as_mut() {
+                    let enabled = running.host.sky.settings().vertex_cache.enabled;
+                    running.host.sky.set_vertex_cache(!enabled);
+                }
+            }
             Key::H => {
                 self.show_keys = !self.show_keys;
                 self.overlay_at = None;
@@ -285,6 +291,7 @@ impl Viewer {
             sprites: stats.sprites_drawn,
             clouds: stats.clouds_drawn,
             impostor_blocks: stats.blocks_far,
+            vertex_cache: running.host.sky.settings().vertex_cache.enabled,
             weather: running.host.sky.world().weather_over(a.position_m),
         }
     }
@@ -442,6 +449,7 @@ fn key_for(code: KeyCode) -> Option<Key> {
         KeyCode::Digit1 => Key::Slow,
         KeyCode::Digit2 => Key::Fast,
         KeyCode::Digit0 => Key::Stop,
+        KeyCode::KeyV => Key::V,
         KeyCode::F12 => Key::F12,
         KeyCode::KeyH => Key::H,
         KeyCode::Escape => Key::Escape,

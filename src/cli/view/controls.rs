@@ -36,6 +36,8 @@ pub enum Key {
     Fast,
     /// Stop in the air.
     Stop,
+    /// The vertex cache on or off.
+    V,
     /// PNG screenshot of the current frame.
     F12,
     /// The keys on screen, or not.
@@ -45,7 +47,7 @@ pub enum Key {
 }
 
 /// Every key with its name and what it does, in the order `--help` lists them.
-pub const KEYS: [(Key, &str, &str); 17] = [
+pub const KEYS: [(Key, &str, &str); 18] = [
     (Key::W, "W", "faster (hold)"),
     (Key::S, "S", "slower (hold)"),
     (Key::A, "A", "turn left (hold)"),
@@ -69,6 +71,11 @@ pub const KEYS: [(Key, &str, &str); 17] = [
     ),
     (Key::Stop, "0", "stop in the air"),
     (
+        Key::V,
+        "V",
+        "vertex cache on/off (off: every cloud recomputed every frame)",
+    ),
+    (
         Key::F12,
         "F12",
         "PNG screenshot of the current frame (skycast-view-N.png)",
@@ -86,6 +93,7 @@ Keys (mouse: drag with the left button to look around):
   Shift              every rate ten times faster (hold)
   1 / 2 / 0          cloud close-up speed (20 m/s) / cross-country (600 m/s) / stop
   + / -              time of day +30 / -30 minutes
+  V                  vertex cache on / off (off: every cloud recomputed every frame)
   F12                PNG screenshot of the current frame (skycast-view-N.png)
   H                  show or hide these keys
   Escape             quit";

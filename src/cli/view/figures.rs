@@ -35,6 +35,8 @@ pub struct Figures {
     pub clouds: u32,
     /// Blocks drawn into the far ring's impostors.
     pub impostor_blocks: u32,
+    /// Whether the vertex cache is on.
+    pub vertex_cache: bool,
     /// The weather of the block the aircraft is in.
     pub weather: BlockWeather,
 }
@@ -86,8 +88,10 @@ impl Figures {
                 w.temperature_c
             ),
             format!(
-                "{:.1} fps  sky CPU {:.1} ms{gpu}",
-                self.fps, self.sky_cpu_ms
+                "{:.1} fps  sky CPU {:.1} ms{gpu}  vertex cache {}",
+                self.fps,
+                self.sky_cpu_ms,
+                if self.vertex_cache { "on" } else { "off" }
             ),
             format!(
                 "{} sprites  {} clouds  {} blocks in impostors   H: keys",
@@ -118,6 +122,7 @@ mod tests {
             sprites: 106_987,
             clouds: 2_499,
             impostor_blocks: 12,
+            vertex_cache: true,
             weather: BlockWeather {
                 visibility_m: 9_999.0,
                 ..Default::default()
@@ -128,7 +133,7 @@ mod tests {
         assert_eq!(lines[1], "heading 090  pitch +6  0 kt  2025-01-27 17:30Z");
         assert_eq!(lines[2], "layers: clear");
         assert_eq!(lines[3], "visibility 10.0 km  wind 000/0 kt  0 C");
-        assert_eq!(lines[4], "4.2 fps  sky CPU 3.2 ms");
+        assert_eq!(lines[4], "4.2 fps  sky CPU 3.2 ms  vertex cache on");
         assert!(lines[5].starts_with("106987 sprites  2499 clouds  12 blocks"));
     }
 }
