@@ -183,7 +183,7 @@ fn the_viewer_presents_a_scripted_flight_in_a_window() {
     );
     // The sky (the top third) after six hours of + is another colour.
     let sky_change = mean_difference(&still, &evening, 0..still.height() / 3);
-    eprintln!("the sky's change after six presses of +: {sky_change:.4}");
+    eprintln!("the sky's change after twelve presses of + (six hours): {sky_change:.4}");
     assert!(sky_change > 0.05, "sky change after +6 h: {sky_change:.4}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -326,7 +326,9 @@ impl Viewer {
             }
         }
         if dt_s > 0.0 {
-            self.fps = 0.9 * self.fps + 0.1 / dt_s;
+            // Smoothed over about ten frames, from the first measured one.
+            let weight = if self.fps == 0.0 { 1.0 } else { 0.1 };
+            self.fps += weight * (1.0 / dt_s - self.fps);
         }
         // The figures four times a second (the GPU time waits for the frame), the keys on H.
         if self
