@@ -4,25 +4,23 @@
 
 use std::collections::HashSet;
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use anyhow::Context;
-use skycast::demo::{DemoHost, HeadlessGpu, HeightField};
-use skycast::flight::{SkySystemConfig, Weather};
+use skycast::demo::HeightField;
+use skycast::flight::SkySystemConfig;
 use skycast::render::FrameStats;
 use skycast::weather::{METRES_PER_FOOT, WeatherField};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, KeyEvent, MouseButton, WindowEvent};
 use winit::event_loop::ActiveEventLoop;
 use winit::keyboard::{KeyCode, PhysicalKey};
-use winit::window::{Window, WindowId};
+use winit::window::WindowId;
 
 use super::controls::{Aircraft, KEYS_HELP, Key, TIME_STEP_S};
 use super::figures::Figures;
-use super::overlay::{self, OverlayImage};
-use super::present::PresentPass;
-use super::script::Press;
+use super::overlay::OverlayImage;
+use super::script::Script;
+use super::window::Running;
 
 /// Metres per second in a knot.
 const KNOT_MPS: f64 = 0.514_444;
@@ -37,8 +35,8 @@ pub struct Setup {
     pub frames: Option<u64>,
     /// Frames to write as PNG.
     pub screenshots: Vec<(u64, PathBuf)>,
-    /// Scripted key presses.
-    pub presses: Vec<Press>,
+    /// Scripted key presses and mouse drags.
+    pub script: Script,
     /// UTC time of the first frame, Unix seconds.
     pub start_unix_s: f64,
     /// Where the flight starts.
@@ -47,29 +45,16 @@ pub struct Setup {
     pub ground: HeightField,
     /// The sky's settings.
     pub config: SkySystemConfig,
-    /// The weather at the start.
-    pub field: WeatherField,
+    /// The weather at the start (moves into the sky when the window opens).
+    pub field: Option<WeatherField>,
     /// The weather file to watch and its settle time.
     pub watch: Option<(PathBuf, Duration)>,
-}
-
-/// The window, its surface and the demo host drawing into it.
-struct Running {
-    window: Arc<Window>,
-    surface: wgpu::Surface<'static>,
-    surface_config: wgpu::SurfaceConfiguration,
-    surface_view_format: wgpu::TextureFormat,
-    present: PresentPass,
-    host: DemoHost,
-    overlay: OverlayImage,
-    overlay_view: wgpu::TextureView,
 }
 
 /// The viewer: the setup, then the running window; the first error ends the loop.
 pub struct Viewer {
     setup: Setup,
     running: Option<Running>,
-    field: Option<WeatherField>,
     error: Option<anyhow::Error>,
     held: HashSet<Key>,
     dragging: Option<(f64, f64)>,
@@ -87,20 +72,10 @@ pub struct Viewer {
 
 impl Viewer {
     /// A viewer that opens its window when the event loop starts.
-    pub fn new(mut setup: Setup) -> Self {
-        let field = Some(std::mem::replace(
-            &mut setup.field,
-            WeatherField::build(
-                skycast::weather::LocalFrame::new(0.0, 0.0),
-                &[],
-                &Default::default(),
-                &Default::default(),
-            ),
-        ));
+    pub fn new(setup: Setup) -> Self {
         Self {
             setup,
             running: None,
-            field,
             error: None,
             held: HashSet::new(),
             dragging: None,
@@ -139,80 +114,6 @@ impl Viewer {
         Ok(())
     }
 
-    /// Makes the window, surface, device, ground and sky.
-    fn open(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<Running> {
-        let (width, height) = self.setup.size;
-        let attributes = Window::default_attributes()
-            .with_title("skycast view")
-            .with_inner_size(winit::dpi::PhysicalSize::new(width, height));
-        let window = Arc::new(
-            event_loop
-                .create_window(attributes)
-                .context("cannot open a window")?,
-        );
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let surface = instance
-            .create_surface(Arc::clone(&window))
-            .context("cannot draw into the window (no surface)")?;
-        let gpu = HeadlessGpu::with_instance(&instance, Some(&surface))?;
-        let caps = surface.get_capabilities(&gpu.adapter);
-        let format = *caps
-            .formats
-            .first()
-            .context("the adapter cannot present to this window")?;
-        // The present pass writes linear colour through an sRGB view, whatever the surface's
-        // own format, so the hardware encodes it as `render`'s PNG is encoded.
-        let surface_view_format = format.add_srgb_suffix();
-        let size = window.inner_size();
-        let surface_config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            format,
-            color_space: wgpu::SurfaceColorSpace::Auto,
-            width: size.width.max(1),
-            height: size.height.max(1),
-            present_mode: if self.setup.vsync {
-                wgpu::PresentMode::AutoVsync
-            } else {
-                wgpu::PresentMode::AutoNoVsync
-            },
-            desired_maximum_frame_latency: 2,
-            alpha_mode: wgpu::CompositeAlphaMode::Auto,
-            view_formats: vec![surface_view_format],
-        };
-        surface.configure(&gpu.device, &surface_config);
-        let present = PresentPass::new(&gpu.device, surface_view_format);
-        let mut host = DemoHost::with_gpu(
-            gpu,
-            surface_config.width,
-            surface_config.height,
-            &self.setup.ground,
-            self.setup.config.clone(),
-        )?;
-        if let Some(field) = self.field.take() {
-            host.sky.set_weather_field(field);
-        }
-        if let Some((path, settle)) = &self.setup.watch {
-            host.sky.set_weather(Weather::Watch {
-                path,
-                settle: *settle,
-            })?;
-            eprintln!("watching {}", path.display());
-        }
-        let overlay = OverlayImage::from_lines(&[]);
-        let overlay_view = overlay::upload(&host.gpu.device, &host.gpu.queue, &overlay);
-        Ok(Running {
-            window,
-            surface,
-            surface_config,
-            surface_view_format,
-            present,
-            host,
-            overlay,
-            overlay_view,
-        })
-    }
-
     /// A key went down (`pressed`) or up, from the keyboard or the script.
     fn key(&mut self, key: Key, pressed: bool, event_loop: &ActiveEventLoop) {
         if !pressed {
@@ -239,11 +140,15 @@ impl Viewer {
         }
     }
 
-    /// The scripted presses and releases of this frame.
+    /// The scripted presses, releases and drags of this frame.
     fn run_script(&mut self, event_loop: &ActiveEventLoop) {
         let frame = self.frame;
+        for look in self.setup.script.looks.iter().filter(|l| l.frame == frame) {
+            self.setup.aircraft.look(look.dx_px, look.dy_px);
+        }
         let events: Vec<(Key, bool)> = self
             .setup
+            .script
             .presses
             .iter()
             .filter_map(|p| {
@@ -379,61 +284,6 @@ impl Viewer {
     }
 }
 
-impl Running {
-    /// Shows `overlay` from the next present on.
-    fn set_overlay(&mut self, overlay: OverlayImage) {
-        self.overlay_view = overlay::upload(&self.host.gpu.device, &self.host.gpu.queue, &overlay);
-        self.overlay = overlay;
-    }
-
-    /// Copies the drawn frame onto the surface and presents it; false when the surface had no
-    /// texture to give this time (resized, occluded), which the next frame retries.
-    fn present_frame(&mut self) -> anyhow::Result<bool> {
-        let texture = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t)
-            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
-            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
-                return Ok(false);
-            }
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                self.surface
-                    .configure(&self.host.gpu.device, &self.surface_config);
-                return Ok(false);
-            }
-            wgpu::CurrentSurfaceTexture::Validation => {
-                anyhow::bail!("the window's surface rejected the frame (a wgpu validation error)")
-            }
-        };
-        let view = texture.texture.create_view(&wgpu::TextureViewDescriptor {
-            format: Some(self.surface_view_format),
-            ..Default::default()
-        });
-        let device = &self.host.gpu.device;
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("view.present"),
-        });
-        let inputs = (&self.host.target.colour_view, &self.overlay_view);
-        self.present.record(device, &mut encoder, inputs, &view);
-        self.host.gpu.queue.submit([encoder.finish()]);
-        self.window.pre_present_notify();
-        self.host.gpu.queue.present(texture);
-        Ok(true)
-    }
-
-    /// The window's new size: the surface and the off-screen frame follow.
-    fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
-        if width == 0 || height == 0 {
-            return Ok(());
-        }
-        self.surface_config.width = width;
-        self.surface_config.height = height;
-        self.surface
-            .configure(&self.host.gpu.device, &self.surface_config);
-        self.host.resize(width, height)?;
-        Ok(())
-    }
-}
-
 /// The viewer's key for a key of the keyboard.
 fn key_for(code: KeyCode) -> Option<Key> {
     Some(match code {
@@ -464,7 +314,7 @@ impl ApplicationHandler for Viewer {
         if self.running.is_some() {
             return;
         }
-        match self.open(event_loop) {
+        match Running::open(event_loop, &mut self.setup) {
             Ok(running) => {
                 running.window.request_redraw();
                 self.running = Some(running);

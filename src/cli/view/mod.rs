@@ -26,6 +26,7 @@ mod figures;
 mod overlay;
 mod present;
 mod script;
+mod window;
 
 pub use controls::KEYS_HELP;
 
@@ -69,7 +70,8 @@ pub struct ViewArgs {
     /// Write frame K (0 = the first) as a PNG, repeatable: K,PATH.
     #[arg(long, value_name = "K,PATH", value_parser = parse_screenshot_at)]
     pub screenshot_at: Vec<(u64, PathBuf)>,
-    /// Timed key presses (TOML: [[press]] frame, key, frames), for tests and recordings.
+    /// Timed key presses and mouse drags (TOML: [[press]] frame, key, frames; [[look]] frame,
+    /// dx_px, dy_px), for tests and recordings.
     #[arg(long)]
     pub script: Option<PathBuf>,
     /// Renderer settings (default: the shipped config/render.toml).
@@ -108,9 +110,9 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
     if !(-2_000.0..=100_000.0).contains(&args.alt_ft) {
         anyhow::bail!("--alt-ft {} is outside -2000..=100000 feet", args.alt_ft);
     }
-    let presses = match &args.script {
+    let script = match &args.script {
         Some(path) => script::load(path)?,
-        None => Vec::new(),
+        None => script::Script::default(),
     };
     // The display first: without one nothing else is worth loading.
     // winit's own reason (which variables it looked at, its source line) goes to the log: the
@@ -139,7 +141,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         vsync: !args.no_vsync,
         frames: args.frames,
         screenshots: args.screenshot_at.clone(),
-        presses,
+        script,
         start_unix_s: time_or_default(args.time)?,
         aircraft: controls::Aircraft {
             position_m: glam::DVec3::new(0.0, 0.0, args.alt_ft * METRES_PER_FOOT),
@@ -149,7 +151,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         },
         ground,
         config,
-        field,
+        field: Some(field),
         watch: watch.map(|path| (path, Duration::from_millis(500))),
     };
     let mut viewer = app::Viewer::new(setup);

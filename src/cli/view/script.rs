@@ -6,6 +6,11 @@
 //! frame = 10        # the frame the key goes down on (0 = the first)
 //! key = "Plus"      # a name from `skycast view --help` (W, Shift, PageUp, F12, ...)
 //! frames = 1        # how many frames it stays down (held keys), default 1
+//!
+//! [[look]]
+//! frame = 20        # a mouse drag on this frame
+//! dx_px = 200       # pixels right (turns right)
+//! dy_px = -50       # pixels down (negative: looks up)
 //! ```
 
 use std::path::Path;
@@ -34,6 +39,31 @@ fn one_frame() -> u64 {
 struct ScriptFile {
     #[serde(default)]
     press: Vec<PressEntry>,
+    #[serde(default)]
+    look: Vec<Look>,
+}
+
+/// A scripted mouse drag: on frame `frame`, the view turned as by a drag of `dx_px`, `dy_px`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Look {
+    /// The frame it happens on.
+    pub frame: u64,
+    /// Pixels right.
+    #[serde(default)]
+    pub dx_px: f64,
+    /// Pixels down.
+    #[serde(default)]
+    pub dy_px: f64,
+}
+
+/// A script: key presses and mouse drags.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Script {
+    /// Key presses.
+    pub presses: Vec<Press>,
+    /// Mouse drags.
+    pub looks: Vec<Look>,
 }
 
 /// A key down from frame `from` until before frame `until`.
@@ -48,17 +78,18 @@ pub struct Press {
 }
 
 /// Reads a script; an error names the file and the line (TOML) or the press and its field.
-pub fn load(path: &Path) -> anyhow::Result<Vec<Press>> {
+pub fn load(path: &Path) -> anyhow::Result<Script> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("{}: cannot read", path.display()))?;
     parse(&text, path)
 }
 
 /// Parses a script's text; `path` names it in errors.
-pub fn parse(text: &str, path: &Path) -> anyhow::Result<Vec<Press>> {
+pub fn parse(text: &str, path: &Path) -> anyhow::Result<Script> {
     let file: ScriptFile =
         toml::from_str(text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    file.press
+    let presses = file
+        .press
         .iter()
         .enumerate()
         .map(|(i, entry)| {
@@ -84,7 +115,24 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Vec<Press>> {
                 until: entry.frame.saturating_add(entry.frames),
             })
         })
-        .collect()
+        .collect::<anyhow::Result<_>>()?;
+    if let Some((i, look)) = file
+        .look
+        .iter()
+        .enumerate()
+        .find(|(_, l)| !(l.dx_px.is_finite() && l.dy_px.is_finite()))
+    {
+        anyhow::bail!(
+            "{}: look {} (frame {}): dx_px and dy_px must be numbers",
+            path.display(),
+            i + 1,
+            look.frame
+        );
+    }
+    Ok(Script {
+        presses,
+        looks: file.look,
+    })
 }
 
 #[cfg(test)]
@@ -92,12 +140,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn presses_hold_for_their_frames() {
-        let text =
-            "[[press]]\nframe = 3\nkey = \"w\"\nframes = 5\n[[press]]\nframe = 9\nkey = \"Plus\"\n";
-        let presses = parse(text, Path::new("s.toml")).unwrap();
+    fn presses_hold_for_their_frames_and_looks_turn_on_theirs() {
+        let text = "[[press]]\nframe = 3\nkey = \"w\"\nframes = 5\n\
+                    [[press]]\nframe = 9\nkey = \"Plus\"\n\
+                    [[look]]\nframe = 4\ndx_px = 20.0\n";
+        let script = parse(text, Path::new("s.toml")).unwrap();
+        let look = Look {
+            frame: 4,
+            dx_px: 20.0,
+            dy_px: 0.0,
+        };
+        assert_eq!(script.looks, [look]);
         assert_eq!(
-            presses,
+            script.presses,
             [
                 Press {
                     key: Key::W,
