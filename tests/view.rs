@@ -1,11 +1,13 @@
 //! `skycast view` in a real window: an X server of its own (Xvfb, which `make test` installs),
 //! lavapipe presenting to the window's surface. One scripted run checks that 60 frames are
 //! presented, that the time-of-day key changes the sky and that a still pose matches
-//! `skycast render` of the same pose; another that no display is a clear message and exit
-//! status 2. Small (320x180) because the software rasteriser shares two cores with other tests.
+//! `skycast render` of the same pose; one that `--watch` applies a replaced weather file while
+//! the window flies; another that no display is a clear message and exit status 2. Small (320x180) because the software rasteriser shares two cores with other tests.
 
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 /// The pose both commands draw: fair-weather cumulus over Orlando at 2 pm local.
@@ -186,6 +188,72 @@ fn the_viewer_presents_a_scripted_flight_in_a_window() {
     eprintln!("the sky's change after twelve presses of + (six hours): {sky_change:.4}");
     assert!(sky_change > 0.05, "sky change after +6 h: {sky_change:.4}");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_replaced_weather_file_reaches_the_window() {
+    let Some(x) = VirtualDisplay::start() else {
+        eprintln!(
+            "SKIPPED: Xvfb cannot be started here (make test installs it: apt-get install xvfb xauth)"
+        );
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("skycast-view-watch-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let weather = dir.join("weather.toml");
+    std::fs::copy("weather/themes/high_cirrus.toml", &weather).unwrap();
+    let mut viewer = Command::new(env!("CARGO_BIN_EXE_skycast"))
+        .args(["view", "--weather"])
+        .arg(&weather)
+        .args([
+            "--at",
+            "28.5,-81.45",
+            "--size",
+            "96x54",
+            "--no-vsync",
+            "--watch",
+        ])
+        .env("DISPLAY", &x.display)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("skycast runs");
+    let (lines_tx, lines) = mpsc::channel();
+    let stderr = BufReader::new(viewer.stderr.take().unwrap());
+    std::thread::spawn(move || {
+        for line in stderr.lines().map_while(Result::ok) {
+            if lines_tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let wait_for = |needle: &str, seen: &mut Vec<String>| -> bool {
+        let deadline = Instant::now() + Duration::from_secs(60);
+        while let Some(left) = deadline.checked_duration_since(Instant::now()) {
+            match lines.recv_timeout(left) {
+                Ok(line) => {
+                    let found = line.contains(needle);
+                    seen.push(line);
+                    if found {
+                        return true;
+                    }
+                }
+                Err(_) => return false,
+            }
+        }
+        false
+    };
+    let mut seen = Vec::new();
+    let watching = wait_for("watching", &mut seen);
+    if watching {
+        std::fs::copy("weather/themes/fair_weather_cumulus.toml", &weather).unwrap();
+    }
+    let applied = watching && wait_for("weather applied", &mut seen);
+    let _ = viewer.kill();
+    let _ = viewer.wait();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(applied, "stderr: {seen:#?}");
 }
 
 #[test]
