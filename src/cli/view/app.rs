@@ -265,8 +265,14 @@ impl Viewer {
         }
         if std::mem::take(&mut self.screenshot_requested) {
             // What the window shows, overlay included.
-            self.screenshots_taken += 1;
-            let path = PathBuf::from(format!("skycast-view-{}.png", self.screenshots_taken));
+            // The first free name: screenshots of earlier runs stay.
+            let path = loop {
+                self.screenshots_taken += 1;
+                let path = PathBuf::from(format!("skycast-view-{}.png", self.screenshots_taken));
+                if !path.exists() {
+                    break path;
+                }
+            };
             let mut frame = running.host.target.read_back(&running.host.gpu)?;
             running.overlay.composite(&mut frame);
             frame.write_png(&path)?;

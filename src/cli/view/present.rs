@@ -47,16 +47,15 @@ impl PresentPass {
         Self { pipeline, layout }
     }
 
-    /// Records the copy of `frame` (same size as the surface) with `overlay` over it onto
-    /// `surface_view`.
-    pub fn record(
+    /// The bind group of `frame` (the demo host's target, same size as the surface) and
+    /// `overlay`: made again only when either is (a resize, new figures).
+    pub fn bind(
         &self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        (frame, overlay): (&wgpu::TextureView, &wgpu::TextureView),
-        surface_view: &wgpu::TextureView,
-    ) {
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        frame: &wgpu::TextureView,
+        overlay: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("view.present_group"),
             layout: &self.layout,
             entries: &[
@@ -69,7 +68,17 @@ impl PresentPass {
                     resource: wgpu::BindingResource::TextureView(overlay),
                 },
             ],
-        });
+        })
+    }
+
+    /// Records the copy of the frame with the overlay over it (`group` from [`Self::bind`])
+    /// onto `surface_view`.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        group: &wgpu::BindGroup,
+        surface_view: &wgpu::TextureView,
+    ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("view.present"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -87,7 +96,7 @@ impl PresentPass {
             multiview_mask: None,
         });
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &group, &[]);
+        pass.set_bind_group(0, group, &[]);
         pass.draw(0..3, 0..1);
     }
 }

@@ -24,6 +24,7 @@ pub struct Running {
     pub host: DemoHost,
     pub overlay: OverlayImage,
     overlay_view: wgpu::TextureView,
+    present_group: wgpu::BindGroup,
 }
 
 impl Running {
@@ -89,6 +90,7 @@ impl Running {
         }
         let overlay = OverlayImage::from_lines(&[]);
         let overlay_view = overlay::upload(&host.gpu.device, &host.gpu.queue, &overlay);
+        let present_group = present.bind(&host.gpu.device, &host.target.colour_view, &overlay_view);
         Ok(Self {
             window,
             surface,
@@ -98,6 +100,7 @@ impl Running {
             host,
             overlay,
             overlay_view,
+            present_group,
         })
     }
 
@@ -105,6 +108,7 @@ impl Running {
     pub fn set_overlay(&mut self, overlay: OverlayImage) {
         self.overlay_view = overlay::upload(&self.host.gpu.device, &self.host.gpu.queue, &overlay);
         self.overlay = overlay;
+        self.rebind();
     }
 
     /// Copies the drawn frame onto the surface and presents it; false when the surface had no
@@ -133,8 +137,8 @@ impl Running {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("view.present"),
         });
-        let inputs = (&self.host.target.colour_view, &self.overlay_view);
-        self.present.record(device, &mut encoder, inputs, &view);
+        self.present
+            .record(&mut encoder, &self.present_group, &view);
         self.host.gpu.queue.submit([encoder.finish()]);
         self.window.pre_present_notify();
         self.host.gpu.queue.present(texture);
@@ -143,7 +147,9 @@ impl Running {
 
     /// The window's new size: the surface and the off-screen frame follow.
     pub fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
-        if width == 0 || height == 0 {
+        // Minimised (0) or unchanged (the first event of a new window): nothing to rebuild.
+        let unchanged = (width, height) == (self.surface_config.width, self.surface_config.height);
+        if width == 0 || height == 0 || unchanged {
             return Ok(());
         }
         self.surface_config.width = width;
@@ -151,6 +157,16 @@ impl Running {
         self.surface
             .configure(&self.host.gpu.device, &self.surface_config);
         self.host.resize(width, height)?;
+        self.rebind();
         Ok(())
+    }
+
+    /// The present pass's inputs changed (the frame's target or the overlay).
+    fn rebind(&mut self) {
+        self.present_group = self.present.bind(
+            &self.host.gpu.device,
+            &self.host.target.colour_view,
+            &self.overlay_view,
+        );
     }
 }
