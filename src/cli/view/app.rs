@@ -125,6 +125,16 @@ impl Viewer {
             Key::Plus => self.time_offset_s += TIME_STEP_S,
             Key::Minus => self.time_offset_s -= TIME_STEP_S,
             Key::F12 => self.screenshot_requested = true,
+            Key::I => {
+                if let Some(running) = self.running.as_mut() {
+                    let enabled = running.host.sky.settings().impostors.enabled;
+                    if !running.host.sky.set_impostors(!enabled) {
+                        eprintln!(
+                            "the impostor ring cannot be turned on: the render settings say impostors.enabled = false"
+                        );
+                    }
+                }
+            }
             Key::V => {
                 if let Some(running) = self.running.as_mut() {
                     let enabled = running.host.sky.settings().vertex_cache.enabled;
@@ -197,6 +207,7 @@ impl Viewer {
             clouds: stats.clouds_drawn,
             impostor_blocks: stats.blocks_far,
             vertex_cache: running.host.sky.settings().vertex_cache.enabled,
+            impostors: running.host.sky.settings().impostors.enabled,
             weather: running.host.sky.world().weather_over(a.position_m),
         }
     }
@@ -205,10 +216,13 @@ impl Viewer {
     fn redraw(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
         self.run_script(event_loop);
         let now = Instant::now();
-        // The first frame is the start pose, as `render` draws it (dt 0).
-        let dt_s = self
+        // The first frame is the start pose, as `render` draws it (dt 0). The flight and the
+        // clouds step at most a quarter second a frame (a stall is not a jump); the frame rate
+        // counts the real interval.
+        let interval_s = self
             .last_frame
-            .map_or(0.0, |t| now.duration_since(t).as_secs_f64().min(0.25));
+            .map_or(0.0, |t| now.duration_since(t).as_secs_f64());
+        let dt_s = interval_s.min(0.25);
         self.last_frame = Some(now);
         let Some(running) = self.running.as_mut() else {
             return Ok(());
@@ -230,10 +244,10 @@ impl Viewer {
                 Err(why) => eprintln!("weather rejected, the last good sky stays: {why}"),
             }
         }
-        if dt_s > 0.0 {
+        if interval_s > 0.0 {
             // Smoothed over about ten frames, from the first measured one.
             let weight = if self.fps == 0.0 { 1.0 } else { 0.1 };
-            self.fps += weight * (1.0 / dt_s - self.fps);
+            self.fps += weight * (1.0 / interval_s - self.fps);
         }
         // The figures four times a second (the GPU time waits for the frame), the keys on H.
         if self
@@ -308,6 +322,7 @@ fn key_for(code: KeyCode) -> Option<Key> {
         KeyCode::Digit2 => Key::Fast,
         KeyCode::Digit0 => Key::Stop,
         KeyCode::KeyV => Key::V,
+        KeyCode::KeyI => Key::I,
         KeyCode::F12 => Key::F12,
         KeyCode::KeyH => Key::H,
         KeyCode::Escape => Key::Escape,

@@ -38,6 +38,8 @@ pub enum Key {
     Stop,
     /// The vertex cache on or off.
     V,
+    /// The far-cloud impostor ring on or off.
+    I,
     /// PNG screenshot of the current frame.
     F12,
     /// The keys on screen, or not.
@@ -47,7 +49,7 @@ pub enum Key {
 }
 
 /// Every key with its name and what it does, in the order `--help` lists them.
-pub const KEYS: [(Key, &str, &str); 18] = [
+pub const KEYS: [(Key, &str, &str); 19] = [
     (Key::W, "W", "faster (hold)"),
     (Key::S, "S", "slower (hold)"),
     (Key::A, "A", "turn left (hold)"),
@@ -76,6 +78,11 @@ pub const KEYS: [(Key, &str, &str); 18] = [
         "vertex cache on/off (off: every cloud recomputed every frame)",
     ),
     (
+        Key::I,
+        "I",
+        "impostor ring on/off (off: every block drawn as sprites)",
+    ),
+    (
         Key::F12,
         "F12",
         "PNG screenshot of the current frame (skycast-view-N.png)",
@@ -94,6 +101,7 @@ Keys (mouse: drag with the left button to look around):
   1 / 2 / 0          cloud close-up speed (20 m/s) / cross-country (600 m/s) / stop
   + / -              time of day +30 / -30 minutes
   V                  vertex cache on / off (off: every cloud recomputed every frame)
+  I                  impostor ring on / off (off: every block drawn as sprites)
   F12                PNG screenshot of the current frame (skycast-view-N.png)
   H                  show or hide these keys
   Escape             quit";

@@ -37,6 +37,8 @@ pub struct Figures {
     pub impostor_blocks: u32,
     /// Whether the vertex cache is on.
     pub vertex_cache: bool,
+    /// Whether the impostor ring is on.
+    pub impostors: bool,
     /// The weather of the block the aircraft is in.
     pub weather: BlockWeather,
 }
@@ -91,14 +93,21 @@ impl Figures {
                 "{:.1} fps  sky CPU {:.1} ms{gpu}  vertex cache {}",
                 self.fps,
                 self.sky_cpu_ms,
-                if self.vertex_cache { "on" } else { "off" }
+                on_off(self.vertex_cache)
             ),
             format!(
-                "{} sprites  {} clouds  {} blocks in impostors   H: keys",
-                self.sprites, self.clouds, self.impostor_blocks
+                "{} sprites  {} clouds  impostor ring {}: {} blocks   H: keys",
+                self.sprites,
+                self.clouds,
+                on_off(self.impostors),
+                self.impostor_blocks
             ),
         ]
     }
+}
+
+fn on_off(on: bool) -> &'static str {
+    if on { "on" } else { "off" }
 }
 
 #[cfg(test)]
@@ -123,6 +132,7 @@ mod tests {
             clouds: 2_499,
             impostor_blocks: 12,
             vertex_cache: true,
+            impostors: true,
             weather: BlockWeather {
                 visibility_m: 9_999.0,
                 ..Default::default()
@@ -134,6 +144,9 @@ mod tests {
         assert_eq!(lines[2], "layers: clear");
         assert_eq!(lines[3], "visibility 10.0 km  wind 000/0 kt  0 C");
         assert_eq!(lines[4], "4.2 fps  sky CPU 3.2 ms  vertex cache on");
-        assert!(lines[5].starts_with("106987 sprites  2499 clouds  12 blocks"));
+        assert_eq!(
+            lines[5],
+            "106987 sprites  2499 clouds  impostor ring on: 12 blocks   H: keys"
+        );
     }
 }
