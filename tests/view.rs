@@ -5,7 +5,7 @@
 //! the window flies; another that no display is a clear message and exit status 2. Small (320x180) because the software rasteriser shares two cores with other tests.
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -33,49 +33,46 @@ struct VirtualDisplay {
 }
 
 impl VirtualDisplay {
-    /// Starts Xvfb on the first free display from :91; `None` where it cannot be started.
+    /// Starts Xvfb on a display it picks itself (`-displayfd`: it takes the first free one
+    /// under its own lock and writes the number when it is ready, so tests running side by side
+    /// never share a server); `None` where it cannot be started.
     fn start() -> Option<Self> {
-        for n in 91..140 {
-            if Path::new(&format!("/tmp/.X{n}-lock")).exists() {
-                continue;
+        let mut server = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "1024x768x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .ok()?;
+        let mut line = String::new();
+        let read = BufReader::new(server.stdout.take()?).read_line(&mut line);
+        match read {
+            Ok(n) if n > 0 && line.trim().parse::<u32>().is_ok() => Some(Self {
+                server,
+                display: format!(":{}", line.trim()),
+            }),
+            _ => {
+                let _ = server.kill();
+                let _ = server.wait();
+                None
             }
-            let mut server = Command::new("Xvfb")
-                .args([
-                    &format!(":{n}"),
-                    "-screen",
-                    "0",
-                    "1024x768x24",
-                    "-nolisten",
-                    "tcp",
-                ])
-                .stdout(Stdio::null())
-                .stderr(Stdio::null())
-                .spawn()
-                .ok()?;
-            let socket = PathBuf::from(format!("/tmp/.X11-unix/X{n}"));
-            let start = Instant::now();
-            while start.elapsed() < Duration::from_secs(10) {
-                if let Ok(Some(_)) = server.try_wait() {
-                    break; // Lost a race for this display: try the next.
-                }
-                if socket.exists() {
-                    return Some(Self {
-                        server,
-                        display: format!(":{n}"),
-                    });
-                }
-                std::thread::sleep(Duration::from_millis(50));
-            }
-            let _ = server.kill();
-            let _ = server.wait();
         }
-        None
     }
 }
 
 impl Drop for VirtualDisplay {
     fn drop(&mut self) {
-        let _ = self.server.kill();
+        // SIGTERM, so the server removes its lock file and socket (SIGKILL would leave them).
+        let _ = Command::new("kill")
+            .arg(self.server.id().to_string())
+            .status();
         let _ = self.server.wait();
     }
 }
