@@ -23,7 +23,7 @@ test: vulkan xvfb
 	RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 	# A simulator embedding the library compiles none of the command line's crates.
 	cargo clippy --lib --no-default-features -- -D warnings
-	! cargo tree -e normal --no-default-features | grep -E '^[^a-z]*(clap|indicatif|env_logger|anyhow|exr|winit) '
+	! cargo tree -e normal --no-default-features | grep -E '^[^a-z]*(clap|indicatif|env_logger|anyhow|exr|winit|noto-sans-mono-bitmap) '
 
 # The live-weather soak test (ignored by default): one simulated hour, a weather change every
 # five minutes; fails if memory (RSS) or the renderer's GPU buffers grow after the first changes.

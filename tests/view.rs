@@ -266,3 +266,13 @@ fn no_display_is_one_message_and_status_2() {
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+#[test]
+fn help_lists_the_keys() {
+    let out = skycast(&["view", "--help"], None);
+    let help = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    for key in ["W / S", "PageUp", "Shift", "+ / -", "F12", "Escape"] {
+        assert!(help.contains(key), "{key} missing from:\n{help}");
+    }
+}
