@@ -1,18 +1,21 @@
 # skycast: the two commands a new user runs are `make demo` and `make test`.
 # Both install Mesa's software Vulkan driver (lavapipe) first when it is missing, so they work on
-# a fresh Debian machine with no GPU.
+# a fresh Debian machine with no GPU; `make test` also installs Xvfb, the X server without a
+# screen that `skycast view`'s window test runs in.
 
 SHELL := /bin/bash
 VULKAN_PACKAGES := mesa-vulkan-drivers libvulkan1
+# Xvfb, and the X client libraries winit loads at run time (nothing is linked at build time).
+XVFB_PACKAGES := xvfb xauth libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0
 # Mesa's Vulkan loader complains on every start when this is unset; /tmp silences it.
 export XDG_RUNTIME_DIR ?= /tmp
 
-.PHONY: demo test vulkan fuzz soak pictures
+.PHONY: demo test vulkan xvfb fuzz soak pictures
 
 demo: vulkan
 	cargo run --release --quiet -- demo
 
-test: vulkan
+test: vulkan xvfb
 	cargo fmt --check
 	cargo clippy --all-targets -- -D warnings
 	cargo test --all-targets
@@ -20,7 +23,7 @@ test: vulkan
 	RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 	# A simulator embedding the library compiles none of the command line's crates.
 	cargo clippy --lib --no-default-features -- -D warnings
-	! cargo tree -e normal --no-default-features | grep -E '^[^a-z]*(clap|indicatif|env_logger|anyhow|exr) '
+	! cargo tree -e normal --no-default-features | grep -E '^[^a-z]*(clap|indicatif|env_logger|anyhow|exr|winit|noto-sans-mono-bitmap) '
 
 # The live-weather soak test (ignored by default): one simulated hour, a weather change every
 # five minutes; fails if memory (RSS) or the renderer's GPU buffers grow after the first changes.
@@ -78,5 +81,22 @@ vulkan:
 	else \
 		echo "skycast renders through Mesa's software Vulkan driver; install it with:"; \
 		echo "  sudo apt-get install -y --no-install-recommends $(VULKAN_PACKAGES)"; \
+		exit 1; \
+	fi
+
+# Installs Xvfb where missing, the same way (tests/view.rs opens `skycast view`'s window in it).
+xvfb:
+	@if command -v Xvfb >/dev/null && command -v xauth >/dev/null && \
+		/sbin/ldconfig -p | grep -q 'libxkbcommon-x11.so.0 ' && /sbin/ldconfig -p | grep -q 'libXcursor.so.1 '; then \
+		exit 0; \
+	elif [ "$$(id -u)" = 0 ]; then \
+		echo "installing the virtual X server: apt-get install $(XVFB_PACKAGES)"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $(XVFB_PACKAGES) >/dev/null; \
+	elif command -v sudo >/dev/null && sudo -n true 2>/dev/null; then \
+		echo "installing the virtual X server: sudo apt-get install $(XVFB_PACKAGES)"; \
+		sudo apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $(XVFB_PACKAGES) >/dev/null; \
+	else \
+		echo "the window test of skycast view runs in Xvfb; install it with:"; \
+		echo "  sudo apt-get install -y --no-install-recommends $(XVFB_PACKAGES)"; \
 		exit 1; \
 	fi

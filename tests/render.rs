@@ -752,7 +752,8 @@ fn changed_pixels(a: &Frame, b: &Frame) -> (usize, f32, f32) {
 }
 
 /// Near blocks are sprites, far ones are in the impostors and still show where the all-sprites
-/// frame shows them; a block beyond the 10,000 ft rule stays sprites even 30 km away.
+/// frame shows them; a block beyond the 10,000 ft rule stays sprites even 30 km away. The ring
+/// switched off and on at run time.
 #[test]
 fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     let cam_at = DVec3::new(0.0, 0.0, 1000.0);
@@ -779,6 +780,20 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     assert!(stats.ring_gpu_bytes >= 2 * 8 * 256 * 256 * 4, "{stats:?}");
 
     assert_far_cloud_where_sprites_have_it(&sprites_only, &ring, &bare, 4.0);
+
+    // Switched off at run time (`skycast view`'s key): every block sprites, as in a sky made
+    // without the ring; on again: built afresh at once.
+    assert!(rig.host.sky.set_impostors(false));
+    let (off, stats) = rig.frame("ring_switched_off", &cam);
+    assert_eq!((stats.blocks_near, stats.blocks_far), (3, 0), "{stats:?}");
+    assert_eq!(stats.sprites_drawn, 180, "{stats:?}");
+    assert_eq!(changed_pixels(&off, &sprites_only).0, 0);
+    assert!(rig.host.sky.set_impostors(true));
+    let (_, stats) = rig.frame("ring_switched_on", &cam);
+    assert_eq!(stats.impostors_rebuilt, 8, "{stats:?}");
+    assert_eq!((stats.blocks_near, stats.blocks_far), (2, 1), "{stats:?}");
+    // A sky made without the ring has no textures to turn it on with.
+    assert!(!plain.host.sky.set_impostors(true));
 }
 
 /// The far cloud (what `sprites` and `ring` add to `bare`) shows in the impostor with about the

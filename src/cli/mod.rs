@@ -13,6 +13,8 @@ mod metar;
 mod preview;
 mod render;
 mod sheet;
+#[cfg(feature = "view")]
+mod view;
 mod weather;
 
 /// skycast: a cloud and weather sky for flight simulators.
@@ -40,6 +42,10 @@ enum Command {
     Render(render::RenderArgs),
     /// Flies a scripted path through real weather: frames, frames.csv and a progress bar.
     Fly(fly::FlyArgs),
+    /// Flies through real weather in a window (mouse and keys; needs a display).
+    #[cfg(feature = "view")]
+    #[command(after_help = view::KEYS_HELP)]
+    View(view::ViewArgs),
     /// Draws one block of a cloud type (or of every type) to a PNG, on the CPU.
     Preview(preview::PreviewArgs),
     /// The cloud block at a place: its layers and types, clouds, sprites and overdraw.
@@ -77,6 +83,8 @@ pub fn main() -> ExitCode {
         Command::Demo(args) => demo::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Fly(args) => fly::run(&args),
+        #[cfg(feature = "view")]
+        Command::View(args) => view::run(&args),
         Command::Sheet(args) => sheet::run(&args),
         Command::Preview(args) => preview::run(&args),
         Command::Block(args) => block::run(&args),

@@ -27,6 +27,8 @@ pub struct HeadlessGpu {
     pub queue: wgpu::Queue,
     /// The adapter's name, backend and type.
     pub adapter_info: wgpu::AdapterInfo,
+    /// The adapter (what a window's surface asks for its formats and present modes).
+    pub adapter: wgpu::Adapter,
     depth_copies: bool,
 }
 
@@ -36,10 +38,20 @@ impl HeadlessGpu {
     pub fn new() -> Result<Self, RenderError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Self::with_instance(&instance, None)
+    }
+
+    /// Creates a device from `instance` on the best adapter that can present to
+    /// `compatible_surface` where one is given (a window's: `skycast view` draws the same
+    /// off-screen frame as the headless host and shows it there).
+    pub fn with_instance(
+        instance: &wgpu::Instance,
+        compatible_surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Self, RenderError> {
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::from_env().unwrap_or_default(),
             force_fallback_adapter: false,
-            compatible_surface: None,
+            compatible_surface,
             apply_limit_buckets: false,
         }))
         .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
@@ -75,6 +87,7 @@ impl HeadlessGpu {
             device,
             queue,
             adapter_info,
+            adapter,
             depth_copies,
         })
     }

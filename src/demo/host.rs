@@ -107,7 +107,17 @@ impl DemoHost {
         ground: &HeightField,
         sky: impl Into<SkySystemConfig>,
     ) -> Result<Self, SkyError> {
-        let gpu = HeadlessGpu::new()?;
+        Self::with_gpu(HeadlessGpu::new()?, width, height, ground, sky)
+    }
+
+    /// [`Self::new`] on a device the caller made (one that can also present to a window).
+    pub fn with_gpu(
+        gpu: HeadlessGpu,
+        width: u32,
+        height: u32,
+        ground: &HeightField,
+        sky: impl Into<SkySystemConfig>,
+    ) -> Result<Self, SkyError> {
         let target = OffscreenTarget::new(&gpu, width, height)?;
         let terrain = Terrain::new(&gpu.device, headless::COLOUR_FORMAT, ground);
         let mut config: SkySystemConfig = sky.into();
@@ -121,6 +131,13 @@ impl DemoHost {
             sky,
             timer,
         })
+    }
+
+    /// Rebuilds the off-screen target at a new size (a window resized); the ground and the sky
+    /// keep everything else.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+        self.target = OffscreenTarget::new(&self.gpu, width, height)?;
+        Ok(())
     }
 
     /// A camera with the sky's projection settings and this target's aspect.

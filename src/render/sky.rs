@@ -516,6 +516,17 @@ impl Sky {
         &self.settings
     }
 
+    /// Turns the far-cloud impostor ring off (every block drawn as sprites) or back on (built
+    /// afresh). Returns false and changes nothing when turning it on in a sky made with
+    /// `impostors.enabled = false`: the ring's textures are made at start-up only.
+    pub fn set_impostors(&mut self, enabled: bool) -> bool {
+        let switched = self.ring.set_enabled(enabled);
+        if switched {
+            self.settings.impostors.enabled = enabled;
+        }
+        switched
+    }
+
     /// Turns the vertex cache on or off (off: every cloud recomputed every frame).
     pub fn set_vertex_cache(&mut self, enabled: bool) {
         self.settings.vertex_cache.enabled = enabled;

@@ -395,6 +395,20 @@ impl ImpostorRing {
         }
     }
 
+    /// Switches the ring off (every block drawn as sprites) or back on (built afresh from the
+    /// next frame, as at the start). Returns false and changes nothing when turning on a ring
+    /// made without impostors: their textures are made at start-up only.
+    pub fn set_enabled(&mut self, enabled: bool) -> bool {
+        if enabled && self.views.is_empty() {
+            return false;
+        }
+        self.settings.enabled = enabled;
+        self.shown = None;
+        self.fade = None;
+        self.build = None;
+        true
+    }
+
     /// Bytes of the ring's textures and buffers.
     pub fn gpu_bytes(&self) -> u64 {
         self.bytes
