@@ -164,14 +164,24 @@ mod tests {
             }
             assert_eq!(last, 0.0, "rf {rf} does not finish");
         }
+        let mut fading = 0;
         for k in 0..=200 {
             let q = k as f32 / 200.0;
             // Inner sprites only start once the outer ones are gone.
             if dissipation_alpha(q, 0.2, &c) < 1.0 {
                 assert_eq!(dissipation_alpha(q, 0.9, &c), 0.0);
             }
-            // Nearer the edge, more transparent.
-            assert!(dissipation_alpha(q, 0.4, &c) <= dissipation_alpha(q, 0.1, &c));
+            // Nearer the edge, more transparent: strictly, while the inner sprites fade (before
+            // that both are 1, after it both are 0). Fails without the `edge` term.
+            let (outer, inner) = (dissipation_alpha(q, 0.4, &c), dissipation_alpha(q, 0.1, &c));
+            if inner > 0.0 && inner < 1.0 {
+                assert!(outer < inner, "q {q}: rf 0.4 {outer}, rf 0.1 {inner}");
+                fading += 1;
+            } else {
+                assert_eq!(outer.min(1.0 - outer), 0.0, "q {q}: rf 0.4 {outer}");
+            }
         }
+        // The inner sprites fade over the last half of the dissipation: about 100 of 200 steps.
+        assert!(fading >= 80, "only {fading} steps fade the inner sprites");
     }
 }
