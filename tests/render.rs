@@ -933,14 +933,17 @@ fn median(mut v: Vec<f32>) -> f32 {
     v[v.len() / 2]
 }
 
-/// Popping, measured: frames during a rebuild or crossfade change no more than 1.5x the median
-/// change of plain motion frames; with the crossfade off, the switch frames exceed it.
+/// Popping, measured: no frame of the flight, rebuilding, crossfading, swapping rings or plain,
+/// changes more than 1.5x the median change of plain motion frames. The negative control: with
+/// the crossfade off the swap frames exceed it, so a crossfade that never blends (the old ring
+/// shown until the swap, `return before;` in `fs_impostor`) fails here, on its swap frame.
 #[test]
 fn ring_rebuilds_do_not_pop() {
     let run = popping_run(0.5);
     let plain = median(run.iter().filter(|c| !c.1).map(|c| c.0).collect());
-    let worst = run.iter().filter(|c| c.1).map(|c| c.0).fold(0.0, f32::max);
-    eprintln!("crossfade: plain median {plain}, worst rebuild/fade {worst}, {run:?}");
+    // Over every frame: the swap to the new ring reports weight 0, so it is not flagged.
+    let worst = run.iter().map(|c| c.0).fold(0.0, f32::max);
+    eprintln!("crossfade: plain median {plain}, worst {worst}, {run:?}");
     let hard = popping_run(0.0);
     let hard_plain = median(hard.iter().filter(|c| !c.1).map(|c| c.0).collect());
     let hard_worst = hard.iter().map(|c| c.0).fold(0.0, f32::max);
@@ -948,7 +951,7 @@ fn ring_rebuilds_do_not_pop() {
     assert!(run.iter().filter(|c| c.1).count() >= 20, "{run:?}");
     assert!(
         worst <= 1.5 * plain,
-        "crossfaded rebuilds pop: {worst} vs median {plain}"
+        "a frame pops: {worst} vs median {plain}"
     );
     assert!(
         hard_worst > 1.5 * hard_plain,
