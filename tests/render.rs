@@ -443,10 +443,15 @@ fn render_command_writes_png_and_exr() {
         String::from_utf8_lossy(&out.stderr)
     );
     let said = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        said.contains("above the ground") && said.contains("sprites"),
-        "{said}"
-    );
+    assert!(said.contains("above the ground"), "{said}");
+    // "525 clouds, 14616 sprites" measured: the deck is drawn, not just mentioned.
+    let sprites: u32 = said
+        .split(" sprites")
+        .next()
+        .and_then(|s| s.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no sprite count: {said}"));
+    assert!(sprites >= 7000, "{sprites} sprites drawn: {said}");
     let img = image::open(&png).unwrap().to_rgba8();
     assert_eq!(img.dimensions(), (160, 90));
     // Looking 20 degrees up under OVC020: the upper half is grey cloud, hardly any blue sky
@@ -461,6 +466,21 @@ fn render_command_writes_png_and_exr() {
         "{blue} of {} upper pixels are blue sky",
         upper.len()
     );
+    // Grey and bright, not merely not blue: a black frame fails (measured: mean luma 187 of 255,
+    // every pixel within 30 levels of grey).
+    let luma =
+        |p: &&image::Rgba<u8>| 0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32;
+    let mean = upper.iter().map(luma).sum::<f32>() / upper.len() as f32;
+    let grey = upper
+        .iter()
+        .filter(|p| (p[0] as i32 - p[2] as i32).abs() < 30)
+        .count();
+    assert!(mean > 140.0 && mean < 240.0, "upper half mean luma {mean}");
+    assert!(
+        grey * 10 >= upper.len() * 9,
+        "{grey} of {} upper pixels grey",
+        upper.len()
+    );
     use exr::prelude::*;
     let layers = read_all_flat_layers_from_file(&exr).unwrap();
     let names: Vec<String> = layers.layer_data[0]
@@ -470,6 +490,33 @@ fn render_command_writes_png_and_exr() {
         .map(|c| c.name.to_string())
         .collect();
     assert_eq!(names, ["A", "B", "G", "R", "Z"]);
+    // The EXR holds the PNG's picture in linear light (within the 8-bit rounding: measured
+    // 0.5 of a level) and the depth in metres: the ground 217 m below fills the bottom row
+    // (measured at most 1,166 m), the clouds write no depth (the top row is the far plane).
+    let channel = |k: usize| -> Vec<f32> {
+        let samples = &layers.layer_data[0].channel_data.list[k].sample_data;
+        (0..samples.len())
+            .map(|i| samples.value_by_flat_index(i).to_f32())
+            .collect()
+    };
+    let (a, b, g, r, z) = (channel(0), channel(1), channel(2), channel(3), channel(4));
+    let srgb = |x: f32| skycast::render::output::linear_to_srgb(x) * 255.0;
+    for (i, p) in img.pixels().enumerate() {
+        let exr = [srgb(r[i]), srgb(g[i]), srgb(b[i])];
+        for c in 0..3 {
+            assert!(
+                (exr[c] - p[c] as f32).abs() <= 1.0,
+                "pixel {i}: EXR {exr:?}, PNG {p:?}"
+            );
+        }
+        assert_eq!(a[i], 1.0, "pixel {i}");
+    }
+    let bottom_row = &z[160 * 89..];
+    assert!(
+        bottom_row.iter().all(|&d| d > 216.0 && d < 2500.0),
+        "{bottom_row:?}"
+    );
+    assert!(z[..160].iter().all(|&d| d == 160_000.0), "{:?}", &z[..160]);
     let bad = run(&[
         "--alt-ft",
         "1500",
