@@ -149,6 +149,17 @@ mod tests {
                 assert!(formation_alpha(p, 0.1, &c) >= c.outer_start_opacity);
             }
         }
+        // And they start as soon as the inner ones pass it: within a step (0.01 of opacity).
+        let first = (0..=200)
+            .map(|k| k as f32 / 200.0)
+            .find(|&p| formation_alpha(p, 0.9, &c) > 0.0)
+            .unwrap();
+        let inner = formation_alpha(first, 0.1, &c);
+        assert!(
+            inner - c.outer_start_opacity <= 0.011,
+            "outer sprites start at inner opacity {inner}, not {}",
+            c.outer_start_opacity
+        );
     }
 
     #[test]
