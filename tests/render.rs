@@ -718,11 +718,13 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     assert_eq!(stats.sprites_drawn, 120, "{stats:?}");
     assert!(stats.ring_gpu_bytes >= 2 * 8 * 256 * 256 * 4, "{stats:?}");
 
-    assert_far_cloud_where_sprites_have_it(&sprites_only, &ring, &bare, 4.0);
+    // Measured 0.05 px off.
+    assert_far_cloud_where_sprites_have_it(&sprites_only, &ring, &bare, 0.2);
 }
 
 /// The far cloud (what `sprites` and `ring` add to `bare`) shows in the impostor with about the
-/// pixels it has as sprites (0.6-1.5x), its centroid within `tolerance_px` of theirs.
+/// pixels it has as sprites (0.9-1.1x; measured 0.98-1.02x), its centroid within `tolerance_px`
+/// of theirs.
 fn assert_far_cloud_where_sprites_have_it(
     sprites: &Frame,
     ring: &Frame,
@@ -734,7 +736,7 @@ fn assert_far_cloud_where_sprites_have_it(
     eprintln!("far cloud: sprites {n_s} px at ({x_s}, {y_s}); ring {n_r} px at ({x_r}, {y_r})");
     assert!(n_s > 150, "the far cloud shows as sprites: {n_s} px");
     assert!(
-        n_r as f32 > 0.6 * n_s as f32 && (n_r as f32) < 1.5 * n_s as f32,
+        n_r as f32 > 0.9 * n_s as f32 && (n_r as f32) < 1.1 * n_s as f32,
         "the far cloud shows in the impostor: {n_r} px vs {n_s} as sprites"
     );
     assert!(
@@ -746,7 +748,7 @@ fn assert_far_cloud_where_sprites_have_it(
 /// Wang translates the impostors vertically with the angle between clouds and camera. Here each
 /// pixel's ray is reprojected to the clouds' stored depth, which does that and more: after a
 /// climb of 2,000 m with no rebuild (climb threshold raised), the far cloud sits 30 km out where
-/// the all-sprites frame has it (within 0.1 px here), not where the quad at the 20 km radius
+/// the all-sprites frame has it (within 0.25 px here), not where the quad at the 20 km radius
 /// would put it: with the reprojection switched off in `impostor_quad.wgsl` (`dist` held at the
 /// ring radius) it lands 4.9 rows lower and this test fails.
 #[test]
@@ -793,7 +795,8 @@ fn ring_moves_far_clouds_with_the_camera_height() {
     );
     assert_eq!((stats.blocks_near, stats.blocks_far), (1, 1), "{stats:?}");
 
-    assert_far_cloud_where_sprites_have_it(&sprites, &ring, &bare, 3.0);
+    // Measured 0.25 px off.
+    assert_far_cloud_where_sprites_have_it(&sprites, &ring, &bare, 0.5);
 }
 
 /// Moving past 15% of the ring radius rebuilds the ring one impostor per frame over 8 frames,
