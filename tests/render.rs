@@ -750,7 +750,7 @@ fn assert_far_cloud_where_sprites_have_it(
 /// climb of 2,000 m with no rebuild (climb threshold raised), the far cloud sits 30 km out where
 /// the all-sprites frame has it (within 0.25 px here), not where the quad at the 20 km radius
 /// would put it: with the reprojection switched off in `impostor_quad.wgsl` (`dist` held at the
-/// ring radius) it lands 4.9 rows lower and this test fails.
+/// ring radius) it lands 3.4 rows lower with 20% fewer pixels and this test fails.
 #[test]
 fn ring_moves_far_clouds_with_the_camera_height() {
     let blocks = |with_far: bool| {
@@ -930,7 +930,7 @@ fn ring_depth_puts_a_far_mountain_between_impostored_clouds() {
         "the cloud behind the ridge shows above it: {right_sky} px"
     );
     // Without the stored depth (the quad's own depth, 20 km) it would cover the ridge: this test
-    // fails with `along = 1.0` in impostor_quad.wgsl (126 px on the ridge).
+    // fails with `dist = ring.size.x / max(at.w, 1e-3);` in `ring_sample` (128 px on the ridge).
 }
 
 /// Mean absolute luminance change per frame along a slow straight flight across several ring
