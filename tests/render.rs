@@ -635,6 +635,19 @@ fn fly_command_writes_frames_and_csv() {
             .all(|r| r[column("clouds_recomputed")].parse::<u32>().is_ok())
     );
     assert!(dir.join("frame_00000.png").exists() && dir.join("frame_00006.png").exists());
+    // The closing summary quotes the frames' own numbers: its median sky CPU is the column's.
+    let said = String::from_utf8_lossy(&out.stdout);
+    let mut cpu: Vec<u64> = rows[1..]
+        .iter()
+        .map(|r| r[column("sky_cpu_us")].parse().unwrap())
+        .collect();
+    cpu.sort_unstable();
+    let median = format!("sky CPU a frame: median {} us", cpu[3]);
+    assert!(said.contains(&median), "{median}: {said}");
+    assert!(
+        said.contains("peak memory (RSS): ") && said.contains(" MB"),
+        "{said}"
+    );
 }
 
 /// `cumulus` scaled up `scale` times (a far cloud big enough to see at 30 km in 320 x 180).
