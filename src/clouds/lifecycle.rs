@@ -194,5 +194,12 @@ mod tests {
         }
         // The inner sprites fade over the last half of the dissipation: about 100 of 200 steps.
         assert!(fading >= 80, "only {fading} steps fade the inner sprites");
+        // The ones at the inner radius (inner ones: untouched over the first half) are gone at
+        // q = 0.75, the centre at q = 1.
+        let at_inner = c.inner_radius_fraction;
+        assert_eq!(dissipation_alpha(0.45, at_inner, &c), 1.0);
+        assert!(dissipation_alpha(0.74, at_inner, &c) > 0.0);
+        assert_eq!(dissipation_alpha(0.75, at_inner, &c), 0.0);
+        assert!(dissipation_alpha(0.99, 0.0, &c) > 0.0);
     }
 }
