@@ -564,6 +564,8 @@ mod tests {
         // A small change (half an okta) re-forms nothing.
         field.update(DVec2::ZERO, &|_| weather(2.5));
         assert_eq!(field.pending(), 0);
+        // Some way into the flight: the change's own times start at this field time, not at 0.
+        field.advance(100.0);
         field.update(DVec2::ZERO, &|_| weather(6.0));
         field.wait_for_pending();
         let config = CloudsConfig::builtin().lifecycle;
