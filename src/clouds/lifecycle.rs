@@ -162,6 +162,22 @@ mod tests {
         );
     }
 
+    /// What the renderer fades by (`Fade::Forming(progress)`): from the phase's own start to its
+    /// end, 1 once settled or gone.
+    #[test]
+    fn progress_runs_from_the_phase_start_to_its_end() {
+        let c = config();
+        let (f, d) = (c.formation_s as f64, c.dissipation_s as f64);
+        let forming = Phase::Forming { since_s: 100.0 };
+        assert_eq!(progress(forming, 100.0, &c), 0.0);
+        assert_eq!(progress(forming, 100.0 + 0.25 * f, &c), 0.25);
+        assert_eq!(progress(forming, 100.0 + 2.0 * f, &c), 1.0);
+        let dissipating = Phase::Dissipating { since_s: 100.0 };
+        assert_eq!(progress(dissipating, 100.0 + 0.5 * d, &c), 0.5);
+        assert_eq!(progress(Phase::Steady, 0.0, &c), 1.0);
+        assert_eq!(progress(Phase::Gone, 0.0, &c), 1.0);
+    }
+
     #[test]
     fn dissipation_is_monotonic_complete_outer_first_and_edges_faster() {
         let c = config();
