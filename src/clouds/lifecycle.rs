@@ -162,6 +162,78 @@ mod tests {
         );
     }
 
+    /// The largest cloud of a generated cumulus block.
+    fn a_cloud() -> Cloud {
+        use crate::weather::{BlockIndex, BlockLayer, BlockWeather, CloudType, TypeSource};
+        let weather = BlockWeather {
+            layers: vec![BlockLayer {
+                cloud_type: CloudType::CumulusMediocris,
+                type_source: TypeSource::HeightRule,
+                coverage_oktas: 4.0,
+                base_ft_agl: 3000.0,
+                thickness_ft: 2000.0,
+            }],
+            ..Default::default()
+        };
+        let types = crate::clouds::CloudTypes::builtin();
+        let block = crate::clouds::generate_block(BlockIndex::new(0, 0), &weather, 7, &types);
+        block
+            .clouds
+            .into_iter()
+            .max_by_key(|c| c.sprites.len())
+            .unwrap()
+    }
+
+    /// `apply` (the CPU pictures, `skycast preview --lifecycle`) sets each sprite's opacity for
+    /// the progress since the phase's own start, and moves on only at the end: Forming becomes
+    /// Steady at `formation_s`, Dissipating becomes Gone at `dissipation_s`. `alpha_at` says the
+    /// same without a cloud.
+    #[test]
+    fn apply_fades_the_sprites_and_ends_the_phase_on_time() {
+        let c = config();
+        let mut cloud = a_cloud();
+        let (f, d) = (c.formation_s as f64, c.dissipation_s as f64);
+        let forming = Phase::Forming { since_s: 100.0 };
+        assert_eq!(apply(&mut cloud, forming, 100.0 + 0.3 * f, &c), forming);
+        for s in &cloud.sprites {
+            let want = formation_alpha(0.3, s.radius_fraction, &c);
+            assert!(
+                (s.alpha_morph - want).abs() < 1e-5,
+                "{} vs {want}",
+                s.alpha_morph
+            );
+            let at = alpha_at(forming, 100.0 + 0.3 * f, s.radius_fraction, &c);
+            assert!((at - want).abs() < 1e-5, "{at} vs {want}");
+        }
+        assert!(
+            cloud
+                .sprites
+                .iter()
+                .any(|s| s.alpha_morph > 0.0 && s.alpha_morph < 1.0)
+        );
+        assert_eq!(apply(&mut cloud, forming, 99.0 + f, &c), forming);
+        assert_eq!(apply(&mut cloud, forming, 100.0 + f, &c), Phase::Steady);
+        assert!(cloud.sprites.iter().all(|s| s.alpha_morph == 1.0));
+        let dissipating = Phase::Dissipating { since_s: 100.0 };
+        assert_eq!(
+            apply(&mut cloud, dissipating, 100.0 + 0.6 * d, &c),
+            dissipating
+        );
+        for s in &cloud.sprites {
+            let want = dissipation_alpha(0.6, s.radius_fraction, &c);
+            assert!(
+                (s.alpha_morph - want).abs() < 1e-5,
+                "{} vs {want}",
+                s.alpha_morph
+            );
+        }
+        assert_eq!(apply(&mut cloud, dissipating, 99.0 + d, &c), dissipating);
+        assert_eq!(apply(&mut cloud, dissipating, 100.0 + d, &c), Phase::Gone);
+        assert!(cloud.sprites.iter().all(|s| s.alpha_morph == 0.0));
+        assert_eq!(alpha_at(Phase::Steady, 0.0, 0.9, &c), 1.0);
+        assert_eq!(alpha_at(Phase::Gone, 0.0, 0.1, &c), 0.0);
+    }
+
     /// What the renderer fades by (`Fade::Forming(progress)`): from the phase's own start to its
     /// end, 1 once settled or gone.
     #[test]
