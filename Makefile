@@ -41,6 +41,7 @@ pictures: vulkan
 	$(THEME) --weather weather/themes/building_cumulus_cb_line.toml --alt-ft 3000 --heading 90 --pitch 8 --out tests/pictures/themes/building_cumulus_cb_line.png
 	$(THEME) --weather weather/themes/low_stratus_and_fog.toml --alt-ft 2600 --heading 90 --pitch -8 --out tests/pictures/themes/low_stratus_and_fog.png
 	$(THEME) --weather weather/themes/frontal_nimbostratus.toml --alt-ft 900 --heading 90 --pitch 8 --out tests/pictures/themes/frontal_nimbostratus.png
+	$(THEME) --weather weather/themes/thunderstorm_cells.toml --alt-ft 1500 --heading 90 --pitch 3 --out tests/pictures/themes/thunderstorm_cells.png
 	$(THEME) --weather weather/themes/high_cirrus.toml --alt-ft 5000 --heading 205 --pitch 20 --out tests/pictures/themes/high_cirrus.png
 	$(FRAME) --weather $(METARS) --at 33.90,-118.36 --alt-ft 3000 --heading 135 --pitch 8 --out tests/pictures/frames/cruise_under_cumulus.png
 	$(FRAME) --weather $(METARS) --at 33.90,-118.36 --alt-ft 5500 --heading 135 --pitch -8 --out tests/pictures/frames/cruise_over_cumulus.png

@@ -11,10 +11,11 @@
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use skycast::demo::{DemoHost, headless};
 use skycast::flight::FlightPlan;
+use skycast::flight::world::{World, WorldSettings};
 use skycast::render::draw_list::sprites_back_to_front;
-use skycast::render::world::{World, WorldSettings};
-use skycast::render::{Camera, DemoHost, SkyBlock, SkyConfig, headless};
+use skycast::render::{Camera, SkyBlock, SkyConfig};
 use skycast::shading::{SunPosition, TimeOfDayTable, sun_position};
 use skycast::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
 use skycast::weather::{LocalFrame, StationTable, files};
@@ -61,7 +62,7 @@ fn cruise() -> Cruise {
     let mut host = DemoHost::new(
         32,
         18,
-        &skycast::render::demo_ground(world.field(), &Default::default()),
+        &skycast::demo::demo_ground(world.field(), &Default::default()),
         SkyConfig {
             targets: headless::TARGETS,
             settings: Default::default(),

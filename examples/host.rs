@@ -1,138 +1,248 @@
 //! A complete host: its own device, colour and depth, its own ground, and skycast's sky in one
-//! object. `cargo run --example host -- [standard|reversed|msaa] [out.png]`.
-use glam::Vec3;
+//! object. `cargo run --example host -- [standard|reversed|msaa] [out.png]`
 use glam::camera::rh::{proj::directx as proj, view::look_at_mat4};
-use skycast::flight::{HostCamera, HostPosition, SkySystem, Weather};
-use skycast::render::HostTargets;
+use glam::{Mat4, Vec3};
+use skycast::{HostCamera, HostPosition, HostTargets, SkySystem, Weather};
+use wgpu::{TextureFormat, TextureUsages as Usage, util::DeviceExt};
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 
-/// The pose both this host and `skycast render` draw: under the fair-weather cumulus theme.
+/// Under the fair-weather cumulus theme near Los Angeles, looking up a little; 320 x 180.
 pub const THEME: &str = "weather/themes/fair_weather_cumulus.toml";
 pub const AT: (f64, f64) = (34.0, -118.4);
 pub const ALT_M: f64 = 800.0;
-pub const W: u32 = 320;
-pub const H: u32 = 180;
 pub const HEADING_DEG: f64 = 30.0;
 pub const PITCH_DEG: f64 = 12.0;
+pub const W: u32 = 320;
+pub const H: u32 = 180;
 pub const UNIX_S: f64 = 1_738_015_200.0; // 2025-01-27T22:00:00Z
 
-/// A drawn frame: sRGB bytes, and whether the host's depth was the same after the sky.
-pub struct HostFrame {
-    pub rgba8: Vec<u8>,
-    pub depth_unchanged: Option<bool>,
+/// The host's ground: a 120 km square at sea level, one colour.
+const GROUND: &str = "@group(0) @binding(0) var<uniform> view_proj: mat4x4<f32>;
+@vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+  let corner = vec2(f32(i & 1u), f32(i >> 1u)) * 2.0 - 1.0;
+  return view_proj * vec4(corner * 60000.0, -ALT, 1.0); }
+@fragment fn fs() -> @location(0) vec4<f32> { return vec4(0.18, 0.24, 0.12, 1.0); }";
+
+/// A simulator's renderer in miniature: device, targets, ground pipeline, and the sky.
+pub struct Host {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub sky: SkySystem,
+    pub targets: HostTargets,
+    pub colour: wgpu::Texture,
+    pub depth: wgpu::Texture,
+    /// The single-sample copy of `colour` (itself when not multisampled).
+    pub resolved: wgpu::Texture,
+    ground: (wgpu::RenderPipeline, wgpu::BindGroup),
+    camera: HostCamera,
 }
 
-const GROUND_WGSL: &str = "@group(0) @binding(0) var<uniform> u: mat4x4<f32>;
-@vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-  let c = array(vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
-  return u * vec4<f32>(c[i] * 60000.0, -ALT, 1.0); }
-@fragment fn fs() -> @location(0) vec4<f32> { return vec4<f32>(0.18, 0.24, 0.12, 1.0); }";
-
-/// Draws one frame with the host's depth `mode`: standard, reversed (infinite far), or msaa.
-pub fn run(mode: &str, weather: Option<&std::path::Path>) -> Result<HostFrame> {
-    let (reversed, samples) = (mode == "reversed", if mode == "msaa" { 4 } else { 1 });
-    let instance =
-        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
-    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-        required_limits: wgpu::Limits {
+impl Host {
+    /// `mode`: "standard" Z, "reversed" Z with an infinite far plane, or "msaa" (4 samples).
+    pub fn new(mode: &str, weather: Option<&std::path::Path>) -> Result<Self> {
+        let (reversed, samples) = (mode == "reversed", if mode == "msaa" { 4 } else { 1 });
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
+        let limits = wgpu::Limits {
             max_storage_buffers_per_shader_stage: 8,
             ..wgpu::Limits::downlevel_defaults()
-        },
-        ..Default::default()
-    }))?;
-    let targets = HostTargets {
-        reversed_z: reversed,
-        sample_count: samples,
-        ..Default::default()
-    };
-    let texture = |format, samples, usage| {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: None,
-            size: wgpu::Extent3d {
+        };
+        let descriptor = wgpu::DeviceDescriptor {
+            required_limits: limits,
+            ..Default::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))?;
+        let targets = HostTargets {
+            reversed_z: reversed,
+            sample_count: samples,
+            ..Default::default()
+        };
+        let texture = |format: TextureFormat, sample_count, usage| {
+            let size = wgpu::Extent3d {
                 width: W,
                 height: H,
                 depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: samples,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
-        })
-    };
-    use wgpu::TextureUsages as U;
-    let colour = texture(
-        targets.colour_format,
-        samples,
-        U::RENDER_ATTACHMENT | U::COPY_SRC,
-    );
-    let resolved = texture(targets.colour_format, 1, U::RENDER_ATTACHMENT | U::COPY_SRC);
-    let depth = texture(
-        targets.depth_format,
-        samples,
-        U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
-    );
-    let (colour_view, depth_view) = (
-        colour.create_view(&Default::default()),
-        depth.create_view(&Default::default()),
-    );
+            };
+            let (dimension, mip_level_count, view_formats) =
+                (wgpu::TextureDimension::D2, 1, &[][..]);
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: None,
+                size,
+                mip_level_count,
+                sample_count,
+                dimension,
+                format,
+                usage,
+                view_formats,
+            })
+        };
+        let colour = texture(
+            targets.colour_format,
+            samples,
+            Usage::RENDER_ATTACHMENT | Usage::COPY_SRC,
+        );
+        let resolved = texture(
+            targets.colour_format,
+            1,
+            Usage::RENDER_ATTACHMENT | Usage::COPY_SRC,
+        );
+        // The sky reads the host's depth as a texture (never writes it).
+        let depth = texture(
+            targets.depth_format,
+            samples,
+            Usage::RENDER_ATTACHMENT | Usage::TEXTURE_BINDING | Usage::COPY_SRC,
+        );
 
-    // The sky: one object, built on this host's device for its targets.
-    let mut sky = SkySystem::new(&device, &queue, targets, AT)?;
-    sky.world_mut().set_synchronous_clouds(true); // the same frame every run, for the test
-    if let Some(path) = weather {
-        sky.set_weather(Weather::File(path))?;
-    }
-    let h = HEADING_DEG.to_radians();
-    let p = PITCH_DEG.to_radians();
-    let forward = Vec3::new(
-        (h.sin() * p.cos()) as f32,
-        (h.cos() * p.cos()) as f32,
-        p.sin() as f32,
-    );
-    let view = look_at_mat4(Vec3::ZERO, forward, Vec3::Z);
-    let (fov, aspect) = (50f32.to_radians(), W as f32 / H as f32);
-    let projection = if reversed {
-        proj::perspective_infinite_reverse(fov, aspect, 1.0)
-    } else {
-        proj::perspective(fov, aspect, 1.0, 300_000.0)
-    };
-    let camera = HostCamera {
-        position: HostPosition::LatLonAlt {
+        // The sky: one object on the host's device, for the host's targets.
+        let mut sky = SkySystem::new(&device, &queue, targets, AT)?;
+        sky.world_mut().set_synchronous_clouds(true); // the same frame every run, for the test
+        if let Some(path) = weather {
+            sky.set_weather(Weather::File(path))?;
+        }
+        let (h, p) = (
+            HEADING_DEG.to_radians() as f32,
+            PITCH_DEG.to_radians() as f32,
+        );
+        let forward = Vec3::new(h.sin() * p.cos(), h.cos() * p.cos(), p.sin());
+        let (fov, aspect) = (50f32.to_radians(), W as f32 / H as f32);
+        let projection = match reversed {
+            true => proj::perspective_infinite_reverse(fov, aspect, 1.0),
+            false => proj::perspective(fov, aspect, 1.0, 300_000.0),
+        };
+        let position = HostPosition::LatLonAlt {
             lat_deg: AT.0,
             lon_deg: AT.1,
             alt_m: ALT_M,
-        },
-        view,
-        projection,
-    };
-    let (stats, _) = sky.update(&queue, &camera, UNIX_S, 0.0)?;
-    println!(
-        "{mode}: {} sprites, sky CPU {} us, fog {:.0} m",
-        stats.sprites_drawn,
-        stats.sky_cpu_us(),
-        sky.lighting().fog_distance_m
-    );
+        };
+        let camera = HostCamera {
+            position,
+            view: look_at_mat4(Vec3::ZERO, forward, Vec3::Z),
+            projection,
+        };
+        let ground = ground(&device, &targets, camera.projection * camera.view);
+        Ok(Self {
+            device,
+            queue,
+            sky,
+            targets,
+            colour,
+            depth,
+            resolved,
+            ground,
+            camera,
+        })
+    }
 
-    // The host's own ground: a plane at sea level under the camera.
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+    /// The ground into colour and depth (cleared to the host's far value).
+    pub fn draw_ground(&self, encoder: &mut wgpu::CommandEncoder) {
+        let (colour, depth) = (
+            self.colour.create_view(&Default::default()),
+            self.depth.create_view(&Default::default()),
+        );
+        let store = wgpu::StoreOp::Store;
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &colour,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(self.targets.background_depth()),
+                    store,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        pass.set_pipeline(&self.ground.0);
+        pass.set_bind_group(0, &self.ground.1, &[]);
+        pass.draw(0..4, 0..1);
+    }
+
+    /// The sky's frame step, then its passes over the host's colour, reading its depth.
+    pub fn draw_sky(&mut self, encoder: &mut wgpu::CommandEncoder) -> Result<skycast::FrameStats> {
+        let (stats, _) = self.sky.update(&self.queue, &self.camera, UNIX_S, 0.0)?;
+        let (colour, depth) = (
+            self.colour.create_view(&Default::default()),
+            self.depth.create_view(&Default::default()),
+        );
+        self.sky.record(encoder, &colour, &depth);
+        if self.targets.sample_count > 1 {
+            let resolve_target = Some(self.resolved.create_view(&Default::default()));
+            let ops = wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: wgpu::StoreOp::Store,
+            };
+            let attachment = wgpu::RenderPassColorAttachment {
+                view: &colour,
+                depth_slice: None,
+                resolve_target: resolve_target.as_ref(),
+                ops,
+            };
+            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                color_attachments: &[Some(attachment)],
+                ..Default::default()
+            });
+        }
+        Ok(stats)
+    }
+
+    /// The frame: ground, then sky; RGBA8 sRGB bytes read back.
+    pub fn frame(&mut self) -> Result<Vec<u8>> {
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.draw_ground(&mut encoder);
+        let stats = self.draw_sky(&mut encoder)?;
+        println!(
+            "{} sprites, sky CPU {} us",
+            stats.sprites_drawn,
+            stats.sky_cpu_us()
+        );
+        let single = if self.targets.sample_count > 1 {
+            &self.resolved
+        } else {
+            &self.colour
+        };
+        read_back(&self.device, &self.queue, encoder, single)
+    }
+}
+
+/// The ground pipeline (depth tested the host's way) and its uniform.
+fn ground(
+    device: &wgpu::Device,
+    targets: &HostTargets,
+    view_proj: Mat4,
+) -> (wgpu::RenderPipeline, wgpu::BindGroup) {
+    let source = wgpu::ShaderSource::Wgsl(GROUND.replace("ALT", &format!("{ALT_M:.1}")).into());
+    let module = &device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: None,
-        source: wgpu::ShaderSource::Wgsl(GROUND_WGSL.replace("ALT", &format!("{ALT_M:.1}")).into()),
+        source,
     });
-    let compare = if reversed {
+    let depth_compare = Some(if targets.reversed_z {
         wgpu::CompareFunction::Greater
     } else {
         wgpu::CompareFunction::Less
+    });
+    let depth = wgpu::DepthStencilState {
+        format: targets.depth_format,
+        depth_write_enabled: Some(true),
+        depth_compare,
+        stencil: Default::default(),
+        bias: Default::default(),
     };
-    let ground = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: None,
         layout: None,
         multiview_mask: None,
         cache: None,
         vertex: wgpu::VertexState {
-            module: &module,
+            module,
             entry_point: Some("vs"),
             compilation_options: Default::default(),
             buffers: &[],
@@ -141,156 +251,90 @@ pub fn run(mode: &str, weather: Option<&std::path::Path>) -> Result<HostFrame> {
             topology: wgpu::PrimitiveTopology::TriangleStrip,
             ..Default::default()
         },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: targets.depth_format,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(compare),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
+        depth_stencil: Some(depth),
         multisample: wgpu::MultisampleState {
-            count: samples,
+            count: targets.sample_count,
             ..Default::default()
         },
         fragment: Some(wgpu::FragmentState {
-            module: &module,
+            module,
             entry_point: Some("fs"),
             compilation_options: Default::default(),
             targets: &[Some(targets.colour_format.into())],
         }),
     });
-    use wgpu::util::DeviceExt;
+    let contents = bytemuck::bytes_of(&view_proj);
     let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: None,
-        contents: bytemuck::bytes_of(&(projection * view)),
+        contents,
         usage: wgpu::BufferUsages::UNIFORM,
     });
+    let entries = [wgpu::BindGroupEntry {
+        binding: 0,
+        resource: uniform.as_entire_binding(),
+    }];
     let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,
-        layout: &ground.get_bind_group_layout(0),
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: uniform.as_entire_binding(),
-        }],
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
     });
-    // The ground pass (clear, draw), or with `resolve` a pass that only resolves the samples.
-    let pass = |e: &mut wgpu::CommandEncoder, clear: bool, resolve: Option<&wgpu::TextureView>| {
-        let load = if clear {
-            wgpu::LoadOp::Clear(wgpu::Color::BLACK)
-        } else {
-            wgpu::LoadOp::Load
-        };
-        let mut p = e.begin_render_pass(&wgpu::RenderPassDescriptor {
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &colour_view,
-                depth_slice: None,
-                resolve_target: resolve,
-                ops: wgpu::Operations {
-                    load,
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: clear.then(|| wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(targets.background_depth()),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        });
-        if clear {
-            p.set_pipeline(&ground);
-            p.set_bind_group(0, &group, &[]);
-            p.draw(0..4, 0..1);
-        }
-    };
-    let mut e = device.create_command_encoder(&Default::default());
-    pass(&mut e, true, None);
-    let before = (samples == 1).then(|| copy(&device, &mut e, &depth, 4));
-    sky.record(&mut e, &colour_view, &depth_view);
-    let after = (samples == 1).then(|| copy(&device, &mut e, &depth, 4));
-    if samples > 1 {
-        pass(
-            &mut e,
-            false,
-            Some(&resolved.create_view(&Default::default())),
-        );
-    }
-    let pixels = copy(
-        &device,
-        &mut e,
-        if samples > 1 { &resolved } else { &colour },
-        4,
-    );
-    queue.submit([e.finish()]);
-    let read = |b: wgpu::Buffer| -> Result<Vec<u8>> {
-        b.map_async(wgpu::MapMode::Read, .., |_| {});
-        device.poll(wgpu::PollType::wait_indefinitely())?;
-        let data = b
-            .get_mapped_range(..)?
-            .chunks(row(4) as usize)
-            .flat_map(|r| r[..W as usize * 4].to_vec())
-            .collect();
-        Ok(data)
-    };
-    let depth_unchanged = match (before, after) {
-        (Some(b), Some(a)) => Some(read(b)? == read(a)?),
-        _ => None,
-    };
-    Ok(HostFrame {
-        rgba8: read(pixels)?,
-        depth_unchanged,
-    })
+    (pipeline, group)
 }
 
-fn row(texel: u32) -> u32 {
-    (W * texel).div_ceil(256) * 256
-}
-
-/// Copies a texture into a new mappable buffer (rows padded to 256 bytes).
-fn copy(
+/// Submits `encoder` with a copy of a 4-byte-texel texture and reads it back (rows unpadded).
+pub fn read_back(
     device: &wgpu::Device,
-    e: &mut wgpu::CommandEncoder,
-    t: &wgpu::Texture,
-    texel: u32,
-) -> wgpu::Buffer {
+    queue: &wgpu::Queue,
+    mut encoder: wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+) -> Result<Vec<u8>> {
+    let row = (W * 4).div_ceil(256) * 256;
+    let usage = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: None,
-        size: (row(texel) * H) as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        size: (row * H) as u64,
+        usage,
         mapped_at_creation: false,
     });
-    e.copy_texture_to_buffer(
-        t.as_image_copy(),
+    let layout = wgpu::TexelCopyBufferLayout {
+        offset: 0,
+        bytes_per_row: Some(row),
+        rows_per_image: Some(H),
+    };
+    let size = wgpu::Extent3d {
+        width: W,
+        height: H,
+        depth_or_array_layers: 1,
+    };
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(row(texel)),
-                rows_per_image: Some(H),
-            },
+            layout,
         },
-        wgpu::Extent3d {
-            width: W,
-            height: H,
-            depth_or_array_layers: 1,
-        },
+        size,
     );
-    buffer
+    queue.submit([encoder.finish()]);
+    buffer.map_async(wgpu::MapMode::Read, .., |_| {});
+    device.poll(wgpu::PollType::wait_indefinitely())?;
+    let bytes = buffer
+        .get_mapped_range(..)?
+        .chunks(row as usize)
+        .flat_map(|r| r[..W as usize * 4].to_vec())
+        .collect();
+    Ok(bytes)
 }
 
 #[allow(dead_code)]
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let mode = args.get(1).map_or("standard", String::as_str);
-    let frame = run(mode, Some(std::path::Path::new(THEME)))?;
+    let mut host = Host::new(mode, Some(std::path::Path::new(THEME)))?;
     let out = args.get(2).map_or("host.png", String::as_str);
-    image::save_buffer(out, &frame.rgba8, W, H, image::ExtendedColorType::Rgba8)?;
+    image::save_buffer(out, &host.frame()?, W, H, image::ExtendedColorType::Rgba8)?;
     println!(
-        "{out}: depth unchanged by the sky: {:?}",
-        frame.depth_unchanged
+        "{mode}: {out}; light for the host's own scene: {:?}",
+        host.sky.lighting()
     );
     Ok(())
 }

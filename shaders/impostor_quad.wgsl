@@ -66,6 +66,13 @@ fn impostor_at(from_centre: vec3<f32>) -> vec4<f32> {
     return vec4<f32>((x + 1.0) * 0.5, (1.0 - y) * 0.5, layer, facing);
 }
 
+// What one ring shows along a ray: premultiplied colour, scene-depth faded, and the distance
+// of its clouds from the camera plane, metres.
+struct RingHit {
+    colour: vec4<f32>,
+    distance_m: f32,
+};
+
 // The premultiplied colour of one ring along `dir` (unit, from the camera), scene-depth faded.
 // Beyond Wang: the impostor was seen from the ring centre, not from the camera, so the ray is
 // reprojected with the stored cloud depth: start with the clouds `guess_m` from the centre,
@@ -78,7 +85,7 @@ fn ring_sample(
     guess_m: f32,
     dir: vec3<f32>,
     frag_xy: vec2<f32>,
-) -> vec4<f32> {
+) -> RingHit {
     var dist = guess_m;
     var at = vec4<f32>(0.0, 0.0, 8.0, 1.0);
     var texel = vec4<f32>(0.0);
@@ -87,7 +94,7 @@ fn ring_sample(
         let from_centre = normalize(on_sphere(centre, dir, dist) - centre);
         at = impostor_at(from_centre);
         if (at.z > 7.5) {
-            return vec4<f32>(0.0);
+            return RingHit(vec4<f32>(0.0), 0.0);
         }
         texel = textureSampleLevel(colour, impostor_sampler, at.xy, u32(at.z), 0.0);
         depth_km = textureSampleLevel(depth, impostor_sampler, at.xy, u32(at.z), 0.0).r;
@@ -112,13 +119,23 @@ fn ring_sample(
     let cloud_m = (frame.view_proj * vec4<f32>(cloud, 1.0)).w;
     let scene_m = linear_depth_m(scene_depth_at(frag_xy));
     let soft = clamp((scene_m - cloud_m) / frame.params.z, 0.0, 1.0);
-    return texel * soft;
+    return RingHit(texel * soft, cloud_m);
 }
 
 @fragment
 fn fs_impostor(i: RingOut) -> @location(0) vec4<f32> {
-    // A point on the pixel's ray (depth 0.5 is finite under any projection, reversed or not).
-    let far = frame.inv_view_proj * vec4<f32>(i.ndc, 0.5, 1.0);
+    return ring_hit(i).colour;
+}
+
+// Into the cloud target (`cloud_target.rs`): the colour and the distance of its clouds.
+@fragment
+fn fs_impostor_offscreen(i: RingOut) -> CloudOut {
+    let hit = ring_hit(i);
+    return cloud_out(hit.colour, hit.distance_m);
+}
+
+fn ring_hit(i: RingOut) -> RingHit {
+    let far = far_point(i.ndc);
     let dir = normalize(far.xyz / far.w);
     let w = ring.old_centre_weight.w;
     let before = ring_sample(
@@ -130,5 +147,8 @@ fn fs_impostor(i: RingOut) -> @location(0) vec4<f32> {
     let after = ring_sample(
         new_colour, new_depth, ring.new_centre.xyz, ring.size.w, dir, i.position.xy
     );
-    return mix(before, after, w);
+    // The distance of the mix: each ring's weighted by what it shows.
+    let a = mix(before.colour.a * before.distance_m, after.colour.a * after.distance_m, w);
+    let colour = mix(before.colour, after.colour, w);
+    return RingHit(colour, a / max(colour.a, 1e-6));
 }

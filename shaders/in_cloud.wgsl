@@ -15,7 +15,18 @@ fn vs_in_cloud(@builtin(vertex_index) vi: u32) -> FogOut {
 
 @fragment
 fn fs_in_cloud(i: FogOut) -> @location(0) vec4<f32> {
-    let d = scene_depth_at(i.position.xy);
+    return in_cloud_fog(i.position.xy);
+}
+
+// Into the cloud target: the fog starts at the camera, so its distance is 0 (the composite never
+// cuts it at a silhouette).
+@fragment
+fn fs_in_cloud_offscreen(i: FogOut) -> CloudOut {
+    return cloud_out(in_cloud_fog(i.position.xy), 0.0);
+}
+
+fn in_cloud_fog(frag_xy: vec2<f32>) -> vec4<f32> {
+    let d = scene_depth_at(frag_xy);
     let dist_m = select(linear_depth_m(d), 1.0e9, is_background(d));
     let density = 1.0 - exp(-dist_m / frame.params.w);
     let alpha = clamp(density * frame.in_cloud_rgba.a, 0.0, 1.0);

@@ -289,6 +289,8 @@ fn build_sprite(k: u32, at: u32) {
     let light = view.directional_ambient;
     let sun = normalize_or(view.sun_dir_camera_z.xyz, vec3<f32>(0.0));
     let cell = s.bits & 15u;
+    // Keep in sync with `SPRITE_PRECIPITATION` in src/render/gpu_types.rs.
+    let rain = (s.bits & 512u) != 0u;
     for (var c = 0u; c < 4u; c++) {
         let corner = vec2<f32>(f32(c & 1u), 1.0 - f32(c >> 1u));
         let p = offset + right * ((corner.x - 0.5) * width) + up * ((corner.y - 0.5) * height);
@@ -300,12 +302,16 @@ fn build_sprite(k: u32, at: u32) {
         let group_dir = normalize_or(p - group, vec3<f32>(0.0));
         let directional = (directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim))
             * light.rgb;
+        let lit = ambient.rgb * light.w + directional;
+        // Rain and snow hang in the cloud's shadow: its base colour, dimmer and greyer, no sun.
+        let shade = ambient.rgb * light.w * 0.6;
+        let rain_rgb = mix(shade, vec3<f32>(dot(shade, vec3<f32>(0.3, 0.59, 0.11))), 0.5);
         // Texture v runs down the sheet: the top of the sprite is v = 0.
         built[at + c] = BuiltCorner(
             vec4<f32>(centre_rel + p, 1.0),
             cell_uv(cell, vec2<f32>(corner.x, 1.0 - corner.y)),
             vec2<f32>(0.0),
-            vec4<f32>(ambient.rgb * light.w + directional, ambient.a * morph * alpha),
+            vec4<f32>(select(lit, rain_rgb, rain), ambient.a * morph * alpha),
         );
     }
 }

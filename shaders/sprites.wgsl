@@ -45,6 +45,13 @@ fn fs_sprite(i: VertexOut) -> @location(0) vec4<f32> {
     return sprite_colour(i);
 }
 
+// Into the cloud target (`cloud_target.wgsl`): the colour, and the sprite's distance weighted
+// by its alpha, blended the same way, so the composite knows how far the clouds of each texel are.
+@fragment
+fn fs_sprite_offscreen(i: VertexOut) -> CloudOut {
+    return cloud_out(sprite_colour(i), i.view_depth_m);
+}
+
 // Premultiplied colour of a sprite fragment (also used by the impostor pass).
 fn sprite_colour(i: VertexOut) -> vec4<f32> {
     let texel = textureSample(sheet, sheet_sampler, i.uv);

@@ -24,6 +24,8 @@ struct TerrainOut {
     @location(0) rel_m: vec3<f32>,
     @location(1) height_m: f32,
     @location(2) normal: vec3<f32>,
+    // Metres from the mesh origin, horizontal: where the ground's patterns are anchored.
+    @location(3) ground_xy: vec2<f32>,
 };
 
 @vertex
@@ -34,18 +36,86 @@ fn vs_terrain(v: TerrainVertex) -> TerrainOut {
     o.rel_m = rel;
     o.height_m = v.height_m;
     o.normal = v.normal.xyz;
+    o.ground_xy = v.position_m.xy;
     return o;
+}
+
+fn hash2(p: vec2<f32>) -> f32 {
+    let q = fract(p * vec2<f32>(0.1031, 0.1030));
+    let r = q + dot(q, q.yx + 33.33);
+    return fract((r.x + r.y) * r.x);
+}
+
+// Smooth value noise, 0..1, one cell a unit.
+fn value_noise(p: vec2<f32>) -> f32 {
+    let i = floor(p);
+    let f = fract(p);
+    let u = f * f * (3.0 - 2.0 * f);
+    let a = hash2(i);
+    let b = hash2(i + vec2<f32>(1.0, 0.0));
+    let c = hash2(i + vec2<f32>(0.0, 1.0));
+    let d = hash2(i + vec2<f32>(1.0, 1.0));
+    return mix(mix(a, b, u.x), mix(c, d, u.x), u.y);
+}
+
+// What the ground is made of from the air, before light: a patchwork of fields (each a few
+// hundred metres, its own crop) with hedges between them, woods and towns in regions a few
+// kilometres across, rock on slopes, bare and then snowy high up, a shore and water below sea
+// level. `footprint_m`: the metres one pixel covers, so detail finer than a pixel fades out
+// instead of shimmering.
+fn ground_albedo(xy: vec2<f32>, height_m: f32, slope: f32, footprint_m: f32) -> vec3<f32> {
+    let crops = array<vec3<f32>, 4>(
+        vec3<f32>(0.09, 0.15, 0.05),
+        vec3<f32>(0.12, 0.16, 0.06),
+        vec3<f32>(0.18, 0.17, 0.09),
+        vec3<f32>(0.15, 0.12, 0.08),
+    );
+    // Fields in rows 440 m deep, each row shifted, each field ~320 m wide and some split in two
+    // at a random point, the whole grid turned off the map's axes.
+    let turned = vec2<f32>(0.956 * xy.x - 0.292 * xy.y, 0.292 * xy.x + 0.956 * xy.y);
+    let row = floor(turned.y / 440.0);
+    let along = turned.x / 320.0 + hash2(vec2<f32>(row, 5.0)) * 7.0;
+    let column = floor(along);
+    let split_at = 0.25 + 0.5 * hash2(vec2<f32>(column, row) + 11.0);
+    let split = hash2(vec2<f32>(column, row) + 3.0) > 0.45;
+    let part = select(0.0, step(split_at, fract(along)), split);
+    var albedo = crops[u32(hash2(vec2<f32>(column + part * 0.5, row)) * 3.999)];
+    // Hedges and tracks along the field edges, where a pixel can still see them.
+    let edge_x = min(min(fract(along), 1.0 - fract(along)), select(1.0, abs(fract(along) - split_at), split)) * 320.0;
+    let edge_y = min(fract(turned.y / 440.0), 1.0 - fract(turned.y / 440.0)) * 440.0;
+    let hedge = 1.0 - smoothstep(3.0, 8.0, min(edge_x, edge_y));
+    albedo *= 1.0 - 0.35 * hedge * (1.0 - smoothstep(8.0, 30.0, footprint_m));
+    // Woods and towns by region (a few kilometres, edges warped so they are not round).
+    let warp = vec2<f32>(value_noise(xy / 1300.0), value_noise(xy / 1100.0 + 17.0)) * 600.0;
+    let region = value_noise((xy + warp) / 2600.0);
+    albedo = mix(albedo, vec3<f32>(0.045, 0.08, 0.035), 1.0 - smoothstep(0.27, 0.3, region));
+    let blocks = hash2(floor(xy / 90.0)) * 0.06;
+    albedo = mix(albedo, vec3<f32>(0.15 + blocks, 0.15 + blocks, 0.14 + blocks), smoothstep(0.78, 0.8, region));
+    // Within a field, texture ~40 m across, fading where a pixel covers more than it.
+    let fine = value_noise(xy / 40.0) - 0.5;
+    albedo *= 1.0 + 0.3 * fine * (1.0 - smoothstep(15.0, 45.0, footprint_m));
+    albedo = mix(albedo, vec3<f32>(0.16, 0.14, 0.09), smoothstep(300.0, 1500.0, height_m));
+    albedo = mix(albedo, vec3<f32>(0.18, 0.16, 0.14), smoothstep(0.15, 0.4, slope));
+    albedo = mix(albedo, vec3<f32>(0.7, 0.72, 0.75), smoothstep(2600.0, 3000.0, height_m) * (1.0 - smoothstep(0.3, 0.5, slope)));
+    albedo = mix(albedo, vec3<f32>(0.30, 0.27, 0.20), 1.0 - smoothstep(0.5, 3.0, height_m));
+    return mix(albedo, vec3<f32>(0.02, 0.05, 0.08), 1.0 - smoothstep(-0.5, 0.5, height_m));
 }
 
 @fragment
 fn fs_terrain(i: TerrainOut) -> @location(0) vec4<f32> {
-    let n = normalize(i.normal);
+    let water = 1.0 - smoothstep(-0.5, 0.5, i.height_m);
+    // Water is flat whatever the mesh's relief says.
+    let n = normalize(mix(normalize(i.normal), vec3<f32>(0.0, 0.0, 1.0), water));
     let slope = 1.0 - n.z;
-    var albedo = mix(vec3<f32>(0.09, 0.16, 0.05), vec3<f32>(0.16, 0.14, 0.09), smoothstep(300.0, 1500.0, i.height_m));
-    albedo = mix(albedo, vec3<f32>(0.18, 0.16, 0.14), smoothstep(0.15, 0.4, slope));
-    albedo = mix(albedo, vec3<f32>(0.7, 0.72, 0.75), smoothstep(2600.0, 3000.0, i.height_m) * (1.0 - smoothstep(0.3, 0.5, slope)));
+    let footprint_m = length(fwidth(i.ground_xy));
+    let albedo = ground_albedo(i.ground_xy, i.height_m, slope, footprint_m);
     let sun = max(dot(n, terrain.sun_dir.xyz), 0.0);
-    let lit = albedo * (terrain.sun_rgb.rgb * sun + vec3<f32>(terrain.sun_dir.w));
+    var lit = albedo * (terrain.sun_rgb.rgb * sun + vec3<f32>(terrain.sun_dir.w));
+    // The water mirrors the sky a little, most at grazing angles (Schlick), and glints.
+    let view = normalize(-i.rel_m);
+    let fresnel = 0.02 + 0.98 * pow(1.0 - max(view.z, 0.0), 5.0);
+    let glint = pow(max(dot(reflect(-terrain.sun_dir.xyz, n), view), 0.0), 200.0);
+    lit += water * (terrain.fog_rgb.rgb * fresnel + terrain.sun_rgb.rgb * glint);
     let dist = length(i.rel_m);
     let fog = 1.0 - exp(-dist * 3.0 / max(terrain.fog_rgb.w, 1.0));
     return vec4<f32>(mix(lit, terrain.fog_rgb.rgb, fog), 1.0);

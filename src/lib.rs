@@ -39,11 +39,15 @@
 //! [`clouds`] (cloud blocks, their lifecycle) -> [`shading`] (sun, light, fog) -> [`render`]
 //! (the only stage that uses wgpu: the sky on the GPU) -> [`flight`] ([`SkySystem`], the frame
 //! step; flight paths). Every stage before `render` is plain data, testable without a device.
+//! `demo` (feature `demo`, on by default with the command line) is the demo host the command
+//! line, tests and benchmarks draw with.
 
 #![deny(missing_docs)]
 
 pub mod clouds;
 pub mod config;
+#[cfg(feature = "demo")]
+pub mod demo;
 pub mod flight;
 pub mod render;
 pub mod shading;

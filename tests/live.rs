@@ -10,8 +10,9 @@ use std::time::{Duration, Instant};
 use glam::DVec3;
 use skycast::clouds::CloudsConfig;
 use skycast::clouds::field::weather_changed;
-use skycast::render::world::{World, WorldSettings};
-use skycast::render::{DemoHost, Frame, GroundSettings, RenderSettings, SkyConfig, demo_ground};
+use skycast::demo::{DemoHost, Frame, GroundSettings, demo_ground};
+use skycast::flight::world::{World, WorldSettings};
+use skycast::render::{RenderSettings, SkyConfig};
 use skycast::shading::{SunPosition, TimeOfDayTable};
 use skycast::weather::live::{LiveChange, LiveWeather, Prepare};
 use skycast::weather::{
@@ -105,7 +106,7 @@ impl Flight {
             H,
             &demo_ground(world.field(), &ground),
             SkyConfig {
-                targets: skycast::render::headless::TARGETS,
+                targets: skycast::demo::headless::TARGETS,
                 settings: RenderSettings::default(),
                 time_of_day: TimeOfDayTable::default(),
                 sheet: world.sheet(),

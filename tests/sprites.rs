@@ -5,11 +5,11 @@
 //! frames) the horizon haze. Small scenes on whatever adapter there is (lavapipe here).
 
 use glam::{DVec2, DVec3, Vec3};
-use skycast::render::Frame;
-use skycast::render::terrain::HeightField;
+use skycast::demo::terrain::HeightField;
+use skycast::demo::{DemoHost, Frame, headless};
 use skycast::render::{
-    BlockMotion, Camera, DemoHost, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteCorner,
-    SpriteSheet, headless, square_sprite,
+    BlockMotion, Camera, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteCorner, SpriteSheet,
+    square_sprite,
 };
 use skycast::shading::{ColourLevels, ForwardScattering, SunPosition, TimeOfDayTable};
 use skycast::weather::BlockWeather;

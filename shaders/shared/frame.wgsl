@@ -33,6 +33,11 @@ fn is_background(d: f32) -> bool {
     return d == frame.params.x;
 }
 
+// The farther of two depths of the host's convention (standard Z: larger, reversed: smaller).
+fn farther_depth(a: f32, b: f32) -> f32 {
+    return select(min(a, b), max(a, b), frame.params.x > 0.5);
+}
+
 fn scene_depth_at(frag_xy: vec2<f32>) -> f32 {
     return textureLoad(scene_depth, vec2<i32>(frag_xy), 0).r;
 }
@@ -55,4 +60,38 @@ fn sky_colour(dir: vec3<f32>) -> vec3<f32> {
     let glow = smoothstep(frame.sun_rgb.w, 1.0, cos_sun);
     c += frame.sun_rgb.rgb * glow * glow * 0.35;
     return c;
+}
+
+// The sky behind everything along a view ray: the gradient and the sun disc (`sky.wgsl`, and the
+// cloud composite below full resolution). `far` is a point of the ray in homogeneous world
+// coordinates (`far_point` of the pixel): the full-screen passes compute it per vertex and let
+// it be interpolated (exact: it is linear across the screen), which spares each pixel a matrix
+// product.
+fn background_along(far: vec4<f32>) -> vec3<f32> {
+    let dir = normalize(far.xyz / far.w);
+    let c = sky_colour(dir);
+    let cos_sun = dot(dir, frame.sun_dir.xyz);
+    let disc = smoothstep(frame.sun_dir.w - 0.00002, frame.sun_dir.w + 0.00002, cos_sun);
+    return mix(c, frame.sun_rgb.rgb * 4.0, disc * step(-0.01, dir.z));
+}
+
+// A point of the view ray (homogeneous world coordinates) at normalised device coordinates
+// `ndc`: at depth 0.5, finite under any projection (a far plane at infinity, reversed Z).
+fn far_point(ndc: vec2<f32>) -> vec4<f32> {
+    return frame.inv_view_proj * vec4<f32>(ndc, 0.5, 1.0);
+}
+
+// What a cloud pass writes into the off-screen cloud target (src/render/cloud_target.rs):
+// premultiplied colour, and the clouds' distance in kilometres times alpha (R16Float), both
+// blended "over", so distance / alpha is the distance of what shows in the texel.
+struct CloudOut {
+    @location(0) colour: vec4<f32>,
+    @location(1) distance: vec4<f32>,
+};
+
+fn cloud_out(colour: vec4<f32>, distance_m: f32) -> CloudOut {
+    var o: CloudOut;
+    o.colour = colour;
+    o.distance = vec4<f32>(distance_m * 0.001 * colour.a, 0.0, 0.0, colour.a);
+    return o;
 }

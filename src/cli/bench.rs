@@ -1,9 +1,13 @@
-//! `skycast bench [--size WxH] [--frames N] [--out DIR]`: the frame-budget benchmark of issue 6
-//! (Wang 2003 section 6.3, figure 15). The three scenarios of `weather/scenarios/` (sparse,
-//! scattered, overcast: about 170 %, 200 % and 475 % block overdraw) are flown along the same
-//! straight path, a cruise due east at 5,000 ft above the scenario's station, each once with
-//! the impostor ring (far blocks in impostors) and once without (every block as sprites). Both
-//! runs see the same view: clouds out to the ring's view radius, sprites drawn that far.
+//! `skycast bench [--size WxH] [--frames N] [--cloud-scale S] [--out DIR]`: the frame-budget
+//! benchmark of issue 6 (Wang 2003 section 6.3, figure 15). The three scenarios of
+//! `weather/scenarios/` (sparse, scattered, overcast: about 170 %, 200 % and 475 % block
+//! overdraw) are flown along the same straight path, a cruise due east at 5,000 ft above the
+//! scenario's station, each with the impostor ring (far blocks in impostors) and without (every
+//! block as sprites), and each of those with the clouds drawn at the cloud scale S (default: the
+//! renderer settings' `[clouds] resolution_scale`) and at full resolution (scale 1), so one run
+//! compares both: the two scales fly side by side, one host each, both drawing each sample
+//! before the camera moves on, so load from elsewhere on a shared machine falls on both alike.
+//! All runs see the same view: clouds out to the ring's view radius, sprites drawn that far.
 //!
 //! The path is sampled, not flown frame by frame: `--frames` points 12 km apart / (N - 1). A
 //! real flight rebuilds the ring every 15% of its radius (3 km at 20 km: 25 s at 120 m/s, some
@@ -13,11 +17,13 @@
 //! a real flight's frames are.
 //!
 //! Out: one table on standard output headed by the adapter's name (scenario, block overdraw,
-//! median and p95 of the steady frames' milliseconds, the median of the frames rendering an
-//! impostor, the off/on ratio of the medians, sprites drawn, the sky's CPU milliseconds (update
-//! and recording) and the GPU memory of the resident sprites, per scenario with impostors on
-//! and off); the same rows as `bench.csv`, every frame in
-//! `frames.csv`, and `frame_time.png`, steady frame time along the path. Frame time is
+//! ring on or off, cloud scale, median and p95 of the steady frames' milliseconds, the sky's
+//! passes alone, the median of the frames rendering an impostor, the off/on ratio of the
+//! medians, the scale-1 over scale-S ratio, sprites drawn, the sky's CPU milliseconds (update
+//! and recording) and the GPU memory of the resident sprites); the same rows as `bench.csv`,
+//! every frame in `frames.csv` (with its cloud scale and the cloud target's bytes), and
+//! `frame_time.png`, steady frame time along the path (plotters: axes with units, a legend
+//! naming each run's scenario, ring and scale). Frame time is
 //! the GPU time between timestamps around the frame's passes where the adapter has timestamp
 //! queries, else the wall time from submit to the end of the poll-wait; the table says which.
 
@@ -28,15 +34,16 @@ use anyhow::Context;
 use clap::Args;
 use glam::{DVec2, DVec3};
 use skycast::clouds::{CloudTypes, generate_block};
-use skycast::render::world::{World, WorldSettings};
-use skycast::render::{DemoHost, GroundSettings, RenderSettings, SkyConfig, demo_ground};
+use skycast::demo::{DemoHost, GroundSettings, demo_ground};
+use skycast::flight::world::{World, WorldSettings};
+use skycast::render::{RenderSettings, SkyConfig};
 use skycast::shading::{TimeOfDayTable, sun_position};
 use skycast::weather::{
     BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, METRES_PER_FOOT, StationTable,
     WeatherInput,
 };
 
-use super::render::{load_look, parse_size, parse_time, time_or_default};
+use super::render::{load_look, parse_cloud_scale, parse_size, parse_time, time_or_default};
 use super::weather::DEFAULT_STATIONS;
 
 mod plot;
@@ -79,6 +86,10 @@ pub struct BenchArgs {
     /// Time-of-day table (default: the shipped config/time_of_day.toml).
     #[arg(long)]
     pub time_of_day: Option<PathBuf>,
+    /// Resolution the clouds are drawn at besides full resolution: 1, 1/2 or 1/4 (default: the
+    /// renderer settings' `[clouds] resolution_scale`); each scenario is run at both.
+    #[arg(long, value_parser = parse_cloud_scale)]
+    pub cloud_scale: Option<f32>,
     /// UTC time, RFC 3339 (default: the shipped weather file's time).
     #[arg(long, value_parser = parse_time)]
     pub time: Option<f64>,
@@ -99,13 +110,16 @@ struct FrameRecord {
     blocks_near: u32,
     blocks_far: u32,
     impostors_rebuilt: u32,
+    /// Bytes of the sky's off-screen cloud target (0 at scale 1).
+    cloud_target_bytes: u64,
 }
 
-/// One run: a scenario with impostors on or off.
+/// One run: a scenario with impostors on or off, the clouds at one resolution scale.
 struct Run {
     scenario: &'static str,
     overdraw: f64,
     impostors: bool,
+    cloud_scale: f32,
     frames: Vec<FrameRecord>,
     /// Sprites in view where the run could not be drawn (too many for the device).
     not_drawn: Option<u64>,
@@ -209,26 +223,41 @@ enum Flown {
     TooMany { sprites: u64, max_sprites: u64 },
 }
 
-/// Flies one run.
-fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> anyhow::Result<Flown> {
-    let mut settings = setup.settings;
-    settings.impostors.enabled = impostors;
+/// Flies the runs of one ring setting side by side, one host a cloud scale: at each sample
+/// every host draws its frames before the camera moves on, so a burst of load on a shared
+/// machine falls on all the scales alike and their ratio holds.
+fn fly(
+    setup: &Setup,
+    world: &mut World,
+    at: (f64, f64),
+    (impostors, scales): (bool, &[f32]),
+) -> anyhow::Result<Vec<Flown>> {
     let ground = demo_ground(world.field(), &GroundSettings::default());
-    let mut host = DemoHost::new(
-        setup.size.0,
-        setup.size.1,
-        &ground,
-        SkyConfig {
-            targets: skycast::render::headless::TARGETS,
-            settings,
-            time_of_day: setup.table.clone(),
-            sheet: world.sheet(),
-        },
-    )?;
+    let mut hosts = Vec::new();
+    for &cloud_scale in scales {
+        let mut settings = setup.settings;
+        settings.impostors.enabled = impostors;
+        settings.clouds.resolution_scale = cloud_scale;
+        hosts.push(DemoHost::new(
+            setup.size.0,
+            setup.size.1,
+            &ground,
+            SkyConfig {
+                targets: skycast::demo::headless::TARGETS,
+                settings,
+                time_of_day: setup.table.clone(),
+                sheet: world.sheet(),
+            },
+        )?);
+    }
+    let Some(first) = hosts.first() else {
+        return Ok(Vec::new());
+    };
     let adapter = format!(
         "{} ({:?})",
-        host.gpu.adapter_info.name, host.gpu.adapter_info.backend
+        first.gpu.adapter_info.name, first.gpu.adapter_info.backend
     );
+    let max_sprites = first.max_sprites();
     let alt_m = ground.height_at_m(DVec2::ZERO) + CRUISE_FT_AGL * METRES_PER_FOOT;
     let sun = sun_position(setup.unix_s, at.0, at.1);
     let visibility_m = world.visibility_m();
@@ -236,15 +265,12 @@ fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> any
     let dt_s = step_m / SPEED_M_S;
     let position = |k: u32| DVec3::new(-PATH_LENGTH_M / 2.0 + k as f64 * step_m, 0.0, alt_m);
     let mut indices = Vec::new();
-    let mut records = Vec::new();
+    let mut records: Vec<Vec<FrameRecord>> = hosts.iter().map(|_| Vec::new()).collect();
     let mut timestamps = true;
     // Sample 0 is drawn twice: the first time (pipelines warming up, the whole ring built at
     // once) is not counted.
-    let mut warm_up = 0;
+    let mut warm_up = vec![0; hosts.len()];
     for (n, k) in std::iter::once(0).chain(0..setup.frames).enumerate() {
-        if n == 1 {
-            warm_up = records.len();
-        }
         let p = position(k);
         let now = world.block_indices(p);
         if now != indices {
@@ -254,58 +280,90 @@ fn fly(setup: &Setup, world: &mut World, at: (f64, f64), impostors: bool) -> any
                 .flat_map(|b| &b.clouds)
                 .map(|c| c.sprites.len() as u64)
                 .sum();
-            if !impostors && sprites > host.max_sprites() {
+            if !impostors && sprites > max_sprites {
                 // All of them as sprites do not fit the device's largest buffer.
-                return Ok(Flown::TooMany {
-                    sprites,
-                    max_sprites: host.max_sprites(),
-                });
+                return Ok(scales
+                    .iter()
+                    .map(|_| Flown::TooMany {
+                        sprites,
+                        max_sprites,
+                    })
+                    .collect());
             }
-            host.sky.set_clouds(blocks);
+            for host in &mut hosts {
+                host.sky.set_clouds(blocks.clone());
+            }
             indices = now;
         }
-        host.sky.set_weather_overhead(&world.weather_over(p));
-        let camera = host.camera(p, 90.0, PITCH_DEG);
-        // Draw until the ring is up to date here (8 rebuild frames and a crossfade at most, plus
-        // slack), then the frame is a steady one.
-        for _ in 0..64 {
-            let start = Instant::now();
-            let stats = host.draw(&camera, &sun, dt_s, visibility_m);
-            let (frame_ms, sky_ms) = match host.last_gpu_split_ms() {
-                Some([ground, sky]) => (ground + sky, sky),
-                None => {
-                    timestamps = false;
-                    host.wait_idle()?;
-                    // Submit to the end of the wait: the draw call minus its CPU update.
-                    let wall = start.elapsed().as_secs_f64() * 1e3;
-                    ((wall - stats.cpu_update_us as f64 / 1e3).max(0.0), f64::NAN)
-                }
-            };
-            let steady = stats.impostors_rebuilt == 0 && stats.crossfade_weight == 0.0;
-            records.push(FrameRecord {
-                steady,
-                distance_m: k as f64 * step_m,
-                frame_ms,
-                sky_ms,
-                cpu_update_ms: stats.sky_cpu_us() as f64 / 1e3,
-                upload_bytes: stats.upload_bytes,
-                sprite_gpu_bytes: stats.sprite_gpu_bytes,
-                sprites_drawn: stats.sprites_drawn,
-                blocks_near: stats.blocks_near,
-                blocks_far: stats.blocks_far,
-                impostors_rebuilt: stats.impostors_rebuilt,
-            });
-            if steady {
-                break;
+        let overhead = world.weather_over(p);
+        for ((host, records), warm_up) in hosts.iter_mut().zip(&mut records).zip(&mut warm_up) {
+            if n == 1 {
+                *warm_up = records.len();
             }
+            host.sky.set_weather_overhead(&overhead);
+            let distance_m = k as f64 * step_m;
+            timestamps &=
+                draw_to_steady(host, (p, distance_m), (&sun, dt_s, visibility_m), records)?;
         }
     }
-    records.drain(..warm_up);
-    Ok(Flown::Frames {
-        frames: records,
-        adapter,
-        timestamps,
-    })
+    Ok(records
+        .into_iter()
+        .zip(warm_up)
+        .map(|(mut frames, warm_up)| {
+            frames.drain(..warm_up);
+            Flown::Frames {
+                frames,
+                adapter: adapter.clone(),
+                timestamps,
+            }
+        })
+        .collect())
+}
+
+/// Draws frames at one sample until the ring is up to date there (8 rebuild frames and a
+/// crossfade at most, plus slack); the last is the steady one. False when the frames were timed
+/// by the wall clock (no GPU timestamps).
+fn draw_to_steady(
+    host: &mut DemoHost,
+    (p, distance_m): (DVec3, f64),
+    (sun, dt_s, visibility_m): (&skycast::shading::SunPosition, f64, f32),
+    records: &mut Vec<FrameRecord>,
+) -> anyhow::Result<bool> {
+    let camera = host.camera(p, 90.0, PITCH_DEG);
+    let mut timestamps = true;
+    for _ in 0..64 {
+        let start = Instant::now();
+        let stats = host.draw(&camera, sun, dt_s, visibility_m);
+        let (frame_ms, sky_ms) = match host.last_gpu_split_ms() {
+            Some([ground, sky]) => (ground + sky, sky),
+            None => {
+                timestamps = false;
+                host.wait_idle()?;
+                // Submit to the end of the wait: the draw call minus its CPU update.
+                let wall = start.elapsed().as_secs_f64() * 1e3;
+                ((wall - stats.cpu_update_us as f64 / 1e3).max(0.0), f64::NAN)
+            }
+        };
+        let steady = stats.impostors_rebuilt == 0 && stats.crossfade_weight == 0.0;
+        records.push(FrameRecord {
+            steady,
+            distance_m,
+            frame_ms,
+            sky_ms,
+            cpu_update_ms: stats.sky_cpu_us() as f64 / 1e3,
+            upload_bytes: stats.upload_bytes,
+            sprite_gpu_bytes: stats.sprite_gpu_bytes,
+            sprites_drawn: stats.sprites_drawn,
+            blocks_near: stats.blocks_near,
+            blocks_far: stats.blocks_far,
+            impostors_rebuilt: stats.impostors_rebuilt,
+            cloud_target_bytes: stats.cloud_target_bytes,
+        });
+        if steady {
+            break;
+        }
+    }
+    Ok(timestamps)
 }
 
 /// Runs `skycast bench`.
@@ -313,7 +371,16 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     if args.frames < 2 {
         anyhow::bail!("--frames {} is less than 2", args.frames);
     }
-    let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
+    let (settings, table) = load_look(
+        args.render_settings.as_ref(),
+        args.time_of_day.as_ref(),
+        args.cloud_scale,
+    )?;
+    // The chosen scale first, then full resolution to compare with.
+    let mut scales = vec![settings.clouds.resolution_scale];
+    if scales[0] != 1.0 {
+        scales.push(1.0);
+    }
     let unix_s = time_or_default(args.time)?;
     let stations =
         StationTable::load(&args.stations).context("station table (choose one with --stations)")?;
@@ -349,40 +416,58 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         let overdraw = mean_overdraw(&world, world_settings.seed);
         for impostors in [true, false] {
             eprintln!(
-                "bench: {scenario}, impostors {}",
-                if impostors { "on" } else { "off" }
+                "bench: {scenario}, impostors {}, cloud scales {}",
+                if impostors { "on" } else { "off" },
+                scales
+                    .iter()
+                    .map(|&s| scale_text(s))
+                    .collect::<Vec<_>>()
+                    .join(" and ")
             );
-            let mut not_drawn = None;
-            let frames = match fly(&setup, &mut world, at, impostors)? {
-                Flown::Frames {
+            let flown = fly(&setup, &mut world, at, (impostors, &scales))?;
+            for (flown, &cloud_scale) in flown.into_iter().zip(&scales) {
+                let mut not_drawn = None;
+                let frames = match flown {
+                    Flown::Frames {
+                        frames,
+                        adapter: name,
+                        timestamps: gpu,
+                    } => {
+                        adapter = name;
+                        timestamps &= gpu;
+                        frames
+                    }
+                    Flown::TooMany {
+                        sprites,
+                        max_sprites,
+                    } => {
+                        eprintln!(
+                            "bench: {scenario} without impostors: {sprites} sprites in view, this device draws at most {max_sprites} at once; not drawn (choose a smaller --view-km to compare)"
+                        );
+                        not_drawn = Some(sprites);
+                        Vec::new()
+                    }
+                };
+                runs.push(Run {
+                    scenario,
+                    overdraw,
+                    impostors,
+                    cloud_scale,
                     frames,
-                    adapter: name,
-                    timestamps: gpu,
-                } => {
-                    adapter = name;
-                    timestamps &= gpu;
-                    frames
-                }
-                Flown::TooMany {
-                    sprites,
-                    max_sprites,
-                } => {
-                    eprintln!(
-                        "bench: {scenario} without impostors: {sprites} sprites in view, this device draws at most {max_sprites} at once; not drawn (choose a smaller --view-km to compare)"
-                    );
-                    not_drawn = Some(sprites);
-                    Vec::new()
-                }
-            };
-            runs.push(Run {
-                scenario,
-                overdraw,
-                impostors,
-                frames,
-                not_drawn,
-            });
+                    not_drawn,
+                });
+            }
         }
     }
+    // In the table each scenario's rows go by scale, then ring on and off.
+    let scale_rank = |run: &Run| scales.iter().position(|&s| s == run.cloud_scale);
+    runs.sort_by_key(|r| {
+        (
+            SCENARIOS.iter().position(|&s| s == r.scenario),
+            scale_rank(r),
+            !r.impostors,
+        )
+    });
     let timing = if timestamps {
         "GPU timestamps"
     } else {
@@ -401,11 +486,21 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// A scale as the table and the CSV files write it: 1, 1/2, 1/4.
+fn scale_text(scale: f32) -> String {
+    if scale >= 1.0 {
+        "1".to_string()
+    } else {
+        format!("1/{}", (1.0 / scale).round())
+    }
+}
+
 /// A row of the table and of `bench.csv`.
 struct Row {
     scenario: &'static str,
     overdraw_pct: f64,
     impostors: bool,
+    cloud_scale: f32,
     median_ms: f64,
     p95_ms: f64,
     /// Median of the sky's passes alone over the steady frames (NaN: no GPU timestamps).
@@ -416,6 +511,10 @@ struct Row {
     ratio: f64,
     /// The same for the sky's passes alone.
     sky_ratio: f64,
+    /// Median at scale 1 over median at this row's scale, same scenario and ring (1 at scale 1).
+    scale_ratio: f64,
+    /// The same for the sky's passes alone.
+    sky_scale_ratio: f64,
     sprites_drawn: f64,
     cpu_update_ms: f64,
     /// Median GPU memory of the resident sprites (records, orders, indices, draw list), MB.
@@ -427,9 +526,14 @@ struct Row {
 fn summary_rows(runs: &[Run]) -> Vec<Row> {
     runs.iter()
         .map(|r| {
-            let other = runs
-                .iter()
-                .find(|o| o.scenario == r.scenario && o.impostors != r.impostors);
+            let other = runs.iter().find(|o| {
+                o.scenario == r.scenario
+                    && o.cloud_scale == r.cloud_scale
+                    && o.impostors != r.impostors
+            });
+            let full = runs.iter().find(|o| {
+                o.scenario == r.scenario && o.impostors == r.impostors && o.cloud_scale == 1.0
+            });
             let (on, off) = match other {
                 Some(o) if r.impostors => (r, o),
                 Some(o) => (o, r),
@@ -440,10 +544,17 @@ fn summary_rows(runs: &[Run]) -> Vec<Row> {
                 Some(_) => (off.median_ms() / on.median_ms(), sky(off) / sky(on)),
                 None => (f64::NAN, f64::NAN),
             };
+            let (scale_ratio, sky_scale_ratio) = match full {
+                Some(f) => (f.median_ms() / r.median_ms(), sky(f) / sky(r)),
+                None => (f64::NAN, f64::NAN),
+            };
             Row {
                 scenario: r.scenario,
                 overdraw_pct: r.overdraw * 100.0,
                 impostors: r.impostors,
+                cloud_scale: r.cloud_scale,
+                scale_ratio,
+                sky_scale_ratio,
                 median_ms: r.median_ms(),
                 p95_ms: r.p95_ms(),
                 sky_ms: sky(r),
@@ -462,16 +573,19 @@ fn summary_rows(runs: &[Run]) -> Vec<Row> {
         .collect()
 }
 
-const HEADER: [&str; 13] = [
+const HEADER: [&str; 16] = [
     "scenario",
     "overdraw_pct",
     "impostors",
+    "cloud_scale",
     "median_ms",
     "p95_ms",
     "sky_ms",
     "rebuild_ms",
     "off_on_ratio",
     "sky_off_on_ratio",
+    "full_scale_ratio",
+    "sky_full_scale_ratio",
     "sprites_drawn",
     "cpu_update_ms",
     "sprite_gpu_mb",
@@ -488,16 +602,19 @@ fn print_table(adapter: &str, args: &BenchArgs, timing: &str, rows: &[Row]) {
         CRUISE_FT_AGL
     );
     println!(
-        "{:<10} {:>9} {:>9} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>10} {:>9} {:>9}",
+        "{:<10} {:>9} {:>9} {:>5} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>6} {:>7} {:>10} {:>9} {:>9}",
         "scenario",
         "overdraw",
         "impostors",
+        "scale",
         "median ms",
         "p95 ms",
         "sky ms",
         "rebuild ms",
         "off/on",
         "sky off/on",
+        "1/S",
+        "sky 1/S",
         "sprites",
         "cpu ms",
         "gpu MB"
@@ -511,16 +628,19 @@ fn print_table(adapter: &str, args: &BenchArgs, timing: &str, rows: &[Row]) {
     };
     for r in rows {
         println!(
-            "{:<10} {:>8.0}% {:>9} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>10.0} {:>9} {:>9.1}{}",
+            "{:<10} {:>8.0}% {:>9} {:>5} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>6} {:>7} {:>10.0} {:>9} {:>9.1}{}",
             r.scenario,
             r.overdraw_pct,
             if r.impostors { "on" } else { "off" },
+            scale_text(r.cloud_scale),
             ms(r.median_ms),
             ms(r.p95_ms),
             ms(r.sky_ms),
             ms(r.rebuild_ms),
             ms(r.ratio),
             ms(r.sky_ratio),
+            ms(r.scale_ratio),
+            ms(r.sky_scale_ratio),
             r.sprites_drawn,
             ms(r.cpu_update_ms),
             r.sprite_mb,
@@ -552,12 +672,15 @@ fn write_csv(path: &Path, adapter: &str, timing: &str, rows: &[Row]) -> anyhow::
             r.scenario.to_string(),
             format!("{:.0}", r.overdraw_pct),
             (if r.impostors { "on" } else { "off" }).to_string(),
+            r.cloud_scale.to_string(),
             ms(r.median_ms),
             ms(r.p95_ms),
             ms(r.sky_ms),
             ms(r.rebuild_ms),
             ms(r.ratio),
             ms(r.sky_ratio),
+            ms(r.scale_ratio),
+            ms(r.sky_scale_ratio),
             format!("{:.0}", r.sprites_drawn),
             ms(r.cpu_update_ms),
             format!("{:.1}", r.sprite_mb),
@@ -581,6 +704,7 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
     csv.write_record([
         "scenario",
         "impostors",
+        "cloud_scale",
         "frame",
         "steady",
         "distance_m",
@@ -593,12 +717,14 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
         "blocks_near",
         "blocks_far",
         "impostors_rebuilt",
+        "cloud_target_bytes",
     ])?;
     for run in runs {
         for (k, f) in run.frames.iter().enumerate() {
             csv.write_record([
                 run.scenario.to_string(),
                 (if run.impostors { "on" } else { "off" }).to_string(),
+                run.cloud_scale.to_string(),
                 k.to_string(),
                 (if f.steady { "yes" } else { "no" }).to_string(),
                 format!("{:.0}", f.distance_m),
@@ -615,6 +741,7 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
                 f.blocks_near.to_string(),
                 f.blocks_far.to_string(),
                 f.impostors_rebuilt.to_string(),
+                f.cloud_target_bytes.to_string(),
             ])?;
         }
     }
@@ -622,13 +749,25 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// One line a run: colour by scenario (lighter at full resolution when another scale is run),
+/// dashed without the impostor ring.
 fn runs_for_plot(runs: &[Run]) -> Vec<plot::Series> {
+    let several_scales = runs.iter().any(|r| r.cloud_scale != runs[0].cloud_scale);
     runs.iter()
         .map(|r| plot::Series {
-            colour: match r.scenario {
-                "sparse" => [40, 110, 220],
-                "scattered" => [30, 160, 60],
-                _ => [210, 50, 40],
+            label: format!(
+                "{}, ring {}, clouds at {}",
+                r.scenario,
+                if r.impostors { "on" } else { "off" },
+                scale_text(r.cloud_scale)
+            ),
+            colour: match (r.scenario, several_scales && r.cloud_scale == 1.0) {
+                ("sparse", false) => [40, 110, 220],
+                ("sparse", true) => [140, 180, 240],
+                ("scattered", false) => [30, 160, 60],
+                ("scattered", true) => [140, 210, 150],
+                (_, false) => [210, 50, 40],
+                (_, true) => [240, 150, 140],
             },
             dashed: !r.impostors,
             points: r.steady().map(|f| (f.distance_m, f.frame_ms)).collect(),

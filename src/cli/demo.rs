@@ -1,6 +1,7 @@
 //! `skycast demo`: the shipped bulk weather file's summary and the interpolated weather of blocks
-//! across the Irish Sea, then the default flight (the cruise through scattered cumulus off Los
-//! Angeles) rendered through the same real weather into `out/`.
+//! across the Irish Sea, then the default flight (along the Los Angeles coast under the cumulus
+//! the file reports there, as a pilot would fly it that day) rendered through the same real
+//! weather into `out/`, with how many of its frames are entirely inside cloud.
 
 use std::path::PathBuf;
 
@@ -58,7 +59,7 @@ pub struct DemoArgs {
 }
 
 /// The default flight of the demo.
-pub const DEFAULT_FLIGHT: &str = "config/flights/cruise_scattered_cumulus.toml";
+pub const DEFAULT_FLIGHT: &str = "config/flights/demo_coast_under_cumulus.toml";
 
 /// Runs `skycast demo`.
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
@@ -89,6 +90,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         every: args.every,
         time: None,
         render_settings: None,
+        cloud_scale: None,
         time_of_day: None,
         watch: false,
         settle_ms: 500,

@@ -13,18 +13,18 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::Context;
 use clap::Args;
 use skycast::clouds::CloudsConfig;
-use skycast::flight::FlightPlan;
-use skycast::render::{DemoHost, SkyConfig};
-use skycast::shading::sun_position;
-use skycast::weather::live::{LiveChange, LiveWeather, Prepare};
-use skycast::weather::{LocalFrame, StationTable, WeatherField, theme};
+use skycast::demo::DemoHost;
+use skycast::flight::{FlightPlan, Weather};
+use skycast::weather::{LocalFrame, StationTable, theme};
 
-use super::render::{ElevationArgs, load_look, parse_size, parse_time, time_or_default, world_at};
+use super::render::{
+    ElevationArgs, load_look, parse_size, parse_time, sky_config, time_or_default,
+};
 use super::weather::{DEFAULT_STATIONS, load};
 
 /// Flags of `skycast fly`.
@@ -57,6 +57,10 @@ pub struct FlyArgs {
     /// Renderer settings (default: the shipped config/render.toml).
     #[arg(long)]
     pub render_settings: Option<PathBuf>,
+    /// Resolution the clouds are drawn at, a fraction of the frames': 1, 1/2 or 1/4 (default:
+    /// the renderer settings' `[clouds] resolution_scale`).
+    #[arg(long, value_parser = super::render::parse_cloud_scale)]
+    pub cloud_scale: Option<f32>,
     /// Time-of-day table (default: the shipped config/time_of_day.toml).
     #[arg(long)]
     pub time_of_day: Option<PathBuf>,
@@ -86,57 +90,46 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let plan = FlightPlan::load(&args.path)?;
     let (lat, lon) = plan.origin_lat_lon_deg;
     let flight = plan.place(&LocalFrame::new(lat, lon));
-    let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
+    let (settings, table) = load_look(
+        args.render_settings.as_ref(),
+        args.time_of_day.as_ref(),
+        args.cloud_scale,
+    )?;
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let start_unix_s = time_or_default(args.time)?;
-    let mut world = world_at(&loaded, lat, lon);
-    let ground = args.elevation.ground(&world)?;
-    if let Some(path) = &args.clouds {
-        world.set_clouds_config(CloudsConfig::load(path)?);
-    }
-    // Live weather: the watched file and the flight's timed events, prepared off the frame thread.
-    let mut live = LiveWeather::<WeatherField>::new();
-    let (field_settings, rule) = (loaded.settings.clone(), loaded.rule.clone());
-    let prepare: Prepare<WeatherField> =
-        Arc::new(move |input| input.field(LocalFrame::new(lat, lon), &field_settings, &rule));
+    let field = loaded
+        .input
+        .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);
+    let ground = args.elevation.ground(&field)?;
+    // Live weather (the watched file, the flight's timed events) needs the station table for
+    // report files; a theme places itself.
     let needs_table = (args.watch && !theme::is_theme_path(&args.weather))
         || plan
             .weather_events
             .iter()
             .any(|e| !theme::is_theme_path(&e.weather));
-    let stations = if needs_table {
-        Some(Arc::new(StationTable::load(&args.stations)?))
-    } else {
-        None
-    };
+    let mut config = sky_config((lat, lon), (settings, table), &loaded);
+    if needs_table {
+        config.stations = Some(Arc::new(StationTable::load(&args.stations)?));
+    }
+    let mut host = DemoHost::new(args.size.0, args.size.1, &ground, config)?;
+    host.sky.set_weather_field(field);
+    if let Some(path) = &args.clouds {
+        host.sky
+            .world_mut()
+            .set_clouds_config(CloudsConfig::load(path)?);
+    }
     for event in &plan.weather_events {
-        live.schedule(
-            event.time_s,
-            &event.weather,
-            stations.clone(),
-            Arc::clone(&prepare),
-        )?;
+        host.sky
+            .schedule_weather(&event.weather, event.time_s - flight.start_s())?;
     }
     if args.watch {
-        live.watch(
-            &args.weather,
-            stations.clone(),
-            Duration::from_millis(args.settle_ms),
-            Arc::clone(&prepare),
-        )?;
+        host.sky.set_weather(Weather::Watch {
+            path: &args.weather,
+            settle: Duration::from_millis(args.settle_ms),
+        })?;
         eprintln!("watching {}", args.weather.display());
     }
-    let mut host = DemoHost::new(
-        args.size.0,
-        args.size.1,
-        &ground,
-        SkyConfig {
-            targets: skycast::render::headless::TARGETS,
-            settings,
-            time_of_day: table,
-            sheet: world.sheet(),
-        },
-    )?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let csv_path = args.out.join("frames.csv");
@@ -166,10 +159,13 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "weather_applied",
         "written",
         "gpu_ms",
+        "cloud_scale",
+        "cloud_target_bytes",
+        "in_cloud",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
-    let mut written = 0u32;
+    let (mut written, mut inside_cloud) = (0u32, 0u32);
     // For the closing summary: what the README quotes, from this run.
     let mut summary = Summary::default();
     // On a terminal only (indicatif hides it when stderr is a file or a pipe).
@@ -182,48 +178,34 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     for k in 0..frames {
         let time_s = flight.start_s() + k as f64 * dt_s;
         let pose = flight.pose_at(time_s);
-        // New weather: only what is ready; the frame never waits for a file.
-        let weather_start = Instant::now();
-        let mut applied = String::new();
-        for change in live.poll(time_s) {
-            match change {
-                LiveChange::Loaded { source, weather } => {
-                    world.set_field(weather);
-                    applied = source
-                        .file_name()
-                        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-                }
-                // Logged where it was found; the last good weather stays.
-                LiveChange::Rejected(_) => applied = "rejected".to_string(),
-            }
-        }
-        let weather_us = weather_start.elapsed().as_micros();
-        // The clouds stage's living field: drift with the wind, formation and dissipation.
-        let step_s = if k == 0 { 0.0 } else { dt_s };
-        world.update_sky(&mut host.sky, pose.position_m, step_s)?;
-        host.sky
-            .set_weather_overhead(&world.weather_over(pose.position_m));
         let camera = host.camera(pose.position_m, pose.heading_deg, pose.pitch_deg);
-        let sun = sun_position(start_unix_s + time_s, lat, lon);
         let write = k % args.every as u64 == 0 || k + 1 == frames;
+        // The frame step: new weather that is ready (the frame never waits for a file), the
+        // living clouds, the sun, the sky's CPU share; drawn on written frames.
+        let step_s = if k == 0 { 0.0 } else { dt_s };
+        let (stats, changes) = host.step(&camera, start_unix_s + time_s, step_s, write)?;
+        let mut applied = String::new();
+        for change in changes {
+            applied = match change {
+                Ok(source) => source
+                    .file_name()
+                    .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+                // Logged where it was found; the last good weather stays.
+                Err(_) => "rejected".to_string(),
+            };
+        }
         let mut gpu_ms = String::new();
-        let stats = if write {
-            let (frame, stats) = host.frame(
-                &camera,
-                &sun,
-                if k == 0 { 0.0 } else { dt_s },
-                world.visibility_m(),
-            )?;
+        if write {
+            let frame = host.target.read_back(&host.gpu)?;
             frame.write_png(&args.out.join(format!("frame_{k:05}.png")))?;
             if let Some(ms) = host.last_gpu_ms() {
                 gpu_ms = format!("{ms:.2}");
             }
             written += 1;
-            stats
-        } else {
-            host.sky.prepare(&host.gpu.queue, camera, &sun, dt_s)
-        };
-        summary.add(&stats, weather_us);
+            // Entirely inside a cloud: the frame is the in-cloud fog and nothing else.
+            inside_cloud += (stats.in_cloud >= 0.99) as u32;
+        }
+        summary.add(&stats);
         let p = pose.position_m;
         csv.write_record([
             k.to_string(),
@@ -245,10 +227,13 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             stats.sprite_gpu_bytes.to_string(),
             stats.blocks_left_out.to_string(),
             stats.impostors_rebuilt.to_string(),
-            weather_us.to_string(),
+            stats.weather_us.to_string(),
             applied,
             (write as u8).to_string(),
             gpu_ms,
+            stats.cloud_scale.to_string(),
+            stats.cloud_target_bytes.to_string(),
+            format!("{:.2}", stats.in_cloud),
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);
@@ -256,7 +241,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     progress.finish();
     csv.flush()?;
     println!(
-        "{}: {written} frames and frames.csv ({frames} simulated at {} fps)",
+        "{}: {written} frames ({inside_cloud} of them entirely inside cloud) and frames.csv ({frames} simulated at {} fps)",
         args.out.display(),
         args.fps
     );
@@ -270,14 +255,14 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
 struct Summary {
     sky_cpu_us: Vec<u64>,
     cache_hit_rate: Vec<f32>,
-    weather_us_max: u128,
+    weather_us_max: u64,
 }
 
 impl Summary {
-    fn add(&mut self, stats: &skycast::render::FrameStats, weather_us: u128) {
+    fn add(&mut self, stats: &skycast::render::FrameStats) {
         self.sky_cpu_us.push(stats.sky_cpu_us());
         self.cache_hit_rate.push(stats.cache_hit_rate);
-        self.weather_us_max = self.weather_us_max.max(weather_us);
+        self.weather_us_max = self.weather_us_max.max(stats.weather_us);
     }
 
     fn line(&mut self) -> String {

@@ -6,12 +6,11 @@ use std::path::PathBuf;
 
 use clap::Args;
 use glam::DVec2;
-use skycast::render::world::{World, WorldSettings};
-use skycast::render::{
-    DemoHost, GroundSettings, HeightField, RenderSettings, SkyConfig, demo_ground,
-};
+use skycast::demo::{DemoHost, GroundSettings, HeightField, demo_ground};
+use skycast::flight::SkySystemConfig;
+use skycast::render::RenderSettings;
 use skycast::shading::{TimeOfDayTable, sun_position};
-use skycast::weather::{LocalFrame, METRES_PER_FOOT};
+use skycast::weather::{LocalFrame, METRES_PER_FOOT, WeatherField};
 
 use super::weather::{DEFAULT_STATIONS, Loaded, load, parse_lat_lon};
 
@@ -52,6 +51,10 @@ pub struct RenderArgs {
     /// Renderer settings (default: the shipped config/render.toml).
     #[arg(long)]
     pub render_settings: Option<PathBuf>,
+    /// Resolution the clouds are drawn at, a fraction of the image's: 1, 1/2 or 1/4 (default:
+    /// the renderer settings' `[clouds] resolution_scale`).
+    #[arg(long, value_parser = parse_cloud_scale)]
+    pub cloud_scale: Option<f32>,
     /// Time-of-day table (default: the shipped config/time_of_day.toml).
     #[arg(long)]
     pub time_of_day: Option<PathBuf>,
@@ -83,16 +86,16 @@ pub struct ElevationArgs {
 }
 
 impl ElevationArgs {
-    /// The ground under `world`: the elevation file when given, else the demo ground of its
-    /// weather (the stations' elevations). Cloud bases stay above the weather's ground, so a
+    /// The ground under the weather `field`: the elevation file when given, else the demo
+    /// ground of the stations' elevations. Cloud bases stay above the weather's ground, so a
     /// mountain of the file higher than that reaches into the clouds.
-    pub fn ground(&self, world: &World) -> anyhow::Result<HeightField> {
+    pub fn ground(&self, field: &WeatherField) -> anyhow::Result<HeightField> {
         let (Some(path), Some(size_km), Some((min_m, max_m))) = (
             &self.elevation,
             self.elevation_size_km,
             self.elevation_range_m,
         ) else {
-            return Ok(demo_ground(world.field(), &GroundSettings::default()));
+            return Ok(demo_ground(field, &GroundSettings::default()));
         };
         if !(1.0..=1000.0).contains(&size_km) {
             anyhow::bail!("--elevation-size-km {size_km} is outside 1..=1000");
@@ -157,6 +160,17 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((side(w)?, side(h)?))
 }
 
+/// Parses `--cloud-scale`: 1, 1/2 or 1/4 (or 0.5, 0.25).
+pub fn parse_cloud_scale(text: &str) -> Result<f32, String> {
+    let scale = match text.trim() {
+        "1" | "1.0" => 1.0,
+        "1/2" | "0.5" => 0.5,
+        "1/4" | "0.25" => 0.25,
+        _ => return Err(format!("`{text}` is not a cloud scale: 1, 1/2 or 1/4")),
+    };
+    Ok(scale)
+}
+
 /// The time a `--time` flag gives, or the shipped weather file's ([`DEFAULT_TIME`]), Unix seconds.
 pub fn time_or_default(time: Option<f64>) -> anyhow::Result<f64> {
     match time {
@@ -165,24 +179,35 @@ pub fn time_or_default(time: Option<f64>) -> anyhow::Result<f64> {
     }
 }
 
-/// The demo world of loaded weather, in the local frame around `lat`, `lon` (degrees).
-pub fn world_at(loaded: &Loaded, lat: f64, lon: f64) -> World {
-    let frame = LocalFrame::new(lat, lon);
-    let field = loaded.input.field(frame, &loaded.settings, &loaded.rule);
-    World::new(field, &WorldSettings::default())
+/// The sky of the demo host around `origin` with the look and the weather settings loaded.
+pub fn sky_config(
+    origin: (f64, f64),
+    (settings, table): (RenderSettings, TimeOfDayTable),
+    loaded: &Loaded,
+) -> SkySystemConfig {
+    let mut config = SkySystemConfig::new(skycast::demo::headless::TARGETS, origin);
+    config.sky.settings = settings;
+    config.sky.time_of_day = table;
+    config.field = loaded.settings.clone();
+    config.rule = loaded.rule.clone();
+    config
 }
 
 /// Loads the renderer settings and time-of-day table the flags name (or the shipped ones).
 pub fn load_look(
     render: Option<&PathBuf>,
     time_of_day: Option<&PathBuf>,
+    cloud_scale: Option<f32>,
 ) -> anyhow::Result<(RenderSettings, TimeOfDayTable)> {
-    let settings = match render {
-        Some(p) => RenderSettings::from_path(p)?,
+    let mut settings = match render {
+        Some(p) => RenderSettings::load(p)?,
         None => RenderSettings::default(),
     };
+    if let Some(scale) = cloud_scale {
+        settings.clouds.resolution_scale = scale;
+    }
     let table = match time_of_day {
-        Some(p) => TimeOfDayTable::from_path(p)?,
+        Some(p) => TimeOfDayTable::load(p)?,
         None => TimeOfDayTable::default(),
     };
     Ok((settings, table))
@@ -194,29 +219,29 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if !(-2_000.0..=100_000.0).contains(&args.alt_ft) {
         anyhow::bail!("--alt-ft {} is outside -2000..=100000 feet", args.alt_ft);
     }
-    let (settings, table) = load_look(args.render_settings.as_ref(), args.time_of_day.as_ref())?;
+    let (settings, table) = load_look(
+        args.render_settings.as_ref(),
+        args.time_of_day.as_ref(),
+        args.cloud_scale,
+    )?;
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let unix_s = time_or_default(args.time)?;
-    let mut world = world_at(&loaded, lat, lon);
-    let ground = args.elevation.ground(&world)?;
-    let sheet = world.sheet();
+    let field = loaded
+        .input
+        .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);
+    let ground = args.elevation.ground(&field)?;
     let mut host = DemoHost::new(
         args.size.0,
         args.size.1,
         &ground,
-        SkyConfig {
-            targets: skycast::render::headless::TARGETS,
-            settings,
-            time_of_day: table,
-            sheet,
-        },
+        sky_config((lat, lon), (settings, table), &loaded),
     )?;
+    host.sky.set_weather_field(field);
     let position = glam::DVec3::new(0.0, 0.0, args.alt_ft * METRES_PER_FOOT);
     let camera = host.camera(position, args.heading, args.pitch);
-    host.sky.set_clouds(world.sky_blocks_around(position));
-    host.sky.set_weather_overhead(&world.weather_over(position));
+    // The same frame step a simulator's frame runs (the clouds around generated before it).
+    let (frame, stats) = host.step_frame(&camera, unix_s, 0.0)?;
     let sun = sun_position(unix_s, lat, lon);
-    let (frame, stats) = host.frame(&camera, &sun, 0.0, world.visibility_m())?;
     frame.write_png(&args.out)?;
     if let Some(exr) = &args.exr {
         frame.write_exr(exr, camera.near_m, camera.far_m)?;

@@ -35,6 +35,9 @@ pub struct Sprite {
     /// (where the foggy ones under the inside make the smooth grey underside).
     #[serde(default)]
     pub upright: bool,
+    /// Falling rain or snow under the cloud (a shaft), not cloud: drawn darker and greyer.
+    #[serde(default)]
+    pub precipitation: bool,
 }
 
 /// A shading group: sprites shaded as one clump (Wang 2003 §5.2, 1 to 30 sprites).

@@ -150,6 +150,24 @@ pub struct AnvilConfig {
     pub width_scale: f32,
 }
 
+/// Precipitation falling from a cloud's base where the weather reports it (rain or snow
+/// shafts; virga, evaporating before the ground, where the air below is dry).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PrecipitationConfig {
+    /// Shafts under one cloud (or lattice cell), the range they are drawn from.
+    pub shafts: [u32; 2],
+    /// A shaft's width over the width of the cloud's base.
+    pub width_over_base: f32,
+    /// Opacity of a shaft at light (intensity 0) and heavy (1) precipitation.
+    pub alpha: [f32; 2],
+    /// Temperature-dewpoint spread at the ground, degrees C: below the first the shaft reaches
+    /// the ground; from the second on it reaches only `min_reach` of the way down (virga).
+    pub virga_spread_c: [f32; 2],
+    /// The least fraction of the way from base to ground a shaft falls.
+    pub min_reach: f32,
+}
+
 /// The shape of one cloud type (one `[section]` of `config/cloud_types.toml`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -175,6 +193,9 @@ pub struct CloudTypeConfig {
     /// The anvil, for cumulonimbus.
     #[serde(default)]
     pub anvil: Option<AnvilConfig>,
+    /// Rain or snow shafts under the type's clouds where the weather has precipitation.
+    #[serde(default)]
+    pub precipitation: Option<PrecipitationConfig>,
     /// Flat types: each cloud is a streak this many times longer than wide, laid along the wind
     /// with every sprite lengthwise along it (cirrus fibres); `cloud_size_m` is its length.
     #[serde(default)]
@@ -483,6 +504,25 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
             anvil.from > 0.0 && anvil.from < 1.0 && anvil.width_scale >= 1.0,
             "anvil",
             "needs 0 < from < 1 and width_scale >= 1",
+        )?;
+    }
+    if let Some(p) = c.precipitation {
+        v.check(
+            p.shafts[0] >= 1 && p.shafts[0] <= p.shafts[1] && p.shafts[1] <= 12,
+            "precipitation",
+            "shafts must be 1..=12, the first at most the second",
+        )?;
+        v.check(
+            p.width_over_base > 0.0
+                && p.width_over_base <= 1.0
+                && (0.0..=1.0).contains(&p.alpha[0])
+                && p.alpha[0] <= p.alpha[1]
+                && p.alpha[1] <= 1.0
+                && p.virga_spread_c[0] < p.virga_spread_c[1]
+                && p.min_reach > 0.0
+                && p.min_reach <= 1.0,
+            "precipitation",
+            "needs width_over_base in (0, 1], alpha ascending within 0..=1, virga_spread_c ascending and min_reach in (0, 1]",
         )?;
     }
     if let Some(aspect) = c.streak_length_over_width {

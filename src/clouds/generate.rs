@@ -22,6 +22,7 @@ use glam::{DVec2, DVec3};
 use super::block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};
 use super::config::{CloudTypeConfig, CloudTypes, TextureCategory};
 use super::heap::heap_sprites;
+use super::rain::add_shafts;
 use super::rng::{SplitMix64, hash_keys};
 use crate::weather::{
     BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, CloudType, METRES_PER_FOOT,
@@ -78,9 +79,29 @@ pub fn generate_block(
             sprites: clouds.iter().map(|c| c.sprites.len() as u32).sum(),
             overdraw: (area / (BLOCK_SIZE_M * BLOCK_SIZE_M)) as f32,
         });
+        // Rain or snow under the layer's clouds, after the layer's own figures (the paper's
+        // overdraw is of the clouds).
+        if let Some(precipitation) = &config.precipitation
+            && weather.precipitation > 0.0
+        {
+            let mut rng = SplitMix64::from_keys(&[
+                seed,
+                index.i as u64,
+                index.j as u64,
+                li as u64,
+                type_key(layer.cloud_type),
+                RAIN_KEY,
+            ]);
+            for cloud in &mut block.clouds[first..] {
+                add_shafts(cloud, precipitation, weather, frame.base_m, &mut rng);
+            }
+        }
     }
     block
 }
+
+/// Keys the randomness of a layer's precipitation apart from that of its clouds.
+const RAIN_KEY: u64 = 0x7261_696e;
 
 /// Vertical placement of one layer, metres above mean sea level.
 struct LayerFrame {
@@ -476,6 +497,7 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
             radius_fraction: (offset.length() / radius).min(1.0) as f32,
             alpha_morph: 1.0,
             upright,
+            precipitation: false,
         });
     }
     let shading_groups = sums

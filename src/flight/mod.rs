@@ -13,8 +13,10 @@
 mod path;
 mod spline;
 pub mod system;
+pub mod world;
 
 pub use path::{CameraPose, FlightPath, FlightPlan, View, Waypoint, WeatherEvent};
 pub use system::{
     HostCamera, HostLighting, HostPosition, SkyError, SkySystem, SkySystemConfig, Weather,
 };
+pub use world::{World, WorldSettings};

@@ -16,8 +16,8 @@ use std::time::{Duration, Instant};
 
 use glam::{DVec3, Mat4, Vec3};
 
-use crate::render::world::{World, WorldSettings};
-use crate::render::{FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView};
+use super::world::{World, WorldSettings};
+use crate::render::{Camera, FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView};
 use crate::shading::sun_position;
 use crate::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
 use crate::weather::live::{LiveChange, LiveWeather, Prepare};
@@ -50,6 +50,16 @@ pub struct SkySystemConfig {
     pub rule: CloudTypeRule,
     /// Places the reports of files that give no positions (NOAA's station table).
     pub stations: Option<Arc<StationTable>>,
+}
+
+impl From<SkyConfig> for SkySystemConfig {
+    /// The sky's own config around latitude and longitude 0 (clear weather until it is given).
+    fn from(sky: SkyConfig) -> Self {
+        Self {
+            sky: sky.clone(),
+            ..Self::new(sky.targets, (0.0, 0.0))
+        }
+    }
 }
 
 impl SkySystemConfig {
@@ -116,6 +126,17 @@ pub struct HostCamera {
     pub view: Mat4,
     /// The host's projection, clip depth `[0, 1]`, standard or reversed as its targets say.
     pub projection: Mat4,
+}
+
+impl From<&Camera> for HostCamera {
+    /// skycast's own heading/pitch camera as a host's: local position, its view and projection.
+    fn from(camera: &Camera) -> Self {
+        Self {
+            position: HostPosition::Local(camera.position_m),
+            view: camera.view_relative(),
+            projection: camera.projection(),
+        }
+    }
 }
 
 /// What the host needs to light and fog its own scene like the sky (linear RGB).
@@ -213,6 +234,11 @@ impl SkySystem {
         Ok(())
     }
 
+    /// Takes a weather field the host built itself (same as [`Self::set_weather`] otherwise).
+    pub fn set_weather_field(&mut self, field: WeatherField) {
+        self.world.set_field(field);
+    }
+
     /// Schedules a weather file for `at_s` seconds of frames from now (a front passing in a
     /// scripted flight): read and built off the frame thread, applied on the first frame at or
     /// after its time.
@@ -228,31 +254,32 @@ impl SkySystem {
 
     /// The frame step, CPU side: applies weather that is ready, advances the living clouds by
     /// `dt_s` around the camera and hands the sky what changed, places the sun for `utc_unix_s`,
-    /// and prepares the sky's frame. Returns the frame's stats (its CPU cost included) and the
-    /// files applied this frame. Call [`Self::record`] after it, in the frame's encoder.
+    /// and prepares the sky's frame. Returns the frame's stats (its CPU cost included, the
+    /// weather's in `weather_us`) and the weather files that arrived this frame: applied, or
+    /// rejected with the one line that says why (the last good sky stays). Call
+    /// [`Self::record`] after it, in the frame's encoder.
     pub fn update(
         &mut self,
         queue: &wgpu::Queue,
         camera: &HostCamera,
         utc_unix_s: f64,
         dt_s: f64,
-    ) -> Result<(FrameStats, Vec<PathBuf>), SkyError> {
+    ) -> Result<(FrameStats, Vec<Result<PathBuf, String>>), SkyError> {
         let start = Instant::now();
         let dt_s = dt_s.max(0.0);
         self.clock_s += dt_s;
-        let mut applied = Vec::new();
+        let mut changes = Vec::new();
         for change in self.live.poll(self.clock_s) {
-            match change {
+            changes.push(match change {
                 LiveChange::Loaded { source, weather } => {
                     self.world.set_field(weather);
-                    applied.push(source);
+                    Ok(source)
                 }
-                // Already logged with its file and line; the last good sky stays.
-                LiveChange::Rejected(_) => {}
-            }
+                LiveChange::Rejected(why) => Err(why),
+            });
         }
-        self.sky
-            .add_field_cpu_us(start.elapsed().as_micros() as u64);
+        let weather_us = start.elapsed().as_micros() as u64;
+        self.sky.add_field_cpu_us(weather_us);
         let position_m = match camera.position {
             HostPosition::Local(p) => p,
             HostPosition::LatLonAlt {
@@ -272,7 +299,9 @@ impl SkySystem {
             view: camera.view,
             projection: camera.projection,
         };
-        Ok((self.sky.prepare(queue, view, &sun, dt_s), applied))
+        let mut stats = self.sky.prepare(queue, view, &sun, dt_s);
+        stats.weather_us = weather_us;
+        Ok((stats, changes))
     }
 
     /// Records the sky's passes into the host's encoder after the host drew its scene: the sky
@@ -307,16 +336,6 @@ impl SkySystem {
         &self.frame
     }
 
-    /// The renderer underneath, for hosts that want its lower-level controls.
-    pub fn sky(&self) -> &Sky {
-        &self.sky
-    }
-
-    /// The renderer underneath, mutable.
-    pub fn sky_mut(&mut self) -> &mut Sky {
-        &mut self.sky
-    }
-
     /// The weather field and the clouds built from it.
     pub fn world(&self) -> &World {
         &self.world
@@ -326,5 +345,21 @@ impl SkySystem {
     /// frames).
     pub fn world_mut(&mut self) -> &mut World {
         &mut self.world
+    }
+}
+
+/// A `SkySystem` is the [`Sky`] with the frame step around it: the renderer's lower-level
+/// controls (its settings, stats, fades, blocks given by hand) are reached through it.
+impl std::ops::Deref for SkySystem {
+    type Target = Sky;
+
+    fn deref(&self) -> &Sky {
+        &self.sky
+    }
+}
+
+impl std::ops::DerefMut for SkySystem {
+    fn deref_mut(&mut self) -> &mut Sky {
+        &mut self.sky
     }
 }

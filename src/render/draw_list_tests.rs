@@ -86,6 +86,7 @@ fn small_cloud() -> SkyCloud {
                 alpha_morph: 1.0,
                 radius_fraction: k as f32 / 40.0,
                 upright: false,
+                precipitation: false,
             }
         })
         .collect();

@@ -105,6 +105,8 @@ impl GpuSpriteVertex {
 
 /// The `bits` flag of an upright sprite.
 pub const SPRITE_UPRIGHT: u32 = 1 << 8;
+/// `GpuSprite::bits`: falling rain or snow, drawn darker and greyer.
+pub const SPRITE_PRECIPITATION: u32 = 1 << 9;
 
 /// One cloud's shading constants on the GPU (written with its block). Keep in sync with
 /// `Cloud` in `shaders/sprites.wgsl`.
@@ -230,3 +232,16 @@ pub struct GpuTerrainVertex {
     pub normal: [f32; 4],
 }
 const _: () = assert!(std::mem::size_of::<GpuTerrainVertex>() == 32);
+
+/// The impostor ring pass's uniform. Keep in sync with `Ring` in `shaders/impostor_quad.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuRing {
+    /// The shown ring's centre relative to the camera, metres; w: the crossfade weight.
+    pub old_centre_weight: [f32; 4],
+    /// The centre of the ring fading in (the shown one's when not fading), metres.
+    pub new_centre: [f32; 4],
+    /// Ring radius, half side of a quad, the old and new rings' mean far distance, metres.
+    pub size: [f32; 4],
+}
+const _: () = assert!(std::mem::size_of::<GpuRing>() == 48);

@@ -16,24 +16,18 @@
 //!   `gpu_types`. `readback`: the built corners read back for tests and tools.
 //! - `targets`: the host's targets and view on its terms (formats, reversed Z, MSAA, its own
 //!   matrices).
-//! - `demo_host`, `terrain`, `headless`, `output` (feature `demo`): the demo host (height-field
-//!   ground with fog, an offscreen device and target on any adapter, lavapipe included) and
-//!   PNG / EXR output.
+//! - `cloud_target`: below full resolution, the clouds drawn off-screen against the farthest
+//!   depth of each block of pixels and composited with a full-resolution depth fix-up.
 //!
 //! Positions are f64 on the CPU and camera-relative f32 on the GPU. Units: metres, degrees,
 //! linear RGB.
 
 mod build;
 pub mod camera;
-#[cfg(feature = "demo")]
-pub mod demo_host;
+pub mod cloud_target;
 pub mod draw_list;
 pub mod gpu_types;
-#[cfg(feature = "demo")]
-pub mod headless;
 pub mod impostor;
-#[cfg(feature = "demo")]
-pub mod output;
 mod pipeline;
 mod readback;
 mod resident;
@@ -45,15 +39,8 @@ mod slots;
 mod sprite_view;
 pub mod stats;
 pub mod targets;
-#[cfg(feature = "demo")]
-pub mod terrain;
-pub mod world;
 
 pub use camera::{Camera, Frustum};
-#[cfg(feature = "demo")]
-pub use demo_host::{DemoHost, GroundSettings, demo_ground, ground_from_field};
-#[cfg(feature = "demo")]
-pub use headless::{Frame, HeadlessGpu, OffscreenTarget};
 pub use readback::SpriteCorner;
 pub use resident::BYTES_PER_SPRITE;
 pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};
@@ -61,8 +48,6 @@ pub use settings::RenderSettings;
 pub use sky::{Sky, SkyConfig, SpriteSheet};
 pub use stats::{FrameStats, Lighting};
 pub use targets::{HostTargets, SkyView};
-#[cfg(feature = "demo")]
-pub use terrain::{HeightField, Terrain, TerrainLight};
 
 /// How to install a software Vulkan driver where there is no GPU (Debian, Ubuntu).
 pub const INSTALL_HINT: &str = "sudo apt-get install -y mesa-vulkan-drivers libvulkan1";

@@ -9,10 +9,15 @@ const SHARED_WGSL: &str = include_str!("../../shaders/shared/frame.wgsl");
 /// The shared WGSL's binding of the host's depth, single-sampled.
 const SINGLE_DEPTH: &str = "var scene_depth: texture_2d<f32>;";
 
-/// A shader module of `shaders/shared/frame.wgsl` followed by `pass_wgsl`; a pass drawn into
-/// `samples` samples a pixel reads a depth texture of as many.
-fn shader(device: &wgpu::Device, label: &str, pass_wgsl: &str, samples: u32) -> wgpu::ShaderModule {
-    let shared = if samples > 1 {
+/// A shader module of `shaders/shared/frame.wgsl` followed by `pass_wgsl`, reading a
+/// multisampled depth texture or not.
+fn shader(
+    device: &wgpu::Device,
+    label: &str,
+    pass_wgsl: &str,
+    multisampled_depth: bool,
+) -> wgpu::ShaderModule {
+    let shared = if multisampled_depth {
         SHARED_WGSL.replace(
             SINGLE_DEPTH,
             "var scene_depth: texture_multisampled_2d<f32>;",
@@ -56,14 +61,15 @@ pub(super) struct PassDesc<'a> {
     pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
     /// Colour targets: format and blending.
     pub targets: &'a [(wgpu::TextureFormat, Option<wgpu::BlendState>)],
-    /// Samples a pixel of the targets (the host's MSAA count, or 1); the host's depth the pass
-    /// reads has as many.
+    /// Samples a pixel of the targets (the host's MSAA count, or 1).
     pub samples: u32,
+    /// Whether the depth the pass reads (group 0) is the host's multisampled depth.
+    pub multisampled_depth: bool,
 }
 
 /// Builds the pipeline `desc` describes.
 pub(super) fn pipeline(device: &wgpu::Device, desc: &PassDesc) -> wgpu::RenderPipeline {
-    let module = shader(device, desc.label, desc.wgsl, desc.samples);
+    let module = shader(device, desc.label, desc.wgsl, desc.multisampled_depth);
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(desc.label),
         bind_group_layouts: desc.bind_groups,
@@ -107,4 +113,14 @@ pub(super) fn pipeline(device: &wgpu::Device, desc: &PassDesc) -> wgpu::RenderPi
         multiview_mask: None,
         cache: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_shared_wgsl_declares_the_depth_the_multisampled_variant_replaces() {
+        assert_eq!(SHARED_WGSL.matches(SINGLE_DEPTH).count(), 1);
+    }
 }

@@ -12,7 +12,7 @@ use std::ops::Range;
 
 use glam::{DVec3, Vec3};
 
-use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_UPRIGHT};
+use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT};
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
 
@@ -152,7 +152,13 @@ pub fn gpu_sprite(cloud: &SkyCloud, s: &super::scene::SkySprite) -> GpuSprite {
         group_xy: halves(group.x, group.y),
         group_z_rotation: (half::f16::from_f32(group.z).to_bits() as u32) | (rotation << 16),
         morph_radius: fractions(s.alpha_morph, s.radius_fraction),
-        bits: (s.cell as u32).min(15) | if s.upright { SPRITE_UPRIGHT } else { 0 },
+        bits: (s.cell as u32).min(15)
+            | if s.upright { SPRITE_UPRIGHT } else { 0 }
+            | if s.precipitation {
+                SPRITE_PRECIPITATION
+            } else {
+                0
+            },
     }
 }
 

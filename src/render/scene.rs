@@ -34,6 +34,8 @@ pub struct SkySprite {
     /// Turns only about the vertical (a cylindrical billboard: its bottom edge stays level) and
     /// fades out as the camera looks at it from steeply below or above.
     pub upright: bool,
+    /// Falling rain or snow (a shaft under the cloud), not cloud: drawn darker and greyer.
+    pub precipitation: bool,
 }
 
 /// One cloud: sprites around a centre, with its Wang 5 shading inputs.
@@ -66,16 +68,20 @@ pub struct SkyBlock {
 
 impl SkyCloud {
     /// Half extents of the box holding the sprite centres plus half of each sprite's size,
-    /// metres, and the box centre offset from `centre_m`.
+    /// metres, and the box centre offset from `centre_m`: the cloud itself, where the camera is
+    /// in cloud (the rain under it is not).
     pub fn core_box_m(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::splat(f32::MAX);
         let mut hi = Vec3::splat(f32::MIN);
-        for s in &self.sprites {
+        let cloud = self.sprites.iter().filter(|s| !s.precipitation);
+        let mut any = false;
+        for s in cloud {
             let r = Vec3::new(s.width_m, s.width_m, s.height_m) * 0.25;
             lo = lo.min(s.offset_m - r);
             hi = hi.max(s.offset_m + r);
+            any = true;
         }
-        if self.sprites.is_empty() {
+        if !any {
             return (Vec3::ZERO, Vec3::ZERO);
         }
         ((hi - lo) * 0.5, (hi + lo) * 0.5)
@@ -124,5 +130,6 @@ pub fn square_sprite(offset_m: Vec3, size_m: f32, cell: u8, group: u16) -> SkySp
         alpha_morph: 1.0,
         radius_fraction: 0.0,
         upright: false,
+        precipitation: false,
     }
 }

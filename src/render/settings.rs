@@ -52,6 +52,15 @@ pub struct CloudSettings {
     pub draw_distance_m: f32,
     /// Distant sprites fade into the horizon haze: 63% at this distance, metres.
     pub haze_distance_m: f32,
+    /// Resolution of the off-screen target the clouds (sprites, impostor ring, in-cloud fog) are
+    /// drawn into, as a fraction of the host's: 1, 0.5 or 0.25 (1: straight into the host's
+    /// colour). See [`super::cloud_target`].
+    #[serde(default = "default_resolution_scale")]
+    pub resolution_scale: f32,
+}
+
+fn default_resolution_scale() -> f32 {
+    0.5
 }
 
 /// In-cloud fog settings (Wang 7.1).
@@ -129,51 +138,16 @@ pub struct RenderSettings {
 }
 
 impl Default for RenderSettings {
+    /// The shipped `config/render.toml` (built in; a test checks that it parses).
     fn default() -> Self {
-        // The built-in text is tested to parse; the fallback is never reached in practice.
-        Self::from_toml_str(DEFAULT_RENDER_TOML, "config/render.toml (built in)").unwrap_or(Self {
-            camera: CameraSettings {
-                fov_y_deg: 60.0,
-                near_m: 2.0,
-                far_m: 160_000.0,
-            },
-            clouds: CloudSettings {
-                soft_depth_fade_m: 120.0,
-                lock_radius_fraction: 0.5,
-                lock_fade_start_deg: 20.0,
-                lock_fade_end_deg: 70.0,
-                upright_fade_start_deg: default_upright_fade_start_deg(),
-                upright_fade_end_deg: default_upright_fade_end_deg(),
-                draw_distance_m: 60_000.0,
-                haze_distance_m: 50_000.0,
-            },
-            in_cloud: InCloudSettings {
-                visibility_m: 70.0,
-                ramp_fraction: 0.35,
-            },
-            sun: SunSettings {
-                disc_radius_deg: 0.8,
-                glow_radius_deg: 12.0,
-            },
-            vertex_cache: VertexCacheSettings {
-                enabled: true,
-                move_fraction: 0.02,
-                min_move_m: 5.0,
-                max_age_s: 2.0,
-                time_distance_m: 2000.0,
-                fading_max_age_s: 0.25,
-                max_sorted_sprites_per_frame: default_sorted_sprites(),
-                max_uploaded_sprites_per_frame: default_uploaded_sprites(),
-            },
-            impostors: Default::default(),
-        })
+        Self::parse(DEFAULT_RENDER_TOML, Path::new("config/render.toml"))
+            .expect("the shipped config/render.toml is valid (tested)")
     }
 }
 
 impl RenderSettings {
-    /// Parses and checks settings; `source_name` names the file in errors.
-    pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self, ConfigError> {
-        let path = Path::new(source_name);
+    /// Parses and checks settings; `path` names the file in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
         let s: Self = parse_toml(text, path)?;
         let positive = [
             ("camera.near_m", s.camera.near_m),
@@ -211,6 +185,14 @@ impl RenderSettings {
                 return Err(ConfigError::at_key(path, text, field, "must be at least 1"));
             }
         }
+        if super::cloud_target::divisor_of(s.clouds.resolution_scale).is_none() {
+            return Err(ConfigError::at_key(
+                path,
+                text,
+                "clouds.resolution_scale",
+                format!("must be 1, 0.5 or 0.25, is {}", s.clouds.resolution_scale),
+            ));
+        }
         if let Some((field, message)) = s.impostors.invalid_field() {
             return Err(ConfigError::at_key(path, text, field, message));
         }
@@ -238,10 +220,10 @@ impl RenderSettings {
     }
 
     /// Reads and checks a settings file.
-    pub fn from_path(path: &Path) -> Result<Self, ConfigError> {
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
         let text = std::fs::read_to_string(path)
             .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::from_toml_str(&text, &path.display().to_string())
+        Self::parse(&text, path)
     }
 }
 
@@ -252,7 +234,7 @@ mod tests {
 
     #[test]
     fn built_in_settings_parse() {
-        let s = RenderSettings::from_toml_str(DEFAULT_RENDER_TOML, "render.toml").unwrap();
+        let s = RenderSettings::parse(DEFAULT_RENDER_TOML, Path::new("render.toml")).unwrap();
         assert_eq!(s, RenderSettings::default());
         assert_eq!(s.clouds.lock_radius_fraction, 0.5);
     }
@@ -261,7 +243,7 @@ mod tests {
     fn bad_values_name_the_field() {
         let text =
             DEFAULT_RENDER_TOML.replace("soft_depth_fade_m = 120.0", "soft_depth_fade_m = -1.0");
-        let err = RenderSettings::from_toml_str(&text, "r.toml")
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
             .unwrap_err()
             .to_string();
         let line = line_of_key(DEFAULT_RENDER_TOML, "clouds.soft_depth_fade_m").unwrap();
@@ -270,13 +252,13 @@ mod tests {
             "{err}"
         );
         let text = DEFAULT_RENDER_TOML.replace("near_m = 2.0", "near_m = \"near\"");
-        let err = RenderSettings::from_toml_str(&text, "r.toml")
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
             .unwrap_err()
             .to_string();
         assert!(err.starts_with("r.toml:7: field `near_m`"), "{err}");
         let text = DEFAULT_RENDER_TOML
             .replace("upright_fade_end_deg = 35.0", "upright_fade_end_deg = 10.0");
-        let err = RenderSettings::from_toml_str(&text, "r.toml")
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
             .unwrap_err()
             .to_string();
         assert!(err.contains("clouds.upright_fade_end_deg"), "{err}");
@@ -284,7 +266,7 @@ mod tests {
             "max_sorted_sprites_per_frame = 8192",
             "max_sorted_sprites_per_frame = 0",
         );
-        let err = RenderSettings::from_toml_str(&text, "r.toml")
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
             .unwrap_err()
             .to_string();
         let line = line_of_key(
@@ -298,17 +280,28 @@ mod tests {
             )),
             "{err}"
         );
+        let text = DEFAULT_RENDER_TOML.replace("resolution_scale = 0.5", "resolution_scale = 0.3");
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
+            .unwrap_err()
+            .to_string();
+        let line = line_of_key(DEFAULT_RENDER_TOML, "clouds.resolution_scale").unwrap();
+        assert!(
+            err.starts_with(&format!("r.toml:{line}: field `clouds.resolution_scale`"))
+                && err.contains("must be 1, 0.5 or 0.25"),
+            "{err}"
+        );
         // Files written before the upright fade existed still load, with its defaults.
         let old = DEFAULT_RENDER_TOML
             .lines()
             .filter(|l| {
                 !l.starts_with("upright_fade")
+                    && !l.starts_with("resolution_scale")
                     && !l.starts_with("max_sorted")
                     && !l.starts_with("max_uploaded")
             })
             .collect::<Vec<_>>()
             .join("\n");
-        let s = RenderSettings::from_toml_str(&old, "old.toml").unwrap();
+        let s = RenderSettings::parse(&old, Path::new("old.toml")).unwrap();
         assert_eq!(s, RenderSettings::default());
     }
 }

@@ -20,6 +20,7 @@ use wgpu::util::DeviceExt;
 
 use super::RenderError;
 use super::build::{CHUNK, SpriteBuild, chunks};
+use super::cloud_target::{CloudShared, CloudTarget, cloud_targets, divisor_of};
 use super::draw_list::{Copies, Locks, main_view};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuSpriteVertex};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
@@ -123,6 +124,8 @@ pub struct Sky {
     /// The fog settings and the weather over the camera they read (visibility, obscuration).
     fog: (crate::shading::FogSettings, BlockWeather),
     ring: ImpostorRing,
+    /// Where the clouds are drawn: the host's colour (scale 1) or the off-screen cloud target.
+    clouds: CloudTarget,
 }
 
 const SKY_WGSL: &str = include_str!("../../shaders/sky.wgsl");
@@ -249,6 +252,7 @@ impl Sky {
                 buffers: &[],
                 targets: &[(format, None)],
                 samples,
+                multisampled_depth: samples > 1,
             },
         );
         let sprite_pipeline = pipeline(
@@ -262,6 +266,7 @@ impl Sky {
                 buffers: &[Some(GpuSpriteVertex::layout())],
                 targets: &[(format, over)],
                 samples,
+                multisampled_depth: samples > 1,
             },
         );
         let in_cloud_pipeline = pipeline(
@@ -275,9 +280,23 @@ impl Sky {
                 buffers: &[],
                 targets: &[(format, over)],
                 samples,
+                multisampled_depth: samples > 1,
             },
         );
         let light = config.time_of_day.at(45.0);
+        // Validated settings hold one of the three scales; a hand-built one falls back to 1.
+        let divisor = divisor_of(config.settings.clouds.resolution_scale).unwrap_or(1);
+        let clouds = CloudTarget::new(
+            device,
+            &CloudShared {
+                host_frame_layout: &frame_layout,
+                frame_layout: &ring_frame_layout,
+                sheet_layout: &sheet_layout,
+                targets: config.targets,
+            },
+            divisor,
+        );
+        let offscreen_targets = cloud_targets();
         let ring = ImpostorRing::new(
             device,
             queue,
@@ -288,6 +307,7 @@ impl Sky {
                 host_frame_layout: &frame_layout,
                 sheet_layout: &sheet_layout,
                 view_layout: &view_layout,
+                cloud_targets: (divisor > 1).then_some(&offscreen_targets[..]),
             },
         );
         Ok(Self {
@@ -328,6 +348,7 @@ impl Sky {
                 },
             ),
             ring,
+            clouds,
         })
     }
 
@@ -727,6 +748,8 @@ impl Sky {
             );
             queue.submit([encoder.finish()]);
         }
+        stats.cloud_scale = self.clouds.scale();
+        stats.cloud_target_bytes = self.clouds.gpu_bytes();
         stats.sprite_gpu_bytes = self.resident.gpu_bytes()
             + self.quads.0.size()
             + self.build.gpu_bytes()
@@ -737,7 +760,9 @@ impl Sky {
         stats
     }
 
-    /// Records the sky's passes into the host's encoder: sky background, sprites, in-cloud fog.
+    /// Records the sky's passes into the host's encoder: sky background, then the ring, sprites
+    /// and in-cloud fog, straight into the host's colour or, below full resolution, into the
+    /// sky's cloud target composited over it (`cloud_target`; it follows the host's frame size).
     /// `depth_view` is the host's depth (Depth32Float with `TEXTURE_BINDING`), only read.
     pub fn record(
         &self,
@@ -775,10 +800,28 @@ impl Sky {
             self.build
                 .record(encoder, group, &self.resident.group, (c, n));
         }
-        let mut pass = self.sky_pass(encoder, colour_view, &frame_group);
-        pass.set_pipeline(&self.sky_pipeline);
-        pass.draw(0..3, 0..1);
-        self.ring.draw(&mut pass);
+        // Below full resolution the clouds go to the cloud target, composited at the end with
+        // the sky background; at full resolution they are drawn over the sky in the host's colour.
+        let offscreen = self
+            .clouds
+            .frame(&self.device, &self.frame_buffer, depth_view);
+        let mut pass = match &offscreen {
+            Some(target) => {
+                target.downsample(encoder, &frame_group);
+                target.pass(encoder, true)
+            }
+            None => {
+                let mut pass = self.sky_pass(encoder, colour_view, &frame_group);
+                pass.set_pipeline(&self.sky_pipeline);
+                pass.draw(0..3, 0..1);
+                pass
+            }
+        };
+        let (sprite_pipeline, in_cloud_pipeline) = match &offscreen {
+            Some(target) => (target.sprite_pipeline(), target.in_cloud_pipeline()),
+            None => (&self.sprite_pipeline, &self.in_cloud_pipeline),
+        };
+        self.ring.draw(&mut pass, offscreen.is_some());
         for &(c, _, n) in &parts {
             if parts.len() > 1 {
                 drop(pass);
@@ -786,19 +829,25 @@ impl Sky {
                     self.build
                         .record(encoder, group, &self.resident.group, (c, n));
                 }
-                pass = self.sky_pass(encoder, colour_view, &frame_group);
+                pass = match &offscreen {
+                    Some(target) => target.pass(encoder, false),
+                    None => self.sky_pass(encoder, colour_view, &frame_group),
+                };
             }
-            pass.set_pipeline(&self.sprite_pipeline);
+            pass.set_pipeline(sprite_pipeline);
             pass.set_bind_group(1, &self.sheet_group, &[]);
             pass.set_vertex_buffer(0, self.build.vertices().slice(..));
             pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..n * 6, 0, 0..1);
         }
         if self.in_cloud > 0.0 {
-            pass.set_pipeline(&self.in_cloud_pipeline);
+            pass.set_pipeline(in_cloud_pipeline);
             pass.draw(0..3, 0..1);
         }
         drop(pass);
+        if let Some(target) = &offscreen {
+            target.composite(encoder, colour_view, &frame_group);
+        }
         self.recorded.set(true);
         self.record_us.set(start.elapsed().as_micros() as u64);
     }

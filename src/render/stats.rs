@@ -25,6 +25,9 @@ pub struct FrameStats {
     /// lifecycle, the blocks handed over), microseconds, as reported to the sky with
     /// [`crate::render::Sky::add_field_cpu_us`].
     pub field_us: u64,
+    /// The host's weather step this frame (polling a watched file, switching in a new field;
+    /// never reading one), microseconds; part of `field_us`.
+    pub weather_us: u64,
     /// CPU time of the last [`crate::render::Sky::record`], microseconds (filled in by hosts that
     /// record after they prepare, like the demo host).
     pub record_us: u64,
@@ -48,6 +51,12 @@ pub struct FrameStats {
     pub crossfade_weight: f32,
     /// Bytes of the ring's GPU textures and buffers.
     pub ring_gpu_bytes: u64,
+    /// Resolution of the clouds' off-screen target as a fraction of the host's (1: drawn
+    /// straight into the host's colour; `[clouds] resolution_scale`).
+    pub cloud_scale: f32,
+    /// Bytes of the off-screen cloud target's textures (colour, distance, farthest depth) at
+    /// the last recorded frame size; 0 at scale 1.
+    pub cloud_target_bytes: u64,
 }
 
 impl FrameStats {

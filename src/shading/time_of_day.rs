@@ -61,31 +61,19 @@ pub struct TimeOfDay {
 }
 
 impl Default for TimeOfDayTable {
+    /// The shipped `config/time_of_day.toml` (built in; a test checks that it parses).
     fn default() -> Self {
-        // The built-in text is tested below to parse.
-        Self::from_toml_str(
+        Self::parse(
             DEFAULT_TIME_OF_DAY_TOML,
-            "config/time_of_day.toml (built in)",
+            Path::new("config/time_of_day.toml"),
         )
-        .unwrap_or_else(|_| Self {
-            directional_mapping: DirectionalMapping::default(),
-            samples: vec![TimeOfDaySample {
-                sun_elevation_deg: 0.0,
-                ambient_percent: 1.0,
-                directional_rgb: [1.0; 3],
-                sky_zenith_rgb: [0.1, 0.25, 0.6],
-                sky_horizon_rgb: [0.5, 0.6, 0.8],
-            }],
-            overcast: OvercastLight::default(),
-            forward_scattering: ForwardScattering::default(),
-        })
+        .expect("the shipped config/time_of_day.toml is valid (tested)")
     }
 }
 
 impl TimeOfDayTable {
-    /// Parses and checks a table; `source_name` names the file in errors.
-    pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self, ShadingError> {
-        let path = Path::new(source_name);
+    /// Parses and checks a table; `path` names the file in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, ShadingError> {
         let table: Self = parse_toml(text, path)?;
         // Rows are checked after parsing; the line is that of the row's elevation key.
         let row_line = |row: usize| {
@@ -138,10 +126,10 @@ impl TimeOfDayTable {
     }
 
     /// Reads and checks a table file.
-    pub fn from_path(path: &Path) -> Result<Self, ShadingError> {
+    pub fn load(path: &Path) -> Result<Self, ShadingError> {
         let text = std::fs::read_to_string(path)
             .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::from_toml_str(&text, &path.display().to_string())
+        Self::parse(&text, path)
     }
 
     /// The light when the sun stands at `sun_elevation_deg`.
@@ -176,7 +164,7 @@ mod tests {
 
     #[test]
     fn built_in_table_parses_with_more_samples_around_dawn() {
-        let t = TimeOfDayTable::from_toml_str(DEFAULT_TIME_OF_DAY_TOML, "built in").unwrap();
+        let t = TimeOfDayTable::parse(DEFAULT_TIME_OF_DAY_TOML, Path::new("built in")).unwrap();
         let near_horizon = t
             .samples
             .iter()
@@ -208,13 +196,13 @@ mod tests {
 
     #[test]
     fn interpolates_linearly_between_samples_and_clamps_at_the_ends() {
-        let t = TimeOfDayTable::from_toml_str(
+        let t = TimeOfDayTable::parse(
             "[directional_mapping]\nc_min = 0.1\nc_median = 0.5\nc_max = 1.0\n\
              [[sample]]\nsun_elevation_deg = 0.0\nambient_percent = 0.2\ndirectional_rgb = [0,0,0]\n\
              sky_zenith_rgb = [0,0,0]\nsky_horizon_rgb = [0,0,0]\n\
              [[sample]]\nsun_elevation_deg = 10.0\nambient_percent = 0.6\ndirectional_rgb = [1,1,1]\n\
              sky_zenith_rgb = [1,1,1]\nsky_horizon_rgb = [1,1,1]\n",
-            "t.toml",
+            Path::new("t.toml"),
         )
         .unwrap();
         assert!((t.at(2.5).ambient_percent - 0.3).abs() < 1e-6);
@@ -230,7 +218,7 @@ mod tests {
             "ambient_percent = \"x\"",
             1,
         );
-        let err = TimeOfDayTable::from_toml_str(&text, "my_tod.toml")
+        let err = TimeOfDayTable::parse(&text, Path::new("my_tod.toml"))
             .unwrap_err()
             .to_string();
         assert!(
@@ -242,7 +230,7 @@ mod tests {
             "sun_elevation_deg = -40.0",
             1,
         );
-        let err = TimeOfDayTable::from_toml_str(&text, "my_tod.toml")
+        let err = TimeOfDayTable::parse(&text, Path::new("my_tod.toml"))
             .unwrap_err()
             .to_string();
         assert!(
@@ -250,7 +238,7 @@ mod tests {
             "{err}"
         );
         let text = DEFAULT_TIME_OF_DAY_TOML.replacen("grey_from = 0.6", "grey_from = 2.0", 1);
-        let err = TimeOfDayTable::from_toml_str(&text, "my_tod.toml")
+        let err = TimeOfDayTable::parse(&text, Path::new("my_tod.toml"))
             .unwrap_err()
             .to_string();
         let line = 1 + DEFAULT_TIME_OF_DAY_TOML

@@ -1,6 +1,6 @@
 //! `skycast bench` at a tiny size and frame count, so the frame-budget benchmark cannot rot: the
 //! table headed by the adapter, `bench.csv` with the three scenarios with impostors on and off,
-//! and the plot, a PNG that decodes.
+//! each at the cloud scale asked for and at full resolution, and the plot, a PNG that decodes.
 
 use std::path::PathBuf;
 
@@ -19,6 +19,8 @@ fn bench_command_writes_table_csv_and_plot() {
             "3",
             "--view-km",
             "30",
+            "--cloud-scale",
+            "1/2",
         ])
         .args(["--out", dir.to_str().unwrap()])
         .output()
@@ -36,27 +38,30 @@ fn bench_command_writes_table_csv_and_plot() {
         lines[1].split_whitespace().next() == Some("scenario"),
         "{stdout}"
     );
-    // Six table rows: each scenario with impostors on, then off.
-    let table: Vec<Vec<&str>> = lines[2..8]
+    // Twelve table rows: each scenario with impostors on, then off, at 1/2, then at 1.
+    let table: Vec<Vec<&str>> = lines[2..14]
         .iter()
         .map(|l| l.split_whitespace().collect())
         .collect();
-    for (row, (scenario, impostors)) in table.iter().zip([
-        ("sparse", "on"),
-        ("sparse", "off"),
-        ("scattered", "on"),
-        ("scattered", "off"),
-        ("overcast", "on"),
-        ("overcast", "off"),
-    ]) {
-        assert_eq!((row[0], row[2]), (scenario, impostors), "{stdout}");
+    let runs = ["sparse", "scattered", "overcast"]
+        .into_iter()
+        .flat_map(|s| {
+            [("on", "1/2"), ("off", "1/2"), ("on", "1"), ("off", "1")]
+                .map(|(impostors, scale)| (s, impostors, scale))
+        });
+    for (row, (scenario, impostors, scale)) in table.iter().zip(runs) {
+        assert_eq!(
+            (row[0], row[2], row[3]),
+            (scenario, impostors, scale),
+            "{stdout}"
+        );
     }
 
     let mut csv = csv::Reader::from_path(dir.join("bench.csv")).unwrap();
     let header = csv.headers().unwrap().clone();
     let column = |name: &str| header.iter().position(|c| c == name).expect(name);
     let rows: Vec<csv::StringRecord> = csv.records().map(Result::unwrap).collect();
-    assert_eq!(rows.len(), 6);
+    assert_eq!(rows.len(), 12);
     let number = |r: &csv::StringRecord, name: &str| r[column(name)].parse::<f64>().unwrap();
     for pair in rows.chunks(2) {
         let (on, off) = (&pair[0], &pair[1]);
@@ -86,31 +91,68 @@ fn bench_command_writes_table_csv_and_plot() {
         assert!(
             on[column("adapter")] == off[column("adapter")] && !on[column("adapter")].is_empty()
         );
+        assert_eq!(on[column("cloud_scale")], off[column("cloud_scale")]);
+    }
+    // Each scenario at 1/2 and at 1; the scale ratios compare a row with its full-resolution
+    // twin (1 at full resolution).
+    for quad in rows.chunks(4) {
+        let scales: Vec<&str> = quad.iter().map(|r| &r[column("cloud_scale")]).collect();
+        assert_eq!(scales, ["0.5", "0.5", "1", "1"]);
+        for (half, full) in [(&quad[0], &quad[2]), (&quad[1], &quad[3])] {
+            let ratio = number(half, "full_scale_ratio");
+            let expected = number(full, "median_ms") / number(half, "median_ms");
+            assert!((ratio - expected).abs() < 0.01 * ratio + 0.002, "{half:?}");
+            assert_eq!(number(full, "full_scale_ratio"), 1.0);
+            assert!(number(half, "sky_full_scale_ratio") > 0.0, "{half:?}");
+        }
     }
     // The overdraw column: the scenarios' block overdraw, rising sparse -> overcast.
     let overdraw: Vec<f64> = rows.iter().map(|r| number(r, "overdraw_pct")).collect();
     assert!(
-        overdraw[0] > 120.0 && overdraw[4] > 2.0 * overdraw[0],
+        overdraw[0] > 120.0 && overdraw[8] > 2.0 * overdraw[0],
         "{overdraw:?}"
     );
 
     // One steady frame a sample; before it, with impostors, the frames that rebuild the ring
     // (the 6 km steps are past 15% of the 20 km ring radius), timed as the rebuild column.
     let mut frames = csv::Reader::from_path(dir.join("frames.csv")).unwrap();
+    let frame_header = frames.headers().unwrap().clone();
     let frames: Vec<csv::StringRecord> = frames.records().map(Result::unwrap).collect();
-    let steady = |run: &str| {
+    let at = |f: &csv::StringRecord, name: &str| -> String {
+        let k = frame_header.iter().position(|c| c == name).expect(name);
+        f[k].to_string()
+    };
+    let steady = |run: &str, scale: &str| {
         frames
             .iter()
-            .filter(|f| &f[1] == run && &f[3] == "yes")
+            .filter(|f| at(f, "impostors") == run && at(f, "cloud_scale") == scale)
+            .filter(|f| at(f, "steady") == "yes")
             .count()
     };
-    assert_eq!((steady("on"), steady("off")), (9, 9));
+    assert_eq!((steady("on", "0.5"), steady("off", "0.5")), (9, 9));
+    assert_eq!((steady("on", "1"), steady("off", "1")), (9, 9));
     let rebuilt = frames
         .iter()
-        .filter(|f| &f[1] == "on" && &f[3] == "no" && f[11].parse::<u32>().unwrap() > 0)
+        .filter(|f| at(f, "impostors") == "on" && at(f, "steady") == "no")
+        .filter(|f| at(f, "impostors_rebuilt").parse::<u32>().unwrap() > 0)
         .count();
-    assert!(rebuilt >= 3 * 8, "{rebuilt} rebuild frames");
-    assert!(frames.iter().all(|f| &f[1] == "on" || &f[3] == "yes"));
+    assert!(rebuilt >= 2 * 3 * 8, "{rebuilt} rebuild frames");
+    assert!(
+        frames
+            .iter()
+            .all(|f| at(f, "impostors") == "on" || at(f, "steady") == "yes")
+    );
+    // The cloud target's memory is in the frames: 32 x 18 texels of 8 + 2 + 4 bytes at 1/2,
+    // none at 1.
+    for f in &frames {
+        let bytes: u64 = at(f, "cloud_target_bytes").parse().unwrap();
+        let expected = if at(f, "cloud_scale") == "1" {
+            0
+        } else {
+            32 * 18 * 14
+        };
+        assert_eq!(bytes, expected, "{f:?}");
+    }
     for pair in rows.chunks(2) {
         assert!(number(&pair[0], "rebuild_ms") > 0.0, "{:?}", pair[0]);
         assert!(pair[1][column("rebuild_ms")].is_empty(), "{:?}", pair[1]);

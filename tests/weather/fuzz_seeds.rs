@@ -62,6 +62,8 @@ fn every_fuzz_seed_passes_its_targets_checks() {
         replay("weather_cycle", |d| {
             common::check_weather_file(&prefixed(common::CYCLE_DATE, d))
         }),
+        replay("config_files", common::check_config_files),
+        replay("flight_path", common::check_flight_path),
     ];
-    assert_eq!(counts, [47, 2, 3, 1, 1]);
+    assert_eq!(counts, [47, 2, 3, 1, 1, 3, 4]);
 }

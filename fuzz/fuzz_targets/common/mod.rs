@@ -7,6 +7,10 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
+use skycast::clouds::{CloudTypes, CloudsConfig};
+use skycast::flight::FlightPlan;
+use skycast::render::RenderSettings;
+use skycast::shading::{FogSettings, TimeOfDayTable};
 use skycast::weather::files;
 use skycast::weather::metar::decode;
 use skycast::weather::{
@@ -137,5 +141,71 @@ pub fn check_weather_file(data: &[u8]) {
                 "{l:?}"
             );
         }
+    }
+}
+
+/// `config_files`: any bytes as each TOML config file skycast reads (renderer, time of day,
+/// clouds, cloud types, weather field, cloud-type rule, fog, themes): no panic; a rejected file's
+/// error names the file, and a line within the text where it names one.
+pub fn check_config_files(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    let lines = text.lines().count().max(1);
+    let path = Path::new("fuzz.toml");
+    let check = |message: String| {
+        assert!(message.contains("fuzz.toml"), "{message}");
+        if let Some(rest) = message.strip_prefix("fuzz.toml:")
+            && let Some(line) = rest.split(':').next().and_then(|l| l.parse::<usize>().ok())
+        {
+            assert!(line >= 1 && line <= lines, "{message}");
+        }
+    };
+    if let Err(e) = RenderSettings::parse(&text, path) {
+        check(e.to_string());
+    }
+    if let Err(e) = TimeOfDayTable::parse(&text, path) {
+        check(e.to_string());
+    }
+    if let Err(e) = CloudsConfig::parse(&text, path) {
+        check(e.to_string());
+    }
+    if let Err(e) = CloudTypes::parse(&text, path) {
+        check(e.to_string());
+    }
+    if let Err(e) = FieldSettings::parse(&text, path) {
+        check(e.to_string());
+    }
+    if let Err(e) = CloudTypeRule::parse(&text, path) {
+        check(e.to_string());
+    }
+    if let Err(e) = FogSettings::parse(&text, path) {
+        check(e.to_string());
+    }
+    if let Err(e) = skycast::weather::theme::parse_theme(&text, path) {
+        check(e.to_string());
+    }
+}
+
+/// `flight_path`: any bytes as a flight path (`config/flights/*.toml`): no panic; a plan that
+/// loads can be placed and sampled anywhere along it, giving finite poses; a rejected one's error
+/// names the file.
+pub fn check_flight_path(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    let plan = match FlightPlan::parse(&text, Path::new("fuzz.toml")) {
+        Ok(plan) => plan,
+        Err(e) => {
+            assert!(e.to_string().contains("fuzz.toml"), "{e}");
+            return;
+        }
+    };
+    let (lat, lon) = plan.origin_lat_lon_deg;
+    let placed = plan.place(&LocalFrame::new(lat, lon));
+    let (start, duration) = (placed.start_s(), placed.duration_s());
+    for k in 0..=8 {
+        let pose = placed.pose_at(start + duration * k as f64 / 8.0);
+        assert!(pose.position_m.is_finite(), "{pose:?}");
+        assert!(
+            pose.heading_deg.is_finite() && pose.pitch_deg.is_finite(),
+            "{pose:?}"
+        );
     }
 }

@@ -38,7 +38,7 @@ use layout::{impostor_camera, in_sector};
 
 use super::build::{SpriteBuild, chunks};
 use super::draw_list::fresh_view;
-use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuSpriteVertex};
+use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuRing, GpuSpriteVertex};
 use super::pipeline::{PassDesc, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
@@ -71,6 +71,9 @@ pub struct ImpostorRing {
     device: wgpu::Device,
     sprite_pipeline: wgpu::RenderPipeline,
     quad_pipeline: wgpu::RenderPipeline,
+    /// The ring pass into the sky's off-screen cloud target (when the clouds are drawn below
+    /// full resolution).
+    quad_offscreen_pipeline: Option<wgpu::RenderPipeline>,
     /// `[ring][impostor]` colour and depth views the impostor passes render into.
     views: Vec<Vec<wgpu::TextureView>>,
     depth_views: Vec<Vec<wgpu::TextureView>>,
@@ -127,6 +130,9 @@ pub struct RingShared<'a> {
     pub host_frame_layout: &'a wgpu::BindGroupLayout,
     /// Group 1 of the sprite pass (sheet and sampler).
     pub sheet_layout: &'a wgpu::BindGroupLayout,
+    /// The targets of the sky's off-screen cloud pass (colour, distance), where the clouds are
+    /// drawn below full resolution; the ring then draws there.
+    pub cloud_targets: Option<&'a [(wgpu::TextureFormat, Option<wgpu::BlendState>)]>,
     /// The build pass's group of a view (uniform, draw list, cloud lists, orders).
     pub view_layout: &'a wgpu::BindGroupLayout,
 }
@@ -186,6 +192,7 @@ impl ImpostorRing {
                 buffers: &[Some(GpuSpriteVertex::layout())],
                 targets: &[(IMPOSTOR_FORMAT, over), (DEPTH_FORMAT, over)],
                 samples: 1,
+                multisampled_depth: false,
             },
         );
         let quad_pipeline = pipeline(
@@ -199,8 +206,25 @@ impl ImpostorRing {
                 buffers: &[],
                 targets: &[(shared.targets.colour_format, over)],
                 samples: shared.targets.sample_count,
+                multisampled_depth: shared.targets.sample_count > 1,
             },
         );
+        let quad_offscreen_pipeline = shared.cloud_targets.map(|targets| {
+            pipeline(
+                device,
+                &PassDesc {
+                    label: "ring.quads_offscreen",
+                    wgsl: QUAD_WGSL,
+                    vs: "vs_impostor",
+                    fs: "fs_impostor_offscreen",
+                    bind_groups: &[Some(shared.frame_layout), Some(&tex_layout)],
+                    buffers: &[],
+                    targets,
+                    samples: 1,
+                    multisampled_depth: false,
+                },
+            )
+        });
         let rings = if settings.enabled { 2 } else { 0 };
         let side = settings.size_px;
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -349,6 +373,7 @@ impl ImpostorRing {
             device: device.clone(),
             sprite_pipeline,
             quad_pipeline,
+            quad_offscreen_pipeline,
             views,
             depth_views,
             quad_groups,
@@ -682,25 +707,18 @@ impl ImpostorRing {
     }
 
     /// Draws the ring into the sky pass (group 0, the sky's frame, must be bound): one
-    /// full-screen pass that mixes the shown ring with the one fading in.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass) {
+    /// full-screen pass that mixes the shown ring with the one fading in. `offscreen`: the pass
+    /// is the sky's cloud target (colour and distance), not the host's colour.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass, offscreen: bool) {
         let Some((old, new)) = self.quads else {
             return;
         };
-        pass.set_pipeline(&self.quad_pipeline);
+        let quads = match (offscreen, &self.quad_offscreen_pipeline) {
+            (true, Some(p)) => p,
+            _ => &self.quad_pipeline,
+        };
+        pass.set_pipeline(quads);
         pass.set_bind_group(1, &self.quad_groups[old][new], &[]);
         pass.draw(0..3, 0..1);
     }
-}
-
-/// The ring pass's uniform. Keep in sync with `Ring` in `shaders/impostor_quad.wgsl`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct GpuRing {
-    /// The shown ring's centre relative to the camera, metres; w: the crossfade weight.
-    old_centre_weight: [f32; 4],
-    /// The centre of the ring fading in (the shown one's when not fading), metres.
-    new_centre: [f32; 4],
-    /// Ring radius, half side of a quad, the old and new rings' mean far distance, metres.
-    size: [f32; 4],
 }

@@ -1,5 +1,5 @@
-//! The demo host: what a flight simulator would do around a [`Sky`], packaged for the CLI, the
-//! render tests and the benchmarks. It owns a headless device, an offscreen colour + depth
+//! The demo host: what a flight simulator would do around a [`SkySystem`], packaged for the
+//! CLI, the render tests and the benchmarks. It owns a headless device, an offscreen colour + depth
 //! target and the demo [`Terrain`]; each frame it draws the ground first (colour and depth), then
 //! lets the sky record its passes reading that depth, then reads the frame back.
 //!
@@ -9,13 +9,11 @@
 
 use glam::DVec2;
 
-use super::RenderError;
-use super::camera::Camera;
-use super::gpu_types::GpuSprite;
 use super::headless::{self, Frame, HeadlessGpu, OffscreenTarget};
-use super::sky::{Sky, SkyConfig};
-use super::stats::FrameStats;
 use super::terrain::{HeightField, Terrain, TerrainLight, procedural_relief_m};
+use crate::flight::{HostCamera, SkyError, SkySystem, SkySystemConfig};
+use crate::render::gpu_types::GpuSprite;
+use crate::render::{Camera, FrameStats, RenderError};
 use crate::shading::SunPosition;
 use crate::weather::field::WeatherField;
 
@@ -27,8 +25,9 @@ pub struct DemoHost {
     pub target: OffscreenTarget,
     /// The ground.
     pub terrain: Terrain,
-    /// The sky.
-    pub sky: Sky,
+    /// The sky: the same object a simulator embeds (its frame step in [`Self::step`]; the
+    /// renderer underneath reached through it for tests that drive the sky by hand).
+    pub sky: SkySystem,
     timer: Option<GpuTimer>,
 }
 
@@ -106,19 +105,14 @@ impl DemoHost {
         width: u32,
         height: u32,
         ground: &HeightField,
-        sky: SkyConfig,
-    ) -> Result<Self, RenderError> {
+        sky: impl Into<SkySystemConfig>,
+    ) -> Result<Self, SkyError> {
         let gpu = HeadlessGpu::new()?;
         let target = OffscreenTarget::new(&gpu, width, height)?;
         let terrain = Terrain::new(&gpu.device, headless::COLOUR_FORMAT, ground);
-        let sky = Sky::new(
-            &gpu.device,
-            &gpu.queue,
-            SkyConfig {
-                targets: headless::TARGETS,
-                ..sky
-            },
-        )?;
+        let mut config: SkySystemConfig = sky.into();
+        config.sky.targets = headless::TARGETS;
+        let sky = SkySystem::with_config(&gpu.device, &gpu.queue, config)?;
         let timer = GpuTimer::new(&gpu);
         Ok(Self {
             gpu,
@@ -143,7 +137,49 @@ impl DemoHost {
         }
     }
 
-    /// Draws one frame (ground, then sky) without reading it back; returns the sky's stats.
+    /// The frame step of the sky a simulator embeds ([`SkySystem::update`]: weather, living
+    /// clouds, sun for `utc_unix_s`, the sky's CPU share), then, when `draw`, the ground and the
+    /// sky drawn (not read back). Returns the sky's stats and the weather files that arrived.
+    pub fn step(
+        &mut self,
+        camera: &Camera,
+        utc_unix_s: f64,
+        dt_s: f64,
+        draw: bool,
+    ) -> Result<(FrameStats, Vec<Result<std::path::PathBuf, String>>), SkyError> {
+        if draw && let Some(t) = &self.timer {
+            t.stamp(&self.gpu, 0);
+        }
+        let (stats, changes) =
+            self.sky
+                .update(&self.gpu.queue, &HostCamera::from(camera), utc_unix_s, dt_s)?;
+        if !draw {
+            return Ok((stats, changes));
+        }
+        if let Some(t) = &self.timer {
+            t.stamp(&self.gpu, 1);
+        }
+        let sun_dir = self.sky.lighting().sun_direction;
+        let visibility_m = self.sky.world().visibility_m();
+        Ok((
+            self.draw_prepared(camera, sun_dir, visibility_m, stats),
+            changes,
+        ))
+    }
+
+    /// [`Self::step`] with `draw`, and the frame read back.
+    pub fn step_frame(
+        &mut self,
+        camera: &Camera,
+        utc_unix_s: f64,
+        dt_s: f64,
+    ) -> Result<(Frame, FrameStats), SkyError> {
+        let (stats, _) = self.step(camera, utc_unix_s, dt_s, true)?;
+        Ok((self.target.read_back(&self.gpu)?, stats))
+    }
+
+    /// Draws one frame (ground, then sky) without reading it back, the sky prepared by hand
+    /// (the clouds given to the renderer directly, no frame step); returns the sky's stats.
     pub fn draw(
         &mut self,
         camera: &Camera,
@@ -154,16 +190,27 @@ impl DemoHost {
         if let Some(t) = &self.timer {
             t.stamp(&self.gpu, 0);
         }
-        let mut stats = self.sky.prepare(&self.gpu.queue, camera, sun, dt_s);
+        let stats = self.sky.prepare(&self.gpu.queue, camera, sun, dt_s);
         if let Some(t) = &self.timer {
             t.stamp(&self.gpu, 1);
         }
+        self.draw_prepared(camera, sun.direction_enu().as_vec3(), visibility_m, stats)
+    }
+
+    /// The ground, then the sky's passes, of a prepared frame.
+    fn draw_prepared(
+        &mut self,
+        camera: &Camera,
+        sun_dir: glam::Vec3,
+        visibility_m: f32,
+        mut stats: FrameStats,
+    ) -> FrameStats {
         let light = self.sky.light();
         self.terrain.prepare(
             &self.gpu.queue,
             camera,
             &TerrainLight {
-                sun_dir: sun.direction_enu().as_vec3(),
+                sun_dir,
                 sun_rgb: light.directional_rgb,
                 ambient: light.ambient_percent * 0.35,
                 fog_rgb: self.sky.fog().rgb,

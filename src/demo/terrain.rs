@@ -9,10 +9,9 @@
 use glam::{DVec2, DVec3, Vec3};
 use wgpu::util::DeviceExt;
 
-use super::RenderError;
-use super::camera::Camera;
-use super::gpu_types::{GpuTerrainFrame, GpuTerrainVertex};
 use super::headless::DEPTH_FORMAT;
+use crate::render::gpu_types::{GpuTerrainFrame, GpuTerrainVertex};
+use crate::render::{Camera, RenderError};
 
 /// A square grid of heights, plain data.
 #[derive(Debug, Clone, PartialEq)]

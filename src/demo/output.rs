@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use super::RenderError;
 use super::headless::Frame;
+use crate::render::RenderError;
 
 /// The sRGB transfer function of a linear value, 0..=1.
 pub fn linear_to_srgb(x: f32) -> f32 {

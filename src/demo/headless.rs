@@ -2,14 +2,14 @@
 //! and an offscreen colour + depth target that can be read back. The CLI and the render tests
 //! use it; a real simulator brings its own device and targets instead.
 
-use super::RenderError;
+use crate::render::{HostTargets, RenderError};
 
 /// The colour format of the offscreen target: linear half floats (EXR-ready).
 pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The depth format of the offscreen target.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The off-screen targets as the sky sees them: standard Z, one sample.
-pub const TARGETS: super::HostTargets = super::HostTargets {
+pub const TARGETS: HostTargets = HostTargets {
     colour_format: COLOUR_FORMAT,
     depth_format: DEPTH_FORMAT,
     reversed_z: false,
@@ -17,7 +17,7 @@ pub const TARGETS: super::HostTargets = super::HostTargets {
 };
 
 /// The apt line that installs the software Vulkan driver.
-pub use super::INSTALL_HINT;
+pub use crate::render::INSTALL_HINT;
 
 /// A device and queue with no window.
 pub struct HeadlessGpu {

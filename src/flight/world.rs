@@ -1,5 +1,5 @@
 //! The world of clouds a sky shows: weather reports go in as a weather field; the cloud blocks
-//! around the camera come out, converted to [`SkyBlock`]s for the [`super::Sky`].
+//! around the camera come out, converted to [`SkyBlock`]s for the [`Sky`].
 //!
 //! Blocks are generated on demand (a pure function of block index, block weather and seed) and
 //! kept, so a flight regenerates nothing it has seen. A living world hands the sky its changes
@@ -12,14 +12,13 @@ use std::time::Instant;
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
-use super::RenderError;
-use super::scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite};
-use super::sky::{Sky, SpriteSheet};
 use crate::clouds::lifecycle::{Phase, progress};
 use crate::clouds::{
     Cloud, CloudField, CloudTypes, CloudsConfig, field::FieldBlock, field::weather_changed,
     generate_block,
 };
+use crate::render::scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite};
+use crate::render::{RenderError, Sky, SpriteSheet};
 use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
 use crate::weather::{BlockIndex, BlockWeather};
@@ -65,6 +64,7 @@ impl From<&Cloud> for SkyCloud {
                     alpha_morph: s.alpha_morph,
                     radius_fraction: s.radius_fraction,
                     upright: s.upright,
+                    precipitation: s.precipitation,
                 })
                 .collect(),
             group_centres_m: c

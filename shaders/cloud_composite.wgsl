@@ -1,0 +1,65 @@
+// Pass `clouds.composite`: the cloud target (premultiplied colour and alpha-weighted cloud
+// distance at 1/DIVISOR of the resolution) over the host's colour at full resolution.
+//
+// The colour is upsampled bilinearly: clouds are soft, so within a cloud nothing is lost. At a
+// silhouette (a ridge in front of a cloud) the cloud texels were drawn against the farthest depth
+// of their block (`cloud_downsample.wgsl`), so they hold cloud where the ridge is; a plain
+// upsample would lay that cloud over the ridge as a halo. Each full-resolution pixel therefore
+// repeats the soft depth fade (Bahnassi) with its own depth, against the distance of the clouds
+// the texel shows (stored distance / alpha): the fade the texel had at its block's farthest
+// depth is replaced by the fade at this pixel's depth. Where the pixel's depth is the block's,
+// the ratio is 1 and the upsample is untouched; on a ridge in front of the cloud it is 0, so the
+// cloud stops at the ridge's full-resolution edge. Where the host drew nothing, the pass also
+// draws the sky background (the sky pass is left out below full resolution). DIVISOR is put in
+// front of this file when the pipeline is built. Shared structs: shared/frame.wgsl (group 0 binds the host's depth).
+
+@group(1) @binding(0) var cloud_colour: texture_2d<f32>;
+@group(1) @binding(1) var cloud_distance: texture_2d<f32>;
+@group(1) @binding(2) var farthest_depth: texture_2d<f32>;
+@group(1) @binding(3) var cloud_sampler: sampler;
+
+struct CompositeOut {
+    @builtin(position) position: vec4<f32>,
+    // The far-plane point of the pixel, homogeneous (see `background_along`).
+    @location(0) far: vec4<f32>,
+};
+
+@vertex
+fn vs_composite(@builtin(vertex_index) vi: u32) -> CompositeOut {
+    var o: CompositeOut;
+    o.position = fullscreen_position(vi);
+    o.far = far_point(o.position.xy);
+    return o;
+}
+
+@fragment
+fn fs_composite(i: CompositeOut) -> @location(0) vec4<f32> {
+    let position = i.position;
+    // Texel i of the cloud target covers host pixels [i * DIVISOR, (i + 1) * DIVISOR).
+    let low_size = vec2<f32>(textureDimensions(cloud_colour));
+    let uv = position.xy / (low_size * f32(DIVISOR));
+    let colour = textureSampleLevel(cloud_colour, cloud_sampler, uv, 0.0);
+    let d = scene_depth_at(position.xy);
+    if (is_background(d)) {
+        // Where the host drew nothing this pass is also the sky background (one full-resolution
+        // pass instead of two): the clouds over it, opaque. Sky pixels are the farthest of their
+        // block, so their clouds need no fix-up.
+        return vec4<f32>(colour.rgb + (1.0 - colour.a) * background_along(i.far), 1.0);
+    }
+    if (colour.a < 1.0 / 2048.0) {
+        discard;
+    }
+    // Every host pixel redoes the fade, not only those nearer than their block's farthest depth:
+    // on terrain in front of the clouds the bilinear upsample also brings in the neighbouring
+    // texels' clouds, drawn against the sky beside it.
+    let farthest = textureLoad(farthest_depth, vec2<i32>(position.xy) / DIVISOR, 0).r;
+    let here_m = linear_depth_m(d);
+    let farthest_m = linear_depth_m(farthest);
+    let cloud_m = textureSampleLevel(cloud_distance, cloud_sampler, uv, 0.0).r * 1000.0 / colour.a;
+    let drawn_with = clamp((farthest_m - cloud_m) / frame.params.z, 0.0, 1.0);
+    let here = clamp((here_m - cloud_m) / frame.params.z, 0.0, 1.0);
+    // Nothing of the cloud was left at the block's depth: it is hidden here too (a neighbour
+    // texel's cloud must not bleed onto terrain in front of it).
+    let keep = select(clamp(here / drawn_with, 0.0, 1.0), here, drawn_with < 1.0e-3);
+    return colour * keep;
+}

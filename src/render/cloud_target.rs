@@ -1,0 +1,454 @@
+//! The off-screen cloud target: the sky's cloud passes (the impostor ring, the sprites, the
+//! in-cloud fog) drawn at a fraction of the host's resolution and composited over the host's
+//! colour (Cantlay, "High-Speed, Off-Screen Particles", GPU Gems 3 chapter 23). Clouds are soft
+//! and low-frequency, and the steady frame is fill-bound by the near deck's overdraw (465% in
+//! the overcast scenario): at half resolution the sprites fill a quarter of the pixels.
+//!
+//! Each frame, when `[clouds] resolution_scale` is below 1:
+//! 1. `clouds.downsample` (`shaders/cloud_downsample.wgsl`): the host's depth, the farthest of
+//!    each block of pixels, into an R32Float texture of the target's size;
+//! 2. the cloud passes draw into the target against that depth (their soft depth fade reads it
+//!    through the frame group's scene depth): premultiplied colour in [`CLOUD_COLOUR_FORMAT`],
+//!    and the clouds' distance times alpha in [`CLOUD_DISTANCE_FORMAT`], both blended "over";
+//! 3. `clouds.composite` (`shaders/cloud_composite.wgsl`): bilinear upsample over the host's
+//!    colour, the soft depth fade redone per full-resolution pixel so a silhouette in front of a
+//!    cloud (a ridge) keeps its full-resolution edge and no halo.
+//!
+//! At scale 1 nothing here runs: the cloud passes draw straight into the host's colour as
+//! before, and cost nothing more. The target follows the host's frame size (checked each
+//! record, rebuilt when it changed); the host's API does not change.
+
+use std::cell::RefCell;
+
+use super::gpu_types::GpuSpriteVertex;
+use super::pipeline::{PassDesc, pipeline, premultiplied_over};
+
+/// The cloud target's colour: premultiplied linear RGBA in half floats. Eight-bit channels band
+/// under 465% overdraw of faint sprites (a sprite's alpha of 0.02 is 5/255, so each blend rounds
+/// by up to a tenth of its own contribution) and cannot hold colours over 1 (the sun's forward
+/// scattering); half floats keep 11 significant bits at any level, are blendable and filterable
+/// on every WebGPU device, and at half resolution cost half the bytes of a full-resolution RGBA8
+/// frame. (RGB10A2 would keep only 4 alpha levels; RG11B10 has no alpha.)
+pub const CLOUD_COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The clouds' distance from the camera plane, kilometres times alpha (half floats: about 4 m at
+/// 6 km, well inside the soft fade's 120 m).
+pub const CLOUD_DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
+/// The farthest host depth of each block of pixels.
+const FARTHEST_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+const SPRITES_WGSL: &str = include_str!("../../shaders/sprites.wgsl");
+const IN_CLOUD_WGSL: &str = include_str!("../../shaders/in_cloud.wgsl");
+const DOWNSAMPLE_WGSL: &str = include_str!("../../shaders/cloud_downsample.wgsl");
+const COMPOSITE_WGSL: &str = include_str!("../../shaders/cloud_composite.wgsl");
+
+/// The colour targets of every pass into the cloud target: colour and distance, both "over".
+pub fn cloud_targets() -> [(wgpu::TextureFormat, Option<wgpu::BlendState>); 2] {
+    let over = Some(premultiplied_over());
+    [(CLOUD_COLOUR_FORMAT, over), (CLOUD_DISTANCE_FORMAT, over)]
+}
+
+/// How many host pixels a side of one cloud texel covers at `resolution_scale` (1, 0.5 or
+/// 0.25: 1, 2 or 4); `None` for other scales.
+pub fn divisor_of(resolution_scale: f32) -> Option<u32> {
+    [1, 2, 4]
+        .into_iter()
+        .find(|&d| (resolution_scale - 1.0 / d as f32).abs() < 1e-6)
+}
+
+/// The layouts and formats of the sky the cloud target draws with.
+pub(super) struct CloudShared<'a> {
+    /// Group 0 of the passes that read the host's depth (the downsample, the composite):
+    /// multisampled when the host's targets are.
+    pub host_frame_layout: &'a wgpu::BindGroupLayout,
+    /// Group 0 of the passes into the cloud target: the frame uniform and the single-sample
+    /// farthest depth.
+    pub frame_layout: &'a wgpu::BindGroupLayout,
+    /// Group 1 of the sprite pass: the sheet and its sampler.
+    pub sheet_layout: &'a wgpu::BindGroupLayout,
+    /// The host's targets (the composite draws into its colour).
+    pub targets: super::targets::HostTargets,
+}
+
+/// The cloud target of one resolution scale: nothing at scale 1.
+pub(super) struct CloudTarget {
+    divisor: u32,
+    offscreen: Option<Offscreen>,
+}
+
+/// Pipelines of the off-screen path, and the size-dependent textures.
+struct Offscreen {
+    divisor: u32,
+    downsample: wgpu::RenderPipeline,
+    composite: wgpu::RenderPipeline,
+    sprites: wgpu::RenderPipeline,
+    in_cloud: wgpu::RenderPipeline,
+    frame_layout: wgpu::BindGroupLayout,
+    composite_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    /// Made at the first record and whenever the host's frame size changes (record takes `&`).
+    textures: RefCell<Option<SizedTextures>>,
+}
+
+/// The textures of one host frame size, and the bind groups that read them.
+struct SizedTextures {
+    host_size: (u32, u32),
+    colour: wgpu::TextureView,
+    distance: wgpu::TextureView,
+    farthest: wgpu::TextureView,
+    /// Group 0 of the cloud passes: the frame uniform and the farthest depth.
+    frame_group: wgpu::BindGroup,
+    /// Group 1 of the composite.
+    composite_group: wgpu::BindGroup,
+    bytes: u64,
+}
+
+/// The cloud target for one frame: what [`super::Sky::record`] draws the clouds with.
+pub(super) struct CloudFrame<'a> {
+    offscreen: &'a Offscreen,
+    textures: std::cell::Ref<'a, SizedTextures>,
+}
+
+impl CloudTarget {
+    /// The pipelines for `divisor` (1: none, the host's colour is drawn into directly).
+    pub fn new(device: &wgpu::Device, shared: &CloudShared, divisor: u32) -> Self {
+        let offscreen = (divisor > 1).then(|| Offscreen::new(device, shared, divisor));
+        Self { divisor, offscreen }
+    }
+
+    /// The resolution scale, 1 / divisor.
+    pub fn scale(&self) -> f32 {
+        1.0 / self.divisor as f32
+    }
+
+    /// Bytes of the target's textures at the last recorded frame size (0 at scale 1).
+    pub fn gpu_bytes(&self) -> u64 {
+        self.offscreen
+            .as_ref()
+            .and_then(|o| o.textures.borrow().as_ref().map(|t| t.bytes))
+            .unwrap_or(0)
+    }
+
+    /// The target for a frame of the host's `depth_view`'s size (made or remade if the size
+    /// changed); `None` at scale 1.
+    pub fn frame(
+        &self,
+        device: &wgpu::Device,
+        frame_buffer: &wgpu::Buffer,
+        depth_view: &wgpu::TextureView,
+    ) -> Option<CloudFrame<'_>> {
+        let offscreen = self.offscreen.as_ref()?;
+        let size = depth_view.texture().size();
+        let host_size = (size.width, size.height);
+        let current = offscreen.textures.borrow().as_ref().map(|t| t.host_size);
+        if current != Some(host_size) {
+            let textures = offscreen.textures_for(device, frame_buffer, host_size);
+            *offscreen.textures.borrow_mut() = Some(textures);
+        }
+        let textures =
+            std::cell::Ref::filter_map(offscreen.textures.borrow(), Option::as_ref).ok()?;
+        Some(CloudFrame {
+            offscreen,
+            textures,
+        })
+    }
+}
+
+impl Offscreen {
+    fn new(device: &wgpu::Device, shared: &CloudShared, divisor: u32) -> Self {
+        let with_divisor = |wgsl: &str| format!("const DIVISOR: i32 = {divisor};\n{wgsl}");
+        let frame_only = [Some(shared.frame_layout)];
+        let host_frame_only = [Some(shared.host_frame_layout)];
+        let host_samples = shared.targets.sample_count;
+        let targets = cloud_targets();
+        let downsample = pipeline(
+            device,
+            &PassDesc {
+                label: "clouds.downsample",
+                wgsl: &with_divisor(DOWNSAMPLE_WGSL),
+                vs: "vs_downsample",
+                fs: "fs_downsample",
+                bind_groups: &host_frame_only,
+                buffers: &[],
+                targets: &[(FARTHEST_DEPTH_FORMAT, None)],
+                samples: 1,
+                multisampled_depth: host_samples > 1,
+            },
+        );
+        let texture_entry = |binding, filterable| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("clouds.composite_layout"),
+            entries: &[
+                texture_entry(0, true),
+                texture_entry(1, true),
+                texture_entry(2, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let composite = pipeline(
+            device,
+            &PassDesc {
+                label: "clouds.composite",
+                wgsl: &with_divisor(COMPOSITE_WGSL),
+                vs: "vs_composite",
+                fs: "fs_composite",
+                bind_groups: &[Some(shared.host_frame_layout), Some(&composite_layout)],
+                buffers: &[],
+                targets: &[(shared.targets.colour_format, Some(premultiplied_over()))],
+                samples: host_samples,
+                multisampled_depth: host_samples > 1,
+            },
+        );
+        let sprites = pipeline(
+            device,
+            &PassDesc {
+                label: "clouds.sprites",
+                wgsl: SPRITES_WGSL,
+                vs: "vs_sprite",
+                fs: "fs_sprite_offscreen",
+                bind_groups: &[Some(shared.frame_layout), Some(shared.sheet_layout)],
+                buffers: &[Some(GpuSpriteVertex::layout())],
+                targets: &targets,
+                samples: 1,
+                multisampled_depth: false,
+            },
+        );
+        let in_cloud = pipeline(
+            device,
+            &PassDesc {
+                label: "clouds.in_cloud",
+                wgsl: IN_CLOUD_WGSL,
+                vs: "vs_in_cloud",
+                fs: "fs_in_cloud_offscreen",
+                bind_groups: &frame_only,
+                buffers: &[],
+                targets: &targets,
+                samples: 1,
+                multisampled_depth: false,
+            },
+        );
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("clouds.sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        Self {
+            divisor,
+            downsample,
+            composite,
+            sprites,
+            in_cloud,
+            frame_layout: shared.frame_layout.clone(),
+            composite_layout,
+            sampler,
+            textures: RefCell::new(None),
+        }
+    }
+
+    /// The target's textures for a host frame of `host_size` (each side divided, rounded up).
+    fn textures_for(
+        &self,
+        device: &wgpu::Device,
+        frame_buffer: &wgpu::Buffer,
+        host_size: (u32, u32),
+    ) -> SizedTextures {
+        let size = wgpu::Extent3d {
+            width: host_size.0.div_ceil(self.divisor).max(1),
+            height: host_size.1.div_ceil(self.divisor).max(1),
+            depth_or_array_layers: 1,
+        };
+        let mut bytes = 0;
+        let mut make = |label, format: wgpu::TextureFormat| {
+            bytes += size.width as u64
+                * size.height as u64
+                * format.block_copy_size(None).unwrap_or(4) as u64;
+            device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size,
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                        | wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                })
+                .create_view(&Default::default())
+        };
+        let colour = make("clouds.colour", CLOUD_COLOUR_FORMAT);
+        let distance = make("clouds.distance", CLOUD_DISTANCE_FORMAT);
+        let farthest = make("clouds.farthest_depth", FARTHEST_DEPTH_FORMAT);
+        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("clouds.frame_group"),
+            layout: &self.frame_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: frame_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&farthest),
+                },
+            ],
+        });
+        let composite_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("clouds.composite_group"),
+            layout: &self.composite_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&colour),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&distance),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&farthest),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+            ],
+        });
+        SizedTextures {
+            host_size,
+            colour,
+            distance,
+            farthest,
+            frame_group,
+            composite_group,
+            bytes,
+        }
+    }
+}
+
+impl CloudFrame<'_> {
+    /// Records `clouds.downsample`: the host's depth (in `host_frame_group`) to the farthest
+    /// depth of each block.
+    pub fn downsample(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        host_frame_group: &wgpu::BindGroup,
+    ) {
+        let mut pass = begin(
+            encoder,
+            "clouds.downsample",
+            &[&self.textures.farthest],
+            wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+        );
+        pass.set_pipeline(&self.offscreen.downsample);
+        pass.set_bind_group(0, host_frame_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// A pass over the cloud target (cleared to transparent when `clear`, else kept), with the
+    /// frame uniform and the farthest depth bound as group 0.
+    pub fn pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        clear: bool,
+    ) -> wgpu::RenderPass<'e> {
+        let load = if clear {
+            wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+        } else {
+            wgpu::LoadOp::Load
+        };
+        let t = &self.textures;
+        let mut pass = begin(encoder, "clouds", &[&t.colour, &t.distance], load);
+        pass.set_bind_group(0, &t.frame_group, &[]);
+        pass
+    }
+
+    /// The sprite pipeline that draws into the target.
+    pub fn sprite_pipeline(&self) -> &wgpu::RenderPipeline {
+        &self.offscreen.sprites
+    }
+
+    /// The in-cloud fog pipeline that draws into the target.
+    pub fn in_cloud_pipeline(&self) -> &wgpu::RenderPipeline {
+        &self.offscreen.in_cloud
+    }
+
+    /// Records `clouds.composite`: the target over the host's colour.
+    pub fn composite(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        colour_view: &wgpu::TextureView,
+        host_frame_group: &wgpu::BindGroup,
+    ) {
+        let mut pass = begin(
+            encoder,
+            "clouds.composite",
+            &[colour_view],
+            wgpu::LoadOp::Load,
+        );
+        pass.set_pipeline(&self.offscreen.composite);
+        pass.set_bind_group(0, host_frame_group, &[]);
+        pass.set_bind_group(1, &self.textures.composite_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+/// A render pass over `views`, each loaded with `load` and stored.
+fn begin<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    views: &[&wgpu::TextureView],
+    load: wgpu::LoadOp<wgpu::Color>,
+) -> wgpu::RenderPass<'e> {
+    let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
+        .iter()
+        .map(|view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        })
+        .collect();
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &attachments,
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scales_map_to_divisors() {
+        assert_eq!(divisor_of(1.0), Some(1));
+        assert_eq!(divisor_of(0.5), Some(2));
+        assert_eq!(divisor_of(0.25), Some(4));
+        assert_eq!(divisor_of(0.3), None);
+        assert_eq!(divisor_of(0.0), None);
+    }
+}
