@@ -550,10 +550,15 @@ fn render_command_writes_png_and_exr() {
         String::from_utf8_lossy(&out.stderr)
     );
     let said = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        said.contains("above the ground") && said.contains("sprites"),
-        "{said}"
-    );
+    assert!(said.contains("above the ground"), "{said}");
+    // "525 clouds, 14616 sprites" measured: the deck is drawn, not just mentioned.
+    let sprites: u32 = said
+        .split(" sprites")
+        .next()
+        .and_then(|s| s.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no sprite count: {said}"));
+    assert!(sprites >= 7000, "{sprites} sprites drawn: {said}");
     let img = image::open(&png).unwrap().to_rgba8();
     assert_eq!(img.dimensions(), (160, 90));
     // Looking 20 degrees up under OVC020: the upper half is grey cloud, hardly any blue sky
@@ -568,6 +573,21 @@ fn render_command_writes_png_and_exr() {
         "{blue} of {} upper pixels are blue sky",
         upper.len()
     );
+    // Grey and bright, not merely not blue: a black frame fails (measured: mean luma 187 of 255,
+    // every pixel within 30 levels of grey).
+    let luma =
+        |p: &&image::Rgba<u8>| 0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32;
+    let mean = upper.iter().map(luma).sum::<f32>() / upper.len() as f32;
+    let grey = upper
+        .iter()
+        .filter(|p| (p[0] as i32 - p[2] as i32).abs() < 30)
+        .count();
+    assert!(mean > 140.0 && mean < 240.0, "upper half mean luma {mean}");
+    assert!(
+        grey * 10 >= upper.len() * 9,
+        "{grey} of {} upper pixels grey",
+        upper.len()
+    );
     use exr::prelude::*;
     let layers = read_all_flat_layers_from_file(&exr).unwrap();
     let names: Vec<String> = layers.layer_data[0]
@@ -577,6 +597,33 @@ fn render_command_writes_png_and_exr() {
         .map(|c| c.name.to_string())
         .collect();
     assert_eq!(names, ["A", "B", "G", "R", "Z"]);
+    // The EXR holds the PNG's picture in linear light (within the 8-bit rounding: measured
+    // 0.5 of a level) and the depth in metres: the ground 217 m below fills the bottom row
+    // (measured at most 1,166 m), the clouds write no depth (the top row is the far plane).
+    let channel = |k: usize| -> Vec<f32> {
+        let samples = &layers.layer_data[0].channel_data.list[k].sample_data;
+        (0..samples.len())
+            .map(|i| samples.value_by_flat_index(i).to_f32())
+            .collect()
+    };
+    let (a, b, g, r, z) = (channel(0), channel(1), channel(2), channel(3), channel(4));
+    let srgb = |x: f32| skycast::demo::output::linear_to_srgb(x) * 255.0;
+    for (i, p) in img.pixels().enumerate() {
+        let exr = [srgb(r[i]), srgb(g[i]), srgb(b[i])];
+        for c in 0..3 {
+            assert!(
+                (exr[c] - p[c] as f32).abs() <= 1.0,
+                "pixel {i}: EXR {exr:?}, PNG {p:?}"
+            );
+        }
+        assert_eq!(a[i], 1.0, "pixel {i}");
+    }
+    let bottom_row = &z[160 * 89..];
+    assert!(
+        bottom_row.iter().all(|&d| d > 216.0 && d < 2500.0),
+        "{bottom_row:?}"
+    );
+    assert!(z[..160].iter().all(|&d| d == 160_000.0), "{:?}", &z[..160]);
     let bad = run(&[
         "--alt-ft",
         "1500",
@@ -695,6 +742,19 @@ fn fly_command_writes_frames_and_csv() {
             .all(|r| r[column("clouds_recomputed")].parse::<u32>().is_ok())
     );
     assert!(dir.join("frame_00000.png").exists() && dir.join("frame_00006.png").exists());
+    // The closing summary quotes the frames' own numbers: its median sky CPU is the column's.
+    let said = String::from_utf8_lossy(&out.stdout);
+    let mut cpu: Vec<u64> = rows[1..]
+        .iter()
+        .map(|r| r[column("sky_cpu_us")].parse().unwrap())
+        .collect();
+    cpu.sort_unstable();
+    let median = format!("sky CPU a frame: median {} us", cpu[3]);
+    assert!(said.contains(&median), "{median}: {said}");
+    assert!(
+        said.contains("peak memory (RSS): ") && said.contains(" MB"),
+        "{said}"
+    );
 }
 
 /// `cumulus` scaled up `scale` times (a far cloud big enough to see at 30 km in 320 x 180).
@@ -779,7 +839,8 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     assert_eq!(stats.sprites_drawn, 120, "{stats:?}");
     assert!(stats.ring_gpu_bytes >= 2 * 8 * 256 * 256 * 4, "{stats:?}");
 
-    assert_far_cloud_where_sprites_have_it(&sprites_only, &ring, &bare, 4.0);
+    // Measured 0.05 px off.
+    assert_far_cloud_where_sprites_have_it(&sprites_only, &ring, &bare, 0.2);
 
     // Switched off at run time (`skycast view`'s key): every block sprites, as in a sky made
     // without the ring; on again: built afresh at once.
@@ -797,7 +858,8 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
 }
 
 /// The far cloud (what `sprites` and `ring` add to `bare`) shows in the impostor with about the
-/// pixels it has as sprites (0.6-1.5x), its centroid within `tolerance_px` of theirs.
+/// pixels it has as sprites (0.9-1.1x; measured 0.98-1.02x), its centroid within `tolerance_px`
+/// of theirs.
 fn assert_far_cloud_where_sprites_have_it(
     sprites: &Frame,
     ring: &Frame,
@@ -809,7 +871,7 @@ fn assert_far_cloud_where_sprites_have_it(
     eprintln!("far cloud: sprites {n_s} px at ({x_s}, {y_s}); ring {n_r} px at ({x_r}, {y_r})");
     assert!(n_s > 150, "the far cloud shows as sprites: {n_s} px");
     assert!(
-        n_r as f32 > 0.6 * n_s as f32 && (n_r as f32) < 1.5 * n_s as f32,
+        n_r as f32 > 0.9 * n_s as f32 && (n_r as f32) < 1.1 * n_s as f32,
         "the far cloud shows in the impostor: {n_r} px vs {n_s} as sprites"
     );
     assert!(
@@ -821,9 +883,9 @@ fn assert_far_cloud_where_sprites_have_it(
 /// Wang translates the impostors vertically with the angle between clouds and camera. Here each
 /// pixel's ray is reprojected to the clouds' stored depth, which does that and more: after a
 /// climb of 2,000 m with no rebuild (climb threshold raised), the far cloud sits 30 km out where
-/// the all-sprites frame has it (within 0.1 px here), not where the quad at the 20 km radius
+/// the all-sprites frame has it (within 0.25 px here), not where the quad at the 20 km radius
 /// would put it: with the reprojection switched off in `impostor_quad.wgsl` (`dist` held at the
-/// ring radius) it lands 4.9 rows lower and this test fails.
+/// ring radius) it lands 3.4 rows lower with 20% fewer pixels and this test fails.
 #[test]
 fn ring_moves_far_clouds_with_the_camera_height() {
     let blocks = |with_far: bool| {
@@ -868,7 +930,8 @@ fn ring_moves_far_clouds_with_the_camera_height() {
     );
     assert_eq!((stats.blocks_near, stats.blocks_far), (1, 1), "{stats:?}");
 
-    assert_far_cloud_where_sprites_have_it(&sprites, &ring, &bare, 3.0);
+    // Measured 0.25 px off.
+    assert_far_cloud_where_sprites_have_it(&sprites, &ring, &bare, 0.5);
 }
 
 /// Moving past 15% of the ring radius rebuilds the ring one impostor per frame over 8 frames,
@@ -1002,7 +1065,7 @@ fn ring_depth_puts_a_far_mountain_between_impostored_clouds() {
         "the cloud behind the ridge shows above it: {right_sky} px"
     );
     // Without the stored depth (the quad's own depth, 20 km) it would cover the ridge: this test
-    // fails with `along = 1.0` in impostor_quad.wgsl (126 px on the ridge).
+    // fails with `dist = ring.size.x / max(at.w, 1e-3);` in `ring_sample` (128 px on the ridge).
 }
 
 /// Mean absolute luminance change per frame along a slow straight flight across several ring
@@ -1055,14 +1118,17 @@ fn median(mut v: Vec<f32>) -> f32 {
     v[v.len() / 2]
 }
 
-/// Popping, measured: frames during a rebuild or crossfade change no more than 1.5x the median
-/// change of plain motion frames; with the crossfade off, the switch frames exceed it.
+/// Popping, measured: no frame of the flight, rebuilding, crossfading, swapping rings or plain,
+/// changes more than 1.5x the median change of plain motion frames. The negative control: with
+/// the crossfade off the swap frames exceed it, so a crossfade that never blends (the old ring
+/// shown until the swap, `return before;` in `fs_impostor`) fails here, on its swap frame.
 #[test]
 fn ring_rebuilds_do_not_pop() {
     let run = popping_run(0.5);
     let plain = median(run.iter().filter(|c| !c.1).map(|c| c.0).collect());
-    let worst = run.iter().filter(|c| c.1).map(|c| c.0).fold(0.0, f32::max);
-    eprintln!("crossfade: plain median {plain}, worst rebuild/fade {worst}, {run:?}");
+    // Over every frame: the swap to the new ring reports weight 0, so it is not flagged.
+    let worst = run.iter().map(|c| c.0).fold(0.0, f32::max);
+    eprintln!("crossfade: plain median {plain}, worst {worst}, {run:?}");
     let hard = popping_run(0.0);
     let hard_plain = median(hard.iter().filter(|c| !c.1).map(|c| c.0).collect());
     let hard_worst = hard.iter().map(|c| c.0).fold(0.0, f32::max);
@@ -1070,7 +1136,7 @@ fn ring_rebuilds_do_not_pop() {
     assert!(run.iter().filter(|c| c.1).count() >= 20, "{run:?}");
     assert!(
         worst <= 1.5 * plain,
-        "crossfaded rebuilds pop: {worst} vs median {plain}"
+        "a frame pops: {worst} vs median {plain}"
     );
     assert!(
         hard_worst > 1.5 * hard_plain,

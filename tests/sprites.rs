@@ -1,17 +1,18 @@
 //! The sprites as the vertex shader builds them (Wang 2003 3.3, 5 and 6.1 on GPU-resident
 //! sprites), read back from the GPU (`Sky::read_back_corners` runs the shader's own corner code):
 //! the order cache, the back-to-front order, facing the camera, the facing lock and its fade,
-//! upright base sprites, the forward-scattering rim, precision far from the origin. Small scenes
-//! on whatever adapter there is (lavapipe here).
+//! upright base sprites, the forward-scattering rim, precision far from the origin, and (in drawn
+//! frames) the horizon haze. Small scenes on whatever adapter there is (lavapipe here).
 
 use glam::{DVec2, DVec3, Vec3};
 use skycast::demo::terrain::HeightField;
-use skycast::demo::{DemoHost, headless};
+use skycast::demo::{DemoHost, Frame, headless};
 use skycast::render::{
     BlockMotion, Camera, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteCorner, SpriteSheet,
     square_sprite,
 };
 use skycast::shading::{ColourLevels, ForwardScattering, SunPosition, TimeOfDayTable};
+use skycast::weather::BlockWeather;
 
 /// A rig: a tiny headless target (the corners do not depend on it) and the sky.
 fn host(table: TimeOfDayTable) -> DemoHost {
@@ -419,4 +420,79 @@ fn past_the_sprite_budget_the_farthest_blocks_are_left_out() {
         "the southern block came in"
     );
     assert!(norths.iter().all(|&y| y < 5_000.0), "the northern one went");
+}
+
+/// Aerial perspective (`sprites.wgsl`): a dark cloud 8 km out fades into the horizon haze. In
+/// clear air (visibility past the fog's cap: the clear-air haze, 13.3 km), against the same cloud
+/// wholly hazed (a 1 m haze distance: the horizon's colour), the cloud at a 2 km haze distance
+/// differs by under a tenth of what it does with the clouds' own haze distance out of the way
+/// (then 13.3 km). Without the haze term (`o.haze = 0.0;`) nothing is hazed and this fails.
+#[test]
+fn a_far_cloud_fades_into_the_horizon_haze() {
+    let contrast = |haze_distance_m: f32| {
+        let mut settings = RenderSettings::default();
+        settings.clouds.haze_distance_m = haze_distance_m;
+        let ground = HeightField::from_fn(DVec2::ZERO, 20_000.0, 9, |_| 0.0);
+        let sheet = SpriteSheet {
+            size_px: 4,
+            mips: vec![vec![255; 64], vec![255; 16], vec![255; 4]],
+        };
+        let mut host = DemoHost::new(
+            64,
+            36,
+            &ground,
+            SkyConfig {
+                targets: headless::TARGETS,
+                settings,
+                time_of_day: TimeOfDayTable::default(),
+                sheet,
+            },
+        )
+        .unwrap_or_else(|e| panic!("sprite tests need an adapter: {e}"));
+        host.sky.set_weather_overhead(&BlockWeather {
+            visibility_m: 1e9,
+            ..BlockWeather::default()
+        });
+        let camera = host.camera(DVec3::new(0.0, 0.0, 1500.0), 0.0, 2.0);
+        let (bare, _) = host.frame(&camera, &SUN, 0.0, 1e9).unwrap();
+        host.sky.set_clouds(one_cloud(SkyCloud {
+            centre_m: DVec3::new(0.0, 8000.0, 1800.0),
+            sprites: vec![square_sprite(Vec3::ZERO, 1500.0, 0, 0)],
+            group_centres_m: vec![Vec3::ZERO],
+            colour_levels: ColourLevels::even(0.0, 4000.0, [[0.05, 0.05, 0.05, 1.0]; 5]),
+            flat: false,
+        }));
+        let (cloud, _) = host.frame(&camera, &SUN, 0.0, 1e9).unwrap();
+        (bare, cloud)
+    };
+    let lum = |p: &[f32; 4]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let summed_difference = |a: &Frame, b: &Frame| -> f32 {
+        a.rgba
+            .iter()
+            .zip(&b.rgba)
+            .map(|(p, q)| (lum(p) - lum(q)).abs())
+            .sum()
+    };
+    let (bare, clear) = contrast(1e10);
+    let (_, hazed) = contrast(2000.0);
+    let (_, horizon) = contrast(1.0);
+    let shown = bare
+        .rgba
+        .iter()
+        .zip(&clear.rgba)
+        .filter(|(p, q)| (lum(p) - lum(q)).abs() > 0.004)
+        .count();
+    let (from_clear, from_hazed) = (
+        summed_difference(&clear, &horizon),
+        summed_difference(&hazed, &horizon),
+    );
+    eprintln!(
+        "against the wholly hazed cloud: {from_hazed} at 2 km, {from_clear} at 13.3 km ({shown} px)"
+    );
+    assert!(shown > 20, "the cloud shows: {shown} px");
+    assert!(from_clear > 0.5, "the haze changes the cloud: {from_clear}");
+    assert!(
+        from_hazed < 0.1 * from_clear,
+        "{from_hazed} vs {from_clear}"
+    );
 }

@@ -6,11 +6,8 @@ mod common;
 
 use libfuzzer_sys::fuzz_target;
 
-const HEADER: &str = "No errors\nNo warnings\n1 ms\ndata source=metars\n1 results\n\
-raw_text,station_id,observation_time,latitude,longitude,elevation_m\n";
-
 fuzz_target!(|data: &[u8]| {
-    let mut file = HEADER.as_bytes().to_vec();
+    let mut file = common::CSV_HEADER.as_bytes().to_vec();
     file.extend_from_slice(data);
     common::check_weather_file(&file);
 });

@@ -7,7 +7,7 @@ mod common;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let mut file = b"2025/01/27 22:00\n".to_vec();
+    let mut file = common::CYCLE_DATE.as_bytes().to_vec();
     file.extend_from_slice(data);
     common::check_weather_file(&file);
 });

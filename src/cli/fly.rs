@@ -166,6 +166,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
     let (mut written, mut inside_cloud) = (0u32, 0u32);
+    // For the closing summary: what the README quotes, from this run.
+    let mut summary = Summary::default();
     // On a terminal only (indicatif hides it when stderr is a file or a pipe).
     let progress = indicatif::ProgressBar::new(frames);
     if let Ok(style) = indicatif::ProgressStyle::with_template(
@@ -203,6 +205,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             // Entirely inside a cloud: the frame is the in-cloud fog and nothing else.
             inside_cloud += (stats.in_cloud >= 0.99) as u32;
         }
+        summary.add(&stats);
         let p = pose.position_m;
         csv.write_record([
             k.to_string(),
@@ -242,5 +245,57 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         args.out.display(),
         args.fps
     );
+    println!("{}", summary.line());
     Ok(())
+}
+
+/// The flight's figures, printed when it ends: the sky's CPU a frame (`sky_cpu_us`), how much of
+/// the sort order came from the cache, the frame thread's time on weather, peak memory.
+#[derive(Default)]
+struct Summary {
+    sky_cpu_us: Vec<u64>,
+    cache_hit_rate: Vec<f32>,
+    weather_us_max: u64,
+}
+
+impl Summary {
+    fn add(&mut self, stats: &skycast::render::FrameStats) {
+        self.sky_cpu_us.push(stats.sky_cpu_us());
+        self.cache_hit_rate.push(stats.cache_hit_rate);
+        self.weather_us_max = self.weather_us_max.max(stats.weather_us);
+    }
+
+    fn line(&mut self) -> String {
+        self.sky_cpu_us.sort_unstable();
+        self.cache_hit_rate.sort_by(f32::total_cmp);
+        let at = |n: usize, q: f64| ((n.saturating_sub(1)) as f64 * q).round() as usize;
+        let n = self.sky_cpu_us.len();
+        let (median, p99) = match n {
+            0 => (0, 0),
+            _ => (self.sky_cpu_us[at(n, 0.5)], self.sky_cpu_us[at(n, 0.99)]),
+        };
+        let hit = self
+            .cache_hit_rate
+            .get(at(self.cache_hit_rate.len(), 0.5))
+            .copied()
+            .unwrap_or(0.0);
+        let peak = peak_rss_bytes().map_or_else(
+            || "unknown (no /proc/self/status)".to_string(),
+            |b| format!("{:.0} MB", b as f64 / 1e6),
+        );
+        format!(
+            "sky CPU a frame: median {median} us, p99 {p99} us; order cache hit rate, median: \
+             {:.1}%; weather on the frame thread: at most {} us; peak memory (RSS): {peak}",
+            hit * 100.0,
+            self.weather_us_max
+        )
+    }
+}
+
+/// The process's peak resident memory (Linux: `VmHWM` of /proc/self/status).
+fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }

@@ -564,6 +564,8 @@ mod tests {
         // A small change (half an okta) re-forms nothing.
         field.update(DVec2::ZERO, &|_| weather(2.5));
         assert_eq!(field.pending(), 0);
+        // Some way into the flight: the change's own times start at this field time, not at 0.
+        field.advance(100.0);
         field.update(DVec2::ZERO, &|_| weather(6.0));
         field.wait_for_pending();
         let config = CloudsConfig::builtin().lifecycle;
@@ -584,13 +586,16 @@ mod tests {
         let (mut old_last, mut new_last) = (f32::MAX, -1.0);
         let total = config.formation_s.max(config.dissipation_s) as f64;
         let mut t = 0.0;
+        let (mut overlapping, mut forming) = (0, 0);
         while t < total {
             field.advance(10.0);
             t += 10.0;
             let gens = field.generations(index);
             // Never nothing, never a swap: the new clouds are there from the start.
             assert!(!gens.is_empty());
+            overlapping += (gens.len() == 2) as usize;
             let new = gens.last().unwrap();
+            forming += matches!(new.phase, Phase::Forming { .. }) as usize;
             let now = field.time_s();
             assert!(opacity(new, now) >= new_last);
             new_last = opacity(new, now);
@@ -599,6 +604,18 @@ mod tests {
                 old_last = opacity(&gens[0], now);
             }
         }
+        // And it takes its time (10 s steps): the old clouds stay while they dissipate, the new
+        // ones form over `formation_s`; settling or going at once is a pop.
+        assert!(
+            overlapping + 1 >= (config.dissipation_s / 10.0) as usize,
+            "the old clouds went after {overlapping} steps of {}",
+            config.dissipation_s
+        );
+        assert!(
+            forming + 1 >= (config.formation_s / 10.0) as usize,
+            "the new clouds formed in {forming} steps of {}",
+            config.formation_s
+        );
         let gens = field.generations(index);
         assert_eq!(gens.len(), 1, "the old clouds are gone");
         assert_eq!(gens[0].phase, Phase::Steady);

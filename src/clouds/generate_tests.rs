@@ -290,9 +290,12 @@ fn coverage_is_honoured_for_every_cover_code() {
             }
             let got = sum / blocks as f64;
             let want = oktas as f64 / 8.0;
+            // Nearer its own cover code than either neighbour: the codes tried are 2 to 2.5
+            // oktas apart, so 1 okta (0.125) is the most that still tells FEW from SCT; measured
+            // at most 0.10 (stratus at SCT, 0.54), 0.02 for the heaped types below OVC.
             assert!(
-                (got - want).abs() <= 0.15,
-                "{t} {oktas} oktas: covered {got:.2}, want {want:.2}"
+                (got - want).abs() < 0.12,
+                "{t} {oktas} oktas: covered {got:.3}, want {want:.3}"
             );
         }
     }

@@ -149,6 +149,105 @@ mod tests {
                 assert!(formation_alpha(p, 0.1, &c) >= c.outer_start_opacity);
             }
         }
+        // And they start as soon as the inner ones pass it: within a step (0.01 of opacity).
+        let first = (0..=200)
+            .map(|k| k as f32 / 200.0)
+            .find(|&p| formation_alpha(p, 0.9, &c) > 0.0)
+            .unwrap();
+        let inner = formation_alpha(first, 0.1, &c);
+        assert!(
+            inner - c.outer_start_opacity <= 0.011,
+            "outer sprites start at inner opacity {inner}, not {}",
+            c.outer_start_opacity
+        );
+    }
+
+    /// The largest cloud of a generated cumulus block.
+    fn a_cloud() -> Cloud {
+        use crate::weather::{BlockIndex, BlockLayer, BlockWeather, CloudType, TypeSource};
+        let weather = BlockWeather {
+            layers: vec![BlockLayer {
+                cloud_type: CloudType::CumulusMediocris,
+                type_source: TypeSource::HeightRule,
+                coverage_oktas: 4.0,
+                base_ft_agl: 3000.0,
+                thickness_ft: 2000.0,
+            }],
+            ..Default::default()
+        };
+        let types = crate::clouds::CloudTypes::builtin();
+        let block = crate::clouds::generate_block(BlockIndex::new(0, 0), &weather, 7, &types);
+        block
+            .clouds
+            .into_iter()
+            .max_by_key(|c| c.sprites.len())
+            .unwrap()
+    }
+
+    /// `apply` (the CPU pictures, `skycast preview --lifecycle`) sets each sprite's opacity for
+    /// the progress since the phase's own start, and moves on only at the end: Forming becomes
+    /// Steady at `formation_s`, Dissipating becomes Gone at `dissipation_s`. `alpha_at` says the
+    /// same without a cloud.
+    #[test]
+    fn apply_fades_the_sprites_and_ends_the_phase_on_time() {
+        let c = config();
+        let mut cloud = a_cloud();
+        let (f, d) = (c.formation_s as f64, c.dissipation_s as f64);
+        let forming = Phase::Forming { since_s: 100.0 };
+        assert_eq!(apply(&mut cloud, forming, 100.0 + 0.3 * f, &c), forming);
+        for s in &cloud.sprites {
+            let want = formation_alpha(0.3, s.radius_fraction, &c);
+            assert!(
+                (s.alpha_morph - want).abs() < 1e-5,
+                "{} vs {want}",
+                s.alpha_morph
+            );
+            let at = alpha_at(forming, 100.0 + 0.3 * f, s.radius_fraction, &c);
+            assert!((at - want).abs() < 1e-5, "{at} vs {want}");
+        }
+        assert!(
+            cloud
+                .sprites
+                .iter()
+                .any(|s| s.alpha_morph > 0.0 && s.alpha_morph < 1.0)
+        );
+        assert_eq!(apply(&mut cloud, forming, 99.0 + f, &c), forming);
+        assert_eq!(apply(&mut cloud, forming, 100.0 + f, &c), Phase::Steady);
+        assert!(cloud.sprites.iter().all(|s| s.alpha_morph == 1.0));
+        let dissipating = Phase::Dissipating { since_s: 100.0 };
+        assert_eq!(
+            apply(&mut cloud, dissipating, 100.0 + 0.6 * d, &c),
+            dissipating
+        );
+        for s in &cloud.sprites {
+            let want = dissipation_alpha(0.6, s.radius_fraction, &c);
+            assert!(
+                (s.alpha_morph - want).abs() < 1e-5,
+                "{} vs {want}",
+                s.alpha_morph
+            );
+        }
+        assert_eq!(apply(&mut cloud, dissipating, 99.0 + d, &c), dissipating);
+        assert_eq!(apply(&mut cloud, dissipating, 100.0 + d, &c), Phase::Gone);
+        assert!(cloud.sprites.iter().all(|s| s.alpha_morph == 0.0));
+        assert_eq!(alpha_at(Phase::Steady, 0.0, 0.9, &c), 1.0);
+        assert_eq!(alpha_at(Phase::Gone, 0.0, 0.1, &c), 0.0);
+    }
+
+    /// What the renderer fades by (`Fade::Forming(progress)`): from the phase's own start to its
+    /// end, 1 once settled or gone.
+    #[test]
+    fn progress_runs_from_the_phase_start_to_its_end() {
+        let c = config();
+        let (f, d) = (c.formation_s as f64, c.dissipation_s as f64);
+        let forming = Phase::Forming { since_s: 100.0 };
+        assert_eq!(progress(forming, 100.0, &c), 0.0);
+        assert_eq!(progress(forming, 100.0 + 0.25 * f, &c), 0.25);
+        assert_eq!(progress(forming, 100.0 + 2.0 * f, &c), 1.0);
+        let dissipating = Phase::Dissipating { since_s: 100.0 };
+        assert_eq!(progress(dissipating, 100.0 + 0.5 * d, &c), 0.5);
+        assert_eq!(progress(Phase::Steady, 0.0, &c), 1.0);
+        assert_eq!(progress(Phase::Gone, 0.0, &c), 1.0);
     }
 
     #[test]
@@ -164,14 +263,31 @@ mod tests {
             }
             assert_eq!(last, 0.0, "rf {rf} does not finish");
         }
+        let mut fading = 0;
         for k in 0..=200 {
             let q = k as f32 / 200.0;
             // Inner sprites only start once the outer ones are gone.
             if dissipation_alpha(q, 0.2, &c) < 1.0 {
                 assert_eq!(dissipation_alpha(q, 0.9, &c), 0.0);
             }
-            // Nearer the edge, more transparent.
-            assert!(dissipation_alpha(q, 0.4, &c) <= dissipation_alpha(q, 0.1, &c));
+            // Nearer the edge, more transparent: strictly, while the inner sprites fade (before
+            // that both are 1, after it both are 0). Fails without the `edge` term.
+            let (outer, inner) = (dissipation_alpha(q, 0.4, &c), dissipation_alpha(q, 0.1, &c));
+            if inner > 0.0 && inner < 1.0 {
+                assert!(outer < inner, "q {q}: rf 0.4 {outer}, rf 0.1 {inner}");
+                fading += 1;
+            } else {
+                assert_eq!(outer.min(1.0 - outer), 0.0, "q {q}: rf 0.4 {outer}");
+            }
         }
+        // The inner sprites fade over the last half of the dissipation: about 100 of 200 steps.
+        assert!(fading >= 80, "only {fading} steps fade the inner sprites");
+        // The ones at the inner radius (inner ones: untouched over the first half) are gone at
+        // q = 0.75, the centre at q = 1.
+        let at_inner = c.inner_radius_fraction;
+        assert_eq!(dissipation_alpha(0.45, at_inner, &c), 1.0);
+        assert!(dissipation_alpha(0.74, at_inner, &c) > 0.0);
+        assert_eq!(dissipation_alpha(0.75, at_inner, &c), 0.0);
+        assert!(dissipation_alpha(0.99, 0.0, &c) > 0.0);
     }
 }

@@ -467,9 +467,14 @@ mod tests {
         assert!(above > 0.5 && below < 0.05, "above {above} below {below}");
     }
 
+    /// The same bytes on every machine and run: pinned, not compared with a second run in the
+    /// same process (which shares the machine's float maths and could not differ). A deliberate
+    /// change to the noise or the cells changes it; update it then.
     #[test]
-    fn the_sheet_is_deterministic() {
-        let again = TextureSheet::generate();
-        assert_eq!(again.content_hash(), sheet().content_hash());
+    fn the_sheet_hashes_the_same_everywhere() {
+        assert_eq!(
+            format!("{:016x}", sheet().content_hash()),
+            "947b5d3b98321002"
+        );
     }
 }

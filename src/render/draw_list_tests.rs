@@ -1,6 +1,8 @@
 //! Tests of `draw_list`'s CPU rules (the GPU side is in `tests/sprites.rs`).
 
 use super::*;
+use crate::render::scene::SkySprite;
+use crate::shading::ColourLevels;
 
 fn cache() -> VertexCacheSettings {
     RenderSettings::default().vertex_cache
@@ -66,4 +68,59 @@ fn facings_keep_up_up_and_upright_ones_level() {
     let u = upright_facing(Vec3::new(0.0, -300.0, -800.0));
     assert_eq!(u.up, Vec3::Z);
     assert!((u.normal - -Vec3::Y).length() < 1e-6);
+}
+
+/// A cloud of 40 sprites on a 12 m spiral (smaller than any tolerance of a whole-cloud order).
+fn small_cloud() -> SkyCloud {
+    let sprites = (0..40)
+        .map(|k| {
+            let a = k as f32 * 2.4;
+            SkySprite {
+                offset_m: Vec3::new(a.cos(), a.sin(), 0.3 * (k % 7) as f32)
+                    * (2.0 + 0.25 * k as f32),
+                width_m: 20.0,
+                height_m: 20.0,
+                rotation_deg: 0.0,
+                cell: 4,
+                group: 0,
+                alpha_morph: 1.0,
+                radius_fraction: k as f32 / 40.0,
+                upright: false,
+                precipitation: false,
+            }
+        })
+        .collect();
+    SkyCloud {
+        centre_m: DVec3::ZERO,
+        sprites,
+        group_centres_m: vec![Vec3::ZERO],
+        colour_levels: ColourLevels::even(0.0, 100.0, [[1.0; 4]; 5]),
+        flat: false,
+    }
+}
+
+/// The renderer's integer-key order (`order_into`) is the CPU reference's
+/// (`sprites_back_to_front`), and both put every sprite no nearer than the next: deleting either
+/// sort fails here, inside one cloud, without a GPU.
+#[test]
+fn sprites_of_one_cloud_are_ordered_back_to_front_by_both_sorts() {
+    let cloud = small_cloud();
+    for cam in [
+        Vec3::new(30.0, -5.0, 2.0),
+        Vec3::new(-3.0, 1.0, 0.5),
+        Vec3::ZERO,
+    ] {
+        let reference = sprites_back_to_front(&cloud, cam);
+        assert_eq!(reference.len(), cloud.sprites.len());
+        for w in reference.windows(2) {
+            assert!(w[0].1 >= w[1].1, "camera {cam}: {reference:?}");
+        }
+        let mut slots = vec![0u32; cloud.sprites.len()];
+        order_into(&cloud, cam, 100, &mut slots, &mut SortKeys::new());
+        let from_slots: Vec<usize> = slots.iter().map(|s| (s - 100) as usize).collect();
+        let from_reference: Vec<usize> = reference.iter().map(|r| r.0).collect();
+        assert_eq!(from_slots, from_reference, "camera {cam}");
+        // Not the identity: the spiral's order depends on where the camera is.
+        assert_ne!(from_reference, (0..40).collect::<Vec<_>>(), "camera {cam}");
+    }
 }

@@ -96,5 +96,16 @@ mod tests {
         s.release(0..60);
         assert_eq!(s.used(), 0);
         assert_eq!(s.allocate(100), Some(0..100));
+        // Full, then the last range back: it goes after every free range (there are none).
+        s.release(0..100);
+        let (x, y) = (s.allocate(60).unwrap(), s.allocate(40).unwrap());
+        s.release(y);
+        assert_eq!((s.used(), s.allocate(40)), (60, Some(60..100)));
+        s.release(60..100);
+        s.release(x);
+        assert_eq!(s.allocate(100), Some(0..100));
+        // Growing keeps at least the old size (`resident`): the capacity is the slots in all,
+        // used or not.
+        assert_eq!((s.capacity(), SlotRanges::new(0).capacity()), (100, 0));
     }
 }

@@ -1,6 +1,8 @@
 //! The geometry and rules of the impostor ring (Wang 2003 6.2), no GPU: the `[impostors]`
-//! settings, which blocks are far, when to rebuild, the impostor cameras and sectors, and the
-//! quads' corners (checked against the impostor cameras). Units: metres, degrees, feet where named.
+//! settings, which blocks are far, when to rebuild, the impostor cameras and sectors. Where the
+//! quads are and their texture coordinates are the shader's (`impostor_at` in
+//! `shaders/impostor_quad.wgsl`), checked by the ring tests in `tests/render.rs` (a flipped u or
+//! v there moves or loses the far cloud). Units: metres, degrees, feet where named.
 
 use glam::{DVec3, Mat4, Vec3};
 use serde::{Deserialize, Serialize};
@@ -154,33 +156,6 @@ pub(super) fn in_sector(i: usize, centre_m: DVec3, block_m: DVec3) -> bool {
     off.abs() <= IMPOSTOR_FOV_DEG * 0.5 + margin
 }
 
-/// The corners of impostor `i`'s quad relative to the ring centre (top left, bottom left, top
-/// right, bottom right) with their texture coordinates: the geometry `ring_sample` in
-/// `shaders/impostor_quad.wgsl` intersects rays with (octagon sides at the ring radius, each
-/// `2 * radius * tan(22.5 deg)` square). Keep the two in sync.
-#[cfg(test)]
-fn quad_corners(i: usize, s: &ImpostorSettings) -> [(Vec3, [f32; 2]); 4] {
-    let h = heading_deg(i).to_radians();
-    let forward = DVec3::new(h.sin(), h.cos(), 0.0);
-    let right = DVec3::new(h.cos(), -h.sin(), 0.0);
-    let half = s.ring_radius_m * (IMPOSTOR_FOV_DEG * 0.5).to_radians().tan();
-    let mid = forward * s.ring_radius_m;
-    let corner = |x: f64, y: f64, uv: [f32; 2]| {
-        let p = mid + right * (x * half) + DVec3::Z * (y * half);
-        // The shader's mapping from a point on the quad to its texture coordinates.
-        let (u, v) = (p.dot(right) / half, p.z / half);
-        assert!(((u + 1.0) * 0.5 - uv[0] as f64).abs() < 1e-9);
-        assert!(((1.0 - v) * 0.5 - uv[1] as f64).abs() < 1e-9);
-        (p.as_vec3(), uv)
-    };
-    [
-        corner(-1.0, 1.0, [0.0, 0.0]),
-        corner(-1.0, -1.0, [0.0, 1.0]),
-        corner(1.0, 1.0, [1.0, 0.0]),
-        corner(1.0, -1.0, [1.0, 1.0]),
-    ]
-}
-
 /// The projection of impostor `i`'s camera (for tests: a far point projects where its quad is).
 pub fn impostor_view_proj(i: usize, s: &ImpostorSettings) -> Mat4 {
     impostor_camera(i, DVec3::ZERO, s).view_proj_relative()
@@ -217,20 +192,6 @@ mod tests {
         assert!(needs_rebuild(at, sun, at + DVec3::Z * 410.0, sun, &s));
         let turned = Vec3::new(0.1, 0.0, 1.0).normalize();
         assert!(needs_rebuild(at, sun, at, turned, &s));
-    }
-
-    #[test]
-    fn quad_corners_match_the_impostor_camera() {
-        let s = ImpostorSettings::default();
-        for i in 0..IMPOSTORS {
-            let vp = impostor_view_proj(i, &s);
-            for (corner, corner_uv) in quad_corners(i, &s) {
-                let p = vp * corner.extend(1.0);
-                let ndc = p.truncate() / p.w;
-                let uv = [(ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5];
-                assert!((uv[0] - corner_uv[0]).abs() < 1e-4 && (uv[1] - corner_uv[1]).abs() < 1e-4);
-            }
-        }
     }
 
     #[test]

@@ -229,11 +229,18 @@ fn identical_positions_keep_the_latest_report() {
     assert_eq!(w.layers[0].cloud_type, CloudType::Stratocumulus);
 }
 
+/// A block without a station is the field at its centre, `(i + 1/2, j + 1/2)` blocks from the
+/// origin (worked out here, not with `centre_m`), where the weather is not its corner's nor the
+/// origin's: sampling either instead fails.
 #[test]
-fn block_weather_is_the_weather_at_the_block_centre() {
+fn a_block_without_a_station_is_the_field_at_its_centre() {
     let f = field(&square());
-    let block = f.frame().block_of(50.2, 8.1);
-    assert_eq!(f.block_weather(block), f.weather_at(block.centre_m()));
+    let block = f.frame().block_of(49.6, 8.0);
+    let centre = DVec2::new(block.i as f64 + 0.5, block.j as f64 + 0.5) * 4000.0;
+    let w = f.block_weather(block);
+    assert_eq!(w, f.weather_at(centre));
+    assert_ne!(w, f.weather_at(centre + DVec2::splat(1900.0)));
+    assert_ne!(w, f.weather_at(DVec2::ZERO));
 }
 
 #[test]

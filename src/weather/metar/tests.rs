@@ -198,3 +198,17 @@ fn groups_skipped_quietly() {
     assert_eq!(r.clouds, [layer(Some(Cover::Ovc), Some(18_000), None)]);
     assert_eq!(ok(quiet[7]).visibility_m, Some(750.0));
 }
+
+/// Bytes past the third that are not a character boundary (a `€` in a group) make a token that is
+/// not a sky group, or a malformed one, never a panic (the split at byte 3 needs both checks).
+#[test]
+fn a_multibyte_character_in_a_sky_group_is_no_panic() {
+    assert!(matches!(sky::parse_sky("F€"), sky::SkyToken::No));
+    assert!(matches!(
+        sky::parse_sky("FEW0€"),
+        sky::SkyToken::Malformed(_)
+    ));
+    let r = ok("KXYZ 271700Z F€ FEW0€ SCT030 10/05 A2992");
+    assert_eq!(r.clouds, [layer(Some(Cover::Sct), Some(3000), None)]);
+    assert!(!r.warnings.is_empty());
+}
