@@ -13,6 +13,6 @@ fn fs_sprite_impostor(i: VertexOut) -> ImpostorOut {
     let c = sprite_colour(i);
     var o: ImpostorOut;
     o.colour = c;
-    o.depth_km = vec4<f32>(i.view_depth_m * 0.001 * c.a, 0.0, 0.0, c.a);
+    o.depth_km = vec4<f32>(view_depth_m(i) * 0.001 * c.a, 0.0, 0.0, c.a);
     return o;
 }

@@ -13,15 +13,22 @@ struct VertexIn {
     @location(2) colour: vec4<f32>,
 };
 
+// Two interpolated vectors: the software rasteriser's triangle setup, run on one core for every
+// sprite at any resolution, costs per interpolated vector. The fragment's view depth is
+// 1 / position.w (WGSL's fragment position holds 1 / clip w, which is the view depth here).
 struct VertexOut {
     @builtin(position) position: vec4<f32>,
-    @location(0) uv: vec2<f32>,
+    // xy: sheet texture coordinates; z: how far the sprite has faded into the horizon haze,
+    // 0..1 (per corner: it varies little across a sprite, and the exponential per fragment was
+    // a tenth of the fill cost).
+    @location(0) uv_haze: vec3<f32>,
     @location(1) colour: vec4<f32>,
-    @location(2) view_depth_m: f32,
-    // How far the sprite has faded into the horizon haze, 0..1 (per corner: it varies little
-    // across a sprite, and the exponential per fragment was a tenth of the fill cost).
-    @location(3) haze: f32,
 };
+
+// The fragment's distance from the camera plane, metres.
+fn view_depth_m(i: VertexOut) -> f32 {
+    return 1.0 / i.position.w;
+}
 
 @vertex
 fn vs_sprite(v: VertexIn) -> VertexOut {
@@ -32,11 +39,10 @@ fn vs_sprite(v: VertexIn) -> VertexOut {
         return o;
     }
     o.colour = v.colour;
-    o.uv = v.uv;
     o.position = frame.view_proj * vec4<f32>(v.position_visible.xyz, 1.0);
-    o.view_depth_m = o.position.w;
     // Aerial perspective: distant clouds fade into the horizon haze.
-    o.haze = 1.0 - exp(-max(o.position.w, 0.0) / frame.haze.x);
+    let haze = 1.0 - exp(-max(o.position.w, 0.0) / frame.haze.x);
+    o.uv_haze = vec3<f32>(v.uv, haze);
     return o;
 }
 
@@ -49,15 +55,15 @@ fn fs_sprite(i: VertexOut) -> @location(0) vec4<f32> {
 // by its alpha, blended the same way, so the composite knows how far the clouds of each texel are.
 @fragment
 fn fs_sprite_offscreen(i: VertexOut) -> CloudOut {
-    return cloud_out(sprite_colour(i), i.view_depth_m);
+    return cloud_out(sprite_colour(i), view_depth_m(i));
 }
 
 // Premultiplied colour of a sprite fragment (also used by the impostor pass).
 fn sprite_colour(i: VertexOut) -> vec4<f32> {
-    let texel = textureSample(sheet, sheet_sampler, i.uv);
+    let texel = textureSample(sheet, sheet_sampler, i.uv_haze.xy);
     let scene_m = linear_depth_m(scene_depth_at(i.position.xy));
-    let soft = clamp((scene_m - i.view_depth_m) / frame.params.z, 0.0, 1.0);
+    let soft = clamp((scene_m - view_depth_m(i)) / frame.params.z, 0.0, 1.0);
     let alpha = texel.a * i.colour.a * soft;
-    let rgb = mix(i.colour.rgb * texel.rgb, frame.sky_horizon_rgb.rgb, i.haze);
+    let rgb = mix(i.colour.rgb * texel.rgb, frame.sky_horizon_rgb.rgb, i.uv_haze.z);
     return vec4<f32>(rgb * alpha, alpha);
 }
