@@ -90,8 +90,8 @@ pub enum Weather<'a> {
         /// Its contents.
         bytes: &'a [u8],
     },
-    /// A file read now and again whenever it changes (read and built off the frame thread;
-    /// a change is applied `settle` after the last write, a broken file keeps the last good sky).
+    /// A file read now and again whenever it changes (a change is read and built off the frame
+    /// thread and applied `settle` after the last write; a broken file keeps the last good sky).
     Watch {
         /// The file.
         path: &'a Path,
@@ -221,13 +221,15 @@ impl SkySystem {
             Weather::File(path) => WeatherInput::load(path, stations)?,
             Weather::Bytes { name, bytes } => WeatherInput::parse(name, bytes, stations)?,
             Weather::Watch { path, settle } => {
+                // Read now, so the sky has this weather from the next frame; then watched.
+                let input = WeatherInput::load(path, stations)?;
                 self.live.watch(
                     path,
                     self.stations.clone(),
                     settle,
                     Arc::clone(&self.prepare_field),
                 )?;
-                return Ok(());
+                input
             }
         };
         self.world.set_field((self.prepare_field)(input));
