@@ -11,10 +11,8 @@ use glam::DVec3;
 use skycast::clouds::CloudsConfig;
 use skycast::clouds::field::weather_changed;
 use skycast::demo::{DemoHost, Frame, GroundSettings, demo_ground};
-use skycast::flight::world::{World, WorldSettings};
-use skycast::render::{RenderSettings, SkyConfig};
-use skycast::shading::{SunPosition, TimeOfDayTable};
-use skycast::weather::live::{LiveChange, LiveWeather, Prepare};
+use skycast::flight::{SkySystemConfig, Weather};
+use skycast::weather::live::Prepare;
 use skycast::weather::{
     BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, StationTable, WeatherField, WeatherInput,
 };
@@ -73,51 +71,38 @@ fn field_of(path: &Path) -> WeatherField {
 }
 
 struct Flight {
-    world: World,
+    /// The demo host: its sky is the `SkySystem` a simulator embeds, whose frame step (weather
+    /// switched in, the living clouds, the sun, the sky's CPU share) every frame runs.
     host: DemoHost,
     time_s: f64,
     /// Circle the origin (a holding pattern) instead of flying east.
     circle: bool,
 }
 
-const SUN: SunPosition = SunPosition {
-    elevation_deg: 40.0,
-    azimuth_deg: 160.0,
-    declination_deg: 0.0,
-};
+/// 2025-01-27 22:00 UTC: the afternoon sun over San Antonio.
+const UTC_S: f64 = 1_738_015_200.0;
 
 impl Flight {
     fn new(field: WeatherField, radius_m: f64, formation_s: f32) -> Flight {
-        let settings = WorldSettings {
-            cloud_radius_m: radius_m,
-            ..WorldSettings::default()
-        };
-        let mut world = World::new(field, &settings);
-        let mut clouds = CloudsConfig::builtin();
-        clouds.lifecycle.formation_s = formation_s;
-        clouds.lifecycle.dissipation_s = formation_s * 0.8;
-        world.set_clouds_config(clouds);
-        // Blocks arrive in the frame they are queued, so each run draws the same frames.
-        world.set_synchronous_clouds(true);
+        let mut config = SkySystemConfig::new(skycast::demo::headless::TARGETS, ORIGIN);
+        config.world.cloud_radius_m = radius_m;
+        config.stations = Some(stations());
         let ground = GroundSettings {
             size_m: 60_000.0,
             samples: 65,
             ..GroundSettings::default()
         };
-        let host = DemoHost::new(
-            W,
-            H,
-            &demo_ground(world.field(), &ground),
-            SkyConfig {
-                targets: skycast::demo::headless::TARGETS,
-                settings: RenderSettings::default(),
-                time_of_day: TimeOfDayTable::default(),
-                sheet: world.sheet(),
-            },
-        )
-        .unwrap_or_else(|e| panic!("live tests need an adapter: {e}"));
+        let mut host = DemoHost::new(W, H, &demo_ground(&field, &ground), config)
+            .unwrap_or_else(|e| panic!("live tests need an adapter: {e}"));
+        host.sky.set_weather_field(field);
+        let mut clouds = CloudsConfig::builtin();
+        clouds.lifecycle.formation_s = formation_s;
+        clouds.lifecycle.dissipation_s = formation_s * 0.8;
+        let world = host.sky.world_mut();
+        world.set_clouds_config(clouds);
+        // Blocks arrive in the frame they are queued, so each run draws the same frames.
+        world.set_synchronous_clouds(true);
         Flight {
-            world,
             host,
             time_s: 0.0,
             circle: false,
@@ -133,49 +118,28 @@ impl Flight {
         DVec3::new(6_000.0 + 60.0 * self.time_s, 0.0, 900.0)
     }
 
-    /// One frame: weather poll, clouds, CPU update; drawn when `draw`. Returns the frame (if
-    /// drawn), what changed and the frame thread's CPU time.
+    /// One frame: the sky's frame step (weather that arrived, the living clouds, the CPU
+    /// update), drawn when `draw`. Returns the frame (if drawn), what weather arrived and the
+    /// frame thread's CPU time.
     fn step(
         &mut self,
-        live: &mut LiveWeather<WeatherField>,
         dt_s: f64,
         draw: bool,
     ) -> (Option<Frame>, Vec<Result<PathBuf, String>>, Duration) {
         let start = Instant::now();
-        let mut changes = Vec::new();
-        for change in live.poll(self.time_s) {
-            changes.push(match change {
-                LiveChange::Loaded { source, weather } => {
-                    self.world.set_field(weather);
-                    Ok(source)
-                }
-                LiveChange::Rejected(m) => Err(m),
-            });
-        }
-        let position = self.position();
-        self.world
-            .update_sky(&mut self.host.sky, position, dt_s)
+        let camera = self.host.camera(self.position(), 90.0, 8.0);
+        let (_, changes) = self
+            .host
+            .step(&camera, UTC_S + self.time_s, dt_s, draw)
             .unwrap();
-        let camera = self.host.camera(position, 90.0, 8.0);
-        let frame = if draw {
-            let (frame, _) = self
-                .host
-                .frame(&camera, &SUN, dt_s, self.world.visibility_m())
-                .unwrap();
-            Some(frame)
-        } else {
-            self.host
-                .sky
-                .prepare(&self.host.gpu.queue, camera, &SUN, dt_s);
-            None
-        };
+        let frame = draw.then(|| self.host.target.read_back(&self.host.gpu).unwrap());
         self.time_s += dt_s;
         (frame, changes, start.elapsed())
     }
 
     /// Content hash of every block generation, by block.
     fn hashes(&self) -> Vec<(BlockIndex, Vec<u64>)> {
-        let field = self.world.living_field().unwrap();
+        let field = self.host.sky.world().living_field().unwrap();
         let mut out: Vec<(BlockIndex, Vec<u64>)> = Vec::new();
         for (index, g) in field.blocks() {
             match out.last_mut() {
@@ -200,12 +164,11 @@ fn mean_abs_luminance_change(a: &Frame, b: &Frame) -> f32 {
 /// Flies frames until a change arrives (at most `limit` frames); returns them.
 fn fly_until_change(
     flight: &mut Flight,
-    live: &mut LiveWeather<WeatherField>,
     limit: usize,
 ) -> (Vec<Result<PathBuf, String>>, usize, Duration) {
     let mut max_cpu = Duration::ZERO;
     for k in 0..limit {
-        let (_, changes, cpu) = flight.step(live, 0.5, false);
+        let (_, changes, cpu) = flight.step(0.5, false);
         max_cpu = max_cpu.max(cpu);
         if !changes.is_empty() {
             return (changes, k + 1, max_cpu);
@@ -228,20 +191,20 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
     std::fs::write(&path, reports("FEW045")).unwrap();
     let old_field = field_of(&path);
     let mut flight = Flight::new(field_of(&path), 10_000.0, FORMATION_S);
-    let mut live = LiveWeather::new();
-    live.watch(
-        &path,
-        Some(stations()),
-        Duration::from_millis(150),
-        prepare(),
-    )
-    .unwrap();
+    flight
+        .host
+        .sky
+        .set_weather(Weather::Watch {
+            path: &path,
+            settle: Duration::from_millis(150),
+        })
+        .unwrap();
 
     // Plain motion: the largest frame-to-frame change over 30 frames of flight.
-    let mut last = flight.step(&mut live, 0.0, true).0.unwrap();
+    let mut last = flight.step(0.0, true).0.unwrap();
     let mut motion = 0.0f32;
     for _ in 0..30 {
-        let frame = flight.step(&mut live, 0.5, true).0.unwrap();
+        let frame = flight.step(0.5, true).0.unwrap();
         motion = motion.max(mean_abs_luminance_change(&last, &frame));
         last = frame;
     }
@@ -251,13 +214,13 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
     // Half-written, then garbage: rejected, one clear message each, the sky untouched.
     let full = reports("OVC035");
     std::fs::write(&path, &full[..full.len() - 12]).unwrap();
-    let (changes, _, _) = fly_until_change(&mut flight, &mut live, 400);
+    let (changes, _, _) = fly_until_change(&mut flight, 400);
     assert!(
         matches!(&changes[..], [Err(m)] if m.contains("metars.txt:7: ends in the middle of a line")),
         "{changes:?}"
     );
     std::fs::write(&path, "<html>503</html>\n").unwrap();
-    let (changes, _, _) = fly_until_change(&mut flight, &mut live, 400);
+    let (changes, _, _) = fly_until_change(&mut flight, 400);
     assert!(
         matches!(&changes[..], [Err(m)] if m.contains("not a weather file")),
         "{changes:?}"
@@ -300,7 +263,7 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
 
     // The good new file: Randolph goes broken.
     std::fs::write(&path, &full).unwrap();
-    let (changes, _, _) = fly_until_change(&mut flight, &mut live, 400);
+    let (changes, _, _) = fly_until_change(&mut flight, 400);
     assert!(matches!(&changes[..], [Ok(p)] if p == &path), "{changes:?}");
     let new_field = field_of(&path);
     // Which blocks of the living field see a different weather now (calm air: no drift).
@@ -323,12 +286,12 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
     );
 
     // While the sky changes, no frame changes more than 1.5x plain motion.
-    let mut last = flight.step(&mut live, 0.5, true).0.unwrap();
+    let mut last = flight.step(0.5, true).0.unwrap();
     let mut worst = 0.0f32;
     let mut kept_compared = 0;
     let frames = (FORMATION_S / 0.5) as usize + 4;
     for k in 0..frames {
-        let frame = flight.step(&mut live, 0.5, true).0.unwrap();
+        let frame = flight.step(0.5, true).0.unwrap();
         let change = mean_abs_luminance_change(&last, &frame);
         worst = worst.max(change);
         last = frame;
@@ -359,7 +322,7 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
     // Plain motion again under the new sky (a cloudier sky changes more as the camera moves).
     let mut motion_after = 0.0f32;
     for _ in 0..20 {
-        let frame = flight.step(&mut live, 0.5, true).0.unwrap();
+        let frame = flight.step(0.5, true).0.unwrap();
         motion_after = motion_after.max(mean_abs_luminance_change(&last, &frame));
         last = frame;
     }
@@ -421,16 +384,12 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
     lines.extend(copies);
     let big = path.with_file_name("bulk.cache.csv");
     std::fs::write(&big, lines.join("\n") + "\n").unwrap();
-    let mut bulk_live = LiveWeather::new();
-    bulk_live
-        .schedule(flight.time_s, &big, None, prepare())
-        .unwrap();
+    flight.host.sky.schedule_weather(&big, 0.0).unwrap();
     let load_start = Instant::now();
-    let (changes, frames_during_load, max_cpu) =
-        fly_until_change(&mut flight, &mut bulk_live, 2000);
+    let (changes, frames_during_load, max_cpu) = fly_until_change(&mut flight, 2000);
     let load = load_start.elapsed();
     assert!(matches!(&changes[..], [Ok(_)]), "{changes:?}");
-    let (_, _, after_cpu) = flight.step(&mut bulk_live, 0.5, false);
+    let (_, _, after_cpu) = flight.step(0.5, false);
     eprintln!(
         "5,000 stations: loaded in {:.0} ms, {frames_during_load} frames flown meanwhile, max \
          frame CPU {:.1} ms, first frame after {:.1} ms",
@@ -459,19 +418,18 @@ fn the_same_change_without_a_fade_pops() {
     std::fs::write(&old, reports("FEW045")).unwrap();
     std::fs::write(&new, reports("OVC035")).unwrap();
     let mut flight = Flight::new(field_of(&old), 10_000.0, 1.0);
-    let mut live = LiveWeather::new();
-    let mut last = flight.step(&mut live, 0.0, true).0.unwrap();
+    let mut last = flight.step(0.0, true).0.unwrap();
     let mut fly = |flight: &mut Flight, frames: usize| {
         let mut most = 0.0f32;
         for _ in 0..frames {
-            let frame = flight.step(&mut live, 0.5, true).0.unwrap();
+            let frame = flight.step(0.5, true).0.unwrap();
             most = most.max(mean_abs_luminance_change(&last, &frame));
             last = frame;
         }
         most
     };
     let motion = fly(&mut flight, 30);
-    flight.world.set_field(field_of(&new));
+    flight.host.sky.set_weather_field(field_of(&new));
     let worst = fly(&mut flight, 6);
     let motion_after = fly(&mut flight, 20);
     let plain = motion.max(motion_after);
@@ -514,21 +472,18 @@ fn soak_one_hour_of_weather_changes_does_not_grow() {
         .collect();
     let mut flight = Flight::new(field_of(&files[0]), 8_000.0, 60.0);
     flight.circle = true;
-    let mut live = LiveWeather::new();
     for k in 1..12 {
-        live.schedule(
-            k as f64 * 300.0,
-            &files[k % files.len()],
-            Some(stations()),
-            prepare(),
-        )
-        .unwrap();
+        flight
+            .host
+            .sky
+            .schedule_weather(&files[k % files.len()], k as f64 * 300.0)
+            .unwrap();
     }
     let mut applied = 0;
     let mut settled: Option<(u64, u64)> = None;
     let (mut rss_max, mut gpu_max) = (0u64, 0u64);
     for s in 0..3600 {
-        let (_, changes, _) = flight.step(&mut live, 1.0, s % 10 == 0);
+        let (_, changes, _) = flight.step(1.0, s % 10 == 0);
         applied += changes.iter().filter(|c| c.is_ok()).count();
         if s == 900 {
             settled = Some((rss_bytes(), flight.host.sky.gpu_buffer_bytes()));
