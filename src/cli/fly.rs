@@ -22,9 +22,7 @@ use skycast::demo::DemoHost;
 use skycast::flight::{FlightPlan, Weather};
 use skycast::weather::{LocalFrame, StationTable, theme};
 
-use super::render::{
-    ElevationArgs, load_look, parse_size, parse_time, sky_config, time_or_default,
-};
+use super::render::{ElevationArgs, LookArgs, parse_size, parse_time, sky_config, time_or_default};
 use super::weather::{DEFAULT_STATIONS, load};
 
 /// Flags of `skycast fly`.
@@ -54,16 +52,9 @@ pub struct FlyArgs {
     /// UTC time at the start of the flight, RFC 3339 (default: the shipped weather file's time).
     #[arg(long, value_parser = parse_time)]
     pub time: Option<f64>,
-    /// Renderer settings (default: the shipped config/render.toml).
-    #[arg(long)]
-    pub render_settings: Option<PathBuf>,
-    /// Resolution the clouds are drawn at, a fraction of the frames': 1, 1/2 or 1/4 (default:
-    /// the renderer settings' `[clouds] resolution_scale`).
-    #[arg(long, value_parser = super::render::parse_cloud_scale)]
-    pub cloud_scale: Option<f32>,
-    /// Time-of-day table (default: the shipped config/time_of_day.toml).
-    #[arg(long)]
-    pub time_of_day: Option<PathBuf>,
+    /// The look: renderer settings, cloud scale, time-of-day table.
+    #[command(flatten)]
+    pub look: LookArgs,
     /// Watch the weather file: when it changes, the sky follows (changed blocks re-form).
     #[arg(long)]
     pub watch: bool,
@@ -90,11 +81,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let plan = FlightPlan::load(&args.path)?;
     let (lat, lon) = plan.origin_lat_lon_deg;
     let flight = plan.place(&LocalFrame::new(lat, lon));
-    let (settings, table) = load_look(
-        args.render_settings.as_ref(),
-        args.time_of_day.as_ref(),
-        args.cloud_scale,
-    )?;
+    let (settings, table) = args.look.load()?;
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let start_unix_s = time_or_default(args.time)?;
     let field = loaded

@@ -48,6 +48,17 @@ pub struct RenderArgs {
     /// Also write an EXR: linear RGBA half floats and depth `Z` in metres.
     #[arg(long)]
     pub exr: Option<PathBuf>,
+    /// The look: renderer settings, cloud scale, time-of-day table.
+    #[command(flatten)]
+    pub look: LookArgs,
+    /// The ground from an elevation file instead of the stations' elevations.
+    #[command(flatten)]
+    pub elevation: ElevationArgs,
+}
+
+/// Flags that set the sky's look (`render`, `fly`, `view`).
+#[derive(Debug, Default, Args)]
+pub struct LookArgs {
     /// Renderer settings (default: the shipped config/render.toml).
     #[arg(long)]
     pub render_settings: Option<PathBuf>,
@@ -58,9 +69,17 @@ pub struct RenderArgs {
     /// Time-of-day table (default: the shipped config/time_of_day.toml).
     #[arg(long)]
     pub time_of_day: Option<PathBuf>,
-    /// The ground from an elevation file instead of the stations' elevations.
-    #[command(flatten)]
-    pub elevation: ElevationArgs,
+}
+
+impl LookArgs {
+    /// The renderer settings and time-of-day table the flags name (or the shipped ones).
+    pub fn load(&self) -> anyhow::Result<(RenderSettings, TimeOfDayTable)> {
+        load_look(
+            self.render_settings.as_ref(),
+            self.time_of_day.as_ref(),
+            self.cloud_scale,
+        )
+    }
 }
 
 /// Flags that put a real elevation model under the sky (the demo host's ground).
@@ -219,11 +238,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if !(-2_000.0..=100_000.0).contains(&args.alt_ft) {
         anyhow::bail!("--alt-ft {} is outside -2000..=100000 feet", args.alt_ft);
     }
-    let (settings, table) = load_look(
-        args.render_settings.as_ref(),
-        args.time_of_day.as_ref(),
-        args.cloud_scale,
-    )?;
+    let (settings, table) = args.look.load()?;
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let unix_s = time_or_default(args.time)?;
     let field = loaded

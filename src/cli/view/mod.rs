@@ -15,9 +15,7 @@ use std::time::Duration;
 use clap::Args;
 use skycast::weather::{LocalFrame, METRES_PER_FOOT, StationTable, theme};
 
-use super::render::{
-    ElevationArgs, load_look, parse_size, parse_time, sky_config, time_or_default,
-};
+use super::render::{ElevationArgs, LookArgs, parse_size, parse_time, sky_config, time_or_default};
 use super::weather::{DEFAULT_STATIONS, load};
 
 mod app;
@@ -74,16 +72,9 @@ pub struct ViewArgs {
     /// dx_px, dy_px), for tests and recordings.
     #[arg(long)]
     pub script: Option<PathBuf>,
-    /// Renderer settings (default: the shipped config/render.toml).
-    #[arg(long)]
-    pub render_settings: Option<PathBuf>,
-    /// Resolution the clouds are drawn at, a fraction of the window's: 1, 1/2 or 1/4 (default:
-    /// the renderer settings' `[clouds] resolution_scale`).
-    #[arg(long, value_parser = super::render::parse_cloud_scale)]
-    pub cloud_scale: Option<f32>,
-    /// Time-of-day table (default: the shipped config/time_of_day.toml).
-    #[arg(long)]
-    pub time_of_day: Option<PathBuf>,
+    /// The look: renderer settings, cloud scale, time-of-day table.
+    #[command(flatten)]
+    pub look: LookArgs,
     /// The ground from an elevation file instead of the stations' elevations.
     #[command(flatten)]
     pub elevation: ElevationArgs,
@@ -125,11 +116,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         log::debug!("winit: {e}");
         anyhow::anyhow!(NO_DISPLAY)
     })?;
-    let look = load_look(
-        args.render_settings.as_ref(),
-        args.time_of_day.as_ref(),
-        args.cloud_scale,
-    )?;
+    let look = args.look.load()?;
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let field = loaded
         .input
