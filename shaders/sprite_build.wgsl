@@ -149,6 +149,25 @@ fn directional_percent(dot_sun: f32) -> f32 {
     return select(m.y + (m.z - m.y) * d, m.y + (m.y - m.x) * d, d < 0.0);
 }
 
+// A deck seen from below gets the sun only diffused through its whole thickness: evenly, with
+// none of the shading groups' sunlit and shaded sides. How much of Wang's directional shading
+// gives way to its even median: 0 seen from above the deck's top, 1 - exp(-thickness / (depth x
+// sin(sun elevation))) from below its base (what of the direct sun the deck stops), in between
+// from inside. Per sprite, not per corner, so a near sprite's corners light alike. 0 for a
+// cloud lit from every side.
+fn deck_evenness(c: Cloud, camera_z: f32, sun_z: f32) -> f32 {
+    let depth = c.level4_radius_flat.w;
+    if (depth <= 0.0) {
+        return 0.0;
+    }
+    let base = c.level_height.x;
+    let top = c.level4_radius_flat.x;
+    let thickness = max(top - base, 1.0);
+    let stopped = 1.0 - exp(-thickness / (depth * max(sun_z, 0.05)));
+    let below = clamp((top - camera_z) / thickness, 0.0, 1.0);
+    return stopped * below;
+}
+
 // Light scattered forward towards the eye: a Henyey-Greenstein lobe, strongest on the rim.
 fn forward_percent(view_dir: vec3<f32>, rim: f32) -> f32 {
     let g = view.mapping_g.w;
@@ -289,6 +308,7 @@ fn build_sprite(k: u32, at: u32) {
     let light = view.directional_ambient;
     let sun = normalize_or(view.sun_dir_camera_z.xyz, vec3<f32>(0.0));
     let cell = s.bits & 15u;
+    let evenness = deck_evenness(cloud, view.sun_dir_camera_z.w, sun.z);
     // Keep in sync with `SPRITE_PRECIPITATION` in src/render/gpu_types.rs.
     let rain = (s.bits & 512u) != 0u;
     for (var c = 0u; c < 4u; c++) {
@@ -300,8 +320,8 @@ fn build_sprite(k: u32, at: u32) {
         let view_dir = normalize_or(p - cam_local, vec3<f32>(0.0));
         let rim = length(p) / flat_radius.y;
         let group_dir = normalize_or(p - group, vec3<f32>(0.0));
-        let directional = (directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim))
-            * light.rgb;
+        let wang = directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim);
+        let directional = mix(wang, view.mapping_g.y, evenness) * light.rgb;
         let lit = ambient.rgb * light.w + directional;
         // Rain and snow hang in the cloud's shadow: its base colour, dimmer and greyer, no sun.
         let shade = ambient.rgb * light.w * 0.6;

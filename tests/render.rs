@@ -85,6 +85,7 @@ fn cumulus(centre: DVec3) -> SkyCloud {
         ],
         colour_levels: levels(centre.z as f32, centre.z as f32 + 500.0),
         flat: false,
+        sunlit_depth_m: 0.0,
     }
 }
 
@@ -105,6 +106,7 @@ fn overcast(centre: DVec2, base: f64) -> SkyCloud {
         group_centres_m: vec![Vec3::new(0.0, 0.0, 150.0)],
         colour_levels: levels(base as f32, base as f32 + 300.0),
         flat: false,
+        sunlit_depth_m: 0.0,
     }
 }
 
@@ -455,6 +457,7 @@ fn cloud_terrain_edge_is_a_ramp() {
         group_centres_m: vec![Vec3::ZERO],
         colour_levels: levels(0.0, 600.0),
         flat: false,
+        sunlit_depth_m: 0.0,
     };
     for scale in CLOUD_SCALES {
         soft_edge_at_scale(&slope, &sprite_cloud, scale);
@@ -1150,7 +1153,9 @@ fn ring_rebuilds_do_not_pop() {
 /// field from below and above, the Cb line, the San Antonio deck from above and below; impostor
 /// ring included) where the host drew no ground (the demo ground has been drawn differently
 /// since: its pixels, from the frame's depth, are left out); and with the clouds at the default
-/// scale (off-screen at 1/2), against full resolution, every pixel.
+/// scale (off-screen at 1/2), against full resolution, every pixel. The deck from below was kept
+/// again when decks stopped taking the sun on their undersides (`sunlit_depth_m`): the sunlit
+/// heaps it showed are gone, an even grey ceiling is left (about 0.1 a channel from before).
 #[test]
 fn gpu_sprites_draw_the_frames_of_the_cpu_path() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("reference");

@@ -69,6 +69,10 @@ pub struct Cloud {
     pub radius_m: f32,
     /// Drawn as flat horizontal rectangles instead of camera-facing sprites (cirrus, §7.1).
     pub flat: bool,
+    /// A deck's sunlit depth, metres (the type's `sunlit_depth_m` for a layer on the lattice;
+    /// 0 for a cloud lit from every side).
+    #[serde(default)]
+    pub sunlit_depth_m: f32,
     /// Five ambient colour levels, lowest first.
     pub colour_levels: [ColourLevel; 5],
     /// The cloud's shading groups.
@@ -162,6 +166,10 @@ impl CloudBlock {
             h = fnv1a(c.cloud_type.name().as_bytes(), h);
             h = fnv1a(&[c.layer, c.flat as u8], h);
             h = fnv1a(&c.radius_m.to_le_bytes(), h);
+            // Only a deck's, so the hashes of blocks without decks stay what they were.
+            if c.sunlit_depth_m != 0.0 {
+                h = fnv1a(&c.sunlit_depth_m.to_le_bytes(), h);
+            }
             for lvl in &c.colour_levels {
                 h = fnv1a(&lvl.height_m.to_le_bytes(), h);
                 for v in lvl.rgba {

@@ -196,6 +196,14 @@ pub struct CloudTypeConfig {
     /// Rain or snow shafts under the type's clouds where the weather has precipitation.
     #[serde(default)]
     pub precipitation: Option<PrecipitationConfig>,
+    /// Decks (the type's layers placed on the lattice): the depth below the deck's top at which
+    /// direct sunlight, along its slanted path, falls to 1/e. Seen from below, the deck takes
+    /// the sun diffused through its whole thickness, evenly (Wang's median directional colour,
+    /// without the shading groups' sunlit sides), so a low stratus is an even grey ceiling, not
+    /// sunlit heaps; from above, its top is lit as Wang lights it. Absent: lit as Wang does from
+    /// every side.
+    #[serde(default)]
+    pub sunlit_depth_m: Option<f32>,
     /// Flat types: each cloud is a streak this many times longer than wide, laid along the wind
     /// with every sprite lengthwise along it (cirrus fibres); `cloud_size_m` is its length.
     #[serde(default)]
@@ -523,6 +531,13 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
                 && p.min_reach <= 1.0,
             "precipitation",
             "needs width_over_base in (0, 1], alpha ascending within 0..=1, virga_spread_c ascending and min_reach in (0, 1]",
+        )?;
+    }
+    if let Some(depth) = c.sunlit_depth_m {
+        v.check(
+            (1.0..=10_000.0).contains(&depth),
+            "sunlit_depth_m",
+            "must be 1..=10000 metres",
         )?;
     }
     if let Some(aspect) = c.streak_length_over_width {

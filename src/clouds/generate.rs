@@ -412,7 +412,11 @@ fn build_cloud(
         }
     }
     let kept = cull(raws, config.cull_radius_fraction as f64);
-    let cloud = finish_cloud(ctx, centre, kept, &mut rng);
+    let mut cloud = finish_cloud(ctx, centre, kept, &mut rng);
+    // A deck on the lattice is lit from above only.
+    if lattice_cell_m.is_some() {
+        cloud.sunlit_depth_m = config.sunlit_depth_m.unwrap_or(0.0);
+    }
     (cloud, n_boxes)
 }
 
@@ -516,6 +520,7 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
         layer: li.min(u8::MAX as usize) as u8,
         radius_m: radius as f32,
         flat: config.flat,
+        sunlit_depth_m: 0.0,
         colour_levels,
         shading_groups,
         sprites,
@@ -561,7 +566,7 @@ mod golden {
             hashes,
             [
                 "6ea2ffa12cd8ec62",
-                "656ebcbc069452f1",
+                "2610fe870de059b1",
                 "388eb9e7de1536aa",
                 "5e9f9fbd940250a3"
             ]

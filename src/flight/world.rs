@@ -77,6 +77,7 @@ impl From<&Cloud> for SkyCloud {
                 rgba: l.rgba,
             })),
             flat: c.flat,
+            sunlit_depth_m: c.sunlit_depth_m,
         }
     }
 }

@@ -96,6 +96,7 @@ fn small_cloud() -> SkyCloud {
         group_centres_m: vec![Vec3::ZERO],
         colour_levels: ColourLevels::even(0.0, 100.0, [[1.0; 4]; 5]),
         flat: false,
+        sunlit_depth_m: 0.0,
     }
 }
 

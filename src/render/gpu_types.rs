@@ -120,7 +120,7 @@ pub struct GpuCloud {
     /// Heights of levels 0..4, metres above mean sea level.
     pub level_height: [f32; 4],
     /// x: height of level 4, metres; y: cloud radius, metres; z: 1 for a flat cloud (cirrus);
-    /// w unused.
+    /// w: a deck's sunlit depth, metres (0: lit from every side).
     pub level4_radius_flat: [f32; 4],
 }
 const _: () = assert!(std::mem::size_of::<GpuCloud>() == 128);

@@ -173,7 +173,7 @@ pub fn gpu_cloud(cloud: &SkyCloud, block_m: DVec3) -> GpuCloud {
             l[4].height_m,
             cloud.radius_m().max(1.0),
             if cloud.flat { 1.0 } else { 0.0 },
-            0.0,
+            cloud.sunlit_depth_m.max(0.0),
         ],
     }
 }

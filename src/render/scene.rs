@@ -52,6 +52,11 @@ pub struct SkyCloud {
     /// Drawn as flat horizontal rectangles instead of camera-facing sprites (cirrus, Wang 7.1);
     /// a flat sprite's height is its north-south extent.
     pub flat: bool,
+    /// A deck's sunlit depth, metres: the depth below its top at which direct sunlight, along
+    /// its slanted path, falls to 1/e. Seen from below, the deck is lit evenly by the sun
+    /// diffused through it (an even grey ceiling, no sunlit heaps). 0: lit from every side, as
+    /// Wang lights clouds.
+    pub sunlit_depth_m: f32,
 }
 
 /// A 4 km x 4 km block of clouds.
