@@ -25,6 +25,7 @@ struct Sprite {
 
 // Keep in sync with `GpuCloud`.
 struct Cloud {
+    // xyz: centre from the block's; w: a heap's shaded base, metres above its base (0: none).
     centre_block: vec4<f32>,
     level_rgba: array<vec4<f32>, 5>,
     level_height: vec4<f32>,
@@ -321,7 +322,11 @@ fn build_sprite(k: u32, at: u32) {
         let rim = length(p) / flat_radius.y;
         let group_dir = normalize_or(p - group, vec3<f32>(0.0));
         let wang = directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim);
-        let directional = mix(wang, view.mapping_g.y, evenness) * light.rgb;
+        // A heap's shaded base: the body above hides the sun from its lowest part.
+        let shaded_base = cloud.centre_block.w;
+        let above_base = height_msl - cloud.level_height.x;
+        let sun_here = select(1.0, smoothstep(0.0, shaded_base, above_base), shaded_base > 0.0);
+        let directional = mix(wang, view.mapping_g.y, evenness) * light.rgb * sun_here;
         let lit = ambient.rgb * light.w + directional;
         // Rain and snow hang in the cloud's shadow: its base colour, dimmer and greyer, no sun.
         let shade = ambient.rgb * light.w * 0.6;

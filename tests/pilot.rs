@@ -236,3 +236,154 @@ fn low_overcast_from_above_hides_the_ground() {
         );
     }
 }
+
+/// Mean luminance and mean saturation ((max - min) / max) of the pixels of `frame` in `columns`
+/// and `rows`.
+fn region_colour(
+    frame: &image::RgbaImage,
+    columns: std::ops::Range<u32>,
+    rows: std::ops::Range<u32>,
+) -> (f32, f32) {
+    let pixels: Vec<&image::Rgba<u8>> = rows
+        .flat_map(|y| columns.clone().map(move |x| (x, y)))
+        .map(|(x, y)| frame.get_pixel(x, y))
+        .collect();
+    let n = pixels.len() as f32;
+    let lum = pixels.iter().map(|p| luminance(p)).sum::<f32>() / n;
+    let sat = pixels
+        .iter()
+        .map(|p| {
+            let max = p[0].max(p[1]).max(p[2]) as f32;
+            let min = p[0].min(p[1]).min(p[2]) as f32;
+            if max > 0.0 { (max - min) / max } else { 0.0 }
+        })
+        .sum::<f32>()
+        / n;
+    (lum, sat)
+}
+
+/// A cumulonimbus 20 km ahead, base 3,000 ft, in heavy rain, seen from 30 ft above flat ground
+/// looking level: the column under its base is measurably darker and greyer than the sky beside
+/// it. The same cell on a dry day has no such column.
+#[test]
+fn rain_falls_out_of_a_storm_seen_from_20_km() {
+    use glam::{DVec2, DVec3};
+    use skycast::clouds::{CloudTypes, generate_block};
+    use skycast::demo::terrain::HeightField;
+    use skycast::demo::{DemoHost, headless};
+    use skycast::flight::SkySystemConfig;
+    use skycast::render::{SkyBlock, SkyCloud};
+    use skycast::shading::SunPosition;
+    use skycast::weather::{BlockIndex, BlockLayer, BlockWeather, CloudType, TypeSource};
+
+    const W: u32 = 640;
+    const H: u32 = 360;
+    const DISTANCE_M: f64 = 20_000.0;
+    const BASE_FT: f32 = 3000.0;
+    let dir = out_dir("storm");
+    let ground = HeightField::from_fn(DVec2::ZERO, 80_000.0, 64, |_| 0.0);
+    let config = SkySystemConfig::new(headless::TARGETS, (28.5, -81.45));
+    let mut host = DemoHost::new(W, H, &ground, config).expect("an adapter (lavapipe)");
+    // Afternoon sun behind the camera's right shoulder.
+    let sun = SunPosition {
+        elevation_deg: 40.0,
+        azimuth_deg: 200.0,
+        declination_deg: 0.0,
+    };
+    let camera = host.camera(DVec3::new(0.0, 0.0, 10.0), 0.0, 0.0);
+    let types = CloudTypes::builtin();
+    let mut looks = Vec::new();
+    for (name, precipitation) in [("rain", 1.0), ("dry", 0.0)] {
+        let weather = BlockWeather {
+            layers: vec![BlockLayer {
+                cloud_type: CloudType::Cumulonimbus,
+                type_source: TypeSource::Reported,
+                coverage_oktas: 2.0,
+                base_ft_agl: BASE_FT,
+                thickness_ft: 30_000.0,
+            }],
+            visibility_m: 50_000.0,
+            temperature_c: 24.0,
+            dewpoint_c: 20.0,
+            precipitation,
+            ..BlockWeather::default()
+        };
+        let block = generate_block(BlockIndex::new(0, 0), &weather, 11, &types);
+        // The biggest cell, moved 20 km north of the camera.
+        let mut cell = block
+            .clouds
+            .into_iter()
+            .max_by_key(|c| c.sprites.len())
+            .expect("a cumulonimbus");
+        cell.centre_m.x = 0.0;
+        cell.centre_m.y = DISTANCE_M;
+        let base_radius_m = cell
+            .sprites
+            .iter()
+            .filter(|s| s.offset_m[2] < 0.0)
+            .map(|s| DVec2::new(s.offset_m[0] as f64, s.offset_m[1] as f64).length())
+            .fold(0.0, f64::max);
+        let centre = cell.centre_m;
+        host.sky.set_clouds(vec![SkyBlock {
+            id: 1 + precipitation as u64,
+            centre_m: centre,
+            clouds: vec![SkyCloud::from(&cell)],
+        }]);
+        let (frame, _) = host.frame(&camera, &sun, 0.0, 50_000.0).unwrap();
+        let png = dir.join(format!("{name}.png"));
+        frame.write_png(&png).unwrap();
+        looks.push((image::open(&png).unwrap().to_rgba8(), base_radius_m));
+    }
+    // Where things are on the frame: columns by angle from the view axis, rows by elevation.
+    let half_w = W as f64 / 2.0;
+    let half_h = H as f64 / 2.0;
+    let tan_half_v = 30f64.to_radians().tan();
+    let tan_half_h = tan_half_v * W as f64 / H as f64;
+    let column = |east_m: f64| (half_w + half_w * (east_m / DISTANCE_M) / tan_half_h) as u32;
+    let row = |up_m: f64| (half_h - half_h * (up_m / DISTANCE_M) / tan_half_v) as u32;
+    let base_row = row(BASE_FT as f64 * 0.3048 - 10.0);
+    let rows = base_row + 3..row(0.0) - 1;
+    let mut measured = Vec::new();
+    for (frame, radius) in &looks {
+        let under = region_colour(
+            frame,
+            column(-0.4 * radius)..column(0.4 * radius),
+            rows.clone(),
+        );
+        let left = region_colour(
+            frame,
+            column(-3.0 * radius)..column(-2.0 * radius),
+            rows.clone(),
+        );
+        let right = region_colour(
+            frame,
+            column(2.0 * radius)..column(3.0 * radius),
+            rows.clone(),
+        );
+        let beside = ((left.0 + right.0) / 2.0, (left.1 + right.1) / 2.0);
+        measured.push((under, beside));
+    }
+    let [(rain, rain_beside), (dry, dry_beside)] = [measured[0], measured[1]];
+    println!(
+        "rows {rows:?}: rain under the base lum {:.3} sat {:.3}, beside {:.3} {:.3}; dry {:.3} {:.3}, beside {:.3} {:.3}",
+        rain.0, rain.1, rain_beside.0, rain_beside.1, dry.0, dry.1, dry_beside.0, dry_beside.1
+    );
+    assert!(
+        rows.len() >= 8,
+        "the column is tall enough to measure: {rows:?}"
+    );
+    // Measured: rain 0.960x the sky's luminance beside it and 0.82x its saturation; dry 1.000x
+    // and 0.99x. Haze takes most of the contrast at 20 km (Koschmieder: a fifth is left).
+    assert!(
+        rain.0 < 0.98 * rain_beside.0,
+        "rain is darker than the sky beside it"
+    );
+    assert!(
+        rain.1 < 0.9 * rain_beside.1,
+        "rain is greyer than the sky beside it"
+    );
+    assert!(
+        (dry.0 / dry_beside.0 - 1.0).abs() < 0.01 && dry.1 > 0.95 * dry_beside.1,
+        "a dry day's cell has no column under it"
+    );
+}

@@ -86,6 +86,7 @@ fn cumulus(centre: DVec3) -> SkyCloud {
         colour_levels: levels(centre.z as f32, centre.z as f32 + 500.0),
         flat: false,
         sunlit_depth_m: 0.0,
+        shaded_base_m: 0.0,
     }
 }
 
@@ -107,6 +108,7 @@ fn overcast(centre: DVec2, base: f64) -> SkyCloud {
         colour_levels: levels(base as f32, base as f32 + 300.0),
         flat: false,
         sunlit_depth_m: 0.0,
+        shaded_base_m: 0.0,
     }
 }
 
@@ -458,6 +460,7 @@ fn cloud_terrain_edge_is_a_ramp() {
         colour_levels: levels(0.0, 600.0),
         flat: false,
         sunlit_depth_m: 0.0,
+        shaded_base_m: 0.0,
     };
     for scale in CLOUD_SCALES {
         soft_edge_at_scale(&slope, &sprite_cloud, scale);

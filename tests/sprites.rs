@@ -60,6 +60,7 @@ fn blocks() -> Vec<SkyBlock> {
         colour_levels: ColourLevels::even(1500.0, 1800.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
         flat: false,
         sunlit_depth_m: 0.0,
+        shaded_base_m: 0.0,
     };
     vec![SkyBlock {
         id: 1,
@@ -215,6 +216,7 @@ fn facing_locks_inside_half_the_radius_and_fades_with_the_angle() {
         colour_levels: ColourLevels::even(900.0, 1100.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
         flat: false,
         sunlit_depth_m: 0.0,
+        shaded_base_m: 0.0,
     }));
     // 40 m south of the centre (inside 50 m = half the 100 m radius): locks facing north.
     let locked = corners(&mut host, DVec3::new(0.0, -40.0, 1000.0), 0.0);
@@ -266,6 +268,7 @@ fn upright_sprites_stay_level_and_fade_seen_from_below() {
         colour_levels: ColourLevels::even(1400.0, 1700.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
         flat: false,
         sunlit_depth_m: 0.0,
+        shaded_base_m: 0.0,
     }));
     let mut quads = |elevation_deg: f64| {
         let cam = DVec3::new(0.0, 3000.0, 1500.0)
@@ -465,6 +468,7 @@ fn a_far_cloud_fades_into_the_horizon_haze() {
             colour_levels: ColourLevels::even(0.0, 4000.0, [[0.05, 0.05, 0.05, 1.0]; 5]),
             flat: false,
             sunlit_depth_m: 0.0,
+            shaded_base_m: 0.0,
         }));
         let (cloud, _) = host.frame(&camera, &SUN, 0.0, 1e9).unwrap();
         (bare, cloud)

@@ -73,6 +73,9 @@ pub struct Cloud {
     /// 0 for a cloud lit from every side).
     #[serde(default)]
     pub sunlit_depth_m: f32,
+    /// A heap's shaded base, metres above its base (the type's `shaded_base_m`; 0 for none).
+    #[serde(default)]
+    pub shaded_base_m: f32,
     /// Five ambient colour levels, lowest first.
     pub colour_levels: [ColourLevel; 5],
     /// The cloud's shading groups.
@@ -169,6 +172,9 @@ impl CloudBlock {
             // Only a deck's, so the hashes of blocks without decks stay what they were.
             if c.sunlit_depth_m != 0.0 {
                 h = fnv1a(&c.sunlit_depth_m.to_le_bytes(), h);
+            }
+            if c.shaded_base_m != 0.0 {
+                h = fnv1a(&c.shaded_base_m.to_le_bytes(), h);
             }
             for lvl in &c.colour_levels {
                 h = fnv1a(&lvl.height_m.to_le_bytes(), h);

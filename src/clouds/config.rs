@@ -204,6 +204,11 @@ pub struct CloudTypeConfig {
     /// every side.
     #[serde(default)]
     pub sunlit_depth_m: Option<f32>,
+    /// Heaped types: the height above a cloud's base, metres, in which its body above hides the
+    /// sun: the base is dark and evenly lit (ambient light only), the sun coming in above it
+    /// (a cumulonimbus's one dark, flat base). Absent: lit as Wang does down to the base.
+    #[serde(default)]
+    pub shaded_base_m: Option<f32>,
     /// Flat types: each cloud is a streak this many times longer than wide, laid along the wind
     /// with every sprite lengthwise along it (cirrus fibres); `cloud_size_m` is its length.
     #[serde(default)]
@@ -538,6 +543,13 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
             (1.0..=10_000.0).contains(&depth),
             "sunlit_depth_m",
             "must be 1..=10000 metres",
+        )?;
+    }
+    if let Some(height) = c.shaded_base_m {
+        v.check(
+            (1.0..=10_000.0).contains(&height) && !c.continuous && !c.flat,
+            "shaded_base_m",
+            "must be 1..=10000 metres, on a heaped type (not continuous, not flat)",
         )?;
     }
     if let Some(aspect) = c.streak_length_over_width {

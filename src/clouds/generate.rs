@@ -332,7 +332,9 @@ fn build_cloud(
             .min(d * config.max_height_over_size as f64);
         let (raws, n_boxes) = heap_sprites(config, d, height, density, &mut rng);
         let kept = cull(raws, config.cull_radius_fraction as f64);
-        return (finish_cloud(ctx, centre, kept, &mut rng), n_boxes);
+        let mut cloud = finish_cloud(ctx, centre, kept, &mut rng);
+        cloud.shaded_base_m = config.shaded_base_m.unwrap_or(0.0);
+        return (cloud, n_boxes);
     }
     let n_boxes = rng.range_u32(config.boxes_per_cloud[0], config.boxes_per_cloud[1]);
     let thickness = frame.thickness_m;
@@ -521,6 +523,7 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
         radius_m: radius as f32,
         flat: config.flat,
         sunlit_depth_m: 0.0,
+        shaded_base_m: 0.0,
         colour_levels,
         shading_groups,
         sprites,
@@ -567,7 +570,7 @@ mod golden {
             [
                 "6ea2ffa12cd8ec62",
                 "2610fe870de059b1",
-                "388eb9e7de1536aa",
+                "601c50867b47c891",
                 "5e9f9fbd940250a3"
             ]
         );

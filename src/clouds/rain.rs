@@ -60,12 +60,14 @@ pub fn add_shafts(
         };
         let width =
             config.width_over_base * 2.0 * base_radius * width_scale * rng.range_f32(0.8, 1.2);
-        // Tall soft sprites, overlapping by half: a curtain, not a stack of puffs; from just
-        // inside the base down to where the shaft ends (the ground, or the virga's end).
-        let height = (width * 2.6).min(length.max(width * 0.3));
-        let top = base_rel + height * 0.1 - height * 0.5;
-        let bottom = (base_rel - length + height * 0.5).min(top);
-        let count = (((top - bottom) / (height * 0.45)).ceil() as u32 + 1).min(MOST_PER_SHAFT);
+        // Soft sprites at most 0.6 of the fall tall, a third of their height apart: a curtain,
+        // even from just inside the base to where the shaft ends, not a few puffs. The lowest is
+        // centred on the shaft's end, so one reaching the ground is opaque down to it (its lower
+        // half is under the ground), and virga frays out there.
+        let height = (width * 1.2).min(length * 0.6).max(width * 0.2);
+        let top = base_rel + height * 0.2 - height * 0.5;
+        let bottom = (base_rel - length).min(top);
+        let count = (((top - bottom) / (height * 0.33)).ceil() as u32 + 1).min(MOST_PER_SHAFT);
         let step = (top - bottom) / (count.max(2) - 1) as f32;
         let group = cloud.shading_groups.len() as u16;
         cloud.shading_groups.push(ShadingGroup {
@@ -80,9 +82,12 @@ pub fn add_shafts(
                 (1.0 - down) * (1.0 - down)
             };
             let z = top - k as f32 * step;
+            // Each a little aside and wider or narrower: ragged sides, not a pillar's.
+            let aside = glam::Vec2::new(rng.range_f32(-0.12, 0.12), rng.range_f32(-0.12, 0.12));
+            let (x, y) = (at.x + aside.x * width, at.y + aside.y * width);
             cloud.sprites.push(Sprite {
-                offset_m: [at.x, at.y, z],
-                width_m: width,
+                offset_m: [x, y, z],
+                width_m: width * rng.range_f32(0.75, 1.15),
                 height_m: height,
                 rotation_deg: 0.0,
                 texture: rng.range_u32(foggy.start as u32, foggy.end as u32 - 1) as u8,
@@ -93,7 +98,7 @@ pub fn add_shafts(
                 upright: true,
                 precipitation: true,
             });
-            let reach_m = Vec3::new(at.x, at.y, z).length() + 0.5 * width.max(height);
+            let reach_m = Vec3::new(x, y, z).length() + 0.6 * width.max(height);
             cloud.radius_m = cloud.radius_m.max(reach_m);
         }
     }
@@ -146,7 +151,9 @@ mod tests {
         }
     }
 
-    /// Per cloud, the lowest bottom edge of its rain, metres above mean sea level (None: dry).
+    /// Per cloud, where its rain ends: the lowest centre of its shafts' sprites, metres above
+    /// mean sea level (None: dry). Below it a sprite's lower half frays out (virga) or is under
+    /// the ground.
     fn rain_bottoms(weather: &BlockWeather) -> Vec<Option<f64>> {
         let block = generate_block(BlockIndex::new(3, -2), weather, 7, &CloudTypes::builtin());
         block
@@ -156,7 +163,7 @@ mod tests {
                 c.sprites
                     .iter()
                     .filter(|s| s.precipitation)
-                    .map(|s| c.centre_m.z + (s.offset_m[2] - 0.5 * s.height_m) as f64)
+                    .map(|s| c.centre_m.z + s.offset_m[2] as f64)
                     .reduce(f64::min)
             })
             .collect()
@@ -169,7 +176,8 @@ mod tests {
         assert!(!wet.is_empty());
         for bottom in &wet {
             let bottom = bottom.expect("every cell rains");
-            // Reaches the ground: its lowest sprite's lower edge there, not above or below it.
+            // Reaches the ground: its lowest sprite centred there (opaque down to it), not above
+            // or below it.
             assert!(
                 (bottom - 100.0).abs() < 30.0,
                 "rain ends at {bottom} m, ground 100 m"

@@ -78,6 +78,7 @@ impl From<&Cloud> for SkyCloud {
             })),
             flat: c.flat,
             sunlit_depth_m: c.sunlit_depth_m,
+            shaded_base_m: c.shaded_base_m,
         }
     }
 }

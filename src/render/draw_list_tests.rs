@@ -97,6 +97,7 @@ fn small_cloud() -> SkyCloud {
         colour_levels: ColourLevels::even(0.0, 100.0, [[1.0; 4]; 5]),
         flat: false,
         sunlit_depth_m: 0.0,
+        shaded_base_m: 0.0,
     }
 }
 

@@ -113,7 +113,7 @@ pub const SPRITE_PRECIPITATION: u32 = 1 << 9;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuCloud {
-    /// xyz: centre, metres from its block's centre; w unused.
+    /// xyz: centre, metres from its block's centre; w: a heap's shaded base, metres (0: none).
     pub centre_block: [f32; 4],
     /// The five ambient colour levels, RGBA (Wang 5.1).
     pub level_rgba: [[f32; 4]; 5],

@@ -166,7 +166,10 @@ pub fn gpu_sprite(cloud: &SkyCloud, s: &super::scene::SkySprite) -> GpuSprite {
 pub fn gpu_cloud(cloud: &SkyCloud, block_m: DVec3) -> GpuCloud {
     let l = &cloud.colour_levels.0;
     GpuCloud {
-        centre_block: (cloud.centre_m - block_m).as_vec3().extend(0.0).to_array(),
+        centre_block: (cloud.centre_m - block_m)
+            .as_vec3()
+            .extend(cloud.shaded_base_m.max(0.0))
+            .to_array(),
         level_rgba: l.map(|level| level.rgba),
         level_height: [l[0].height_m, l[1].height_m, l[2].height_m, l[3].height_m],
         level4_radius_flat: [

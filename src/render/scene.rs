@@ -57,6 +57,9 @@ pub struct SkyCloud {
     /// diffused through it (an even grey ceiling, no sunlit heaps). 0: lit from every side, as
     /// Wang lights clouds.
     pub sunlit_depth_m: f32,
+    /// A heap's shaded base, metres above its base: below it the body above hides the sun (one
+    /// dark, evenly lit base), the sun coming in over it. 0: lit down to the base.
+    pub shaded_base_m: f32,
 }
 
 /// A 4 km x 4 km block of clouds.
