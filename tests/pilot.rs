@@ -264,7 +264,7 @@ fn region_colour(
 
 /// A cumulonimbus 20 km ahead, base 3,000 ft, in heavy rain, seen from 30 ft above flat ground
 /// looking level: the column under its base is measurably darker and greyer than the sky beside
-/// it. The same cell on a dry day has no such column.
+/// it. The same cell on a dry day has no such column. Flown into the rain, the visibility drops.
 #[test]
 fn rain_falls_out_of_a_storm_seen_from_20_km() {
     use glam::{DVec2, DVec3};
@@ -333,6 +333,22 @@ fn rain_falls_out_of_a_storm_seen_from_20_km() {
         let png = dir.join(format!("{name}.png"));
         frame.write_png(&png).unwrap();
         looks.push((image::open(&png).unwrap().to_rgba8(), base_radius_m));
+        // Flown into the heart of a shaft (its upper sprite's axis, 100 m up), the visibility
+        // drops to the rain's; 20 km away it is the air's.
+        let air = host.sky.fog().distance_m;
+        let shaft = cell.sprites.iter().find(|s| s.precipitation);
+        assert_eq!(shaft.is_some(), precipitation > 0.0, "{name}: shafts");
+        if let Some(s) = shaft {
+            let at = centre + DVec3::new(s.offset_m[0] as f64, s.offset_m[1] as f64, 0.0);
+            let inside = host.camera(DVec3::new(at.x, at.y, 100.0), 0.0, 0.0);
+            host.frame(&inside, &sun, 0.0, 50_000.0).unwrap();
+            let in_rain = host.sky.fog().distance_m;
+            println!("{name}: visibility {air} m 20 km away, {in_rain} m in a shaft");
+            assert!(
+                in_rain < 3_000.0 && air > 10_000.0,
+                "{air} m, then {in_rain} m in rain"
+            );
+        }
     }
     // Where things are on the frame: columns by angle from the view axis, rows by elevation.
     let half_w = W as f64 / 2.0;

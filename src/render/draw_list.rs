@@ -235,7 +235,7 @@ pub(super) struct Copies<'a> {
 /// The sky camera's frame: fills `out` with the draw list of the blocks marked near, placed and
 /// in view (`frustum`: nothing of a block wholly outside it is built or drawn), looks again at the blocks whose slack is used up (re-sorting their clouds, recomputing the
 /// orders the cache says are stale, into `copies`, marked dirty), updates `locks`, and counts
-/// into `stats`. Returns how far inside a cloud the camera is, 0..=1.
+/// into `stats`. Returns how far inside a cloud, and how deep in rain, the camera is.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn main_view(
     blocks: &mut Blocks,
@@ -246,7 +246,7 @@ pub(super) fn main_view(
     locks: &mut Locks,
     out: &mut Vec<GpuDrawBlock>,
     stats: &mut FrameStats,
-) -> f32 {
+) -> Inside {
     // A block out of view is not looked at again either: its slack check catches up with the
     // camera the frame it comes into view.
     let mut order: Vec<(f64, &mut Resident)> = blocks
@@ -290,14 +290,16 @@ pub(super) fn main_view(
             }
         }
     }
-    let mut in_cloud = 0.0f32;
+    let mut inside = Inside::default();
     let mut total = 0u32;
     out.clear();
     locks.begin();
     for (d2, r) in order {
         let rel = camera_m - r.centre_m();
         if d2.sqrt() < r.radius_m {
-            in_cloud = in_cloud.max(inside_clouds(r, camera_m, settings, locks));
+            let here = inside_clouds(r, camera_m, settings, locks);
+            inside.cloud = inside.cloud.max(here.cloud);
+            inside.rain = inside.rain.max(here.rain);
         }
         let (fade_kind, fade_progress) = fade_code(r.motion.fade);
         out.push(GpuDrawBlock {
@@ -318,7 +320,17 @@ pub(super) fn main_view(
     } else {
         1.0 - stats.clouds_recomputed as f32 / stats.clouds_drawn as f32
     };
-    in_cloud
+    inside
+}
+
+/// Where the camera is among the clouds of a frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct Inside {
+    /// How far inside a cloud, 0 (outside) ..= 1 (deep in its core).
+    pub cloud: f32,
+    /// How opaque the rain or snow shaft the camera is in is there: the shaft's opacity, less
+    /// towards its edge; 0 out of any.
+    pub rain: f32,
 }
 
 /// Looks at every cloud of a block again: its clouds within the draw distance sorted back to
@@ -415,15 +427,16 @@ fn recheck(
     });
 }
 
-/// The camera is within a block's radius: how far inside its clouds it is, and the facing locks
-/// of the sprites it is within half the radius of.
+/// The camera is within a block's radius: how far inside its clouds and their rain it is, and
+/// the facing locks of the sprites it is within half the radius of.
 fn inside_clouds(
     r: &Resident,
     camera_m: DVec3,
     settings: &RenderSettings,
     locks: &mut Locks,
-) -> f32 {
+) -> Inside {
     let mut in_cloud = 0.0f32;
+    let mut in_rain = 0.0f32;
     let lock_fraction = settings.clouds.lock_radius_fraction;
     for (state, cloud) in r.clouds.iter().zip(&r.block.clouds) {
         let cam_local = (camera_m - (state.centre_m + r.motion.offset_m)).as_vec3();
@@ -440,6 +453,11 @@ fn inside_clouds(
         }
         for (k, s) in cloud.sprites.iter().enumerate() {
             let to_cam = cam_local - s.offset_m;
+            if s.precipitation && to_cam.z.abs() < 0.5 * s.height_m {
+                // An upright column: as opaque as the shaft, less towards its side.
+                let aside = to_cam.truncate().length() / (0.5 * s.width_m).max(1.0);
+                in_rain = in_rain.max(s.alpha_morph * (1.0 - aside).max(0.0));
+            }
             let radius = 0.5 * s.width_m.max(s.height_m);
             if to_cam.length() < lock_fraction * radius {
                 let face = if s.upright {
@@ -451,7 +469,10 @@ fn inside_clouds(
             }
         }
     }
-    in_cloud
+    Inside {
+        cloud: in_cloud,
+        rain: in_rain,
+    }
 }
 
 /// An impostor's view from `from_m` (no cache, no locks): the draw list of the blocks `ids`

@@ -109,6 +109,8 @@ pub struct Sky {
     elapsed_s: f64,
     sprites_to_draw: u32,
     in_cloud: f32,
+    /// How opaque the rain or snow shaft the camera is in is there (0: none): the fog thickens.
+    in_rain: f32,
     /// CPU time of block changes since the last prepare, and the host's field time.
     pending_us: u64,
     field_us: u64,
@@ -333,6 +335,7 @@ impl Sky {
             elapsed_s: 0.0,
             sprites_to_draw: 0,
             in_cloud: 0.0,
+            in_rain: 0.0,
             pending_us: 0,
             field_us: 0,
             record_us: Cell::new(0),
@@ -543,9 +546,11 @@ impl Sky {
     }
 
     /// The fog a host draws over its scene: the visibility and obscuration of the weather over
-    /// the camera ([`crate::shading::fog`]) under the last frame's horizon sky.
+    /// the camera ([`crate::shading::fog`]) under the last frame's horizon sky, thicker where the
+    /// last frame found the camera in a rain or snow shaft.
     pub fn fog(&self) -> crate::shading::Fog {
-        self.fog.0.fog(&self.fog.1, self.seen_light.sky_horizon_rgb)
+        let air = self.fog.0.fog(&self.fog.1, self.seen_light.sky_horizon_rgb);
+        self.fog.0.in_rain(air, self.in_rain)
     }
 
     /// The fraction of the sky hidden above `altitude_m` by the weather overhead, 0..=1.
@@ -628,7 +633,7 @@ impl Sky {
         self.ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
         let resident = &mut self.resident;
-        let in_cloud = main_view(
+        let inside = main_view(
             &mut resident.blocks,
             Copies {
                 orders: &mut resident.orders_cpu,
@@ -681,7 +686,9 @@ impl Sky {
             },
         );
         self.sprites_to_draw = stats.sprites_drawn;
+        let in_cloud = inside.cloud;
         self.in_cloud = in_cloud;
+        self.in_rain = inside.rain;
         stats.in_cloud = in_cloud;
 
         let view_proj = camera.view_proj();

@@ -34,6 +34,9 @@ pub struct FogSettings {
     pub clear_visibility_m: f32,
     /// Share of the obscuration's own colour in the fog, 0..=1.
     pub tint: f32,
+    /// Visibility inside a rain or snow shaft, metres, divided by the shaft's opacity where the
+    /// camera is.
+    pub rain_visibility_m: f32,
     /// Linear RGB of each obscuration in daylight.
     pub colours: ObscurationColours,
 }
@@ -100,6 +103,9 @@ impl FogSettings {
         if !(0.0..=1.0).contains(&s.tint) {
             return Err(bad("tint", "must be within 0..=1"));
         }
+        if !(s.rain_visibility_m >= 1.0 && s.rain_visibility_m.is_finite()) {
+            return Err(bad("rain_visibility_m", "must be at least 1 metre"));
+        }
         Ok(s)
     }
 
@@ -128,6 +134,20 @@ impl FogSettings {
         Fog {
             distance_m: self.visibility_m(weather),
             rgb,
+        }
+    }
+
+    /// `fog` with the camera in a rain or snow shaft `in_rain` (0..=1) opaque where it is: the
+    /// visibility `rain_visibility_m / in_rain`, if less than the air's.
+    pub fn in_rain(&self, fog: Fog, in_rain: f32) -> Fog {
+        if in_rain <= 0.0 {
+            return fog;
+        }
+        Fog {
+            distance_m: fog
+                .distance_m
+                .min(self.rain_visibility_m / in_rain.min(1.0)),
+            ..fog
         }
     }
 
@@ -176,6 +196,20 @@ mod tests {
         assert!((lum(fog.rgb) - lum(horizon)).abs() < 0.02);
         // The clouds fade by the same law: 63% at a third of the visibility.
         assert!((s.haze_distance_m(&fog, 50_000.0) - 800.0 / 3.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn rain_thickens_the_fog_by_its_opacity_and_never_clears_it() {
+        let s = FogSettings::default();
+        let clear = s.fog(&weather(9999.0, None), Vec3::ONE);
+        assert_eq!(s.in_rain(clear, 0.0), clear);
+        // Heavy rain at a storm's core (0.8 opaque): 1,500 m / 0.8; light (0.35): over 4 km.
+        assert_eq!(s.in_rain(clear, 0.8).distance_m, 1875.0);
+        assert!((s.in_rain(clear, 0.35).distance_m - 4285.7).abs() < 1.0);
+        assert_eq!(s.in_rain(clear, 0.8).rgb, clear.rgb);
+        // A fog thicker than the rain's stays as it is.
+        let fog = s.fog(&weather(600.0, Some(Obscuration::Fog)), Vec3::ONE);
+        assert_eq!(s.in_rain(fog, 0.8).distance_m, 600.0);
     }
 
     #[test]
