@@ -162,7 +162,8 @@ fn scattered_layer(
         // Near the target, shrink the last clouds so they do not overshoot it.
         let remaining_m2 = (target - frac) * BLOCK_SIZE_M * BLOCK_SIZE_M;
         let disc_m2 = std::f64::consts::FRAC_PI_4 * d * d;
-        if disc_m2 > remaining_m2 * 1.3 {
+        let streaks = config.flat && config.streak_length_over_width.is_some();
+        if !streaks && disc_m2 > remaining_m2 * 1.3 {
             d = (remaining_m2 * 1.3 / std::f64::consts::FRAC_PI_4)
                 .sqrt()
                 .max(if config.anvil.is_some() {
@@ -179,6 +180,17 @@ fn scattered_layer(
             );
         let cloud_seed = rng.next_u64();
         let (cloud, n_boxes) = build_cloud(ctx, centre, d, None, cloud_seed);
+        if streaks {
+            // A streak bigger than the block's share is not shrunk to fit (every block would
+            // get one dash of the same length, an even grid of them): it is drawn whole, as
+            // often as the share allows, so a few oktas of cirrus are a few long, irregular
+            // streaks with clear sky between, wherever they reach.
+            let footprint_m2 = streak_footprint_m2(&cloud);
+            let chance = remaining_m2 / footprint_m2.max(1.0);
+            if footprint_m2 > remaining_m2 * 1.3 && rng.range_f64(0.0, 1.0) > chance {
+                break;
+            }
+        }
         let cells = cloud_cells(&cloud, corner);
         let new = cells.iter().filter(|&&c| !grid[c]).count();
         if cells.is_empty() || (new as f64) < min_new_share * cells.len() as f64 {
@@ -194,6 +206,16 @@ fn scattered_layer(
         out.push(cloud);
     }
     (covered as f64 / (GRID * GRID) as f64, boxes)
+}
+
+/// The sky a streak covers, m2: its flat sprites' dense cores (the ellipses within 0.7 of their
+/// half extents, as [`cloud_cells`] counts them), wherever they lie.
+fn streak_footprint_m2(cloud: &Cloud) -> f64 {
+    cloud
+        .sprites
+        .iter()
+        .map(|s| std::f64::consts::PI * 0.35 * s.width_m as f64 * 0.35 * s.height_m as f64)
+        .sum()
 }
 
 /// Coverage-grid cells (of the block, 100 m) under a cloud: those whose centre lies within
@@ -571,7 +593,7 @@ mod golden {
                 "6ea2ffa12cd8ec62",
                 "2610fe870de059b1",
                 "601c50867b47c891",
-                "5e9f9fbd940250a3"
+                "f6cfc024a1869c4d"
             ]
         );
     }

@@ -92,20 +92,25 @@ fn cirrus_are_streaks_along_the_wind() {
             from_deg,
             speed_kt: 40.0,
         };
-        let block = generate_block(BlockIndex::new(2, 1), &w, 5, types());
+        // Streaks bigger than a block fall in some blocks and not others: four blocks.
+        let blocks: Vec<CloudBlock> = [(2, 1), (3, 1), (2, 2), (3, 2)]
+            .map(|(i, j)| generate_block(BlockIndex::new(i, j), &w, 5, types()))
+            .into();
         let along = DVec2::from_angle((90.0 - from_deg as f64).to_radians());
         let mut checked = 0;
-        for c in block.clouds.iter().filter(|c| c.sprites.len() >= 3) {
-            let extent = |axis: DVec2| {
-                let d: Vec<f64> = c
-                    .sprites
-                    .iter()
-                    .map(|s| DVec2::new(s.offset_m[0] as f64, s.offset_m[1] as f64).dot(axis))
-                    .collect();
-                d.iter().cloned().fold(f64::MIN, f64::max)
-                    - d.iter().cloned().fold(f64::MAX, f64::min)
+        let clouds = blocks.iter().flat_map(|b| &b.clouds);
+        for c in clouds.filter(|c| c.sprites.len() >= 3) {
+            // The sky the streak spans: its sprites, each lying along the wind (its width
+            // along, its height across).
+            let extent = |axis: DVec2, half: &dyn Fn(&Sprite) -> f64| {
+                let (lo, hi) = c.sprites.iter().fold((f64::MAX, f64::MIN), |(lo, hi), s| {
+                    let d = DVec2::new(s.offset_m[0] as f64, s.offset_m[1] as f64).dot(axis);
+                    (lo.min(d - half(s)), hi.max(d + half(s)))
+                });
+                hi - lo
             };
-            let (l, a) = (extent(along), extent(along.perp()));
+            let l = extent(along, &|s| s.width_m as f64 / 2.0);
+            let a = extent(along.perp(), &|s| s.height_m as f64 / 2.0);
             assert!(
                 l > 2.5 * a,
                 "from {from_deg}: {l:.0} m along, {a:.0} m across"
@@ -114,6 +119,72 @@ fn cirrus_are_streaks_along_the_wind() {
         }
         assert!(checked >= 2, "from {from_deg}: {checked} streaks");
     }
+}
+
+/// Cirrus follows the oktas, in irregular streaks: over 8 x 8 blocks the sky their sprites'
+/// cores cover grows with the cover reported (and stays near it), the streaks per block vary
+/// (some blocks have none at a few oktas) and so do their lengths; not one dash of the same
+/// length in every block.
+#[test]
+fn cirrus_amount_follows_the_oktas_in_irregular_streaks() {
+    let mut covers = Vec::new();
+    for oktas in [1.0f32, 2.0, 4.0] {
+        let w = weather(CloudType::Cirrus, oktas, 28_000.0, 800.0);
+        let blocks: Vec<CloudBlock> = (0..8)
+            .flat_map(|j| (0..8).map(move |i| BlockIndex::new(i, j)))
+            .map(|index| generate_block(index, &w, 2003, types()))
+            .collect();
+        // The sky covered over the middle 4 x 4 blocks, by every streak of the 8 x 8 (those
+        // of the outer blocks reach in), cell by cell as the generator counts it.
+        let mut covered = 0usize;
+        for index in (2..6).flat_map(|j| (2..6).map(move |i| BlockIndex::new(i, j))) {
+            let corner = index.min_corner_m();
+            let mut cells: Vec<usize> = blocks
+                .iter()
+                .flat_map(|b| &b.clouds)
+                .flat_map(|c| super::cloud_cells(c, corner))
+                .collect();
+            cells.sort_unstable();
+            cells.dedup();
+            covered += cells.len();
+        }
+        let cover = covered as f64 / (16 * GRID * GRID) as f64;
+        let per_block: Vec<usize> = blocks.iter().map(|b| b.clouds.len()).collect();
+        let lengths: Vec<f64> = blocks
+            .iter()
+            .flat_map(|b| &b.clouds)
+            .map(|c| 2.0 * c.radius_m as f64)
+            .collect();
+        let mean = lengths.iter().sum::<f64>() / lengths.len() as f64;
+        let spread =
+            (lengths.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lengths.len() as f64).sqrt()
+                / mean;
+        let (fewest, most) = (per_block.iter().min(), per_block.iter().max());
+        eprintln!(
+            "{oktas} oktas: cover {cover:.3} (asked {:.3}), streaks a block {fewest:?}..={most:?}, length spread {spread:.2}",
+            oktas / 8.0
+        );
+        assert!(
+            cover > 0.75 * oktas as f64 / 8.0 && cover < 1.25 * oktas as f64 / 8.0,
+            "{oktas} oktas: streaks cover {cover}"
+        );
+        assert!(
+            spread > 0.2,
+            "{oktas} oktas: streak lengths alike ({spread})"
+        );
+        assert!(fewest < most, "{oktas} oktas: every block alike");
+        covers.push(cover);
+    }
+    assert!(covers[0] < covers[1] && covers[1] < covers[2], "{covers:?}");
+    let w = weather(CloudType::Cirrus, 1.0, 28_000.0, 800.0);
+    let empty = (0..16)
+        .filter(|&i| {
+            generate_block(BlockIndex::new(i, 0), &w, 2003, types())
+                .clouds
+                .is_empty()
+        })
+        .count();
+    assert!(empty > 0, "one okta of cirrus puts a streak in every block");
 }
 
 #[test]
