@@ -24,6 +24,7 @@
 
 mod build;
 pub mod camera;
+mod cloud_light;
 pub mod cloud_target;
 pub mod draw_list;
 pub mod gpu_types;

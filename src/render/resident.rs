@@ -12,14 +12,16 @@ use std::ops::Range;
 
 use glam::{DVec3, Vec3};
 
+use super::cloud_light::CloudLight;
 use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT};
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
 
-/// Bytes of GPU memory each sprite slot costs: its record and its order entry (a cloud's record
+/// Bytes of GPU memory each sprite slot costs: its record, its order entry and its Harris and
+/// Lastra light (a cloud's record
 /// and list entry come on top, about a twentieth of it for 30-sprite clouds; the quad indices
 /// are for the sprites drawn, not held).
-pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4;
+pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4 + 4;
 
 /// A cloud's bounds (computed once when its block arrives) and its order cache.
 #[derive(Debug, Clone)]
@@ -68,6 +70,11 @@ pub(super) struct Resident {
     pub place: Option<(Range<u32>, Range<u32>)>,
     /// Written to its slots yet.
     pub uploaded: bool,
+    /// The sun direction its Harris and Lastra light was computed for, if it was (not when
+    /// its light is provisional), and that light (packed, its sprites' order; the skylight
+    /// bytes are kept when the sun's are computed again).
+    pub lit_for: Option<Vec3>,
+    pub lights: Vec<u32>,
     /// Drawn as sprites this frame (not in the impostor ring); set by the ring's split.
     pub near: bool,
     pub clouds: Vec<CloudState>,
@@ -105,6 +112,8 @@ impl Resident {
             check: None,
             place: None,
             uploaded: false,
+            lit_for: None,
+            lights: Vec::new(),
             near: true,
             clouds,
         }
@@ -188,6 +197,13 @@ pub(super) struct ResidentSet {
     limit_sprites: u32,
     pub sprite_buffer: wgpu::Buffer,
     pub cloud_buffer: wgpu::Buffer,
+    /// Per sprite slot its Harris and Lastra light (`cloud_light`; zeros under Wang's model).
+    pub light_buffer: wgpu::Buffer,
+    /// The Harris and Lastra light's state (off under Wang's model).
+    pub light: CloudLight,
+    /// Sprites lit this frame (written or relit), and the CPU time it took, microseconds.
+    pub lit_sprites: u32,
+    pub light_us: u64,
     /// The sky camera's per-cloud orders, at the clouds' sprite slots.
     pub order_buffer: wgpu::Buffer,
     /// The sky camera's per-block cloud lists, at the blocks' cloud slots.
@@ -236,7 +252,7 @@ impl ResidentSet {
         };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sky.resident_layout"),
-            entries: &[storage(0), storage(1)],
+            entries: &[storage(0), storage(1), storage(2)],
         });
         let sprites = FIRST_SPRITES.min(limit_sprites.max(1));
         let b = buffers(device, &layout, sprites, FIRST_CLOUDS);
@@ -248,6 +264,10 @@ impl ResidentSet {
             limit_sprites,
             sprite_buffer: b.sprites,
             cloud_buffer: b.clouds,
+            light_buffer: b.lights,
+            light: CloudLight::default(),
+            lit_sprites: 0,
+            light_us: 0,
             order_buffer: b.orders,
             list_buffer: b.lists,
             layout,
@@ -269,6 +289,7 @@ impl ResidentSet {
     pub fn gpu_bytes(&self) -> u64 {
         self.sprite_buffer.size()
             + self.cloud_buffer.size()
+            + self.light_buffer.size()
             + self.order_buffer.size()
             + self.list_buffer.size()
     }
@@ -424,6 +445,7 @@ impl ResidentSet {
         let b = buffers(&self.device, &self.layout, sprites, clouds);
         self.sprite_buffer = b.sprites;
         self.cloud_buffer = b.clouds;
+        self.light_buffer = b.lights;
         self.order_buffer = b.orders;
         self.list_buffer = b.lists;
         self.group = b.group;
@@ -456,6 +478,13 @@ impl ResidentSet {
         let mut bytes = 0;
         let mut sprites: Vec<GpuSprite> = Vec::new();
         let mut clouds: Vec<GpuCloud> = Vec::new();
+        // A whole rewrite is lit at once; blocks arriving one by one within the frame's budget.
+        let light_start = std::time::Instant::now();
+        let mut light_left = if budget == u32::MAX {
+            u32::MAX
+        } else {
+            self.light.budget()
+        };
         let mut todo: Vec<(f64, &mut Resident)> = self
             .blocks
             .values_mut()
@@ -494,9 +523,73 @@ impl ResidentSet {
             }
             bytes += sprites.len() as u64 * sprite_bytes + clouds.len() as u64 * cloud_bytes;
             r.uploaded = true;
+            r.lit_for = None;
+            if self.light.enabled() {
+                let n = s.end - s.start;
+                if n <= light_left {
+                    self.light.block(&r.block, &mut r.lights, false);
+                    r.lit_for = Some(self.light.sun_dir);
+                    light_left -= n;
+                    self.lit_sprites += n;
+                } else {
+                    self.light.provisional(&r.block, &mut r.lights);
+                }
+                bytes += write_lights(queue, &self.light_buffer, s.start, &r.lights);
+            }
+        }
+        if self.light.enabled() {
+            self.light_us += light_start.elapsed().as_micros() as u64;
         }
         bytes
     }
+
+    /// Computes again the Harris and Lastra light of written blocks lit for another sun than
+    /// the current lit direction, nearest to `camera_m` first, until the budget of sprites a
+    /// frame is spent (at least one block); returns the bytes written.
+    pub fn relight(&mut self, queue: &wgpu::Queue, camera_m: DVec3) -> u64 {
+        if !self.light.enabled() {
+            return 0;
+        }
+        let start = std::time::Instant::now();
+        let target = self.light.sun_dir;
+        let mut stale: Vec<(f64, &mut Resident)> = self
+            .blocks
+            .values_mut()
+            .filter(|r| r.place.is_some() && r.uploaded && r.lit_for != Some(target))
+            .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
+            .collect();
+        if stale.is_empty() {
+            return 0;
+        }
+        stale.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.block.id.cmp(&b.1.block.id)));
+        // What this frame's arrivals left of the budget (at least one block a frame).
+        let budget = self.light.budget().saturating_sub(self.lit_sprites);
+        let (mut lit, mut bytes) = (0u32, 0u64);
+        for (_, r) in stale {
+            if lit > 0 && lit >= budget {
+                break;
+            }
+            let Some((s, _)) = &r.place else { continue };
+            // A provisional light's skylight is provisional too.
+            let sky_known = r.lit_for.is_some();
+            self.light.block(&r.block, &mut r.lights, sky_known);
+            bytes += write_lights(queue, &self.light_buffer, s.start, &r.lights);
+            r.lit_for = Some(target);
+            lit += s.end - s.start;
+        }
+        self.lit_sprites += lit;
+        self.light_us += start.elapsed().as_micros() as u64;
+        bytes
+    }
+}
+
+/// Writes packed lights at sprite slot `first`; returns the bytes.
+fn write_lights(queue: &wgpu::Queue, buffer: &wgpu::Buffer, first: u32, lights: &[u32]) -> u64 {
+    if lights.is_empty() {
+        return 0;
+    }
+    queue.write_buffer(buffer, first as u64 * 4, bytemuck::cast_slice(lights));
+    lights.len() as u64 * 4
 }
 
 /// A storage buffer the queue writes into, of at least 16 bytes.
@@ -513,6 +606,7 @@ pub(super) fn storage_buffer(device: &wgpu::Device, label: &str, bytes: u64) -> 
 struct Buffers {
     sprites: wgpu::Buffer,
     clouds: wgpu::Buffer,
+    lights: wgpu::Buffer,
     orders: wgpu::Buffer,
     lists: wgpu::Buffer,
     group: wgpu::BindGroup,
@@ -534,6 +628,7 @@ fn buffers(
         "sky.clouds",
         clouds as u64 * std::mem::size_of::<GpuCloud>() as u64,
     );
+    let light_buffer = storage("sky.sprite_lights", sprites as u64 * 4);
     let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("sky.resident_group"),
         layout,
@@ -546,11 +641,16 @@ fn buffers(
                 binding: 1,
                 resource: cloud_buffer.as_entire_binding(),
             },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: light_buffer.as_entire_binding(),
+            },
         ],
     });
     Buffers {
         sprites: sprite_buffer,
         clouds: cloud_buffer,
+        lights: light_buffer,
         orders: storage("sky.orders", sprites as u64 * 4),
         lists: storage(
             "sky.lists",

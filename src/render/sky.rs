@@ -617,14 +617,24 @@ impl Sky {
             time_of_day: self.clear_light,
             mapping: self.time_of_day.directional_mapping,
             forward: self.time_of_day.forward_scattering,
+            model: self.time_of_day.shading.model,
+            harris_lastra: self.time_of_day.harris_lastra,
         };
         let mut stats = FrameStats::default();
+        self.resident.light.set(
+            self.time_of_day.shading.model,
+            &self.time_of_day.harris_lastra,
+            sun_dir,
+        );
+        (self.resident.lit_sprites, self.resident.light_us) = (0, 0);
         let (mut upload_bytes, left_out) = self.resident.place_and_upload(
             queue,
             camera.position_m,
             self.settings.vertex_cache.max_uploaded_sprites_per_frame,
         );
         stats.blocks_left_out = left_out;
+        upload_bytes += self.resident.relight(queue, camera.position_m);
+        (stats.sprites_lit, stats.light_us) = (self.resident.lit_sprites, self.resident.light_us);
         self.ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
         let resident = &mut self.resident;

@@ -39,7 +39,8 @@ pub use cover::{OvercastLight, hidden_above};
 pub use directional::{DirectionalMapping, directional_percent};
 pub use fog::{Fog, FogSettings};
 pub use harris_lastra::{
-    HarrisLastra, Particle, ParticleLight, RelightTrigger, ShadingModel, ShadingSettings,
+    HarrisLastra, LightScratch, Particle, ParticleLight, RelightTrigger, ShadingModel,
+    ShadingSettings,
 };
 pub use scatter::ForwardScattering;
 pub use sun::{SunPosition, sun_position};
