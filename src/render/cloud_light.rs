@@ -46,12 +46,14 @@ impl Default for CloudLight {
 
 impl CloudLight {
     /// Sets the model and the sun of this frame; the lit direction follows the sun only when it
-    /// turned past the threshold (or the settings changed).
-    pub fn set(&mut self, model: ShadingModel, settings: &HarrisLastra, sun_dir: Vec3) {
+    /// turned past the threshold (or the settings changed). True when the model was just
+    /// switched on (the blocks already written have no light yet).
+    pub fn set(&mut self, model: ShadingModel, settings: &HarrisLastra, sun_dir: Vec3) -> bool {
         if model != ShadingModel::HarrisLastra {
             self.settings = None;
-            return;
+            return false;
         }
+        let switched_on = self.settings.is_none();
         if self.settings.as_ref() != Some(settings) {
             self.settings = Some(*settings);
             self.trigger = RelightTrigger::new(settings.relight_sun_deg);
@@ -59,6 +61,7 @@ impl CloudLight {
         if self.trigger.update(sun_dir) {
             self.sun_dir = self.trigger.lit_for.unwrap_or(Vec3::Z);
         }
+        switched_on
     }
 
     /// Whether the model is on.

@@ -543,6 +543,24 @@ impl ResidentSet {
         bytes
     }
 
+    /// Gives every written block a provisional Harris and Lastra light (the model was just
+    /// switched on; [`Self::relight`] refines them, a budget a frame); returns the bytes.
+    pub fn provisional_all(&mut self, queue: &wgpu::Queue) -> u64 {
+        let start = std::time::Instant::now();
+        let mut bytes = 0;
+        for r in self.blocks.values_mut() {
+            let Some((s, _)) = &r.place else { continue };
+            if !r.uploaded {
+                continue;
+            }
+            self.light.provisional(&r.block, &mut r.lights);
+            bytes += write_lights(queue, &self.light_buffer, s.start, &r.lights);
+            r.lit_for = None;
+        }
+        self.light_us += start.elapsed().as_micros() as u64;
+        bytes
+    }
+
     /// Computes again the Harris and Lastra light of written blocks lit for another sun than
     /// the current lit direction, nearest to `camera_m` first, until the budget of sprites a
     /// frame is spent (at least one block); returns the bytes written.

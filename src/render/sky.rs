@@ -447,6 +447,18 @@ impl Sky {
         self.resident.blocks.get(&id).map(|r| &r.block)
     }
 
+    /// Switches the cloud shading model (`[shading] model` of the time-of-day table). Switched
+    /// to Harris and Lastra's, the clouds held get a provisional light at the next
+    /// [`Self::prepare`] and their own within the model's budget of sprites a frame.
+    pub fn set_shading_model(&mut self, model: crate::shading::ShadingModel) {
+        self.time_of_day.shading.model = model;
+    }
+
+    /// The cloud shading model in use.
+    pub fn shading_model(&self) -> crate::shading::ShadingModel {
+        self.time_of_day.shading.model
+    }
+
     /// How clouds form and dissipate (the clouds stage's `[lifecycle]`): which sprites of a
     /// forming or dissipating block show at a given progress.
     pub fn set_lifecycle(&mut self, lifecycle: LifecycleConfig) {
@@ -621,18 +633,23 @@ impl Sky {
             harris_lastra: self.time_of_day.harris_lastra,
         };
         let mut stats = FrameStats::default();
-        self.resident.light.set(
+        (self.resident.lit_sprites, self.resident.light_us) = (0, 0);
+        let switched_on = self.resident.light.set(
             self.time_of_day.shading.model,
             &self.time_of_day.harris_lastra,
             sun_dir,
         );
-        (self.resident.lit_sprites, self.resident.light_us) = (0, 0);
-        let (mut upload_bytes, left_out) = self.resident.place_and_upload(
+        let mut upload_bytes = 0;
+        if switched_on {
+            upload_bytes += self.resident.provisional_all(queue);
+        }
+        let (placed_bytes, left_out) = self.resident.place_and_upload(
             queue,
             camera.position_m,
             self.settings.vertex_cache.max_uploaded_sprites_per_frame,
         );
         stats.blocks_left_out = left_out;
+        upload_bytes += placed_bytes;
         upload_bytes += self.resident.relight(queue, camera.position_m);
         (stats.sprites_lit, stats.light_us) = (self.resident.lit_sprites, self.resident.light_us);
         self.ring
