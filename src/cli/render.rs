@@ -304,3 +304,27 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     );
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shading_flag_names_the_two_models_and_overrides_the_table() {
+        assert_eq!(parse_shading("wang"), Ok(ShadingModel::Wang));
+        assert_eq!(
+            parse_shading("harris-lastra"),
+            Ok(ShadingModel::HarrisLastra)
+        );
+        let err = parse_shading("phong").unwrap_err();
+        assert!(err.contains("wang or harris-lastra"), "{err}");
+        let look = LookArgs {
+            shading: Some(ShadingModel::HarrisLastra),
+            ..LookArgs::default()
+        };
+        let (_, table) = look.load().unwrap();
+        assert_eq!(table.shading.model, ShadingModel::HarrisLastra);
+        let (_, table) = LookArgs::default().load().unwrap();
+        assert_eq!(table.shading.model, ShadingModel::Wang);
+    }
+}

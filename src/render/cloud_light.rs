@@ -95,7 +95,7 @@ impl CloudLight {
             self.particles
                 .extend(cloud.sprites.iter().map(|s| Particle {
                     centre_m: s.offset_m,
-                    radius_m: (0.25 * (s.width_m + s.height_m)).max(1e-3),
+                    radius_m: (0.5 * s.width_m.max(s.height_m)).max(1e-3),
                     density: if s.precipitation { 0.0 } else { s.alpha_morph },
                 }));
             settings.light(
