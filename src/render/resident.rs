@@ -12,7 +12,7 @@ use std::ops::Range;
 
 use glam::{DVec3, Vec3};
 
-use super::cloud_light::CloudLight;
+use super::cloud_light::{BlockLight, CloudLight};
 use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT};
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
@@ -70,11 +70,8 @@ pub(super) struct Resident {
     pub place: Option<(Range<u32>, Range<u32>)>,
     /// Written to its slots yet.
     pub uploaded: bool,
-    /// The sun direction its Harris and Lastra light was computed for, if it was (not when
-    /// its light is provisional), and that light (packed, its sprites' order; the skylight
-    /// bytes are kept when the sun's are computed again).
-    pub lit_for: Option<Vec3>,
-    pub lights: Vec<u32>,
+    /// Its Harris and Lastra light (empty under Wang's model).
+    pub light: BlockLight,
     /// Drawn as sprites this frame (not in the impostor ring); set by the ring's split.
     pub near: bool,
     pub clouds: Vec<CloudState>,
@@ -112,8 +109,7 @@ impl Resident {
             check: None,
             place: None,
             uploaded: false,
-            lit_for: None,
-            lights: Vec::new(),
+            light: BlockLight::default(),
             near: true,
             clouds,
         }
@@ -483,7 +479,7 @@ impl ResidentSet {
         let mut light_left = if budget == u32::MAX {
             u32::MAX
         } else {
-            self.light.budget()
+            self.light.budget().saturating_sub(self.lit_sprites)
         };
         let mut todo: Vec<(f64, &mut Resident)> = self
             .blocks
@@ -497,7 +493,9 @@ impl ResidentSet {
             if written > 0 && written >= budget {
                 break;
             }
-            let Some((s, c)) = &r.place else { continue };
+            let Some((s, c)) = r.place.clone() else {
+                continue;
+            };
             written = written.saturating_add(s.end - s.start);
             sprites.clear();
             clouds.clear();
@@ -523,18 +521,11 @@ impl ResidentSet {
             }
             bytes += sprites.len() as u64 * sprite_bytes + clouds.len() as u64 * cloud_bytes;
             r.uploaded = true;
-            r.lit_for = None;
             if self.light.enabled() {
-                let n = s.end - s.start;
-                if n <= light_left {
-                    self.light.block(&r.block, &mut r.lights, false);
-                    r.lit_for = Some(self.light.sun_dir);
-                    light_left -= n;
-                    self.lit_sprites += n;
-                } else {
-                    self.light.provisional(&r.block, &mut r.lights);
-                }
-                bytes += write_lights(queue, &self.light_buffer, s.start, &r.lights);
+                let to = (queue, &self.light_buffer, s.start);
+                let (light_bytes, lit) = self.light.written(r, to, &mut light_left);
+                bytes += light_bytes;
+                self.lit_sprites += lit;
             }
         }
         if self.light.enabled() {
@@ -542,72 +533,6 @@ impl ResidentSet {
         }
         bytes
     }
-
-    /// Gives every written block a provisional Harris and Lastra light (the model was just
-    /// switched on; [`Self::relight`] refines them, a budget a frame); returns the bytes.
-    pub fn provisional_all(&mut self, queue: &wgpu::Queue) -> u64 {
-        let start = std::time::Instant::now();
-        let mut bytes = 0;
-        for r in self.blocks.values_mut() {
-            let Some((s, _)) = &r.place else { continue };
-            if !r.uploaded {
-                continue;
-            }
-            self.light.provisional(&r.block, &mut r.lights);
-            bytes += write_lights(queue, &self.light_buffer, s.start, &r.lights);
-            r.lit_for = None;
-        }
-        self.light_us += start.elapsed().as_micros() as u64;
-        bytes
-    }
-
-    /// Computes again the Harris and Lastra light of written blocks lit for another sun than
-    /// the current lit direction, nearest to `camera_m` first, until the budget of sprites a
-    /// frame is spent (at least one block); returns the bytes written.
-    pub fn relight(&mut self, queue: &wgpu::Queue, camera_m: DVec3) -> u64 {
-        if !self.light.enabled() {
-            return 0;
-        }
-        let start = std::time::Instant::now();
-        let target = self.light.sun_dir;
-        let mut stale: Vec<(f64, &mut Resident)> = self
-            .blocks
-            .values_mut()
-            .filter(|r| r.place.is_some() && r.uploaded && r.lit_for != Some(target))
-            .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
-            .collect();
-        if stale.is_empty() {
-            return 0;
-        }
-        stale.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.block.id.cmp(&b.1.block.id)));
-        // What this frame's arrivals left of the budget (at least one block a frame).
-        let budget = self.light.budget().saturating_sub(self.lit_sprites);
-        let (mut lit, mut bytes) = (0u32, 0u64);
-        for (_, r) in stale {
-            if lit > 0 && lit >= budget {
-                break;
-            }
-            let Some((s, _)) = &r.place else { continue };
-            // A provisional light's skylight is provisional too.
-            let sky_known = r.lit_for.is_some();
-            self.light.block(&r.block, &mut r.lights, sky_known);
-            bytes += write_lights(queue, &self.light_buffer, s.start, &r.lights);
-            r.lit_for = Some(target);
-            lit += s.end - s.start;
-        }
-        self.lit_sprites += lit;
-        self.light_us += start.elapsed().as_micros() as u64;
-        bytes
-    }
-}
-
-/// Writes packed lights at sprite slot `first`; returns the bytes.
-fn write_lights(queue: &wgpu::Queue, buffer: &wgpu::Buffer, first: u32, lights: &[u32]) -> u64 {
-    if lights.is_empty() {
-        return 0;
-    }
-    queue.write_buffer(buffer, first as u64 * 4, bytemuck::cast_slice(lights));
-    lights.len() as u64 * 4
 }
 
 /// A storage buffer the queue writes into, of at least 16 bytes.
