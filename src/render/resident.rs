@@ -474,9 +474,11 @@ impl ResidentSet {
         let mut bytes = 0;
         let mut sprites: Vec<GpuSprite> = Vec::new();
         let mut clouds: Vec<GpuCloud> = Vec::new();
-        // A whole rewrite is lit at once; blocks arriving one by one within the frame's budget.
-        let light_start = std::time::Instant::now();
-        let mut light_left = if budget == u32::MAX {
+        // A scene written whole and new (the first frame) is lit at once; blocks arriving one by
+        // one, or many after the buffers grew, within the frame's budget.
+        let mut light_us = 0;
+        let fresh = budget == u32::MAX && self.blocks.values().all(|r| r.light.lights.is_empty());
+        let mut light_left = if fresh {
             u32::MAX
         } else {
             self.light.budget().saturating_sub(self.lit_sprites)
@@ -522,15 +524,15 @@ impl ResidentSet {
             bytes += sprites.len() as u64 * sprite_bytes + clouds.len() as u64 * cloud_bytes;
             r.uploaded = true;
             if self.light.enabled() {
+                let light_start = std::time::Instant::now();
                 let to = (queue, &self.light_buffer, s.start);
                 let (light_bytes, lit) = self.light.written(r, to, &mut light_left);
+                light_us += light_start.elapsed().as_micros() as u64;
                 bytes += light_bytes;
                 self.lit_sprites += lit;
             }
         }
-        if self.light.enabled() {
-            self.light_us += light_start.elapsed().as_micros() as u64;
-        }
+        self.light_us += light_us;
         bytes
     }
 }
