@@ -1473,4 +1473,20 @@ fn harris_lastra_darkens_a_cumulus_body_against_a_low_sun() {
         bright > 1.5 * hl_body,
         "no bright rim: {bright} vs body {hl_body}"
     );
+    // The light is computed again only after the sun turned more than 1 degree.
+    let mut lit_after = |azimuth_deg: f64| {
+        let sun = SunPosition {
+            azimuth_deg,
+            ..low_sun
+        };
+        let (_, stats) = rig.host.frame(&camera, &sun, 0.1, 40_000.0).unwrap();
+        stats.sprites_lit
+    };
+    assert_eq!(lit_after(270.5), 0, "half a degree: nothing relit");
+    assert_eq!(
+        lit_after(272.0),
+        180,
+        "two degrees: the cloud's 180 sprites"
+    );
+    assert_eq!(lit_after(272.5), 0, "half a degree from the last light");
 }
