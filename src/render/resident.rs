@@ -18,9 +18,8 @@ use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
 
 /// Bytes of GPU memory each sprite slot costs: its record, its order entry and its Harris and
-/// Lastra light (a cloud's record
-/// and list entry come on top, about a twentieth of it for 30-sprite clouds; the quad indices
-/// are for the sprites drawn, not held).
+/// Lastra light (a cloud's record and list entry come on top, about a twentieth of it for
+/// 30-sprite clouds; the quad indices are for the sprites drawn, not held).
 pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4 + 4;
 
 /// A cloud's bounds (computed once when its block arrives) and its order cache.

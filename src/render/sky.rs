@@ -6,7 +6,7 @@
 //! writes it): the sky gradient and sun where the host drew nothing, the cloud sprites with soft
 //! depth fades (Bahnassi), and in-cloud fog (Wang 7.1).
 //!
-//! The device needs 6 storage buffers per shader stage (WebGPU's default limit is 8) and compute
+//! The device needs 7 storage buffers per shader stage (WebGPU's default limit is 8) and compute
 //! shaders. The host's depth texture needs `TEXTURE_BINDING` usage; it is read through the
 //! host's own projection ([`SkyView`]) in the convention its [`HostTargets`] name (standard or
 //! reversed Z, one sample or four).
@@ -141,9 +141,9 @@ impl Sky {
     ) -> Result<Self, RenderError> {
         config.targets.validate()?;
         let stage_buffers = device.limits().max_storage_buffers_per_shader_stage;
-        if stage_buffers < 6 {
+        if stage_buffers < 7 {
             return Err(RenderError::Device(format!(
-                "the sky builds its sprites in a compute pass reading 6 storage buffers (WebGPU's default limit is 8); this device was created with {stage_buffers}"
+                "the sky builds its sprites in a compute pass reading 7 storage buffers (WebGPU's default limit is 8); this device was created with {stage_buffers}"
             )));
         }
         let sheet = &config.sheet;
