@@ -243,7 +243,7 @@ impl ResidentSet {
         stale.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.block.id.cmp(&b.1.block.id)));
         let budget = self.light.budget().saturating_sub(self.lit_sprites);
         let (mut lit, mut bytes) = (0u32, 0u64);
-        'blocks: for (_, r) in stale {
+        for (_, r) in stale {
             let Some((s, _)) = r.place.clone() else {
                 continue;
             };
@@ -257,20 +257,30 @@ impl ResidentSet {
                 Some((sun, next, with_sky)) if sun == target => (next, with_sky),
                 _ => (0, !light.sky_exact),
             };
+            // The clouds lit this frame are next to each other: one write a block.
+            let from = r.clouds.get(next).map_or(0, |c| c.sprite_base - s.start) as usize;
+            let mut to = from;
+            let mut done = true;
             while next < r.block.clouds.len() {
                 if lit > 0 && lit >= budget {
                     light.pass = Some((target, next, with_sky));
-                    break 'blocks;
+                    done = false;
+                    break;
                 }
                 let cloud = &r.block.clouds[next];
-                let first = r.clouds[next].sprite_base - s.start;
-                let span = first as usize..first as usize + cloud.sprites.len();
+                let first = (r.clouds[next].sprite_base - s.start) as usize;
+                to = first + cloud.sprites.len();
                 self.light
-                    .cloud(cloud, with_sky, &mut light.lights[span.clone()]);
-                let to = (queue, &self.light_buffer, s.start);
-                bytes += write_lights(to, first, &light.lights[span]);
+                    .cloud(cloud, with_sky, &mut light.lights[first..to]);
                 lit += cloud.sprites.len() as u32;
                 next += 1;
+            }
+            if to > from {
+                let at = (queue, &self.light_buffer, s.start);
+                bytes += write_lights(at, from as u32, &light.lights[from..to]);
+            }
+            if !done {
+                break;
             }
             (light.lit_for, light.pass) = (Some(target), None);
             light.sky_exact |= with_sky;
