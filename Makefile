@@ -36,6 +36,8 @@ SKYCAST := cargo run --quiet --
 METARS := weather/awc-metars-2025-01-27T22Z.cache.csv
 THEME = $(SKYCAST) render --at 28.5,-81.45 --time 2025-01-27T19:00:00Z --size 480x270
 FRAME = $(SKYCAST) render --size 640x360
+# The two shading models side by side (README, "Two shading models").
+SHADING = $(SKYCAST) render --weather weather/themes/fair_weather_cumulus.toml --at 28.5,-81.45 --size 480x270
 pictures: vulkan
 	$(SKYCAST) sheet --out /tmp/skycast-sheet.png --over-sky tests/pictures/sheet_over_sky.png
 	$(SKYCAST) preview --type cumulus_mediocris --lifecycle --out tests/pictures/lifecycle.png
@@ -55,6 +57,11 @@ pictures: vulkan
 	$(FRAME) --weather $(METARS) --at 53.43,-6.10 --time 2025-01-27T14:00:00Z --alt-ft 700 --heading 280 --pitch 12 --out tests/pictures/airports/dublin_approach.png
 	$(FRAME) --weather $(METARS) --at -4.80,136.887 --alt-ft 900 --heading 0 --pitch 14 --out tests/pictures/airports/timika_cb.png
 	$(FRAME) --weather weather/themes/low_stratus_and_fog.toml --at 28.5,-81.45 --time 2025-01-27T13:30:00Z --alt-ft 450 --heading 90 --pitch -4 --out tests/pictures/airports/fog_morning.png
+	for m in wang harris_lastra; do \
+		$(SHADING) --shading $$m --time 2025-01-27T19:00:00Z --alt-ft 2500 --heading 90 --pitch 6 --out tests/pictures/shading/noon_$$m.png && \
+		$(SHADING) --shading $$m --time 2025-01-27T22:30:00Z --alt-ft 4500 --heading 246 --pitch 3 --out tests/pictures/shading/low_sun_$$m.png && \
+		$(SHADING) --shading $$m --time 2025-01-27T22:52:00Z --alt-ft 3000 --heading 150 --pitch 5 --out tests/pictures/shading/dusk_$$m.png || exit 1; \
+	done
 
 # Runs every cargo-fuzz target for FUZZ_SECONDS each (see fuzz/README.md); needs cargo-fuzz.
 FUZZ_SECONDS ?= 120

@@ -65,6 +65,8 @@ struct SpriteView {
     mapping_g: vec4<f32>,
     forward_lock: vec4<f32>,
     upright_lifecycle: vec4<f32>,
+    hl_phase: vec4<f32>,
+    hl_sky: vec4<f32>,
     locks: array<Lock, 128>,
 };
 
@@ -82,6 +84,9 @@ struct Draws {
 @group(0) @binding(3) var<storage, read> orders: array<u32>;
 @group(1) @binding(0) var<storage, read> sprites: array<Sprite>;
 @group(1) @binding(1) var<storage, read> clouds: array<Cloud>;
+// Per sprite slot its Harris and Lastra light (src/render/cloud_light.rs): bytes 0, 1, 2 the
+// sun's direct and total light and the skylight that reach it, fractions.
+@group(1) @binding(2) var<storage, read> lights: array<u32>;
 
 // One built corner. Keep in sync with `GpuSpriteVertex` in src/render/gpu_types.rs.
 struct BuiltCorner {
@@ -177,6 +182,21 @@ fn forward_percent(view_dir: vec3<f32>, rim: f32) -> f32 {
     let lobe = base * sqrt(base);
     let r = clamp(rim, 0.0, 1.0);
     return view.forward_lock.x * lobe * r * r * r * r;
+}
+
+// Harris and Lastra 2001: the light a sprite scatters towards the eye. `light` is its packed
+// light (direct sun, total sun, sky); the direct sun goes through the phase function (a
+// Henyey-Greenstein lobe plus an isotropic rest), the light scattered forward on its way in and
+// the skylight count as isotropic; plus the ambient term. Same as HarrisLastra::phase.
+fn harris_lastra_rgb(light: vec4<f32>, view_dir: vec3<f32>) -> vec3<f32> {
+    let hl = view.hl_phase;
+    let g = hl.y;
+    let cos_sun = clamp(dot(view_dir, view.sun_dir_camera_z.xyz), -1.0, 1.0);
+    let base = 1.0 + g * g - 2.0 * g * cos_sun;
+    let hg = (1.0 - g * g) / (base * sqrt(base));
+    let phase = (1.0 - hl.z) + hl.z * hg;
+    let sun = view.directional_ambient.rgb * hl.w * (light.x * phase + max(light.y - light.x, 0.0));
+    return sun + view.hl_sky.rgb * light.z + vec3<f32>(view.hl_sky.w);
 }
 
 // Wang 4: forming, the inner sprites fade in first; dissipating, the outer ones go first.
@@ -312,6 +332,8 @@ fn build_sprite(k: u32, at: u32) {
     let evenness = deck_evenness(cloud, view.sun_dir_camera_z.w, sun.z);
     // Keep in sync with `SPRITE_PRECIPITATION` in src/render/gpu_types.rs.
     let rain = (s.bits & 512u) != 0u;
+    let harris_lastra = view.hl_phase.x > 0.5;
+    let hl_light = unpack4x8unorm(lights[slot]);
     for (var c = 0u; c < 4u; c++) {
         let corner = vec2<f32>(f32(c & 1u), 1.0 - f32(c >> 1u));
         let p = offset + right * ((corner.x - 0.5) * width) + up * ((corner.y - 0.5) * height);
@@ -327,9 +349,14 @@ fn build_sprite(k: u32, at: u32) {
         let above_base = height_msl - cloud.level_height.x;
         let sun_here = select(1.0, smoothstep(0.0, shaded_base, above_base), shaded_base > 0.0);
         let directional = mix(wang, view.mapping_g.y, evenness) * light.rgb * sun_here;
-        let lit = ambient.rgb * light.w + directional;
+        var lit = ambient.rgb * light.w + directional;
+        var base_rgb = ambient.rgb * light.w;
+        if (harris_lastra) {
+            lit = harris_lastra_rgb(hl_light, view_dir);
+            base_rgb = view.hl_sky.rgb * hl_light.z + vec3<f32>(view.hl_sky.w);
+        }
         // Rain and snow hang in the cloud's shadow: its base colour, dimmer and greyer, no sun.
-        let shade = ambient.rgb * light.w * 0.6;
+        let shade = base_rgb * 0.6;
         let rain_rgb = mix(shade, vec3<f32>(dot(shade, vec3<f32>(0.3, 0.59, 0.11))), 0.5);
         // Texture v runs down the sheet: the top of the sprite is v = 0.
         built[at + c] = BuiltCorner(

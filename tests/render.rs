@@ -1385,3 +1385,116 @@ fn a_fog_report_hides_the_ground_beyond_its_visibility() {
         "near/far ground differ by {fogged} in fog, {unfogged} in clear air"
     );
 }
+
+/// `cumulus` three times over, turned a third and two thirds of a turn about its vertical axis:
+/// a body thick enough to hide the sun.
+fn thick_cumulus(centre: DVec3) -> SkyCloud {
+    let mut cloud = cumulus(centre);
+    let first = cloud.sprites.clone();
+    for turn in [1.0f32, 2.0] {
+        let rotation = glam::Quat::from_rotation_z(turn * std::f32::consts::TAU / 3.0);
+        cloud
+            .sprites
+            .extend(first.iter().map(|s| skycast::render::SkySprite {
+                offset_m: rotation * s.offset_m,
+                ..*s
+            }));
+    }
+    cloud
+}
+
+/// Harris and Lastra's model (`[shading] model = "harris_lastra"`) against Wang's: a cumulus
+/// between the camera and a low sun (6 degrees, straight ahead behind it) is lit through its
+/// body, so its body is darker than Wang's (whose artist levels do not know where the sun is
+/// behind the cloud) while the thin edges towards the sun stay bright; both models draw it.
+#[test]
+fn harris_lastra_darkens_a_cumulus_body_against_a_low_sun() {
+    use skycast::shading::ShadingModel;
+    let mut rig = Rig::new(flat_ground(0.0));
+    let base = 1200.0;
+    // The sun 6 degrees up rises 170 m over the 1.6 km to the cloud: behind its middle.
+    let camera = rig.camera(DVec3::new(0.0, 0.0, base + 40.0), 270.0, 4.0);
+    let low_sun = SunPosition {
+        elevation_deg: 6.0,
+        azimuth_deg: 270.0,
+        declination_deg: 0.0,
+    };
+    let frame = |rig: &mut Rig, name: &str| {
+        let (frame, _) = rig.host.frame(&camera, &low_sun, 0.0, 40_000.0).unwrap();
+        let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
+        std::fs::create_dir_all(&dir).unwrap();
+        frame.write_png(&dir.join(format!("{name}.png"))).unwrap();
+        frame
+    };
+    let empty = frame(&mut rig, "low_sun_empty");
+    rig.set_clouds(vec![SkyBlock {
+        id: 1,
+        centre_m: DVec3::new(-1600.0, 0.0, base),
+        clouds: vec![thick_cumulus(DVec3::new(-1600.0, 0.0, base))],
+    }]);
+    assert_eq!(rig.host.sky.shading_model(), ShadingModel::Wang);
+    let wang = frame(&mut rig, "low_sun_wang");
+    rig.host.sky.set_shading_model(ShadingModel::HarrisLastra);
+    let hl = frame(&mut rig, "low_sun_harris_lastra");
+    // The cloud: where either frame differs from the empty one.
+    let differs = |f: &Frame, i: usize| {
+        let (a, b) = (f.rgba[i], empty.rgba[i]);
+        (0..3).any(|c| (a[c] - b[c]).abs() > 0.03)
+    };
+    let cloud: Vec<usize> = (0..empty.rgba.len())
+        .filter(|&i| differs(&wang, i) && differs(&hl, i))
+        .collect();
+    let share = cloud.len() as f32 / empty.rgba.len() as f32;
+    assert!(share > 0.03, "the cumulus covers {share} of the frame");
+    // Its body: the middle half of the cloud's box on screen.
+    let (xs, ys): (Vec<usize>, Vec<usize>) = cloud
+        .iter()
+        .map(|&i| (i % W as usize, i / W as usize))
+        .unzip();
+    let (x0, x1) = (*xs.iter().min().unwrap(), *xs.iter().max().unwrap());
+    let (y0, y1) = (*ys.iter().min().unwrap(), *ys.iter().max().unwrap());
+    let inner = |i: &&usize| {
+        let (x, y) = (*i % W as usize, *i / W as usize);
+        4 * x > 3 * x0 + x1 && 4 * x < x0 + 3 * x1 && 4 * y > 3 * y0 + y1 && 4 * y < y0 + 3 * y1
+    };
+    let body: Vec<usize> = cloud.iter().filter(inner).copied().collect();
+    assert!(body.len() > 200, "{} body pixels", body.len());
+    let mean = |f: &Frame, px: &[usize]| {
+        px.iter().map(|&i| luminance(f.rgba[i])).sum::<f32>() / px.len() as f32
+    };
+    let (wang_body, hl_body) = (mean(&wang, &body), mean(&hl, &body));
+    eprintln!(
+        "cumulus against a 6 degree sun: body luminance Wang {wang_body:.3}, Harris-Lastra {hl_body:.3} ({:.2}x); cloud {} px, body {} px",
+        hl_body / wang_body,
+        cloud.len(),
+        body.len()
+    );
+    assert!(
+        hl_body < 0.75 * wang_body,
+        "the body is not darker: Wang {wang_body}, Harris-Lastra {hl_body}"
+    );
+    // The bright rim: the brightest tenth of the cloud's pixels is well above its body.
+    let mut lum: Vec<f32> = cloud.iter().map(|&i| luminance(hl.rgba[i])).collect();
+    lum.sort_by(f32::total_cmp);
+    let bright = lum[lum.len() * 9 / 10];
+    assert!(
+        bright > 1.5 * hl_body,
+        "no bright rim: {bright} vs body {hl_body}"
+    );
+    // The light is computed again only after the sun turned more than 1 degree.
+    let mut lit_after = |azimuth_deg: f64| {
+        let sun = SunPosition {
+            azimuth_deg,
+            ..low_sun
+        };
+        let (_, stats) = rig.host.frame(&camera, &sun, 0.1, 40_000.0).unwrap();
+        stats.sprites_lit
+    };
+    assert_eq!(lit_after(270.5), 0, "half a degree: nothing relit");
+    assert_eq!(
+        lit_after(272.0),
+        180,
+        "two degrees: the cloud's 180 sprites"
+    );
+    assert_eq!(lit_after(272.5), 0, "half a degree from the last light");
+}

@@ -149,6 +149,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "cloud_scale",
         "cloud_target_bytes",
         "in_cloud",
+        "light_us",
+        "sprites_lit",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
@@ -221,6 +223,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             stats.cloud_scale.to_string(),
             stats.cloud_target_bytes.to_string(),
             format!("{:.2}", stats.in_cloud),
+            stats.light_us.to_string(),
+            stats.sprites_lit.to_string(),
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);

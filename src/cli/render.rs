@@ -9,7 +9,7 @@ use glam::DVec2;
 use skycast::demo::{DemoHost, GroundSettings, HeightField, demo_ground};
 use skycast::flight::SkySystemConfig;
 use skycast::render::RenderSettings;
-use skycast::shading::{TimeOfDayTable, sun_position};
+use skycast::shading::{ShadingModel, TimeOfDayTable, sun_position};
 use skycast::weather::{LocalFrame, METRES_PER_FOOT, WeatherField};
 
 use super::weather::{DEFAULT_STATIONS, Loaded, load, parse_lat_lon};
@@ -69,6 +69,11 @@ pub struct LookArgs {
     /// Time-of-day table (default: the shipped config/time_of_day.toml).
     #[arg(long)]
     pub time_of_day: Option<PathBuf>,
+    /// Cloud shading model: `wang` (Wang 2003's artist model) or `harris-lastra` (Harris and
+    /// Lastra 2001: light through the cloud, phase function, skylight) (default: the
+    /// time-of-day table's `[shading] model`).
+    #[arg(long, value_parser = parse_shading)]
+    pub shading: Option<ShadingModel>,
 }
 
 impl LookArgs {
@@ -79,6 +84,12 @@ impl LookArgs {
             self.time_of_day.as_ref(),
             self.cloud_scale,
         )
+        .map(|(settings, mut table)| {
+            if let Some(model) = self.shading {
+                table.shading.model = model;
+            }
+            (settings, table)
+        })
     }
 }
 
@@ -179,6 +190,12 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((side(w)?, side(h)?))
 }
 
+/// Parses `--shading`: wang, or harris-lastra (or harris_lastra).
+pub fn parse_shading(text: &str) -> Result<ShadingModel, String> {
+    ShadingModel::from_name(text.trim())
+        .ok_or_else(|| format!("`{text}` is not a shading model: wang or harris-lastra"))
+}
+
 /// Parses `--cloud-scale`: 1, 1/2 or 1/4 (or 0.5, 0.25).
 pub fn parse_cloud_scale(text: &str) -> Result<f32, String> {
     let scale = match text.trim() {
@@ -263,7 +280,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     let ground_m = ground.height_at_m(glam::DVec2::ZERO);
     println!(
-        "{}: {}x{} on {} ({:?}); sun elevation {:.1} deg, azimuth {:.1} deg; camera {:.0} ft MSL, {:.0} ft above the ground; {} clouds, {} sprites; CPU update {} us",
+        "{}: {}x{} on {} ({:?}); sun elevation {:.1} deg, azimuth {:.1} deg; camera {:.0} ft MSL, {:.0} ft above the ground; {} clouds, {} sprites; CPU update {} us{}",
         args.out.display(),
         frame.width,
         frame.height,
@@ -276,6 +293,38 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         stats.clouds_drawn,
         stats.sprites_drawn,
         stats.cpu_update_us,
+        if stats.sprites_lit > 0 {
+            format!(
+                " (Harris-Lastra light of {} sprites: {} us)",
+                stats.sprites_lit, stats.light_us
+            )
+        } else {
+            String::new()
+        },
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shading_flag_names_the_two_models_and_overrides_the_table() {
+        assert_eq!(parse_shading("wang"), Ok(ShadingModel::Wang));
+        assert_eq!(
+            parse_shading("harris-lastra"),
+            Ok(ShadingModel::HarrisLastra)
+        );
+        let err = parse_shading("phong").unwrap_err();
+        assert!(err.contains("wang or harris-lastra"), "{err}");
+        let look = LookArgs {
+            shading: Some(ShadingModel::HarrisLastra),
+            ..LookArgs::default()
+        };
+        let (_, table) = look.load().unwrap();
+        assert_eq!(table.shading.model, ShadingModel::HarrisLastra);
+        let (_, table) = LookArgs::default().load().unwrap();
+        assert_eq!(table.shading.model, ShadingModel::Wang);
+    }
 }

@@ -198,10 +198,16 @@ pub struct GpuSpriteView {
     /// x, y: sines of the upright fade start and end angles; z: lifecycle inner radius fraction;
     /// w: lifecycle outer start opacity.
     pub upright_lifecycle: [f32; 4],
+    /// Harris and Lastra: x 1 for that model (0 Wang's); y: the phase function's
+    /// Henyey-Greenstein g; z: its lobe weight; w: the sun's strength.
+    pub hl_phase: [f32; 4],
+    /// Harris and Lastra: rgb the skylight (the sky's mean colour times its strength); w: the
+    /// ambient grey.
+    pub hl_sky: [f32; 4],
     /// The locked facings.
     pub locks: [GpuLock; MAX_LOCKS],
 }
-const _: () = assert!(std::mem::size_of::<GpuSpriteView>() == 80 + 48 * MAX_LOCKS);
+const _: () = assert!(std::mem::size_of::<GpuSpriteView>() == 112 + 48 * MAX_LOCKS);
 
 /// Per-frame uniform of the demo terrain. Keep in sync with `shaders/terrain.wgsl`.
 #[repr(C)]

@@ -6,6 +6,9 @@
 //! it).
 //!
 //! - `resident`, `slots`: the sprites and clouds on the GPU, each block in slots it keeps.
+//! - `cloud_light`: under Harris and Lastra's model, the light each resident sprite gets through
+//!   its cloud (computed on the CPU when a block arrives and after the sun turned, a budget a
+//!   frame), in a buffer beside the sprites.
 //! - `draw_list`: per frame on the CPU: the near blocks back to front, each block's cloud list
 //!   and each cloud's sprite order recomputed only when Wang's cache thresholds say (6.1), the
 //!   facing locks (3.3), the draw list. `sprite_view`: a view's uniform, draw list, lists and
@@ -24,6 +27,7 @@
 
 mod build;
 pub mod camera;
+mod cloud_light;
 pub mod cloud_target;
 pub mod draw_list;
 pub mod gpu_types;

@@ -12,14 +12,15 @@ use std::ops::Range;
 
 use glam::{DVec3, Vec3};
 
+use super::cloud_light::{BlockLight, CloudLight};
 use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT};
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
 
-/// Bytes of GPU memory each sprite slot costs: its record and its order entry (a cloud's record
-/// and list entry come on top, about a twentieth of it for 30-sprite clouds; the quad indices
-/// are for the sprites drawn, not held).
-pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4;
+/// Bytes of GPU memory each sprite slot costs: its record, its order entry and its Harris and
+/// Lastra light (a cloud's record and list entry come on top, about a twentieth of it for
+/// 30-sprite clouds; the quad indices are for the sprites drawn, not held).
+pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4 + 4;
 
 /// A cloud's bounds (computed once when its block arrives) and its order cache.
 #[derive(Debug, Clone)]
@@ -68,6 +69,8 @@ pub(super) struct Resident {
     pub place: Option<(Range<u32>, Range<u32>)>,
     /// Written to its slots yet.
     pub uploaded: bool,
+    /// Its Harris and Lastra light (empty under Wang's model).
+    pub light: BlockLight,
     /// Drawn as sprites this frame (not in the impostor ring); set by the ring's split.
     pub near: bool,
     pub clouds: Vec<CloudState>,
@@ -105,6 +108,7 @@ impl Resident {
             check: None,
             place: None,
             uploaded: false,
+            light: BlockLight::default(),
             near: true,
             clouds,
         }
@@ -191,6 +195,13 @@ pub(super) struct ResidentSet {
     limit_sprites: u32,
     pub sprite_buffer: wgpu::Buffer,
     pub cloud_buffer: wgpu::Buffer,
+    /// Per sprite slot its Harris and Lastra light (`cloud_light`; zeros under Wang's model).
+    pub light_buffer: wgpu::Buffer,
+    /// The Harris and Lastra light's state (off under Wang's model).
+    pub light: CloudLight,
+    /// Sprites lit this frame (written or relit), and the CPU time it took, microseconds.
+    pub lit_sprites: u32,
+    pub light_us: u64,
     /// The sky camera's per-cloud orders, at the clouds' sprite slots.
     pub order_buffer: wgpu::Buffer,
     /// The sky camera's per-block cloud lists, at the blocks' cloud slots.
@@ -239,7 +250,7 @@ impl ResidentSet {
         };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sky.resident_layout"),
-            entries: &[storage(0), storage(1)],
+            entries: &[storage(0), storage(1), storage(2)],
         });
         let sprites = FIRST_SPRITES.min(limit_sprites.max(1));
         let b = buffers(device, &layout, sprites, FIRST_CLOUDS);
@@ -251,6 +262,10 @@ impl ResidentSet {
             limit_sprites,
             sprite_buffer: b.sprites,
             cloud_buffer: b.clouds,
+            light_buffer: b.lights,
+            light: CloudLight::default(),
+            lit_sprites: 0,
+            light_us: 0,
             order_buffer: b.orders,
             list_buffer: b.lists,
             layout,
@@ -272,6 +287,7 @@ impl ResidentSet {
     pub fn gpu_bytes(&self) -> u64 {
         self.sprite_buffer.size()
             + self.cloud_buffer.size()
+            + self.light_buffer.size()
             + self.order_buffer.size()
             + self.list_buffer.size()
     }
@@ -427,6 +443,7 @@ impl ResidentSet {
         let b = buffers(&self.device, &self.layout, sprites, clouds);
         self.sprite_buffer = b.sprites;
         self.cloud_buffer = b.clouds;
+        self.light_buffer = b.lights;
         self.order_buffer = b.orders;
         self.list_buffer = b.lists;
         self.group = b.group;
@@ -459,6 +476,15 @@ impl ResidentSet {
         let mut bytes = 0;
         let mut sprites: Vec<GpuSprite> = Vec::new();
         let mut clouds: Vec<GpuCloud> = Vec::new();
+        // A scene written whole and new (the first frame) is lit at once; blocks arriving one by
+        // one, or many after the buffers grew, within the frame's budget.
+        let mut light_us = 0;
+        let fresh = budget == u32::MAX && self.blocks.values().all(|r| r.light.lights.is_empty());
+        let mut light_left = if fresh {
+            u32::MAX
+        } else {
+            self.light.budget().saturating_sub(self.lit_sprites)
+        };
         let mut todo: Vec<(f64, &mut Resident)> = self
             .blocks
             .values_mut()
@@ -471,7 +497,9 @@ impl ResidentSet {
             if written > 0 && written >= budget {
                 break;
             }
-            let Some((s, c)) = &r.place else { continue };
+            let Some((s, c)) = r.place.clone() else {
+                continue;
+            };
             written = written.saturating_add(s.end - s.start);
             sprites.clear();
             clouds.clear();
@@ -497,7 +525,16 @@ impl ResidentSet {
             }
             bytes += sprites.len() as u64 * sprite_bytes + clouds.len() as u64 * cloud_bytes;
             r.uploaded = true;
+            if self.light.enabled() {
+                let light_start = std::time::Instant::now();
+                let to = (queue, &self.light_buffer, s.start);
+                let (light_bytes, lit) = self.light.written(r, to, &mut light_left);
+                light_us += light_start.elapsed().as_micros() as u64;
+                bytes += light_bytes;
+                self.lit_sprites += lit;
+            }
         }
+        self.light_us += light_us;
         bytes
     }
 }
@@ -516,6 +553,7 @@ pub(super) fn storage_buffer(device: &wgpu::Device, label: &str, bytes: u64) -> 
 struct Buffers {
     sprites: wgpu::Buffer,
     clouds: wgpu::Buffer,
+    lights: wgpu::Buffer,
     orders: wgpu::Buffer,
     lists: wgpu::Buffer,
     group: wgpu::BindGroup,
@@ -537,6 +575,7 @@ fn buffers(
         "sky.clouds",
         clouds as u64 * std::mem::size_of::<GpuCloud>() as u64,
     );
+    let light_buffer = storage("sky.sprite_lights", sprites as u64 * 4);
     let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("sky.resident_group"),
         layout,
@@ -549,11 +588,16 @@ fn buffers(
                 binding: 1,
                 resource: cloud_buffer.as_entire_binding(),
             },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: light_buffer.as_entire_binding(),
+            },
         ],
     });
     Buffers {
         sprites: sprite_buffer,
         clouds: cloud_buffer,
+        lights: light_buffer,
         orders: storage("sky.orders", sprites as u64 * 4),
         lists: storage(
             "sky.lists",

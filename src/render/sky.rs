@@ -6,7 +6,7 @@
 //! writes it): the sky gradient and sun where the host drew nothing, the cloud sprites with soft
 //! depth fades (Bahnassi), and in-cloud fog (Wang 7.1).
 //!
-//! The device needs 6 storage buffers per shader stage (WebGPU's default limit is 8) and compute
+//! The device needs 7 storage buffers per shader stage (WebGPU's default limit is 8) and compute
 //! shaders. The host's depth texture needs `TEXTURE_BINDING` usage; it is read through the
 //! host's own projection ([`SkyView`]) in the convention its [`HostTargets`] name (standard or
 //! reversed Z, one sample or four).
@@ -143,9 +143,9 @@ impl Sky {
     ) -> Result<Self, RenderError> {
         config.targets.validate()?;
         let stage_buffers = device.limits().max_storage_buffers_per_shader_stage;
-        if stage_buffers < 6 {
+        if stage_buffers < 7 {
             return Err(RenderError::Device(format!(
-                "the sky builds its sprites in a compute pass reading 6 storage buffers (WebGPU's default limit is 8); this device was created with {stage_buffers}"
+                "the sky builds its sprites in a compute pass reading 7 storage buffers (WebGPU's default limit is 8); this device was created with {stage_buffers}"
             )));
         }
         let sheet = &config.sheet;
@@ -450,6 +450,18 @@ impl Sky {
         self.resident.blocks.get(&id).map(|r| &r.block)
     }
 
+    /// Switches the cloud shading model (`[shading] model` of the time-of-day table). Switched
+    /// to Harris and Lastra's, the clouds held get a provisional light at the next
+    /// [`Self::prepare`] and their own within the model's budget of sprites a frame.
+    pub fn set_shading_model(&mut self, model: crate::shading::ShadingModel) {
+        self.time_of_day.shading.model = model;
+    }
+
+    /// The cloud shading model in use.
+    pub fn shading_model(&self) -> crate::shading::ShadingModel {
+        self.time_of_day.shading.model
+    }
+
     /// How clouds form and dissipate (the clouds stage's `[lifecycle]`): which sprites of a
     /// forming or dissipating block show at a given progress.
     pub fn set_lifecycle(&mut self, lifecycle: LifecycleConfig) {
@@ -622,14 +634,29 @@ impl Sky {
             time_of_day: self.clear_light,
             mapping: self.time_of_day.directional_mapping,
             forward: self.time_of_day.forward_scattering,
+            model: self.time_of_day.shading.model,
+            harris_lastra: self.time_of_day.harris_lastra,
         };
         let mut stats = FrameStats::default();
-        let (mut upload_bytes, left_out) = self.resident.place_and_upload(
+        (self.resident.lit_sprites, self.resident.light_us) = (0, 0);
+        let switched_on = self.resident.light.set(
+            self.time_of_day.shading.model,
+            &self.time_of_day.harris_lastra,
+            sun_dir,
+        );
+        let mut upload_bytes = 0;
+        if switched_on {
+            upload_bytes += self.resident.provisional_all(queue);
+        }
+        let (placed_bytes, left_out) = self.resident.place_and_upload(
             queue,
             camera.position_m,
             self.settings.vertex_cache.max_uploaded_sprites_per_frame,
         );
         stats.blocks_left_out = left_out;
+        upload_bytes += placed_bytes;
+        upload_bytes += self.resident.relight(queue, camera.position_m);
+        (stats.sprites_lit, stats.light_us) = (self.resident.lit_sprites, self.resident.light_us);
         self.ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
         let resident = &mut self.resident;

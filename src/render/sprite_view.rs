@@ -11,6 +11,7 @@ use super::resident::storage_buffer;
 use super::settings::CloudSettings;
 use super::stats::Lighting;
 use crate::clouds::LifecycleConfig;
+use crate::shading::ShadingModel;
 
 /// Bytes of the view uniform before its lock table.
 const HEADER_BYTES: usize = std::mem::size_of::<GpuSpriteView>() - MAX_LOCKS * 48;
@@ -57,6 +58,7 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
     } = *light;
     let tod = &lighting.time_of_day;
     let m = &lighting.mapping;
+    let hl = &lighting.harris_lastra;
     let cos = |deg: f32| deg.to_radians().cos();
     let sin = |deg: f32| deg.to_radians().sin();
     GpuSpriteView {
@@ -75,6 +77,15 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
             lifecycle.inner_radius_fraction.max(1e-4),
             lifecycle.outer_start_opacity,
         ],
+        hl_phase: [
+            (lighting.model == ShadingModel::HarrisLastra) as u32 as f32,
+            hl.g,
+            hl.lobe_weight,
+            hl.sun_strength,
+        ],
+        hl_sky: (0.5 * (tod.sky_zenith_rgb + tod.sky_horizon_rgb) * hl.sky_strength)
+            .extend(hl.ambient * tod.ambient_percent)
+            .to_array(),
         locks: [GpuLock {
             right: [0.0; 4],
             up: [0.0; 4],

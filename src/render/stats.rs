@@ -3,7 +3,9 @@
 
 use glam::Vec3;
 
-use crate::shading::{DirectionalMapping, ForwardScattering, TimeOfDay};
+use crate::shading::{
+    DirectionalMapping, ForwardScattering, HarrisLastra, ShadingModel, TimeOfDay,
+};
 
 /// What one frame's update did and cost.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -57,6 +59,11 @@ pub struct FrameStats {
     /// Bytes of the off-screen cloud target's textures (colour, distance, farthest depth) at
     /// the last recorded frame size; 0 at scale 1.
     pub cloud_target_bytes: u64,
+    /// Sprites whose Harris and Lastra light was computed this frame (blocks written, or relit
+    /// after the sun turned); 0 under Wang's model.
+    pub sprites_lit: u32,
+    /// CPU time of that light, microseconds (part of `cpu_update_us`).
+    pub light_us: u64,
 }
 
 impl FrameStats {
@@ -78,4 +85,8 @@ pub struct Lighting {
     pub mapping: DirectionalMapping,
     /// Light scattered forward towards the eye (the silver lining).
     pub forward: ForwardScattering,
+    /// Which shading model the clouds use.
+    pub model: ShadingModel,
+    /// The Harris and Lastra model's constants.
+    pub harris_lastra: HarrisLastra,
 }

@@ -15,6 +15,9 @@
 //!   `[-1, 0] -> [Cmin, Cmedian]`, `[0, 1] -> [Cmedian, Cmax]`.
 //! - [`scatter`]: beyond Wang, light scattered forward towards the eye (Harris and Lastra
 //!   2001): the silver lining of a cloud between the camera and the sun.
+//! - [`harris_lastra`]: a second, switchable model (Harris and Lastra 2001): the light each
+//!   particle gets through the others (multiple forward scattering), a phase function towards
+//!   the eye, skylight as a second light.
 //! - [`cover`]: beyond Wang, the daylight under the clouds: how much of the sky the layers above
 //!   a point hide, and the grey, sunless light below a thick deck.
 //! - [`fog`]: the weather's visibility and obscuration as the fog a host draws (distance and
@@ -26,6 +29,7 @@ pub mod ambient;
 pub mod cover;
 pub mod directional;
 pub mod fog;
+pub mod harris_lastra;
 pub mod scatter;
 pub mod sun;
 pub mod time_of_day;
@@ -34,6 +38,10 @@ pub use ambient::{ColourLevel, ColourLevels};
 pub use cover::{OvercastLight, hidden_above};
 pub use directional::{DirectionalMapping, directional_percent};
 pub use fog::{Fog, FogSettings};
+pub use harris_lastra::{
+    HarrisLastra, LightScratch, Particle, ParticleLight, RelightTrigger, ShadingModel,
+    ShadingSettings,
+};
 pub use scatter::ForwardScattering;
 pub use sun::{SunPosition, sun_position};
 pub use time_of_day::{TimeOfDay, TimeOfDaySample, TimeOfDayTable};

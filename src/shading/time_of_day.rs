@@ -8,7 +8,10 @@ use std::path::Path;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::{DirectionalMapping, ForwardScattering, OvercastLight, ShadingError};
+use super::{
+    DirectionalMapping, ForwardScattering, HarrisLastra, OvercastLight, ShadingError,
+    ShadingSettings,
+};
 use crate::config::{ConfigError, line_of, parse_toml};
 
 /// The built-in table, `config/time_of_day.toml`.
@@ -45,6 +48,12 @@ pub struct TimeOfDayTable {
     /// Light scattered forward towards the eye (defaults when the table is absent).
     #[serde(default)]
     pub forward_scattering: ForwardScattering,
+    /// Which cloud shading model (Wang when the table is absent).
+    #[serde(default)]
+    pub shading: ShadingSettings,
+    /// The Harris and Lastra model's constants (defaults when the table is absent).
+    #[serde(default)]
+    pub harris_lastra: HarrisLastra,
 }
 
 /// The light at one moment, interpolated from the table.
@@ -118,7 +127,8 @@ impl TimeOfDayTable {
         let invalid = table
             .overcast
             .invalid_field()
-            .or(table.forward_scattering.invalid_field());
+            .or(table.forward_scattering.invalid_field())
+            .or(table.harris_lastra.invalid_field());
         if let Some((field, message)) = invalid {
             return Err(ConfigError::at_key(path, text, field, message).into());
         }
@@ -249,5 +259,34 @@ mod tests {
             err.starts_with(&format!("my_tod.toml:{line}: field `overcast.grey_from`")),
             "{err}"
         );
+    }
+
+    #[test]
+    fn the_shading_model_is_named_in_the_table_and_a_wrong_one_says_where() {
+        assert_eq!(
+            TimeOfDayTable::default().shading.model,
+            crate::shading::ShadingModel::Wang
+        );
+        let text =
+            DEFAULT_TIME_OF_DAY_TOML.replacen("model = \"wang\"", "model = \"harris_lastra\"", 1);
+        let t = TimeOfDayTable::parse(&text, Path::new("my_tod.toml")).unwrap();
+        assert_eq!(t.shading.model, crate::shading::ShadingModel::HarrisLastra);
+        let text = DEFAULT_TIME_OF_DAY_TOML.replacen("model = \"wang\"", "model = \"phong\"", 1);
+        let err = TimeOfDayTable::parse(&text, Path::new("my_tod.toml"))
+            .unwrap_err()
+            .to_string();
+        let line = 1 + DEFAULT_TIME_OF_DAY_TOML
+            .lines()
+            .position(|l| l.starts_with("model ="))
+            .unwrap();
+        assert!(
+            err.starts_with(&format!("my_tod.toml:{line}: field `model`")) && err.contains("phong"),
+            "{err}"
+        );
+        let text = DEFAULT_TIME_OF_DAY_TOML.replacen("albedo = 0.9", "albedo = 2.0", 1);
+        let err = TimeOfDayTable::parse(&text, Path::new("my_tod.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("field `harris_lastra.albedo`"), "{err}");
     }
 }

@@ -1,0 +1,292 @@
+//! The Harris and Lastra light of the resident sprites (`crate::shading::harris_lastra`): per
+//! sprite the sun's direct and total light and the skylight that reach it through its cloud,
+//! packed into one `u32` of the resident light buffer (`lights` in `shaders/sprite_build.wgsl`,
+//! at the sprite's slot). Computed on the CPU when a block is written and again after the sun
+//! turned past the threshold, within a budget of sprites a frame, nearest blocks first, a cloud
+//! at a time (at least one cloud a frame): a block that arrives past the budget is written with a
+//! provisional light and lit cloud by cloud in the next frames; a whole scene written at once
+//! (the first frame) is lit at once; a block written again (the buffers grew) keeps the light it
+//! had. The skylight, which does not move with the sun, once a block. Never under Wang's model.
+//! Its time is part of the frame's `cpu_update_us` and shown as `light_us`.
+
+use glam::{DVec3, Vec3};
+
+use super::resident::{Resident, ResidentSet};
+use super::scene::{SkyBlock, SkyCloud};
+use crate::shading::{
+    HarrisLastra, LightScratch, Particle, ParticleLight, RelightTrigger, ShadingModel,
+    harris_lastra,
+};
+
+/// The light state of the resident set: the model's settings while it is on, the sun
+/// direction the sprites are lit for, scratch space.
+#[derive(Debug, Clone)]
+pub(super) struct CloudLight {
+    /// The model's constants, `None` under Wang's model (nothing computed).
+    settings: Option<HarrisLastra>,
+    trigger: RelightTrigger,
+    /// The direction towards the sun the sprites are lit for (unit).
+    pub sun_dir: Vec3,
+    particles: Vec<Particle>,
+    scratch: LightScratch,
+    sun: Vec<ParticleLight>,
+    sky: Vec<ParticleLight>,
+}
+
+/// A block's light: its packed lights (its sprites' order) and how far they are.
+#[derive(Debug, Clone, Default)]
+pub(super) struct BlockLight {
+    /// Packed per sprite (empty until first lit).
+    pub lights: Vec<u32>,
+    /// The sun direction every cloud of it is lit for (none while provisional).
+    pub lit_for: Option<Vec3>,
+    /// Whether the skylight bytes are computed (not provisional).
+    pub sky_exact: bool,
+    /// A relight under way: the sun it is for, the next cloud, whether it computes the skylight.
+    pass: Option<(Vec3, usize, bool)>,
+}
+
+impl Default for CloudLight {
+    fn default() -> Self {
+        Self {
+            settings: None,
+            trigger: RelightTrigger::new(1.0),
+            sun_dir: Vec3::Z,
+            particles: Vec::new(),
+            scratch: LightScratch::default(),
+            sun: Vec::new(),
+            sky: Vec::new(),
+        }
+    }
+}
+
+/// Where a block's lights go: the queue, the light buffer and the block's first sprite slot.
+pub(super) type LightTarget<'a> = (&'a wgpu::Queue, &'a wgpu::Buffer, u32);
+
+impl CloudLight {
+    /// Sets the model and the sun of this frame; the lit direction follows the sun only when it
+    /// turned past the threshold (or the settings changed). True when the model was just
+    /// switched on (the blocks already written have no light yet).
+    pub fn set(&mut self, model: ShadingModel, settings: &HarrisLastra, sun_dir: Vec3) -> bool {
+        if model != ShadingModel::HarrisLastra {
+            self.settings = None;
+            return false;
+        }
+        let switched_on = self.settings.is_none();
+        if self.settings.as_ref() != Some(settings) {
+            self.settings = Some(*settings);
+            self.trigger = RelightTrigger::new(settings.relight_sun_deg);
+        }
+        if self.trigger.update(sun_dir) {
+            self.sun_dir = self.trigger.lit_for.unwrap_or(Vec3::Z);
+        }
+        switched_on
+    }
+
+    /// Whether the model is on.
+    pub fn enabled(&self) -> bool {
+        self.settings.is_some()
+    }
+
+    /// Most sprites lit a frame (blocks arriving, and relit after the sun turned).
+    pub fn budget(&self) -> u32 {
+        self.settings
+            .map_or(0, |s| s.max_lit_sprites_per_frame.max(1))
+    }
+
+    /// The packed light of the sprites of `cloud` into `out` (one per sprite): the sun's always,
+    /// the skylight when `with_sky`, else `out`'s sky bytes are kept.
+    fn cloud(&mut self, cloud: &SkyCloud, with_sky: bool, out: &mut [u32]) {
+        let Some(settings) = self.settings else {
+            return;
+        };
+        self.particles.clear();
+        self.particles
+            .extend(cloud.sprites.iter().map(|s| Particle {
+                centre_m: s.offset_m,
+                radius_m: (0.5 * s.width_m.max(s.height_m)).max(1e-3),
+                density: if s.precipitation { 0.0 } else { s.alpha_morph },
+            }));
+        settings.light(
+            &self.particles,
+            self.sun_dir,
+            &mut self.scratch,
+            &mut self.sun,
+        );
+        if with_sky {
+            settings.light(&self.particles, Vec3::Z, &mut self.scratch, &mut self.sky);
+        }
+        for (i, (packed, sun)) in out.iter_mut().zip(&self.sun).enumerate() {
+            let sky = if with_sky {
+                self.sky[i]
+            } else {
+                ParticleLight {
+                    direct: 0.0,
+                    total: ((*packed >> 16) & 0xff) as f32 / 255.0,
+                }
+            };
+            *packed = harris_lastra::pack_light(*sun, sky);
+        }
+    }
+
+    /// The packed light of every sprite of `block`, in its sprites' order, into `lights`.
+    pub fn block(&mut self, block: &SkyBlock, lights: &mut Vec<u32>) {
+        let sprites: usize = block.clouds.iter().map(|c| c.sprites.len()).sum();
+        lights.clear();
+        lights.resize(sprites, 0);
+        let mut at = 0;
+        for cloud in &block.clouds {
+            let n = cloud.sprites.len();
+            self.cloud(cloud, true, &mut lights[at..at + n]);
+            at += n;
+        }
+    }
+
+    /// A first light for a block that arrives when the frame's budget is spent, until its own
+    /// replaces it in later frames: each sprite as lit as its place in its cloud's sphere says
+    /// (towards the sun and the top brighter), O(n), no shadows.
+    pub fn provisional(&self, block: &SkyBlock, lights: &mut Vec<u32>) {
+        lights.clear();
+        for cloud in &block.clouds {
+            let radius = cloud.radius_m().max(1.0);
+            lights.extend(cloud.sprites.iter().map(|s| {
+                let towards = (0.5 + 0.5 * s.offset_m.dot(self.sun_dir) / radius).clamp(0.0, 1.0);
+                let up = (0.5 + 0.5 * s.offset_m.z / radius).clamp(0.0, 1.0);
+                let total = 0.3 + 0.7 * towards;
+                let sun = ParticleLight {
+                    direct: total * total,
+                    total,
+                };
+                let sky = ParticleLight {
+                    direct: 0.0,
+                    total: 0.4 + 0.6 * up,
+                };
+                harris_lastra::pack_light(sun, sky)
+            }));
+        }
+    }
+
+    /// The light of block `r` as it is written to its slots: the light it has if it has one
+    /// (written again after the buffers grew; a stale one is relit later), else its own when
+    /// `budget` (sprites, taken from) allows, else a provisional one. Returns the bytes written
+    /// and the sprites lit.
+    pub fn written(&mut self, r: &mut Resident, to: LightTarget, budget: &mut u32) -> (u64, u32) {
+        let n = r.sprite_count();
+        let light = &mut r.light;
+        let mut lit = 0;
+        if light.lights.len() != n as usize {
+            if n <= *budget {
+                self.block(&r.block, &mut light.lights);
+                light.lit_for = Some(self.sun_dir);
+                light.sky_exact = true;
+                *budget -= n;
+                lit = n;
+            } else {
+                self.provisional(&r.block, &mut light.lights);
+                (light.lit_for, light.sky_exact) = (None, false);
+            }
+            light.pass = None;
+        }
+        (write_lights(to, 0, &light.lights), lit)
+    }
+}
+
+/// Writes packed lights at the block's slot `to.2` plus `offset`; returns the bytes.
+fn write_lights((queue, buffer, first): LightTarget, offset: u32, lights: &[u32]) -> u64 {
+    if lights.is_empty() {
+        return 0;
+    }
+    let at = (first + offset) as u64 * 4;
+    queue.write_buffer(buffer, at, bytemuck::cast_slice(lights));
+    lights.len() as u64 * 4
+}
+
+impl ResidentSet {
+    /// Gives every written block a provisional light (the model was just switched on;
+    /// [`Self::relight`] gives them their own, a budget a frame); returns the bytes.
+    pub fn provisional_all(&mut self, queue: &wgpu::Queue) -> u64 {
+        let start = std::time::Instant::now();
+        let mut bytes = 0;
+        for r in self.blocks.values_mut() {
+            let Some((s, _)) = r.place.clone() else {
+                continue;
+            };
+            if !r.uploaded {
+                continue;
+            }
+            self.light.provisional(&r.block, &mut r.light.lights);
+            (r.light.lit_for, r.light.sky_exact, r.light.pass) = (None, false, None);
+            bytes += write_lights((queue, &self.light_buffer, s.start), 0, &r.light.lights);
+        }
+        self.light_us += start.elapsed().as_micros() as u64;
+        bytes
+    }
+
+    /// Computes again the light of written blocks not lit for the current lit direction,
+    /// nearest to `camera_m` first, a cloud at a time, until what this frame's arrivals left of
+    /// the budget is spent (at least one cloud a frame); returns the bytes written.
+    pub fn relight(&mut self, queue: &wgpu::Queue, camera_m: DVec3) -> u64 {
+        if !self.light.enabled() {
+            return 0;
+        }
+        let start = std::time::Instant::now();
+        let target = self.light.sun_dir;
+        let mut stale: Vec<(f64, &mut Resident)> = self
+            .blocks
+            .values_mut()
+            .filter(|r| r.place.is_some() && r.uploaded && r.light.lit_for != Some(target))
+            .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
+            .collect();
+        if stale.is_empty() {
+            return 0;
+        }
+        stale.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.block.id.cmp(&b.1.block.id)));
+        let budget = self.light.budget().saturating_sub(self.lit_sprites);
+        let (mut lit, mut bytes) = (0u32, 0u64);
+        for (_, r) in stale {
+            let Some((s, _)) = r.place.clone() else {
+                continue;
+            };
+            let n = r.sprite_count() as usize;
+            let light = &mut r.light;
+            if light.lights.len() != n {
+                self.light.provisional(&r.block, &mut light.lights);
+                light.sky_exact = false;
+            }
+            let (mut next, with_sky) = match light.pass {
+                Some((sun, next, with_sky)) if sun == target => (next, with_sky),
+                _ => (0, !light.sky_exact),
+            };
+            // The clouds lit this frame are next to each other: one write a block.
+            let from = r.clouds.get(next).map_or(0, |c| c.sprite_base - s.start) as usize;
+            let mut to = from;
+            let mut done = true;
+            while next < r.block.clouds.len() {
+                if lit > 0 && lit >= budget {
+                    light.pass = Some((target, next, with_sky));
+                    done = false;
+                    break;
+                }
+                let cloud = &r.block.clouds[next];
+                let first = (r.clouds[next].sprite_base - s.start) as usize;
+                to = first + cloud.sprites.len();
+                self.light
+                    .cloud(cloud, with_sky, &mut light.lights[first..to]);
+                lit += cloud.sprites.len() as u32;
+                next += 1;
+            }
+            if to > from {
+                let at = (queue, &self.light_buffer, s.start);
+                bytes += write_lights(at, from as u32, &light.lights[from..to]);
+            }
+            if !done {
+                break;
+            }
+            (light.lit_for, light.pass) = (Some(target), None);
+            light.sky_exact |= with_sky;
+        }
+        self.lit_sprites += lit;
+        self.light_us += start.elapsed().as_micros() as u64;
+        bytes
+    }
+}
