@@ -458,13 +458,16 @@ impl CloudFrame<'_> {
 }
 
 /// Whether the host's depth can be a read-only depth attachment of the sky's passes (the
-/// split full-screen passes test it): a depth buffer the host renders into.
+/// split full-screen passes test it): a depth buffer the host renders into, without stencil,
+/// of one level and one layer (so the view the host hands is the whole texture).
 pub(super) fn can_test_against(depth_view: &wgpu::TextureView) -> bool {
     let texture = depth_view.texture();
     texture
         .usage()
         .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
         && !texture.format().has_stencil_aspect()
+        && texture.mip_level_count() == 1
+        && texture.depth_or_array_layers() == 1
 }
 
 /// A render pass over `views`, each loaded with `load` and stored.
