@@ -19,7 +19,8 @@
 @group(1) @binding(3) var cloud_sampler: sampler;
 
 struct CompositeOut {
-    @builtin(position) position: vec4<f32>,
+    // Invariant: the split composite's depth tests compare it with the host's depth exactly.
+    @invariant @builtin(position) position: vec4<f32>,
     // The far-plane point of the pixel, homogeneous (see `background_along`).
     @location(0) far: vec4<f32>,
 };
@@ -29,30 +30,35 @@ fn vs_composite(@builtin(vertex_index) vi: u32) -> CompositeOut {
     var o: CompositeOut;
     o.position = fullscreen_position(vi);
     o.far = far_point(o.position.xy);
+    // At the host's background depth: the split composite's two draws test the host's depth
+    // against it (equal: the sky's pixels; not equal: the host's scene).
+    o.position.z = frame.params.x;
     return o;
 }
 
-@fragment
-fn fs_composite(i: CompositeOut) -> @location(0) vec4<f32> {
-    let position = i.position;
+// The cloud target's premultiplied colour over host pixel `position`, and where it is sampled.
+fn cloud_colour_at(position: vec2<f32>) -> vec4<f32> {
     // Texel i of the cloud target covers host pixels [i * DIVISOR, (i + 1) * DIVISOR).
     let low_size = vec2<f32>(textureDimensions(cloud_colour));
-    let uv = position.xy / (low_size * f32(DIVISOR));
-    let colour = textureSampleLevel(cloud_colour, cloud_sampler, uv, 0.0);
-    let d = scene_depth_at(position.xy);
-    if (is_background(d)) {
-        // Where the host drew nothing this pass is also the sky background (one full-resolution
-        // pass instead of two): the clouds over it, opaque. Sky pixels are the farthest of their
-        // block, so their clouds need no fix-up.
-        return vec4<f32>(colour.rgb + (1.0 - colour.a) * background_along(i.far), 1.0);
-    }
-    if (colour.a < 1.0 / 2048.0) {
-        discard;
-    }
-    // Every host pixel redoes the fade, not only those nearer than their block's farthest depth:
-    // on terrain in front of the clouds the bilinear upsample also brings in the neighbouring
-    // texels' clouds, drawn against the sky beside it.
-    let farthest = textureLoad(farthest_depth, vec2<i32>(position.xy) / DIVISOR, 0).r;
+    let uv = position / (low_size * f32(DIVISOR));
+    return textureSampleLevel(cloud_colour, cloud_sampler, uv, 0.0);
+}
+
+// Where the host drew nothing this pass is also the sky background (one full-resolution pass
+// instead of two): the clouds over it, opaque. Sky pixels are the farthest of their block, so
+// their clouds need no fix-up.
+fn over_sky(i: CompositeOut, colour: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(colour.rgb + (1.0 - colour.a) * background_along(i.far), 1.0);
+}
+
+// Over the host's scene (depth `d`): the clouds with their fade redone at this pixel's depth.
+// Every host pixel redoes the fade, not only those nearer than their block's farthest depth:
+// on terrain in front of the clouds the bilinear upsample also brings in the neighbouring
+// texels' clouds, drawn against the sky beside it.
+fn over_scene(position: vec2<f32>, colour: vec4<f32>, d: f32) -> vec4<f32> {
+    let low_size = vec2<f32>(textureDimensions(cloud_colour));
+    let uv = position / (low_size * f32(DIVISOR));
+    let farthest = textureLoad(farthest_depth, vec2<i32>(position) / DIVISOR, 0).r;
     let here_m = linear_depth_m(d);
     let farthest_m = linear_depth_m(farthest);
     let cloud_m = textureSampleLevel(cloud_distance, cloud_sampler, uv, 0.0).r * 1000.0 / colour.a;
@@ -62,4 +68,38 @@ fn fs_composite(i: CompositeOut) -> @location(0) vec4<f32> {
     // texel's cloud must not bleed onto terrain in front of it).
     let keep = select(clamp(here / drawn_with, 0.0, 1.0), here, drawn_with < 1.0e-3);
     return colour * keep;
+}
+
+// One draw over every pixel, sky and scene told apart in the shader: for hosts whose depth
+// cannot also be the pass's depth attachment (see `cloud_target.rs`).
+@fragment
+fn fs_composite(i: CompositeOut) -> @location(0) vec4<f32> {
+    let colour = cloud_colour_at(i.position.xy);
+    let d = scene_depth_at(i.position.xy);
+    if (is_background(d)) {
+        return over_sky(i, colour);
+    }
+    if (colour.a < 1.0 / 2048.0) {
+        discard;
+    }
+    return over_scene(i.position.xy, colour, d);
+}
+
+// The split composite's first draw, where the depth test passed the host's background only
+// (written, not blended). On a software rasteriser a shader runs both sides of a branch for
+// every pixel, while pixels the depth test rejects are not shaded at all: two draws, each
+// shading only its own pixels, cost less than one that runs the sky and the fix-up everywhere.
+@fragment
+fn fs_composite_sky(i: CompositeOut) -> @location(0) vec4<f32> {
+    return over_sky(i, cloud_colour_at(i.position.xy));
+}
+
+// The split composite's second draw, where the depth test passed the host's scene only. No
+// `discard` (a shader that may discard is depth-tested after it runs, on every pixel): where
+// the target holds nothing it blends zero, which leaves the host's colour as it was.
+@fragment
+fn fs_composite_scene(i: CompositeOut) -> @location(0) vec4<f32> {
+    let colour = cloud_colour_at(i.position.xy);
+    let over = over_scene(i.position.xy, colour, scene_depth_at(i.position.xy));
+    return select(over, vec4<f32>(0.0), colour.a < 1.0 / 2048.0);
 }

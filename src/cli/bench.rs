@@ -93,6 +93,13 @@ pub struct BenchArgs {
     /// UTC time, RFC 3339 (default: the shipped weather file's time).
     #[arg(long, value_parser = parse_time)]
     pub time: Option<f64>,
+    /// Run only this scenario (sparse, scattered or overcast); repeat for more (default: all
+    /// three).
+    #[arg(long = "scenario", value_parser = ["sparse", "scattered", "overcast"])]
+    pub scenarios_only: Vec<String>,
+    /// Run only with the impostor ring (`on`), only without it (`off`), or both.
+    #[arg(long, default_value = "both", value_parser = ["on", "off", "both"])]
+    pub impostors: String,
 }
 
 /// One frame of one run.
@@ -410,11 +417,19 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let mut runs = Vec::new();
     let mut adapter = String::new();
     let mut timestamps = true;
+    let rings: &[bool] = match args.impostors.as_str() {
+        "on" => &[true],
+        "off" => &[false],
+        _ => &[true, false],
+    };
     for scenario in SCENARIOS {
+        if !args.scenarios_only.is_empty() && !args.scenarios_only.iter().any(|s| s == scenario) {
+            continue;
+        }
         let (mut world, at) =
             scenario_world(&args.scenarios, scenario, &stations, &world_settings)?;
         let overdraw = mean_overdraw(&world, world_settings.seed);
-        for impostors in [true, false] {
+        for &impostors in rings {
             eprintln!(
                 "bench: {scenario}, impostors {}, cloud scales {}",
                 if impostors { "on" } else { "off" },

@@ -1,7 +1,8 @@
 //! What every sky pipeline shares: the WGSL of `shaders/shared/frame.wgsl` put in front of each
 //! pass's shader, premultiplied-alpha blending, and one way to build a pipeline. None of them
-//! has a depth attachment (the host's depth is read as a texture) or culls (sprites and
-//! full-screen triangles face the camera either way).
+//! culls (sprites and full-screen triangles face the camera either way), and they read the
+//! host's depth as a texture; only the full-screen passes split by the host's background also
+//! test it as a read-only depth attachment ([`background_test`]).
 
 /// The structs and helpers every sky pass shares.
 const SHARED_WGSL: &str = include_str!("../../shaders/shared/frame.wgsl");
@@ -69,6 +70,33 @@ pub(super) struct PassDesc<'a> {
 
 /// Builds the pipeline `desc` describes.
 pub(super) fn pipeline(device: &wgpu::Device, desc: &PassDesc) -> wgpu::RenderPipeline {
+    pipeline_with_depth(device, desc, None)
+}
+
+/// A full-screen pass's depth test against the host's depth as a read-only attachment of
+/// `format`: the triangle is drawn at the host's background depth, and `compare` keeps the
+/// pixels where the host drew nothing (`Equal`) or drew its scene (`NotEqual`). Nothing is
+/// written.
+pub(super) fn background_test(
+    format: wgpu::TextureFormat,
+    compare: wgpu::CompareFunction,
+) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(compare),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+/// [`pipeline`] with a depth test (`None`: no depth attachment, as every sky pass but the
+/// split full-screen ones).
+pub(super) fn pipeline_with_depth(
+    device: &wgpu::Device,
+    desc: &PassDesc,
+    depth: Option<wgpu::DepthStencilState>,
+) -> wgpu::RenderPipeline {
     let module = shader(device, desc.label, desc.wgsl, desc.multisampled_depth);
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(desc.label),
@@ -99,7 +127,7 @@ pub(super) fn pipeline(device: &wgpu::Device, desc: &PassDesc) -> wgpu::RenderPi
             cull_mode: None,
             ..Default::default()
         },
-        depth_stencil: None,
+        depth_stencil: depth,
         multisample: wgpu::MultisampleState {
             count: desc.samples,
             ..Default::default()

@@ -9,7 +9,11 @@
 //! The device needs 7 storage buffers per shader stage (WebGPU's default limit is 8) and compute
 //! shaders. The host's depth texture needs `TEXTURE_BINDING` usage; it is read through the
 //! host's own projection ([`SkyView`]) in the convention its [`HostTargets`] name (standard or
-//! reversed Z, one sample or four).
+//! reversed Z, one sample or four). Where it also has `RENDER_ATTACHMENT` usage (a depth buffer
+//! the host draws into) and no stencil, the full-screen passes that draw only where the host drew
+//! nothing (the sky background, the cloud composite's sky) are also depth-tested against it as a
+//! read-only attachment: a software rasteriser then shades only those pixels, while a shader's
+//! own test runs the whole shader on every pixel.
 
 use std::cell::Cell;
 use std::collections::HashSet;
@@ -20,11 +24,13 @@ use wgpu::util::DeviceExt;
 
 use super::RenderError;
 use super::build::{CHUNK, SpriteBuild, chunks};
-use super::cloud_target::{CloudShared, CloudTarget, cloud_targets, divisor_of};
+use super::cloud_target::{CloudShared, CloudTarget, can_test_against, cloud_targets, divisor_of};
 use super::draw_list::{Copies, Locks, main_view};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuSpriteVertex};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
-use super::pipeline::{PassDesc, pipeline, premultiplied_over};
+use super::pipeline::{
+    PassDesc, background_test, pipeline, pipeline_with_depth, premultiplied_over,
+};
 use super::resident::{ResidentSet, quad_index_buffer};
 use super::scatter::Scatter;
 use super::scene::{BlockMotion, SkyBlock};
@@ -95,6 +101,10 @@ pub struct Sky {
     targets: HostTargets,
     sheet_group: wgpu::BindGroup,
     sky_pipeline: wgpu::RenderPipeline,
+    /// The sky background kept by a depth test against the host's depth as a read-only
+    /// attachment (in a pass of its own); `None` where the host's depth format has a stencil
+    /// aspect.
+    sky_tested_pipeline: Option<wgpu::RenderPipeline>,
     sprite_pipeline: wgpu::RenderPipeline,
     in_cloud_pipeline: wgpu::RenderPipeline,
     resident: ResidentSet,
@@ -243,20 +253,31 @@ impl Sky {
         let frame_only = [Some(&frame_layout)];
         let sprite_groups = [Some(&frame_layout), Some(&sheet_layout)];
         let over = Some(premultiplied_over());
-        let sky_pipeline = pipeline(
-            device,
-            &PassDesc {
-                label: "sky.background",
-                wgsl: SKY_WGSL,
-                vs: "vs_sky",
-                fs: "fs_sky",
-                bind_groups: &frame_only,
-                buffers: &[],
-                targets: &[(format, None)],
-                samples,
-                multisampled_depth: samples > 1,
-            },
-        );
+        let sky_pipeline_for = |fs, depth| {
+            pipeline_with_depth(
+                device,
+                &PassDesc {
+                    label: "sky.background",
+                    wgsl: SKY_WGSL,
+                    vs: "vs_sky",
+                    fs,
+                    bind_groups: &frame_only,
+                    buffers: &[],
+                    targets: &[(format, None)],
+                    samples,
+                    multisampled_depth: samples > 1,
+                },
+                depth,
+            )
+        };
+        let sky_pipeline = sky_pipeline_for("fs_sky", None);
+        let depth_format = config.targets.depth_format;
+        let sky_tested_pipeline = (!depth_format.has_stencil_aspect()).then(|| {
+            sky_pipeline_for(
+                "fs_sky_tested",
+                Some(background_test(depth_format, wgpu::CompareFunction::Equal)),
+            )
+        });
         let sprite_pipeline = pipeline(
             device,
             &PassDesc {
@@ -321,6 +342,7 @@ impl Sky {
             targets: config.targets,
             sheet_group,
             sky_pipeline,
+            sky_tested_pipeline,
             sprite_pipeline,
             in_cloud_pipeline,
             resident,
@@ -856,9 +878,22 @@ impl Sky {
                 target.pass(encoder, true)
             }
             None => {
-                let mut pass = self.sky_pass(encoder, colour_view, &frame_group);
-                pass.set_pipeline(&self.sky_pipeline);
-                pass.draw(0..3, 0..1);
+                let tested = self
+                    .sky_tested_pipeline
+                    .as_ref()
+                    .filter(|_| can_test_against(depth_view));
+                if let Some(tested) = tested {
+                    // The background in a pass of its own, the host's depth attached.
+                    let mut pass =
+                        self.sky_pass(encoder, colour_view, &frame_group, Some(depth_view));
+                    pass.set_pipeline(tested);
+                    pass.draw(0..3, 0..1);
+                }
+                let mut pass = self.sky_pass(encoder, colour_view, &frame_group, None);
+                if tested.is_none() {
+                    pass.set_pipeline(&self.sky_pipeline);
+                    pass.draw(0..3, 0..1);
+                }
                 pass
             }
         };
@@ -876,7 +911,7 @@ impl Sky {
                 }
                 pass = match &offscreen {
                     Some(target) => target.pass(encoder, false),
-                    None => self.sky_pass(encoder, colour_view, &frame_group),
+                    None => self.sky_pass(encoder, colour_view, &frame_group, None),
                 };
             }
             pass.set_pipeline(sprite_pipeline);
@@ -891,18 +926,20 @@ impl Sky {
         }
         drop(pass);
         if let Some(target) = &offscreen {
-            target.composite(encoder, colour_view, &frame_group);
+            target.composite(encoder, colour_view, depth_view, &frame_group);
         }
         self.recorded.set(true);
         self.record_us.set(start.elapsed().as_micros() as u64);
     }
 
-    /// A pass over the host's colour (kept), with the frame's group 0 bound.
+    /// A pass over the host's colour (kept), with the frame's group 0 bound, and the host's
+    /// depth as a read-only attachment when `depth` is given.
     fn sky_pass<'e>(
         &self,
         encoder: &'e mut wgpu::CommandEncoder,
         colour_view: &wgpu::TextureView,
         frame_group: &wgpu::BindGroup,
+        depth: Option<&wgpu::TextureView>,
     ) -> wgpu::RenderPass<'e> {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sky"),
@@ -915,7 +952,11 @@ impl Sky {
                     store: wgpu::StoreOp::Store,
                 },
             })],
-            depth_stencil_attachment: None,
+            depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
+                view,
+                depth_ops: None,
+                stencil_ops: None,
+            }),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,

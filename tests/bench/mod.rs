@@ -1,6 +1,7 @@
 //! `skycast bench` at a tiny size and frame count, so the frame-budget benchmark cannot rot: the
 //! table headed by the adapter, `bench.csv` with the three scenarios with impostors on and off,
-//! each at the cloud scale asked for and at full resolution, and the plot, a PNG that decodes.
+//! each at the cloud scale asked for and at full resolution, and the plot, a PNG that decodes;
+//! `--scenario` and `--impostors` run only part of it.
 
 use std::path::PathBuf;
 
@@ -162,4 +163,55 @@ fn bench_command_writes_table_csv_and_plot() {
     // Lines were drawn: the overcast colour is in it.
     let rgb = plot.to_rgb8();
     assert!(rgb.pixels().any(|p| p.0 == [210, 50, 40]));
+}
+
+#[test]
+fn bench_runs_only_the_scenario_and_ring_asked_for() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bench-one-scenario");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_skycast"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .args([
+            "bench",
+            "--size",
+            "64x36",
+            "--frames",
+            "2",
+            "--view-km",
+            "30",
+        ])
+        .args([
+            "--scenario",
+            "overcast",
+            "--impostors",
+            "on",
+            "--cloud-scale",
+            "1/2",
+        ])
+        .args(["--out", dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut csv = csv::Reader::from_path(dir.join("bench.csv")).unwrap();
+    let header = csv.headers().unwrap().clone();
+    let column = |name: &str| header.iter().position(|c| c == name).expect(name);
+    let rows: Vec<(String, String, String)> = csv
+        .records()
+        .map(Result::unwrap)
+        .map(|r| {
+            (
+                r[column("scenario")].to_string(),
+                r[column("impostors")].to_string(),
+                r[column("cloud_scale")].to_string(),
+            )
+        })
+        .collect();
+    let row = |scale: &str| ("overcast".to_string(), "on".to_string(), scale.to_string());
+    assert_eq!(rows, [row("0.5"), row("1")], "{stdout}");
 }
