@@ -57,6 +57,9 @@ pictures: vulkan
 	$(FRAME) --weather $(METARS) --at 53.43,-6.10 --time 2025-01-27T14:00:00Z --alt-ft 700 --heading 280 --pitch 12 --out tests/pictures/airports/dublin_approach.png
 	$(FRAME) --weather $(METARS) --at -4.80,136.887 --alt-ft 900 --heading 0 --pitch 14 --out tests/pictures/airports/timika_cb.png
 	$(FRAME) --weather weather/themes/low_stratus_and_fog.toml --at 28.5,-81.45 --time 2025-01-27T13:30:00Z --alt-ft 450 --heading 90 --pitch -4 --out tests/pictures/airports/fog_morning.png
+	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 283 --heading 315 --pitch 10 --out tests/pictures/pilot/deck_below.png
+	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 3083 --heading 135 --pitch -10 --out tests/pictures/pilot/deck_above.png
+	cargo test --quiet --test pilot rain_falls_out_of_a_storm && cp target/tmp/pilot/storm/rain.png tests/pictures/pilot/storm_20km.png
 	for m in wang harris_lastra; do \
 		$(SHADING) --shading $$m --time 2025-01-27T19:00:00Z --alt-ft 2500 --heading 90 --pitch 6 --out tests/pictures/shading/noon_$$m.png && \
 		$(SHADING) --shading $$m --time 2025-01-27T22:30:00Z --alt-ft 4500 --heading 246 --pitch 3 --out tests/pictures/shading/low_sun_$$m.png && \
