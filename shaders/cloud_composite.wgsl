@@ -18,22 +18,11 @@
 @group(1) @binding(2) var farthest_depth: texture_2d<f32>;
 @group(1) @binding(3) var cloud_sampler: sampler;
 
-struct CompositeOut {
-    // Invariant: the split composite's depth tests compare it with the host's depth exactly.
-    @invariant @builtin(position) position: vec4<f32>,
-    // The far-plane point of the pixel, homogeneous (see `background_along`).
-    @location(0) far: vec4<f32>,
-};
-
+// The split composite's two draws test the host's depth against the background depth of
+// `background_vertex` (equal: the sky's pixels; not equal: the host's scene).
 @vertex
-fn vs_composite(@builtin(vertex_index) vi: u32) -> CompositeOut {
-    var o: CompositeOut;
-    o.position = fullscreen_position(vi);
-    o.far = far_point(o.position.xy);
-    // At the host's background depth: the split composite's two draws test the host's depth
-    // against it (equal: the sky's pixels; not equal: the host's scene).
-    o.position.z = frame.params.x;
-    return o;
+fn vs_composite(@builtin(vertex_index) vi: u32) -> BackgroundOut {
+    return background_vertex(vi);
 }
 
 // The cloud target's premultiplied colour over host pixel `position`, and where it is sampled.
@@ -47,7 +36,7 @@ fn cloud_colour_at(position: vec2<f32>) -> vec4<f32> {
 // Where the host drew nothing this pass is also the sky background (one full-resolution pass
 // instead of two): the clouds over it, opaque. Sky pixels are the farthest of their block, so
 // their clouds need no fix-up.
-fn over_sky(i: CompositeOut, colour: vec4<f32>) -> vec4<f32> {
+fn over_sky(i: BackgroundOut, colour: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(colour.rgb + (1.0 - colour.a) * background_along(i.far), 1.0);
 }
 
@@ -73,7 +62,7 @@ fn over_scene(position: vec2<f32>, colour: vec4<f32>, d: f32) -> vec4<f32> {
 // One draw over every pixel, sky and scene told apart in the shader: for hosts whose depth
 // cannot also be the pass's depth attachment (see `cloud_target.rs`).
 @fragment
-fn fs_composite(i: CompositeOut) -> @location(0) vec4<f32> {
+fn fs_composite(i: BackgroundOut) -> @location(0) vec4<f32> {
     let colour = cloud_colour_at(i.position.xy);
     let d = scene_depth_at(i.position.xy);
     if (is_background(d)) {
@@ -90,7 +79,7 @@ fn fs_composite(i: CompositeOut) -> @location(0) vec4<f32> {
 // every pixel, while pixels the depth test rejects are not shaded at all: two draws, each
 // shading only its own pixels, cost less than one that runs the sky and the fix-up everywhere.
 @fragment
-fn fs_composite_sky(i: CompositeOut) -> @location(0) vec4<f32> {
+fn fs_composite_sky(i: BackgroundOut) -> @location(0) vec4<f32> {
     return over_sky(i, cloud_colour_at(i.position.xy));
 }
 
@@ -98,7 +87,7 @@ fn fs_composite_sky(i: CompositeOut) -> @location(0) vec4<f32> {
 // `discard` (a shader that may discard is depth-tested after it runs, on every pixel): where
 // the target holds nothing it blends zero, which leaves the host's colour as it was.
 @fragment
-fn fs_composite_scene(i: CompositeOut) -> @location(0) vec4<f32> {
+fn fs_composite_scene(i: BackgroundOut) -> @location(0) vec4<f32> {
     let colour = cloud_colour_at(i.position.xy);
     let over = over_scene(i.position.xy, colour, scene_depth_at(i.position.xy));
     return select(over, vec4<f32>(0.0), colour.a < 1.0 / 2048.0);

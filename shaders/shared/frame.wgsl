@@ -81,6 +81,24 @@ fn far_point(ndc: vec2<f32>) -> vec4<f32> {
     return frame.inv_view_proj * vec4<f32>(ndc, 0.5, 1.0);
 }
 
+// The vertex of a full-screen pass over the host's background (`sky.wgsl`, the cloud composite).
+struct BackgroundOut {
+    // Invariant: the passes' depth tests compare it with the host's depth exactly.
+    @invariant @builtin(position) position: vec4<f32>,
+    // The far-plane point of the pixel, homogeneous (see `background_along`).
+    @location(0) far: vec4<f32>,
+};
+
+// Full-screen triangle vertex `vi` at the host's background depth: with the host's depth
+// attached, an `Equal` test keeps the pixels where the host drew nothing, `NotEqual` its scene.
+fn background_vertex(vi: u32) -> BackgroundOut {
+    var o: BackgroundOut;
+    o.position = fullscreen_position(vi);
+    o.far = far_point(o.position.xy);
+    o.position.z = frame.params.x;
+    return o;
+}
+
 // What a cloud pass writes into the off-screen cloud target (src/render/cloud_target.rs):
 // premultiplied colour, and the clouds' distance in kilometres times alpha (R16Float), both
 // blended "over", so distance / alpha is the distance of what shows in the texel.

@@ -480,8 +480,9 @@ fn begin<'e>(
     begin_with_depth(encoder, label, views, load, None)
 }
 
-/// [`begin`] with `depth` (the host's) as a read-only depth attachment.
-fn begin_with_depth<'e>(
+/// [`begin`] with `depth` (the host's) as a read-only depth attachment (the sky's own passes
+/// over the host's colour begin this way too).
+pub(super) fn begin_with_depth<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
     label: &str,
     views: &[&wgpu::TextureView],

@@ -941,26 +941,13 @@ impl Sky {
         frame_group: &wgpu::BindGroup,
         depth: Option<&wgpu::TextureView>,
     ) -> wgpu::RenderPass<'e> {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("sky"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: colour_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
-                view,
-                depth_ops: None,
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = super::cloud_target::begin_with_depth(
+            encoder,
+            "sky",
+            &[colour_view],
+            wgpu::LoadOp::Load,
+            depth,
+        );
         pass.set_bind_group(0, frame_group, &[]);
         pass
     }
