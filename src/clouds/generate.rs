@@ -208,13 +208,18 @@ fn scattered_layer(
     (covered as f64 / (GRID * GRID) as f64, boxes)
 }
 
-/// The sky a streak covers, m2: its flat sprites' dense cores (the ellipses within 0.7 of their
-/// half extents, as [`cloud_cells`] counts them), wherever they lie.
+/// A sprite's dense core, the part that counts as cover: within 0.7 of its half extents, i.e.
+/// this fraction of its full width (and, flat, of its height) from its centre.
+const CORE_HALF_EXTENT: f64 = 0.35;
+
+/// The sky a streak covers, m2: its flat sprites' dense cores (as [`cloud_cells`] counts them),
+/// wherever they lie.
 fn streak_footprint_m2(cloud: &Cloud) -> f64 {
+    let core = |extent: f32| CORE_HALF_EXTENT * extent as f64;
     cloud
         .sprites
         .iter()
-        .map(|s| std::f64::consts::PI * 0.35 * s.width_m as f64 * 0.35 * s.height_m as f64)
+        .map(|s| std::f64::consts::PI * core(s.width_m) * core(s.height_m))
         .sum()
 }
 
@@ -229,9 +234,9 @@ fn cloud_cells(cloud: &Cloud, corner: DVec2) -> Vec<usize> {
             cloud.centre_m.x + s.offset_m[0] as f64,
             cloud.centre_m.y + s.offset_m[1] as f64,
         ) - corner;
-        let a = 0.35 * s.width_m as f64;
+        let a = CORE_HALF_EXTENT * s.width_m as f64;
         let b = if cloud.flat {
-            0.35 * s.height_m as f64
+            CORE_HALF_EXTENT * s.height_m as f64
         } else {
             a
         };
