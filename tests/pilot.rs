@@ -204,7 +204,6 @@ fn low_overcast_from_above_hides_the_ground() {
         };
         let bkn = showing("BKN004");
         let ovc = showing("OVC004");
-        let over_a_quarter = ovc.iter().filter(|&&s| s > 0.25).count() as f32 / ovc.len() as f32;
         println!(
             "heading {heading}: {} ground pixels; showing through the overcast at most {:.3}, the broken deck {:.3}",
             ovc.len(),
@@ -216,15 +215,14 @@ fn low_overcast_from_above_hides_the_ground() {
             "the ground is plain to see in the lower frame: {} pixels",
             ovc.len()
         );
-        // Measured: at most 0.08 anywhere. Bounds with room for a glitch of the renderer's not
-        // yet understood (looking towards the sun, some runs, more often in a debug build or on
-        // a loaded machine, draw a patch of the deck over water up to 12/255 brighter than
-        // over land: 0.44 at most, 3% of the pixels over a quarter; the frame comes out one way
-        // or the other), and none for a hole: a hole shows all of the ground (the broken
-        // deck's 1.0).
+        // Measured: at most 0.08 anywhere; a hole shows all of the ground (the broken deck's
+        // 1.0). The frames over land and water are separate runs of `skycast render`, so this
+        // also holds the renderer to drawing the same deck each run: when equally far blocks
+        // were drawn in the order their ids came (as the background generation finished), some
+        // runs drew a patch of it up to 17/255 brighter, 0.44 here.
         assert!(
-            worst(&ovc) <= 0.5 && over_a_quarter < 0.05,
-            "heading {heading}: the ground shows through the overcast (at most {}, {over_a_quarter} of it over a quarter)",
+            worst(&ovc) <= 0.15,
+            "heading {heading}: the ground shows through the overcast (at most {})",
             worst(&ovc)
         );
         assert!(

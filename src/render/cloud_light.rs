@@ -240,7 +240,7 @@ impl ResidentSet {
         if stale.is_empty() {
             return 0;
         }
-        stale.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.block.id.cmp(&b.1.block.id)));
+        stale.sort_by(|a, b| a.0.total_cmp(&b.0).then_with(|| a.1.tie_order(b.1)));
         let budget = self.light.budget().saturating_sub(self.lit_sprites);
         let (mut lit, mut bytes) = (0u32, 0u64);
         for (_, r) in stale {

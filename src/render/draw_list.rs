@@ -210,17 +210,22 @@ fn fade_code(fade: Fade) -> (u32, f32) {
 /// The blocks the sky holds, by id.
 pub(super) type Blocks = HashMap<u64, Resident>;
 
-/// Blocks' ids, farthest centre (with its drift) from `from_m` first; equal distances by id (the
-/// impostor views; the sky camera's sorts the near blocks themselves).
+/// Blocks' ids, farthest centre (with its drift) from `from_m` first (the impostor views; the
+/// sky camera's sorts the near blocks themselves).
 fn blocks_back_to_front(blocks: &Blocks, ids: &[u64], from_m: DVec3) -> Vec<(f64, u64)> {
-    let mut order: Vec<(f64, u64)> = ids
+    let mut order: Vec<(f64, &Resident)> = ids
         .iter()
         .filter_map(|id| blocks.get(id))
         .filter(|r| r.place.is_some())
-        .map(|r| ((r.centre_m() - from_m).length_squared(), r.block.id))
+        .map(|r| ((r.centre_m() - from_m).length_squared(), r))
         .collect();
-    order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-    order
+    order.sort_by(|a, b| farthest_first((a.0, a.1), (b.0, b.1)));
+    order.into_iter().map(|(d, r)| (d, r.block.id)).collect()
+}
+
+/// Back to front by squared distance, equally far blocks in [`Resident::tie_order`].
+fn farthest_first(a: (f64, &Resident), b: (f64, &Resident)) -> std::cmp::Ordering {
+    b.0.total_cmp(&a.0).then_with(|| a.1.tie_order(b.1))
 }
 
 /// Where the sky camera's sprite orders and cloud lists go: CPU copies of the order and list
@@ -255,7 +260,7 @@ pub(super) fn main_view(
         .filter(|r| frustum.sees_sphere((r.centre_m() - camera_m).as_vec3(), r.radius_m as f32))
         .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
         .collect();
-    order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.block.id.cmp(&b.1.block.id)));
+    order.sort_by(|a, b| farthest_first((a.0, &*a.1), (b.0, &*b.1)));
     let Copies {
         orders,
         dirty_orders,

@@ -77,7 +77,7 @@ pub(super) struct Resident {
 }
 
 impl Resident {
-    fn new(block: SkyBlock, motion: BlockMotion) -> Self {
+    pub(super) fn new(block: SkyBlock, motion: BlockMotion) -> Self {
         let clouds: Vec<CloudState> = block
             .clouds
             .iter()
@@ -126,6 +126,19 @@ impl Resident {
     /// Its centre now (with the drift), metres.
     pub fn centre_m(&self) -> DVec3 {
         self.block.centre_m + self.motion.offset_m
+    }
+
+    /// A fixed order for blocks as far from the camera as each other (a camera on the corner
+    /// of four blocks sees them at one distance): by place, west then south first, then by id
+    /// (generations of one place, oldest first). Never by id alone: ids are handed out as the
+    /// background generation finishes, in an order that differs from run to run, and the
+    /// frame must not (equally far blocks' overlapping sprites blend differently in either
+    /// order, and the upload and relight budgets would take either first).
+    pub(super) fn tie_order(&self, other: &Resident) -> std::cmp::Ordering {
+        let (a, b) = (self.block.centre_m, other.block.centre_m);
+        a.x.total_cmp(&b.x)
+            .then(a.y.total_cmp(&b.y))
+            .then(self.block.id.cmp(&other.block.id))
     }
 }
 
@@ -322,14 +335,16 @@ impl ResidentSet {
         budget_sprites: u32,
     ) -> (u64, u32) {
         let generation = self.generation;
-        let mut waiting: Vec<(f64, u64)> = self
+        let mut waiting: Vec<(f64, &Resident)> = self
             .blocks
             .values()
             .filter(|r| r.place.is_none())
-            .map(|r| ((r.centre_m() - camera_m).length_squared(), r.block.id))
+            .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
             .collect();
         if !waiting.is_empty() {
-            waiting.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            waiting.sort_by(|a, b| a.0.total_cmp(&b.0).then_with(|| a.1.tie_order(b.1)));
+            let waiting: Vec<(f64, u64)> =
+                waiting.iter().map(|(d2, r)| (*d2, r.block.id)).collect();
             for &(d2, id) in &waiting {
                 self.place(id, d2, camera_m);
             }
@@ -358,8 +373,9 @@ impl ResidentSet {
                 .blocks
                 .values()
                 .filter(|r| r.place.is_some())
-                .map(|r| ((r.centre_m() - camera_m).length_squared(), r.block.id))
-                .max_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
+                .max_by(|a, b| a.0.total_cmp(&b.0).then_with(|| a.1.tie_order(b.1)))
+                .map(|(d2, r)| (d2, r.block.id));
             match farthest {
                 Some((far_d2, far_id)) if far_d2 > d2 => {
                     if let Some(r) = self.blocks.get_mut(&far_id)
@@ -491,7 +507,7 @@ impl ResidentSet {
             .filter(|r| r.place.is_some() && !r.uploaded)
             .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
             .collect();
-        todo.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.block.id.cmp(&b.1.block.id)));
+        todo.sort_by(|a, b| a.0.total_cmp(&b.0).then_with(|| a.1.tie_order(b.1)));
         let mut written = 0u32;
         for (_, r) in todo {
             if written > 0 && written >= budget {
