@@ -46,6 +46,7 @@ use skycast::weather::{
 use super::render::{load_look, parse_cloud_scale, parse_size, parse_time, time_or_default};
 use super::weather::DEFAULT_STATIONS;
 
+mod passes;
 mod plot;
 
 /// The scenarios, in the order of the table.
@@ -100,6 +101,12 @@ pub struct BenchArgs {
     /// Run only with the impostor ring (`on`), only without it (`off`), or both.
     #[arg(long, default_value = "both", value_parser = ["on", "off", "both"])]
     pub impostors: String,
+    /// Also time each group of the sky's passes on the GPU (the build, the background or the
+    /// downsample, the ring, the sprites, the composite; the ring and the sprites then go in
+    /// passes of their own): a table of their medians, and columns in frames.csv. Needs GPU
+    /// timestamps between passes.
+    #[arg(long)]
+    pub passes: bool,
 }
 
 /// One frame of one run.
@@ -119,6 +126,8 @@ struct FrameRecord {
     impostors_rebuilt: u32,
     /// Bytes of the sky's off-screen cloud target (0 at scale 1).
     cloud_target_bytes: u64,
+    /// The sky's passes one by one (`--passes`, where the device times them).
+    passes: Option<skycast::render::PassTimes>,
 }
 
 /// One run: a scenario with impostors on or off, the clouds at one resolution scale.
@@ -216,6 +225,8 @@ struct Setup {
     size: (u32, u32),
     frames: u32,
     unix_s: f64,
+    /// Time the sky's passes one by one (`--passes`).
+    passes: bool,
 }
 
 /// What a run came to.
@@ -256,6 +267,13 @@ fn fly(
                 sheet: world.sheet(),
             },
         )?);
+    }
+    if setup.passes {
+        for host in &mut hosts {
+            if !host.sky.set_pass_timing(true) {
+                eprintln!("bench: --passes: this device has no GPU timestamps between passes");
+            }
+        }
     }
     let Some(first) = hosts.first() else {
         return Ok(Vec::new());
@@ -365,6 +383,7 @@ fn draw_to_steady(
             blocks_far: stats.blocks_far,
             impostors_rebuilt: stats.impostors_rebuilt,
             cloud_target_bytes: stats.cloud_target_bytes,
+            passes: host.sky.pass_times(),
         });
         if steady {
             break;
@@ -404,6 +423,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         size: args.size,
         frames: args.frames,
         unix_s,
+        passes: args.passes,
     };
     setup.settings.impostors.view_radius_m = view_radius_m;
     let clouds = &mut setup.settings.clouds;
@@ -490,6 +510,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     };
     let rows = summary_rows(&runs);
     print_table(&adapter, args, timing, &rows);
+    passes::print(&runs);
     write_csv(&args.out.join("bench.csv"), &adapter, timing, &rows)?;
     write_frames_csv(&args.out.join("frames.csv"), &runs)?;
     let png = args.out.join("frame_time.png");
@@ -716,7 +737,7 @@ fn write_csv(path: &Path, adapter: &str, timing: &str, rows: &[Row]) -> anyhow::
 fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
     let mut csv =
         csv::Writer::from_path(path).with_context(|| format!("cannot write {}", path.display()))?;
-    csv.write_record([
+    let mut header = vec![
         "scenario",
         "impostors",
         "cloud_scale",
@@ -733,10 +754,12 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
         "blocks_far",
         "impostors_rebuilt",
         "cloud_target_bytes",
-    ])?;
+    ];
+    header.extend(passes::COLUMNS.map(|(name, _)| name));
+    csv.write_record(&header)?;
     for run in runs {
         for (k, f) in run.frames.iter().enumerate() {
-            csv.write_record([
+            let mut row = vec![
                 run.scenario.to_string(),
                 (if run.impostors { "on" } else { "off" }).to_string(),
                 run.cloud_scale.to_string(),
@@ -757,7 +780,13 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
                 f.blocks_far.to_string(),
                 f.impostors_rebuilt.to_string(),
                 f.cloud_target_bytes.to_string(),
-            ])?;
+            ];
+            row.extend(passes::COLUMNS.map(|(_, read)| {
+                f.passes
+                    .as_ref()
+                    .map_or(String::new(), |p| format!("{:.3}", read(p)))
+            }));
+            csv.write_record(&row)?;
         }
     }
     csv.flush()?;

@@ -21,6 +21,7 @@
 //!   matrices).
 //! - `cloud_target`: below full resolution, the clouds drawn off-screen against the farthest
 //!   depth of each block of pixels and composited with a full-resolution depth fix-up.
+//! - `pass_timing`: GPU time of each of the sky's passes, a profiling aid (off by default).
 //!
 //! Positions are f64 on the CPU and camera-relative f32 on the GPU. Units: metres, degrees,
 //! linear RGB.
@@ -32,6 +33,7 @@ pub mod cloud_target;
 pub mod draw_list;
 pub mod gpu_types;
 pub mod impostor;
+mod pass_timing;
 mod pipeline;
 mod readback;
 mod resident;
@@ -45,6 +47,7 @@ pub mod stats;
 pub mod targets;
 
 pub use camera::{Camera, Frustum};
+pub use pass_timing::PassTimes;
 pub use readback::SpriteCorner;
 pub use resident::BYTES_PER_SPRITE;
 pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};

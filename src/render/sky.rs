@@ -28,6 +28,7 @@ use super::cloud_target::{CloudShared, CloudTarget, can_test_against, cloud_targ
 use super::draw_list::{Copies, Locks, main_view};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuSpriteVertex};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
+use super::pass_timing::Stamp;
 use super::pipeline::{
     PassDesc, background_test, pipeline, pipeline_with_depth, premultiplied_over,
 };
@@ -127,6 +128,10 @@ pub struct Sky {
     record_us: Cell<u64>,
     /// Whether the last prepared frame was recorded (if not, its writes are flushed).
     recorded: Cell<bool>,
+    /// Timestamps between the passes, while pass timing is on.
+    pass_timer: Option<super::pass_timing::PassTimer>,
+    /// Kept to make the pass timer.
+    queue: wgpu::Queue,
     /// The time-of-day light of the last frame, clear sky: what the clouds are lit with.
     clear_light: TimeOfDay,
     /// `clear_light` under the cloud cover over the camera: the sky colours and the host's light.
@@ -362,6 +367,8 @@ impl Sky {
             field_us: 0,
             record_us: Cell::new(0),
             recorded: Cell::new(true),
+            pass_timer: None,
+            queue: queue.clone(),
             clear_light: light,
             seen_light: light,
             overhead: (Vec::new(), 0.0),
@@ -541,6 +548,25 @@ impl Sky {
             }
         }
         super::readback::read_corners(&self.device, queue, encoder, &read, self.sprites_to_draw)
+    }
+
+    /// Times each group of the sky's passes on the GPU from the next [`Self::record`] on (a
+    /// profiling aid: the ring and the sprites then go in passes of their own), or stops.
+    /// Returns whether timing is on: the device needs timestamp queries inside encoders
+    /// (`wgpu::Features::TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS`).
+    pub fn set_pass_timing(&mut self, on: bool) -> bool {
+        self.pass_timer = if on {
+            super::pass_timing::PassTimer::new(&self.device, &self.queue)
+        } else {
+            None
+        };
+        self.pass_timer.is_some()
+    }
+
+    /// GPU time of each group of passes of the last recorded frame, once it was submitted:
+    /// waits for the device. `None` while pass timing is off or if the times cannot be read.
+    pub fn pass_times(&self) -> Option<super::PassTimes> {
+        self.pass_timer.as_ref()?.read(&self.device)
     }
 
     /// CPU time of the last [`Self::record`], microseconds.
@@ -855,6 +881,13 @@ impl Sky {
         // The patch of changed orders, then the sky, the ring, the sprites a chunk at a time
         // (each built just before it is drawn; one pass when they fit one chunk), the in-cloud
         // fog.
+        let timer = self.pass_timer.as_ref();
+        let stamp = |encoder: &mut wgpu::CommandEncoder, at| {
+            if let Some(timer) = timer {
+                timer.stamp(encoder, at);
+            }
+        };
+        stamp(encoder, Stamp::Start);
         self.scatter.record(encoder);
         let view_group = self.view.group().filter(|_| self.sprites_to_draw > 0);
         let parts: Vec<(u32, u32, u32)> = view_group
@@ -869,12 +902,14 @@ impl Sky {
         }
         // Below full resolution the clouds go to the cloud target, composited at the end with
         // the sky background; at full resolution they are drawn over the sky in the host's colour.
+        stamp(encoder, Stamp::Build);
         let offscreen = self
             .clouds
             .frame(&self.device, &self.frame_buffer, depth_view);
         let mut pass = match &offscreen {
             Some(target) => {
                 target.downsample(encoder, &frame_group);
+                stamp(encoder, Stamp::Background);
                 target.pass(encoder, true)
             }
             None => {
@@ -894,6 +929,11 @@ impl Sky {
                     pass.set_pipeline(&self.sky_pipeline);
                     pass.draw(0..3, 0..1);
                 }
+                if timer.is_some() {
+                    drop(pass);
+                    stamp(encoder, Stamp::Background);
+                    pass = self.sky_pass(encoder, colour_view, &frame_group, None);
+                }
                 pass
             }
         };
@@ -902,6 +942,14 @@ impl Sky {
             None => (&self.sprite_pipeline, &self.in_cloud_pipeline),
         };
         self.ring.draw(&mut pass, offscreen.is_some());
+        if timer.is_some() {
+            drop(pass);
+            stamp(encoder, Stamp::Ring);
+            pass = match &offscreen {
+                Some(target) => target.pass(encoder, false),
+                None => self.sky_pass(encoder, colour_view, &frame_group, None),
+            };
+        }
         for &(c, _, n) in &parts {
             if parts.len() > 1 {
                 drop(pass);
@@ -925,8 +973,13 @@ impl Sky {
             pass.draw(0..3, 0..1);
         }
         drop(pass);
+        stamp(encoder, Stamp::Sprites);
         if let Some(target) = &offscreen {
             target.composite(encoder, colour_view, depth_view, &frame_group);
+        }
+        stamp(encoder, Stamp::Composite);
+        if let Some(timer) = timer {
+            timer.resolve(encoder);
         }
         self.recorded.set(true);
         self.record_us.set(start.elapsed().as_micros() as u64);

@@ -1,7 +1,7 @@
 //! `skycast bench` at a tiny size and frame count, so the frame-budget benchmark cannot rot: the
 //! table headed by the adapter, `bench.csv` with the three scenarios with impostors on and off,
 //! each at the cloud scale asked for and at full resolution, and the plot, a PNG that decodes;
-//! `--scenario` and `--impostors` run only part of it.
+//! `--scenario` and `--impostors` run only part of it, and `--passes` times the sky's passes.
 
 use std::path::PathBuf;
 
@@ -188,6 +188,7 @@ fn bench_runs_only_the_scenario_and_ring_asked_for() {
             "on",
             "--cloud-scale",
             "1/2",
+            "--passes",
         ])
         .args(["--out", dir.to_str().unwrap()])
         .output()
@@ -198,6 +199,7 @@ fn bench_runs_only_the_scenario_and_ring_asked_for() {
         "{stdout}{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    passes_add_up_to_the_sky(&dir, &stdout);
     let mut csv = csv::Reader::from_path(dir.join("bench.csv")).unwrap();
     let header = csv.headers().unwrap().clone();
     let column = |name: &str| header.iter().position(|c| c == name).expect(name);
@@ -214,4 +216,41 @@ fn bench_runs_only_the_scenario_and_ring_asked_for() {
         .collect();
     let row = |scale: &str| ("overcast".to_string(), "on".to_string(), scale.to_string());
     assert_eq!(rows, [row("0.5"), row("1")], "{stdout}");
+}
+
+/// `--passes`: the table of where the time goes, and per frame the sky's groups of passes, each
+/// timed, together no more than the sky's time around them; below full resolution the
+/// downsample and the composite take time, and every frame draws the ring and the sprites.
+fn passes_add_up_to_the_sky(dir: &std::path::Path, stdout: &str) {
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l.starts_with("where the sky's GPU time goes")),
+        "{stdout}"
+    );
+    let mut frames = csv::Reader::from_path(dir.join("frames.csv")).unwrap();
+    let header = frames.headers().unwrap().clone();
+    let frames: Vec<csv::StringRecord> = frames.records().map(Result::unwrap).collect();
+    let at = |f: &csv::StringRecord, name: &str| -> f64 {
+        let k = header.iter().position(|c| c == name).expect(name);
+        f[k].parse().unwrap_or_else(|_| panic!("{name} in {f:?}"))
+    };
+    assert!(!frames.is_empty());
+    for f in &frames {
+        let parts = [
+            "build_ms",
+            "background_ms",
+            "ring_ms",
+            "sprites_ms",
+            "composite_ms",
+        ]
+        .map(|name| at(f, name));
+        assert!(parts.iter().all(|&ms| ms >= 0.0), "{f:?}");
+        let sum: f64 = parts.iter().sum();
+        assert!(sum <= at(f, "sky_ms") + 0.5, "{sum} ms of passes in {f:?}");
+        assert!(parts[2] > 0.0 && parts[3] > 0.0, "{f:?}");
+        if at(f, "cloud_scale") < 1.0 {
+            assert!(parts[1] > 0.0 && parts[4] > 0.0, "{f:?}");
+        }
+    }
 }
