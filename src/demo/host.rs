@@ -13,7 +13,7 @@ use super::headless::{self, Frame, HeadlessGpu, OffscreenTarget};
 use super::terrain::{HeightField, Terrain, TerrainLight, procedural_relief_m};
 use crate::flight::{HostCamera, SkyError, SkySystem, SkySystemConfig};
 use crate::render::gpu_types::GpuSprite;
-use crate::render::{Camera, FrameStats, RenderError};
+use crate::render::{Camera, FrameStats, RenderError, Timestamps};
 use crate::shading::SunPosition;
 use crate::weather::field::WeatherField;
 
@@ -34,68 +34,29 @@ pub struct DemoHost {
 /// Five timestamps: around the sky's own submission from `prepare`, then before the frame's
 /// passes, between the ground and the sky, after; where the device has timestamp queries.
 struct GpuTimer {
-    queries: wgpu::QuerySet,
-    resolve: wgpu::Buffer,
-    read: wgpu::Buffer,
-    period_ns: f32,
+    stamps: Timestamps,
 }
 
 impl GpuTimer {
     fn new(gpu: &HeadlessGpu) -> Option<Self> {
-        let needed =
-            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        if !gpu.device.features().contains(needed) {
-            return None;
-        }
-        let queries = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("host.frame_time"),
-            ty: wgpu::QueryType::Timestamp,
-            count: 5,
-        });
-        let buffer = |label, usage| {
-            gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: 40,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
-        Some(Self {
-            queries,
-            resolve: buffer(
-                "host.frame_time_resolve",
-                wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            ),
-            read: buffer(
-                "host.frame_time_read",
-                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            ),
-            period_ns: gpu.queue.get_timestamp_period(),
-        })
+        let stamps = Timestamps::new(&gpu.device, &gpu.queue, "host.frame_time", 5)?;
+        Some(Self { stamps })
     }
 
     /// Writes timestamp `index` in a submission of its own (around the sky's `prepare`, which
     /// submits the sky's own work).
     fn stamp(&self, gpu: &HeadlessGpu, index: u32) {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        encoder.write_timestamp(&self.queries, index);
+        self.stamps.write(&mut encoder, index);
         gpu.queue.submit([encoder.finish()]);
     }
 
     /// Milliseconds of the ground and of the sky (its own submission from `prepare` and its
     /// passes in the frame) of the last submitted frame (waits for it).
     fn read_ms(&self, gpu: &HeadlessGpu) -> Option<[f64; 2]> {
-        self.read.map_async(wgpu::MapMode::Read, .., |_| {});
-        gpu.device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
-        let t: Vec<u64> = {
-            let view = self.read.get_mapped_range(..).ok()?;
-            (0..5)
-                .map(|i| u64::from_le_bytes(view[i * 8..i * 8 + 8].try_into().unwrap_or([0; 8])))
-                .collect()
-        };
-        self.read.unmap();
-        let ms = |a: u64, b: u64| b.saturating_sub(a) as f64 * self.period_ns as f64 / 1.0e6;
-        Some([ms(t[2], t[3]), ms(t[0], t[1]) + ms(t[3], t[4])])
+        let t = self.stamps.read_ms(&gpu.device)?;
+        let ms = |a: usize, b: usize| (t[b] - t[a]).max(0.0);
+        Some([ms(2, 3), ms(0, 1) + ms(3, 4)])
     }
 }
 
@@ -241,7 +202,7 @@ impl DemoHost {
                 label: Some("host.frame"),
             });
         if let Some(t) = &self.timer {
-            encoder.write_timestamp(&t.queries, 2);
+            t.stamps.write(&mut encoder, 2);
         }
         self.terrain.record(
             &mut encoder,
@@ -249,7 +210,7 @@ impl DemoHost {
             &self.target.depth_view,
         );
         if let Some(t) = &self.timer {
-            encoder.write_timestamp(&t.queries, 3);
+            t.stamps.write(&mut encoder, 3);
         }
         self.sky.record(
             &mut encoder,
@@ -258,9 +219,8 @@ impl DemoHost {
         );
         stats.record_us = self.sky.last_record_us();
         if let Some(t) = &self.timer {
-            encoder.write_timestamp(&t.queries, 4);
-            encoder.resolve_query_set(&t.queries, 0..5, &t.resolve, 0);
-            encoder.copy_buffer_to_buffer(&t.resolve, 0, &t.read, 0, 40);
+            t.stamps.write(&mut encoder, 4);
+            t.stamps.resolve(&mut encoder);
         }
         self.gpu.queue.submit([encoder.finish()]);
         stats

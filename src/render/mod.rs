@@ -47,7 +47,7 @@ pub mod stats;
 pub mod targets;
 
 pub use camera::{Camera, Frustum};
-pub use pass_timing::PassTimes;
+pub use pass_timing::{PassTimes, Timestamps};
 pub use readback::SpriteCorner;
 pub use resident::BYTES_PER_SPRITE;
 pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};

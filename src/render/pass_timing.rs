@@ -4,11 +4,11 @@
 //! buffer of its own and copies them out; [`super::Sky::pass_times`] waits for the frame and
 //! reads them. While timing, the impostor ring and the sprites go in passes of their own, one
 //! pass boundary more than an untimed frame has. `skycast bench` reports them per frame.
+//! [`Timestamps`] (a query set, resolved and read back) also times the demo host's frames.
 
 /// Timestamps of one frame: its start, after the compute passes, after the background or the
 /// downsample, after the ring, after the sprites, after the composite.
-const STAMPS: u32 = 6;
-const BYTES: u64 = STAMPS as u64 * 8;
+pub(super) const STAMPS: u32 = 6;
 
 /// GPU milliseconds of one recorded frame's sky passes, by group.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -45,74 +45,78 @@ pub(super) enum Stamp {
     Composite = 5,
 }
 
-/// The query set and buffers of the timestamps.
-pub(super) struct PassTimer {
+/// Timestamps written between passes into a query set of their own, resolved and read back
+/// (the sky's pass timer, and the demo host's frame timer).
+pub struct Timestamps {
     queries: wgpu::QuerySet,
     resolve: wgpu::Buffer,
     read: wgpu::Buffer,
+    count: u32,
     period_ns: f64,
-    /// Whether a frame's timestamps were resolved since the timer was made.
+    /// Whether they were resolved since they were made.
     resolved: std::cell::Cell<bool>,
 }
 
-impl PassTimer {
+impl Timestamps {
     /// The device's features needed: timestamps, written between passes.
     pub const FEATURES: wgpu::Features =
         wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
 
-    /// A timer on `device`; `None` where it lacks [`Self::FEATURES`].
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Option<Self> {
+    /// `count` timestamps on `device`; `None` where it lacks [`Self::FEATURES`].
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        label: &str,
+        count: u32,
+    ) -> Option<Self> {
         if !device.features().contains(Self::FEATURES) {
             return None;
         }
-        let buffer = |label, usage| {
+        let bytes = count as u64 * 8;
+        let buffer = |usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: BYTES,
+                size: bytes,
                 usage,
                 mapped_at_creation: false,
             })
         };
         Some(Self {
             queries: device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("sky.pass_times"),
+                label: Some(label),
                 ty: wgpu::QueryType::Timestamp,
-                count: STAMPS,
+                count,
             }),
-            resolve: buffer(
-                "sky.pass_times_resolve",
-                wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            ),
-            read: buffer(
-                "sky.pass_times_read",
-                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            ),
+            resolve: buffer(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
+            read: buffer(wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ),
+            count,
             period_ns: queue.get_timestamp_period() as f64,
             resolved: std::cell::Cell::new(false),
         })
     }
 
-    /// Writes timestamp `stamp` (between passes).
-    pub fn stamp(&self, encoder: &mut wgpu::CommandEncoder, stamp: Stamp) {
-        encoder.write_timestamp(&self.queries, stamp as u32);
+    /// Writes timestamp `index` (between passes).
+    pub fn write(&self, encoder: &mut wgpu::CommandEncoder, index: u32) {
+        encoder.write_timestamp(&self.queries, index);
     }
 
-    /// Resolves the frame's timestamps and copies them where [`Self::read`] finds them.
+    /// Resolves them all and copies them where [`Self::read_ms`] finds them (at the end of the
+    /// frame's last encoder).
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.resolve_query_set(&self.queries, 0..STAMPS, &self.resolve, 0);
-        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, BYTES);
+        encoder.resolve_query_set(&self.queries, 0..self.count, &self.resolve, 0);
+        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, self.count as u64 * 8);
         self.resolved.set(true);
     }
 
-    /// The last submitted frame's times (waits for the device); `None` before the first timed
-    /// frame or if they cannot be read.
-    pub fn read(&self, device: &wgpu::Device) -> Option<PassTimes> {
+    /// The last submitted frame's timestamps in milliseconds after the first (waits for the
+    /// device); `None` before the first resolve or if they cannot be read.
+    pub fn read_ms(&self, device: &wgpu::Device) -> Option<Vec<f64>> {
         if !self.resolved.get() {
             return None;
         }
         self.read.map_async(wgpu::MapMode::Read, .., |_| {});
         let waited = device.poll(wgpu::PollType::wait_indefinitely());
-        let stamps: Option<Vec<u64>> = waited.ok().and_then(|_| {
+        let ticks: Option<Vec<u64>> = waited.ok().and_then(|_| {
             let view = self.read.get_mapped_range(..).ok()?;
             Some(
                 view.chunks_exact(8)
@@ -122,16 +126,27 @@ impl PassTimer {
         });
         // Unmapped whatever happened: the next frame copies into it.
         self.read.unmap();
-        let t = stamps?;
-        let ms = |a: Stamp, b: Stamp| {
-            t[b as usize].saturating_sub(t[a as usize]) as f64 * self.period_ns / 1.0e6
-        };
-        Some(PassTimes {
-            build_ms: ms(Stamp::Start, Stamp::Build),
-            background_ms: ms(Stamp::Build, Stamp::Background),
-            ring_ms: ms(Stamp::Background, Stamp::Ring),
-            sprites_ms: ms(Stamp::Ring, Stamp::Sprites),
-            composite_ms: ms(Stamp::Sprites, Stamp::Composite),
-        })
+        let ticks = ticks?;
+        let first = *ticks.first()?;
+        Some(
+            ticks
+                .iter()
+                .map(|&t| t.saturating_sub(first) as f64 * self.period_ns / 1.0e6)
+                .collect(),
+        )
     }
+}
+
+/// The groups' times from the frame's stamps (milliseconds after the first, as
+/// [`Timestamps::read_ms`] gives them).
+pub(super) fn pass_times(stamps_ms: &[f64]) -> Option<PassTimes> {
+    let at = |s: Stamp| stamps_ms.get(s as usize).copied();
+    let ms = |a: Stamp, b: Stamp| Some((at(b)? - at(a)?).max(0.0));
+    Some(PassTimes {
+        build_ms: ms(Stamp::Start, Stamp::Build)?,
+        background_ms: ms(Stamp::Build, Stamp::Background)?,
+        ring_ms: ms(Stamp::Background, Stamp::Ring)?,
+        sprites_ms: ms(Stamp::Ring, Stamp::Sprites)?,
+        composite_ms: ms(Stamp::Sprites, Stamp::Composite)?,
+    })
 }

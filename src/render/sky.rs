@@ -28,7 +28,7 @@ use super::cloud_target::{CloudShared, CloudTarget, can_test_against, cloud_targ
 use super::draw_list::{Copies, Locks, main_view};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuSpriteVertex};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
-use super::pass_timing::Stamp;
+use super::pass_timing::{STAMPS, Stamp};
 use super::pipeline::{
     PassDesc, background_test, pipeline, pipeline_with_depth, premultiplied_over,
 };
@@ -129,7 +129,7 @@ pub struct Sky {
     /// Whether the last prepared frame was recorded (if not, its writes are flushed).
     recorded: Cell<bool>,
     /// Timestamps between the passes, while pass timing is on.
-    pass_timer: Option<super::pass_timing::PassTimer>,
+    pass_timer: Option<super::Timestamps>,
     /// Kept to make the pass timer.
     queue: wgpu::Queue,
     /// The time-of-day light of the last frame, clear sky: what the clouds are lit with.
@@ -556,7 +556,7 @@ impl Sky {
     /// (`wgpu::Features::TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS`).
     pub fn set_pass_timing(&mut self, on: bool) -> bool {
         self.pass_timer = if on {
-            super::pass_timing::PassTimer::new(&self.device, &self.queue)
+            super::Timestamps::new(&self.device, &self.queue, "sky.pass_times", STAMPS)
         } else {
             None
         };
@@ -566,7 +566,7 @@ impl Sky {
     /// GPU time of each group of passes of the last recorded frame, once it was submitted:
     /// waits for the device. `None` while pass timing is off or if the times cannot be read.
     pub fn pass_times(&self) -> Option<super::PassTimes> {
-        self.pass_timer.as_ref()?.read(&self.device)
+        super::pass_timing::pass_times(&self.pass_timer.as_ref()?.read_ms(&self.device)?)
     }
 
     /// CPU time of the last [`Self::record`], microseconds.
@@ -882,9 +882,9 @@ impl Sky {
         // (each built just before it is drawn; one pass when they fit one chunk), the in-cloud
         // fog.
         let timer = self.pass_timer.as_ref();
-        let stamp = |encoder: &mut wgpu::CommandEncoder, at| {
+        let stamp = |encoder: &mut wgpu::CommandEncoder, at: Stamp| {
             if let Some(timer) = timer {
-                timer.stamp(encoder, at);
+                timer.write(encoder, at as u32);
             }
         };
         stamp(encoder, Stamp::Start);
