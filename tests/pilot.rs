@@ -257,77 +257,127 @@ fn region_colour(
     (lum, sat)
 }
 
+/// The storm tests' frame, and a cumulonimbus's base above the ground there, feet.
+const STORM_W: u32 = 640;
+const STORM_H: u32 = 360;
+const STORM_BASE_FT: f32 = 3000.0;
+
+/// A demo host over flat ground for the storm tests, the afternoon sun behind the camera's right
+/// shoulder, and the camera 10 m up looking level due north.
+fn storm_view() -> (
+    skycast::demo::DemoHost,
+    skycast::shading::SunPosition,
+    skycast::render::Camera,
+) {
+    use skycast::demo::terrain::HeightField;
+    let ground = HeightField::from_fn(glam::DVec2::ZERO, 80_000.0, 64, |_| 0.0);
+    let config =
+        skycast::flight::SkySystemConfig::new(skycast::demo::headless::TARGETS, (28.5, -81.45));
+    let host = skycast::demo::DemoHost::new(STORM_W, STORM_H, &ground, config)
+        .expect("an adapter (lavapipe)");
+    let sun = skycast::shading::SunPosition {
+        elevation_deg: 40.0,
+        azimuth_deg: 200.0,
+        declination_deg: 0.0,
+    };
+    let camera = host.camera(glam::DVec3::new(0.0, 0.0, 10.0), 0.0, 0.0);
+    (host, sun, camera)
+}
+
+/// The biggest cell of a 2-okta cumulonimbus layer based at [`STORM_BASE_FT`] with
+/// `precipitation`, moved `distance_m` due north of the camera, and the radius of its base,
+/// metres.
+fn storm_cell(precipitation: f32, distance_m: f64) -> (skycast::clouds::Cloud, f64) {
+    use skycast::weather::{BlockIndex, BlockLayer, BlockWeather, CloudType, TypeSource};
+    let weather = BlockWeather {
+        layers: vec![BlockLayer {
+            cloud_type: CloudType::Cumulonimbus,
+            type_source: TypeSource::Reported,
+            coverage_oktas: 2.0,
+            base_ft_agl: STORM_BASE_FT,
+            thickness_ft: 30_000.0,
+        }],
+        visibility_m: 50_000.0,
+        temperature_c: 24.0,
+        dewpoint_c: 20.0,
+        precipitation,
+        ..BlockWeather::default()
+    };
+    let types = skycast::clouds::CloudTypes::builtin();
+    let block = skycast::clouds::generate_block(BlockIndex::new(0, 0), &weather, 11, &types);
+    let mut cell = block
+        .clouds
+        .into_iter()
+        .max_by_key(|c| c.sprites.len())
+        .expect("a cumulonimbus");
+    cell.centre_m.x = 0.0;
+    cell.centre_m.y = distance_m;
+    let base_radius_m = cell
+        .sprites
+        .iter()
+        .filter(|s| s.offset_m[2] < 0.0)
+        .map(|s| glam::DVec2::new(s.offset_m[0] as f64, s.offset_m[1] as f64).length())
+        .fold(0.0, f64::max);
+    (cell, base_radius_m)
+}
+
+/// Where a point `distance_m` ahead of the storm camera lands on its frame: the column of a
+/// point `east_m` to the right, the row of one `up_m` above the camera's height.
+struct StormFrame {
+    distance_m: f64,
+}
+
+impl StormFrame {
+    fn tan_half_v() -> f64 {
+        30f64.to_radians().tan()
+    }
+
+    fn column(&self, east_m: f64) -> u32 {
+        let half_w = STORM_W as f64 / 2.0;
+        let tan_half_h = Self::tan_half_v() * STORM_W as f64 / STORM_H as f64;
+        (half_w + half_w * (east_m / self.distance_m) / tan_half_h) as u32
+    }
+
+    fn row(&self, up_m: f64) -> u32 {
+        let half_h = STORM_H as f64 / 2.0;
+        (half_h - half_h * (up_m / self.distance_m) / Self::tan_half_v()) as u32
+    }
+}
+
+/// Draws `host`'s frame, keeps it as `png` and returns the picture as written.
+fn storm_picture(
+    host: &mut skycast::demo::DemoHost,
+    camera: &skycast::render::Camera,
+    sun: &skycast::shading::SunPosition,
+    png: &Path,
+) -> image::RgbaImage {
+    let (frame, _) = host.frame(camera, sun, 0.0, 50_000.0).unwrap();
+    frame.write_png(png).unwrap();
+    image::open(png).unwrap().to_rgba8()
+}
+
 /// A cumulonimbus 20 km ahead, base 3,000 ft, in heavy rain, seen from 30 ft above flat ground
 /// looking level: the column under its base is measurably darker and greyer than the sky beside
 /// it. The same cell on a dry day has no such column. Flown into the rain, the visibility drops.
 #[test]
 fn rain_falls_out_of_a_storm_seen_from_20_km() {
-    use glam::{DVec2, DVec3};
-    use skycast::clouds::{CloudTypes, generate_block};
-    use skycast::demo::terrain::HeightField;
-    use skycast::demo::{DemoHost, headless};
-    use skycast::flight::SkySystemConfig;
+    use glam::DVec3;
     use skycast::render::{SkyBlock, SkyCloud};
-    use skycast::shading::SunPosition;
-    use skycast::weather::{BlockIndex, BlockLayer, BlockWeather, CloudType, TypeSource};
 
-    const W: u32 = 640;
-    const H: u32 = 360;
     const DISTANCE_M: f64 = 20_000.0;
-    const BASE_FT: f32 = 3000.0;
     let dir = out_dir("storm");
-    let ground = HeightField::from_fn(DVec2::ZERO, 80_000.0, 64, |_| 0.0);
-    let config = SkySystemConfig::new(headless::TARGETS, (28.5, -81.45));
-    let mut host = DemoHost::new(W, H, &ground, config).expect("an adapter (lavapipe)");
-    // Afternoon sun behind the camera's right shoulder.
-    let sun = SunPosition {
-        elevation_deg: 40.0,
-        azimuth_deg: 200.0,
-        declination_deg: 0.0,
-    };
-    let camera = host.camera(DVec3::new(0.0, 0.0, 10.0), 0.0, 0.0);
-    let types = CloudTypes::builtin();
+    let (mut host, sun, camera) = storm_view();
     let mut looks = Vec::new();
     for (name, precipitation) in [("rain", 1.0), ("dry", 0.0)] {
-        let weather = BlockWeather {
-            layers: vec![BlockLayer {
-                cloud_type: CloudType::Cumulonimbus,
-                type_source: TypeSource::Reported,
-                coverage_oktas: 2.0,
-                base_ft_agl: BASE_FT,
-                thickness_ft: 30_000.0,
-            }],
-            visibility_m: 50_000.0,
-            temperature_c: 24.0,
-            dewpoint_c: 20.0,
-            precipitation,
-            ..BlockWeather::default()
-        };
-        let block = generate_block(BlockIndex::new(0, 0), &weather, 11, &types);
-        // The biggest cell, moved 20 km north of the camera.
-        let mut cell = block
-            .clouds
-            .into_iter()
-            .max_by_key(|c| c.sprites.len())
-            .expect("a cumulonimbus");
-        cell.centre_m.x = 0.0;
-        cell.centre_m.y = DISTANCE_M;
-        let base_radius_m = cell
-            .sprites
-            .iter()
-            .filter(|s| s.offset_m[2] < 0.0)
-            .map(|s| DVec2::new(s.offset_m[0] as f64, s.offset_m[1] as f64).length())
-            .fold(0.0, f64::max);
+        let (cell, base_radius_m) = storm_cell(precipitation, DISTANCE_M);
         let centre = cell.centre_m;
         host.sky.set_clouds(vec![SkyBlock {
             id: 1 + precipitation as u64,
             centre_m: centre,
             clouds: vec![SkyCloud::from(&cell)],
         }]);
-        let (frame, _) = host.frame(&camera, &sun, 0.0, 50_000.0).unwrap();
         let png = dir.join(format!("{name}.png"));
-        frame.write_png(&png).unwrap();
-        looks.push((image::open(&png).unwrap().to_rgba8(), base_radius_m));
+        looks.push((storm_picture(&mut host, &camera, &sun, &png), base_radius_m));
         // Flown into the heart of a shaft (its upper sprite's axis, 100 m up), the visibility
         // drops to the rain's; 20 km away it is the air's.
         let air = host.sky.fog().distance_m;
@@ -346,14 +396,12 @@ fn rain_falls_out_of_a_storm_seen_from_20_km() {
         }
     }
     // Where things are on the frame: columns by angle from the view axis, rows by elevation.
-    let half_w = W as f64 / 2.0;
-    let half_h = H as f64 / 2.0;
-    let tan_half_v = 30f64.to_radians().tan();
-    let tan_half_h = tan_half_v * W as f64 / H as f64;
-    let column = |east_m: f64| (half_w + half_w * (east_m / DISTANCE_M) / tan_half_h) as u32;
-    let row = |up_m: f64| (half_h - half_h * (up_m / DISTANCE_M) / tan_half_v) as u32;
-    let base_row = row(BASE_FT as f64 * 0.3048 - 10.0);
-    let rows = base_row + 3..row(0.0) - 1;
+    let on_frame = StormFrame {
+        distance_m: DISTANCE_M,
+    };
+    let column = |east_m: f64| on_frame.column(east_m);
+    let base_row = on_frame.row(STORM_BASE_FT as f64 * 0.3048 - 10.0);
+    let rows = base_row + 3..on_frame.row(0.0) - 1;
     let mut measured = Vec::new();
     for (frame, radius) in &looks {
         let under = region_colour(
@@ -405,69 +453,24 @@ fn rain_falls_out_of_a_storm_seen_from_20_km() {
 /// base, while its body 2.5-3.5 km up is the same in both.
 #[test]
 fn a_storm_base_lies_in_the_shadow_of_its_tower() {
-    use glam::{DVec2, DVec3};
-    use skycast::clouds::{CloudTypes, generate_block};
-    use skycast::demo::terrain::HeightField;
-    use skycast::demo::{DemoHost, headless};
-    use skycast::flight::SkySystemConfig;
     use skycast::render::{SkyBlock, SkyCloud};
-    use skycast::shading::SunPosition;
-    use skycast::weather::{BlockIndex, BlockLayer, BlockWeather, CloudType, TypeSource};
 
-    const W: u32 = 640;
-    const H: u32 = 360;
     const DISTANCE_M: f64 = 8_000.0;
-    const BASE_M: f64 = 3000.0 * 0.3048;
+    const BASE_M: f64 = STORM_BASE_FT as f64 * 0.3048;
     let dir = out_dir("storm-base");
-    let ground = HeightField::from_fn(DVec2::ZERO, 80_000.0, 64, |_| 0.0);
-    let config = SkySystemConfig::new(headless::TARGETS, (28.5, -81.45));
-    let mut host = DemoHost::new(W, H, &ground, config).expect("an adapter (lavapipe)");
-    let sun = SunPosition {
-        elevation_deg: 40.0,
-        azimuth_deg: 200.0,
-        declination_deg: 0.0,
-    };
-    let camera = host.camera(DVec3::new(0.0, 0.0, 10.0), 0.0, 0.0);
-    let weather = BlockWeather {
-        layers: vec![BlockLayer {
-            cloud_type: CloudType::Cumulonimbus,
-            type_source: TypeSource::Reported,
-            coverage_oktas: 2.0,
-            base_ft_agl: 3000.0,
-            thickness_ft: 30_000.0,
-        }],
-        visibility_m: 50_000.0,
-        temperature_c: 24.0,
-        dewpoint_c: 20.0,
-        ..BlockWeather::default()
-    };
-    let types = CloudTypes::builtin();
-    let block = generate_block(BlockIndex::new(0, 0), &weather, 11, &types);
-    let mut cell = block
-        .clouds
-        .into_iter()
-        .max_by_key(|c| c.sprites.len())
-        .expect("a cumulonimbus");
-    cell.centre_m = DVec3::new(0.0, DISTANCE_M, cell.centre_m.z);
-    let radius_m = cell
-        .sprites
-        .iter()
-        .filter(|s| s.offset_m[2] < 0.0)
-        .map(|s| DVec2::new(s.offset_m[0] as f64, s.offset_m[1] as f64).length())
-        .fold(0.0, f64::max);
+    let (mut host, sun, camera) = storm_view();
+    let (cell, radius_m) = storm_cell(0.0, DISTANCE_M);
     let shaded = SkyCloud::from(&cell);
     assert!(shaded.shaded_base_m > 1000.0, "{}", shaded.shaded_base_m);
     let lit = SkyCloud {
         shaded_base_m: 0.0,
         ..shaded.clone()
     };
-    let half_w = W as f64 / 2.0;
-    let half_h = H as f64 / 2.0;
-    let tan_half_v = 30f64.to_radians().tan();
-    let tan_half_h = tan_half_v * W as f64 / H as f64;
-    let column = |east_m: f64| (half_w + half_w * (east_m / DISTANCE_M) / tan_half_h) as u32;
-    let row = |up_m: f64| (half_h - half_h * (up_m / DISTANCE_M) / tan_half_v) as u32;
-    let columns = column(-0.3 * radius_m)..column(0.3 * radius_m);
+    let on_frame = StormFrame {
+        distance_m: DISTANCE_M,
+    };
+    let row = |up_m: f64| on_frame.row(up_m);
+    let columns = on_frame.column(-0.3 * radius_m)..on_frame.column(0.3 * radius_m);
     let base_rows = row(BASE_M + 600.0)..row(BASE_M + 100.0);
     let body_rows = row(BASE_M + 3500.0)..row(BASE_M + 2500.0);
     let mut looks = Vec::new();
@@ -477,10 +480,7 @@ fn a_storm_base_lies_in_the_shadow_of_its_tower() {
             centre_m: cell.centre_m,
             clouds: vec![cloud],
         }]);
-        let (frame, _) = host.frame(&camera, &sun, 0.0, 50_000.0).unwrap();
-        let png = dir.join(format!("{name}.png"));
-        frame.write_png(&png).unwrap();
-        let image = image::open(&png).unwrap().to_rgba8();
+        let image = storm_picture(&mut host, &camera, &sun, &dir.join(format!("{name}.png")));
         looks.push([
             region_colour(&image, columns.clone(), base_rows.clone()).0,
             region_colour(&image, columns.clone(), body_rows.clone()).0,

@@ -5,32 +5,33 @@
 
 use std::path::PathBuf;
 
-#[test]
-fn bench_command_writes_table_csv_and_plot() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bench-command");
+/// Runs `skycast bench` at 64 x 36 with `args`, its output into a fresh directory `name` of
+/// the test's temporary directory; returns the directory and what it printed (it must succeed).
+fn bench(name: &str, args: &[&str]) -> (PathBuf, String) {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
     let _ = std::fs::remove_dir_all(&dir);
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_skycast"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .env("XDG_RUNTIME_DIR", "/tmp")
-        .args([
-            "bench",
-            "--size",
-            "64x36",
-            "--frames",
-            "3",
-            "--view-km",
-            "30",
-            "--cloud-scale",
-            "1/2",
-        ])
+        .args(["bench", "--size", "64x36"])
+        .args(args)
         .args(["--out", dir.to_str().unwrap()])
         .output()
         .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(
         out.status.success(),
         "{stdout}{}",
         String::from_utf8_lossy(&out.stderr)
+    );
+    (dir, stdout)
+}
+
+#[test]
+fn bench_command_writes_table_csv_and_plot() {
+    let (dir, stdout) = bench(
+        "bench-command",
+        &["--frames", "3", "--view-km", "30", "--cloud-scale", "1/2"],
     );
     let lines: Vec<&str> = stdout.lines().collect();
     assert!(lines[0].starts_with("skycast bench on "), "{stdout}");
@@ -167,21 +168,13 @@ fn bench_command_writes_table_csv_and_plot() {
 
 #[test]
 fn bench_runs_only_the_scenario_and_ring_asked_for() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bench-one-scenario");
-    let _ = std::fs::remove_dir_all(&dir);
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_skycast"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env("XDG_RUNTIME_DIR", "/tmp")
-        .args([
-            "bench",
-            "--size",
-            "64x36",
+    let (dir, stdout) = bench(
+        "bench-one-scenario",
+        &[
             "--frames",
             "2",
             "--view-km",
             "30",
-        ])
-        .args([
             "--scenario",
             "overcast",
             "--impostors",
@@ -189,15 +182,7 @@ fn bench_runs_only_the_scenario_and_ring_asked_for() {
             "--cloud-scale",
             "1/2",
             "--passes",
-        ])
-        .args(["--out", dir.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
+        ],
     );
     passes_add_up_to_the_sky(&dir, &stdout);
     let mut csv = csv::Reader::from_path(dir.join("bench.csv")).unwrap();
