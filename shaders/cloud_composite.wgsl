@@ -15,7 +15,8 @@
 
 @group(1) @binding(0) var cloud_colour: texture_2d<f32>;
 @group(1) @binding(1) var cloud_distance: texture_2d<f32>;
-@group(1) @binding(2) var farthest_depth: texture_2d<f32>;
+// The farthest distance of each block of host pixels, metres (`cloud_downsample.wgsl`).
+@group(1) @binding(2) var farthest_distance: texture_2d<f32>;
 @group(1) @binding(3) var cloud_sampler: sampler;
 
 // The split composite's two draws test the host's depth against the background depth of
@@ -47,12 +48,11 @@ fn over_sky(i: BackgroundOut, colour: vec4<f32>) -> vec4<f32> {
 fn over_scene(position: vec2<f32>, colour: vec4<f32>, d: f32) -> vec4<f32> {
     let low_size = vec2<f32>(textureDimensions(cloud_colour));
     let uv = position / (low_size * f32(DIVISOR));
-    let farthest = textureLoad(farthest_depth, vec2<i32>(position) / DIVISOR, 0).r;
+    let farthest_m = textureLoad(farthest_distance, vec2<i32>(position) / DIVISOR, 0).r;
     let here_m = linear_depth_m(d);
-    let farthest_m = linear_depth_m(farthest);
     let cloud_m = textureSampleLevel(cloud_distance, cloud_sampler, uv, 0.0).r * 1000.0 / colour.a;
-    let drawn_with = clamp((farthest_m - cloud_m) / frame.params.z, 0.0, 1.0);
-    let here = clamp((here_m - cloud_m) / frame.params.z, 0.0, 1.0);
+    let drawn_with = clamp((farthest_m - cloud_m) * frame.params.y, 0.0, 1.0);
+    let here = clamp((here_m - cloud_m) * frame.params.y, 0.0, 1.0);
     // Nothing of the cloud was left at the block's depth: it is hidden here too (a neighbour
     // texel's cloud must not bleed onto terrain in front of it).
     let keep = select(clamp(here / drawn_with, 0.0, 1.0), here, drawn_with < 1.0e-3);

@@ -117,8 +117,8 @@ fn ring_sample(
     }
     let cloud = on_sphere(centre, dir, dist);
     let cloud_m = (frame.view_proj * vec4<f32>(cloud, 1.0)).w;
-    let scene_m = linear_depth_m(scene_depth_at(frag_xy));
-    let soft = clamp((scene_m - cloud_m) / frame.params.z, 0.0, 1.0);
+    let scene_m = scene_m_at(frag_xy);
+    let soft = clamp((scene_m - cloud_m) * frame.params.y, 0.0, 1.0);
     return RingHit(texel * soft, cloud_m);
 }
 

@@ -26,8 +26,9 @@ fn fs_in_cloud_offscreen(i: FogOut) -> CloudOut {
 }
 
 fn in_cloud_fog(frag_xy: vec2<f32>) -> vec4<f32> {
-    let d = scene_depth_at(frag_xy);
-    let dist_m = select(linear_depth_m(d), 1.0e9, is_background(d));
+    // Where the host drew nothing this is its far plane's distance (1e9 for a far plane at
+    // infinity): at the fog's tens of metres of visibility, opaque to within a millionth.
+    let dist_m = scene_m_at(frag_xy);
     let density = 1.0 - exp(-dist_m / frame.params.w);
     let alpha = clamp(density * frame.in_cloud_rgba.a, 0.0, 1.0);
     return vec4<f32>(frame.in_cloud_rgba.rgb * alpha, alpha);

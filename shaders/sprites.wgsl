@@ -61,8 +61,8 @@ fn fs_sprite_offscreen(i: VertexOut) -> CloudOut {
 // Premultiplied colour of a sprite fragment (also used by the impostor pass).
 fn sprite_colour(i: VertexOut) -> vec4<f32> {
     let texel = textureSample(sheet, sheet_sampler, i.uv_haze.xy);
-    let scene_m = linear_depth_m(scene_depth_at(i.position.xy));
-    let soft = clamp((scene_m - view_depth_m(i)) / frame.params.z, 0.0, 1.0);
+    let scene_m = scene_m_at(i.position.xy);
+    let soft = clamp((scene_m - view_depth_m(i)) * frame.params.y, 0.0, 1.0);
     let alpha = texel.a * i.colour.a * soft;
     let rgb = mix(i.colour.rgb * texel.rgb, frame.sky_horizon_rgb.rgb, i.uv_haze.z);
     return vec4<f32>(rgb * alpha, alpha);

@@ -7,8 +7,9 @@ struct Frame {
     sky_zenith_rgb: vec4<f32>,
     sky_horizon_rgb: vec4<f32>,
     in_cloud_rgba: vec4<f32>,
-    // x: the host's background depth (1 standard Z, 0 reversed), y unused, soft_depth_fade_m,
-    // in_cloud_visibility_m
+    // x: the host's background depth (1 standard Z, 0 reversed), y: 1 / soft_depth_fade_m (the
+    // soft fades multiply by it: a division per fragment spared), z: soft_depth_fade_m,
+    // w: in_cloud_visibility_m
     params: vec4<f32>,
     // x: haze distance, metres
     haze: vec4<f32>,
@@ -40,6 +41,21 @@ fn farther_depth(a: f32, b: f32) -> f32 {
 
 fn scene_depth_at(frag_xy: vec2<f32>) -> f32 {
     return textureLoad(scene_depth, vec2<i32>(frag_xy), 0).r;
+}
+
+// Whether `scene_depth` already holds metres from the camera plane instead of the host's depth:
+// set for the passes into the off-screen cloud target, which read the farthest distance of each
+// block of host pixels (`cloud_downsample.wgsl`), converted once a texel there instead of once a
+// fragment here (the conversion's division was a tenth of the sprites' fill cost on lavapipe).
+override SCENE_IN_METRES: bool = false;
+
+// Metres from the camera plane to what the host drew at a pixel (`linear_depth_m` of its depth).
+fn scene_m_at(frag_xy: vec2<f32>) -> f32 {
+    let stored = scene_depth_at(frag_xy);
+    if (SCENE_IN_METRES) {
+        return stored;
+    }
+    return linear_depth_m(stored);
 }
 
 // Full-screen triangle.

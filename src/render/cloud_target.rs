@@ -6,9 +6,11 @@
 //!
 //! Each frame, when `[clouds] resolution_scale` is below 1:
 //! 1. `clouds.downsample` (`shaders/cloud_downsample.wgsl`): the host's depth, the farthest of
-//!    each block of pixels, into an R32Float texture of the target's size;
-//! 2. the cloud passes draw into the target against that depth (their soft depth fade reads it
-//!    through the frame group's scene depth): premultiplied colour in [`CLOUD_COLOUR_FORMAT`],
+//!    each block of pixels, as metres from the camera plane into an R32Float texture of the
+//!    target's size;
+//! 2. the cloud passes draw into the target against that distance (their soft depth fade reads
+//!    it through the frame group's scene depth, `SceneDepth::FarthestMetres`: converted once a
+//!    texel, not once a fragment): premultiplied colour in [`CLOUD_COLOUR_FORMAT`],
 //!    and the clouds' distance times alpha in [`CLOUD_DISTANCE_FORMAT`], both blended "over";
 //! 3. `clouds.composite` (`shaders/cloud_composite.wgsl`): bilinear upsample over the host's
 //!    colour, the soft depth fade redone per full-resolution pixel so a silhouette in front of a
@@ -26,7 +28,7 @@ use std::cell::RefCell;
 
 use super::gpu_types::GpuSpriteVertex;
 use super::pipeline::{
-    PassDesc, background_test, pipeline, pipeline_with_depth, premultiplied_over,
+    PassDesc, SceneDepth, background_test, pipeline, pipeline_with_depth, premultiplied_over,
 };
 
 /// The cloud target's colour: premultiplied linear RGBA in half floats. Eight-bit channels band
@@ -39,7 +41,8 @@ pub const CLOUD_COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16
 /// The clouds' distance from the camera plane, kilometres times alpha (half floats: about 4 m at
 /// 6 km, well inside the soft fade's 120 m).
 pub const CLOUD_DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
-/// The farthest host depth of each block of pixels.
+/// The farthest host depth of each block of pixels, as metres from the camera plane (full
+/// floats: the host's far plane may be 1e9, the stand-in for infinity).
 const FARTHEST_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 const SPRITES_WGSL: &str = include_str!("../../shaders/sprites.wgsl");
@@ -67,7 +70,7 @@ pub(super) struct CloudShared<'a> {
     /// multisampled when the host's targets are.
     pub host_frame_layout: &'a wgpu::BindGroupLayout,
     /// Group 0 of the passes into the cloud target: the frame uniform and the single-sample
-    /// farthest depth.
+    /// farthest distance.
     pub frame_layout: &'a wgpu::BindGroupLayout,
     /// Group 1 of the sprite pass: the sheet and its sampler.
     pub sheet_layout: &'a wgpu::BindGroupLayout,
@@ -104,7 +107,7 @@ struct SizedTextures {
     colour: wgpu::TextureView,
     distance: wgpu::TextureView,
     farthest: wgpu::TextureView,
-    /// Group 0 of the cloud passes: the frame uniform and the farthest depth.
+    /// Group 0 of the cloud passes: the frame uniform and the farthest distance.
     frame_group: wgpu::BindGroup,
     /// Group 1 of the composite.
     composite_group: wgpu::BindGroup,
@@ -180,7 +183,7 @@ impl Offscreen {
                 buffers: &[],
                 targets: &[(FARTHEST_DEPTH_FORMAT, None)],
                 samples: 1,
-                multisampled_depth: host_samples > 1,
+                scene: SceneDepth::host(host_samples),
             },
         );
         let texture_entry = |binding, filterable| wgpu::BindGroupLayoutEntry {
@@ -222,7 +225,7 @@ impl Offscreen {
                     buffers: &[],
                     targets: &[(colour_format, blend)],
                     samples: host_samples,
-                    multisampled_depth: host_samples > 1,
+                    scene: SceneDepth::host(host_samples),
                 },
                 depth,
             )
@@ -251,7 +254,7 @@ impl Offscreen {
                 buffers: &[Some(GpuSpriteVertex::layout())],
                 targets: &targets,
                 samples: 1,
-                multisampled_depth: false,
+                scene: SceneDepth::FarthestMetres,
             },
         );
         let in_cloud = pipeline(
@@ -265,7 +268,7 @@ impl Offscreen {
                 buffers: &[],
                 targets: &targets,
                 samples: 1,
-                multisampled_depth: false,
+                scene: SceneDepth::FarthestMetres,
             },
         );
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -372,7 +375,7 @@ impl Offscreen {
 
 impl CloudFrame<'_> {
     /// Records `clouds.downsample`: the host's depth (in `host_frame_group`) to the farthest
-    /// depth of each block.
+    /// distance of each block, metres.
     pub fn downsample(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -390,7 +393,7 @@ impl CloudFrame<'_> {
     }
 
     /// A pass over the cloud target (cleared to transparent when `clear`, else kept), with the
-    /// frame uniform and the farthest depth bound as group 0.
+    /// frame uniform and the farthest distance bound as group 0.
     pub fn pass<'e>(
         &self,
         encoder: &'e mut wgpu::CommandEncoder,

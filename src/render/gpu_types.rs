@@ -23,7 +23,8 @@ pub struct GpuFrame {
     pub sky_horizon_rgb: [f32; 4],
     /// rgb: in-cloud fog colour; a: how far inside a cloud the camera is, 0..=1.
     pub in_cloud_rgba: [f32; 4],
-    /// The host's background depth (1 standard Z, 0 reversed), unused, soft_depth_fade_m,
+    /// The host's background depth (1 standard Z, 0 reversed), 1 / soft_depth_fade_m (a
+    /// multiplication per fragment instead of a division), soft_depth_fade_m,
     /// in_cloud_visibility_m.
     pub params: [f32; 4],
     /// x: distance at which sprites have faded 63% into the horizon haze, metres; yzw unused.

@@ -10,15 +10,47 @@ const SHARED_WGSL: &str = include_str!("../../shaders/shared/frame.wgsl");
 /// The shared WGSL's binding of the host's depth, single-sampled.
 const SINGLE_DEPTH: &str = "var scene_depth: texture_2d<f32>;";
 
+/// What a pass's `scene_depth` (group 0 of `shaders/shared/frame.wgsl`) holds, and so how its
+/// shader reads it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum SceneDepth {
+    /// The host's depth, single-sampled (also the blank depth of the impostor renders).
+    Host,
+    /// The host's depth, multisampled.
+    HostMultisampled,
+    /// The cloud target's farthest distance of each block of host pixels, metres
+    /// (`shaders/cloud_downsample.wgsl`): the shader skips the depth-to-metres conversion.
+    FarthestMetres,
+}
+
+impl SceneDepth {
+    /// The host's depth at `samples` a pixel.
+    pub(super) fn host(samples: u32) -> Self {
+        if samples > 1 {
+            Self::HostMultisampled
+        } else {
+            Self::Host
+        }
+    }
+
+    /// The values of the shared WGSL's pipeline-overridable constants.
+    fn constants(self) -> &'static [(&'static str, f64)] {
+        match self {
+            Self::FarthestMetres => &[("SCENE_IN_METRES", 1.0)],
+            Self::Host | Self::HostMultisampled => &[],
+        }
+    }
+}
+
 /// A shader module of `shaders/shared/frame.wgsl` followed by `pass_wgsl`, reading a
 /// multisampled depth texture or not.
 fn shader(
     device: &wgpu::Device,
     label: &str,
     pass_wgsl: &str,
-    multisampled_depth: bool,
+    scene: SceneDepth,
 ) -> wgpu::ShaderModule {
-    let shared = if multisampled_depth {
+    let shared = if scene == SceneDepth::HostMultisampled {
         SHARED_WGSL.replace(
             SINGLE_DEPTH,
             "var scene_depth: texture_multisampled_2d<f32>;",
@@ -64,8 +96,8 @@ pub(super) struct PassDesc<'a> {
     pub targets: &'a [(wgpu::TextureFormat, Option<wgpu::BlendState>)],
     /// Samples a pixel of the targets (the host's MSAA count, or 1).
     pub samples: u32,
-    /// Whether the depth the pass reads (group 0) is the host's multisampled depth.
-    pub multisampled_depth: bool,
+    /// What the depth the pass reads (group 0) holds.
+    pub scene: SceneDepth,
 }
 
 /// Builds the pipeline `desc` describes.
@@ -97,7 +129,11 @@ pub(super) fn pipeline_with_depth(
     desc: &PassDesc,
     depth: Option<wgpu::DepthStencilState>,
 ) -> wgpu::RenderPipeline {
-    let module = shader(device, desc.label, desc.wgsl, desc.multisampled_depth);
+    let module = shader(device, desc.label, desc.wgsl, desc.scene);
+    let compilation_options = wgpu::PipelineCompilationOptions {
+        constants: desc.scene.constants(),
+        ..Default::default()
+    };
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(desc.label),
         bind_group_layouts: desc.bind_groups,
@@ -120,7 +156,7 @@ pub(super) fn pipeline_with_depth(
         vertex: wgpu::VertexState {
             module: &module,
             entry_point: Some(desc.vs),
-            compilation_options: Default::default(),
+            compilation_options: compilation_options.clone(),
             buffers: desc.buffers,
         },
         primitive: wgpu::PrimitiveState {
@@ -135,7 +171,7 @@ pub(super) fn pipeline_with_depth(
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some(desc.fs),
-            compilation_options: Default::default(),
+            compilation_options: compilation_options.clone(),
             targets: &targets,
         }),
         multiview_mask: None,

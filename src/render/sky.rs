@@ -30,7 +30,7 @@ use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuSpriteVertex};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
 use super::pass_timing::{STAMPS, Stamp};
 use super::pipeline::{
-    PassDesc, background_test, pipeline, pipeline_with_depth, premultiplied_over,
+    PassDesc, SceneDepth, background_test, pipeline, pipeline_with_depth, premultiplied_over,
 };
 use super::resident::{ResidentSet, quad_index_buffer};
 use super::scatter::Scatter;
@@ -270,7 +270,7 @@ impl Sky {
                     buffers: &[],
                     targets: &[(format, None)],
                     samples,
-                    multisampled_depth: samples > 1,
+                    scene: SceneDepth::host(samples),
                 },
                 depth,
             )
@@ -294,7 +294,7 @@ impl Sky {
                 buffers: &[Some(GpuSpriteVertex::layout())],
                 targets: &[(format, over)],
                 samples,
-                multisampled_depth: samples > 1,
+                scene: SceneDepth::host(samples),
             },
         );
         let in_cloud_pipeline = pipeline(
@@ -308,7 +308,7 @@ impl Sky {
                 buffers: &[],
                 targets: &[(format, over)],
                 samples,
-                multisampled_depth: samples > 1,
+                scene: SceneDepth::host(samples),
             },
         );
         let light = config.time_of_day.at(45.0);
@@ -787,7 +787,7 @@ impl Sky {
             in_cloud_rgba: fog_rgb.extend(in_cloud).to_array(),
             params: [
                 self.targets.background_depth(),
-                0.0,
+                self.settings.clouds.soft_depth_fade_m.recip(),
                 self.settings.clouds.soft_depth_fade_m,
                 self.settings.in_cloud.visibility_m,
             ],

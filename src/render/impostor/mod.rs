@@ -39,7 +39,7 @@ use layout::{impostor_camera, in_sector};
 use super::build::{SpriteBuild, chunks};
 use super::draw_list::fresh_view;
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuRing, GpuSpriteVertex};
-use super::pipeline::{PassDesc, pipeline, premultiplied_over};
+use super::pipeline::{PassDesc, SceneDepth, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
@@ -192,7 +192,7 @@ impl ImpostorRing {
                 buffers: &[Some(GpuSpriteVertex::layout())],
                 targets: &[(IMPOSTOR_FORMAT, over), (DEPTH_FORMAT, over)],
                 samples: 1,
-                multisampled_depth: false,
+                scene: SceneDepth::Host,
             },
         );
         let quad_pipeline = pipeline(
@@ -206,7 +206,7 @@ impl ImpostorRing {
                 buffers: &[],
                 targets: &[(shared.targets.colour_format, over)],
                 samples: shared.targets.sample_count,
-                multisampled_depth: shared.targets.sample_count > 1,
+                scene: SceneDepth::host(shared.targets.sample_count),
             },
         );
         let quad_offscreen_pipeline = shared.cloud_targets.map(|targets| {
@@ -221,7 +221,7 @@ impl ImpostorRing {
                     buffers: &[],
                     targets,
                     samples: 1,
-                    multisampled_depth: false,
+                    scene: SceneDepth::FarthestMetres,
                 },
             )
         });
@@ -601,7 +601,12 @@ impl ImpostorRing {
                     inv_view_proj: vp.inverse().to_cols_array_2d(),
                     in_cloud_rgba: [0.0; 4],
                     // Its own standard-Z view over a scene of nothing (a depth of 1 everywhere).
-                    params: [1.0, 0.0, template.params[2], template.params[3]],
+                    params: [
+                        1.0,
+                        template.params[1],
+                        template.params[2],
+                        template.params[3],
+                    ],
                     depth_to_view: cam.sky_view().depth_to_view(),
                     ..*template
                 };
