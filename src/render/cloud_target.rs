@@ -43,7 +43,7 @@ pub const CLOUD_COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16
 pub const CLOUD_DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
 /// The farthest host depth of each block of pixels, as metres from the camera plane (full
 /// floats: the host's far plane may be 1e9, the stand-in for infinity).
-const FARTHEST_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+const FARTHEST_DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 const SPRITES_WGSL: &str = include_str!("../../shaders/sprites.wgsl");
 const IN_CLOUD_WGSL: &str = include_str!("../../shaders/in_cloud.wgsl");
@@ -181,7 +181,7 @@ impl Offscreen {
                 fs: "fs_downsample",
                 bind_groups: &host_frame_only,
                 buffers: &[],
-                targets: &[(FARTHEST_DEPTH_FORMAT, None)],
+                targets: &[(FARTHEST_DISTANCE_FORMAT, None)],
                 samples: 1,
                 scene: SceneDepth::host(host_samples),
             },
@@ -324,7 +324,7 @@ impl Offscreen {
         };
         let colour = make("clouds.colour", CLOUD_COLOUR_FORMAT);
         let distance = make("clouds.distance", CLOUD_DISTANCE_FORMAT);
-        let farthest = make("clouds.farthest_depth", FARTHEST_DEPTH_FORMAT);
+        let farthest = make("clouds.farthest_distance", FARTHEST_DISTANCE_FORMAT);
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("clouds.frame_group"),
             layout: &self.frame_layout,

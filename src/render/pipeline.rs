@@ -187,4 +187,22 @@ mod tests {
     fn the_shared_wgsl_declares_the_depth_the_multisampled_variant_replaces() {
         assert_eq!(SHARED_WGSL.matches(SINGLE_DEPTH).count(), 1);
     }
+
+    #[test]
+    fn the_shared_wgsl_declares_every_constant_a_pass_overrides() {
+        let all = [
+            SceneDepth::Host,
+            SceneDepth::HostMultisampled,
+            SceneDepth::FarthestMetres,
+        ];
+        let overridden: Vec<&str> = all
+            .iter()
+            .flat_map(|scene| scene.constants().iter().map(|(name, _)| *name))
+            .collect();
+        assert!(!overridden.is_empty());
+        for name in overridden {
+            let declaration = format!("override {name}: bool = false;");
+            assert_eq!(SHARED_WGSL.matches(&declaration).count(), 1, "{name}");
+        }
+    }
 }

@@ -56,7 +56,7 @@ pub struct FrameStats {
     /// Resolution of the clouds' off-screen target as a fraction of the host's (1: drawn
     /// straight into the host's colour; `[clouds] resolution_scale`).
     pub cloud_scale: f32,
-    /// Bytes of the off-screen cloud target's textures (colour, distance, farthest depth) at
+    /// Bytes of the off-screen cloud target's textures (colour, distance, farthest distance) at
     /// the last recorded frame size; 0 at scale 1.
     pub cloud_target_bytes: u64,
     /// Sprites whose Harris and Lastra light was computed this frame (blocks written, or relit
