@@ -27,6 +27,26 @@ fn bench(name: &str, args: &[&str]) -> (PathBuf, String) {
     (dir, stdout)
 }
 
+/// A CSV the bench wrote: its header and rows, a cell found by its column's name.
+struct Table {
+    header: csv::StringRecord,
+    rows: Vec<csv::StringRecord>,
+}
+
+impl Table {
+    fn read(path: &std::path::Path) -> Self {
+        let mut reader = csv::Reader::from_path(path).unwrap();
+        let header = reader.headers().unwrap().clone();
+        let rows = reader.records().map(Result::unwrap).collect();
+        Self { header, rows }
+    }
+
+    /// The index of column `name` (it must be there).
+    fn column(&self, name: &str) -> usize {
+        self.header.iter().position(|c| c == name).expect(name)
+    }
+}
+
 #[test]
 fn bench_command_writes_table_csv_and_plot() {
     let (dir, stdout) = bench(
@@ -59,10 +79,9 @@ fn bench_command_writes_table_csv_and_plot() {
         );
     }
 
-    let mut csv = csv::Reader::from_path(dir.join("bench.csv")).unwrap();
-    let header = csv.headers().unwrap().clone();
-    let column = |name: &str| header.iter().position(|c| c == name).expect(name);
-    let rows: Vec<csv::StringRecord> = csv.records().map(Result::unwrap).collect();
+    let table = Table::read(&dir.join("bench.csv"));
+    let column = |name: &str| table.column(name);
+    let rows = &table.rows;
     assert_eq!(rows.len(), 12);
     let number = |r: &csv::StringRecord, name: &str| r[column(name)].parse::<f64>().unwrap();
     for pair in rows.chunks(2) {
@@ -117,13 +136,10 @@ fn bench_command_writes_table_csv_and_plot() {
 
     // One steady frame a sample; before it, with impostors, the frames that rebuild the ring
     // (the 6 km steps are past 15% of the 20 km ring radius), timed as the rebuild column.
-    let mut frames = csv::Reader::from_path(dir.join("frames.csv")).unwrap();
-    let frame_header = frames.headers().unwrap().clone();
-    let frames: Vec<csv::StringRecord> = frames.records().map(Result::unwrap).collect();
-    let at = |f: &csv::StringRecord, name: &str| -> String {
-        let k = frame_header.iter().position(|c| c == name).expect(name);
-        f[k].to_string()
-    };
+    let frame_table = Table::read(&dir.join("frames.csv"));
+    let frames = &frame_table.rows;
+    let at =
+        |f: &csv::StringRecord, name: &str| -> String { f[frame_table.column(name)].to_string() };
     let steady = |run: &str, scale: &str| {
         frames
             .iter()
@@ -146,7 +162,7 @@ fn bench_command_writes_table_csv_and_plot() {
     );
     // The cloud target's memory is in the frames: 32 x 18 texels of 8 + 2 + 4 bytes at 1/2,
     // none at 1.
-    for f in &frames {
+    for f in frames {
         let bytes: u64 = at(f, "cloud_target_bytes").parse().unwrap();
         let expected = if at(f, "cloud_scale") == "1" {
             0
@@ -185,12 +201,11 @@ fn bench_runs_only_the_scenario_and_ring_asked_for() {
         ],
     );
     passes_add_up_to_the_sky(&dir, &stdout);
-    let mut csv = csv::Reader::from_path(dir.join("bench.csv")).unwrap();
-    let header = csv.headers().unwrap().clone();
-    let column = |name: &str| header.iter().position(|c| c == name).expect(name);
-    let rows: Vec<(String, String, String)> = csv
-        .records()
-        .map(Result::unwrap)
+    let table = Table::read(&dir.join("bench.csv"));
+    let column = |name: &str| table.column(name);
+    let rows: Vec<(String, String, String)> = table
+        .rows
+        .iter()
         .map(|r| {
             (
                 r[column("scenario")].to_string(),
@@ -213,15 +228,15 @@ fn passes_add_up_to_the_sky(dir: &std::path::Path, stdout: &str) {
             .any(|l| l.starts_with("where the sky's GPU time goes")),
         "{stdout}"
     );
-    let mut frames = csv::Reader::from_path(dir.join("frames.csv")).unwrap();
-    let header = frames.headers().unwrap().clone();
-    let frames: Vec<csv::StringRecord> = frames.records().map(Result::unwrap).collect();
+    let table = Table::read(&dir.join("frames.csv"));
+    let frames = &table.rows;
     let at = |f: &csv::StringRecord, name: &str| -> f64 {
-        let k = header.iter().position(|c| c == name).expect(name);
-        f[k].parse().unwrap_or_else(|_| panic!("{name} in {f:?}"))
+        f[table.column(name)]
+            .parse()
+            .unwrap_or_else(|_| panic!("{name} in {f:?}"))
     };
     assert!(!frames.is_empty());
-    for f in &frames {
+    for f in frames {
         let parts = [
             "build_ms",
             "background_ms",
