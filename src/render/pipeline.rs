@@ -42,8 +42,9 @@ impl SceneDepth {
     }
 }
 
-/// A shader module of `shaders/shared/frame.wgsl` followed by `pass_wgsl`, reading a
-/// multisampled depth texture or not.
+/// A shader module of `shaders/shared/frame.wgsl` followed by `pass_wgsl`, its `scene_depth`
+/// declared multisampled where `scene` is the host's multisampled depth (the override that
+/// `scene` may set is given when the pipeline is built).
 fn shader(
     device: &wgpu::Device,
     label: &str,
