@@ -67,6 +67,7 @@ struct SpriteView {
     upright_lifecycle: vec4<f32>,
     hl_phase: vec4<f32>,
     hl_sky: vec4<f32>,
+    hl_deck: vec4<f32>,
     locks: array<Lock, 128>,
 };
 
@@ -174,6 +175,14 @@ fn deck_evenness(c: Cloud, camera_z: f32, sun_z: f32) -> f32 {
     return stopped * below;
 }
 
+// The part of the direct sun that reaches `height_msl` in a deck (Beer's law along the slanted
+// path from its top, 1/e at `sunlit_depth_m` along it): 1 at and above the top. What Wang's
+// directional shading of a deck's corner goes by instead of the side of its cloud it is on.
+fn deck_sunlit(c: Cloud, height_msl: f32, sun_z: f32) -> f32 {
+    let below_top = max(c.level4_radius_flat.x - height_msl, 0.0);
+    return exp(-below_top / (c.level4_radius_flat.w * max(sun_z, 0.05)));
+}
+
 // Light scattered forward towards the eye: a Henyey-Greenstein lobe, strongest on the rim.
 fn forward_percent(view_dir: vec3<f32>, rim: f32) -> f32 {
     let g = view.mapping_g.w;
@@ -182,6 +191,19 @@ fn forward_percent(view_dir: vec3<f32>, rim: f32) -> f32 {
     let lobe = base * sqrt(base);
     let r = clamp(rim, 0.0, 1.0);
     return view.forward_lock.x * lobe * r * r * r * r;
+}
+
+// Harris and Lastra's light (as `lights` packs it: direct sun, total sun, sky) at `height_msl` in a
+// deck taken as a homogeneous slab, 1/e of the direct sun at `sunlit_depth_m` along its path, as
+// Wang's deck above: the same at every place and per corner, where the CPU's light through each
+// lattice cell alone would light the cell's sunward side. The light scattered forward on the way
+// fades at `hl_deck.x` of that rate (the recurrence of `HarrisLastra::light` through many faint
+// particles); the sky's comes straight down.
+fn deck_harris_lastra(c: Cloud, height_msl: f32, sun_z: f32) -> vec4<f32> {
+    let depth = max(c.level4_radius_flat.x - height_msl, 0.0) / c.level4_radius_flat.w;
+    let sun_depth = depth / max(sun_z, 0.05);
+    let kept = view.hl_deck.x;
+    return vec4<f32>(exp(-sun_depth), exp(-kept * sun_depth), exp(-kept * depth), 0.0);
 }
 
 // Harris and Lastra 2001: the light a sprite scatters towards the eye. `light` is its packed
@@ -343,7 +365,15 @@ fn build_sprite(k: u32, at: u32) {
         let view_dir = normalize_or(p - cam_local, vec3<f32>(0.0));
         let rim = length(p) / flat_radius.y;
         let group_dir = normalize_or(p - group, vec3<f32>(0.0));
-        let wang = directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim);
+        var wang = directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim);
+        if (cloud.level4_radius_flat.w > 0.0) {
+            // A deck is lit as one slab, not cell by cell: the direct sun falls off with the
+            // depth below its top, the same at every place, so its lattice of clouds shows no
+            // sunlit and shaded side per cell (a grid seen from above). Deeper in, the sun
+            // diffused through the deck is left: the even median it shows from below.
+            let sunlit = deck_sunlit(cloud, height_msl, sun.z);
+            wang = directional_percent(sunlit) + forward_percent(view_dir, sunlit);
+        }
         // A heap's shaded base: the body above hides the sun from its lowest part.
         let shaded_base = cloud.centre_block.w;
         let above_base = height_msl - cloud.level_height.x;
@@ -352,8 +382,12 @@ fn build_sprite(k: u32, at: u32) {
         var lit = ambient.rgb * light.w + directional;
         var base_rgb = ambient.rgb * light.w;
         if (harris_lastra) {
-            lit = harris_lastra_rgb(hl_light, view_dir);
-            base_rgb = view.hl_sky.rgb * hl_light.z + vec3<f32>(view.hl_sky.w);
+            var received = hl_light;
+            if (cloud.level4_radius_flat.w > 0.0) {
+                received = deck_harris_lastra(cloud, height_msl, sun.z);
+            }
+            lit = harris_lastra_rgb(received, view_dir);
+            base_rgb = view.hl_sky.rgb * received.z + vec3<f32>(view.hl_sky.w);
         }
         // Rain and snow hang in the cloud's shadow: its base colour, dimmer and greyer, no sun.
         let shade = base_rgb * 0.6;

@@ -114,6 +114,67 @@ fn low_overcast_from_below_is_an_even_ceiling() {
     }
 }
 
+/// The amplitude (of 1) of the strongest wave with a period of `periods` pixels in the
+/// luminance of `frame`'s rows averaged across (north to south when looking straight down with
+/// north up): a Hann-windowed Fourier transform of the profile.
+fn row_wave(frame: &image::RgbaImage, periods: std::ops::RangeInclusive<f32>) -> f32 {
+    let (w, h) = frame.dimensions();
+    let profile: Vec<f32> = (0..h)
+        .map(|y| {
+            (0..w)
+                .map(|x| luminance(frame.get_pixel(x, y)))
+                .sum::<f32>()
+                / w as f32
+        })
+        .collect();
+    let mean = profile.iter().sum::<f32>() / h as f32;
+    let n = h as f32;
+    let tau = std::f32::consts::TAU;
+    let windowed: Vec<f32> = profile
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (p - mean) * (0.5 - 0.5 * (tau * i as f32 / (n - 1.0)).cos()))
+        .collect();
+    (1..h / 2)
+        .filter(|&k| periods.contains(&(n / k as f32)))
+        .map(|k| {
+            let (re, im) = windowed
+                .iter()
+                .enumerate()
+                .fold((0.0, 0.0), |(re, im), (i, v)| {
+                    let a = tau * k as f32 * i as f32 / n;
+                    (re + v * a.cos(), im + v * a.sin())
+                });
+            // A sine of amplitude A gives |X_k| = A n / 4 under the Hann window.
+            4.0 * (re * re + im * im).sqrt() / n
+        })
+        .fold(0.0, f32::max)
+}
+
+/// Straight down from 20,000 ft onto the same overcast: the deck is one slab, not a grid. The
+/// layer is laid as one cloud per cell of a 1 km lattice; lit cloud by cloud, each cell took the
+/// sun on its southern side and the deck showed rows of bright and dark 1 km apart (26-30
+/// pixels here): a wave of 9/255 in luminance under Harris and Lastra's model, 2.6/255 under
+/// Wang's. Both now light a deck by depth below its top alike everywhere: measured 0.7/255 and
+/// 1.0/255 (what is left is the sprites' own placement on the lattice).
+#[test]
+fn low_overcast_from_high_above_shows_no_lattice() {
+    let dir = out_dir("deck-lattice");
+    let report = "EGLL 271150Z 24008KT 9999 OVC004 08/06 Q1015";
+    for model in ["wang", "harris-lastra"] {
+        let file = format!("{model}.png");
+        let pose = (20_000.0, 0.0, -89.0);
+        let frame = render_with(&dir, &file, report, pose, &["--shading", model]);
+        let wave = row_wave(&frame, 22.0..=34.0);
+        println!("{model}: the lattice's wave {:.2}/255", wave * 255.0);
+        assert!(
+            wave < 1.6 / 255.0,
+            "{model}: the deck's 1 km cells show, a wave of {}/255",
+            wave * 255.0
+        );
+    }
+}
+
 /// A flat ground 40 km across, all at the file's highest value (24 m, Heathrow's fields) or its
 /// lowest (-20 m, water): two grounds of different colour under the same sky.
 fn flat_grounds(dir: &Path) -> [(PathBuf, &'static str); 2] {

@@ -200,8 +200,9 @@ pub struct CloudTypeConfig {
     /// direct sunlight, along its slanted path, falls to 1/e. Seen from below, the deck takes
     /// the sun diffused through its whole thickness, evenly (Wang's median directional colour,
     /// without the shading groups' sunlit sides), so a low stratus is an even grey ceiling, not
-    /// sunlit heaps; from above, its top is lit as Wang lights it. Absent: lit as Wang does from
-    /// every side.
+    /// sunlit heaps; from above and inside, each part of it by its depth below the top, the same
+    /// everywhere (one slab, not a grid of cells each with a sunlit side), under either shading
+    /// model. Absent: lit as Wang does from every side.
     #[serde(default)]
     pub sunlit_depth_m: Option<f32>,
     /// Heaped types: the height above a cloud's base, metres, in which its body above hides the

@@ -100,6 +100,13 @@ impl CloudLight {
         let Some(settings) = self.settings else {
             return;
         };
+        if cloud.sunlit_depth_m > 0.0 {
+            // A deck (one cloud per lattice cell) is lit as one slab, corner by corner, in the
+            // shader (`deck_harris_lastra` in shaders/sprite_build.wgsl): each cell lit alone
+            // here would take the sun on its sunward side, a grid seen from above.
+            out.fill(0);
+            return;
+        }
         self.particles.clear();
         self.particles
             .extend(cloud.sprites.iter().map(|s| Particle {

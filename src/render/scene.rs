@@ -54,8 +54,10 @@ pub struct SkyCloud {
     pub flat: bool,
     /// A deck's sunlit depth, metres: the depth below its top at which direct sunlight, along
     /// its slanted path, falls to 1/e. Seen from below, the deck is lit evenly by the sun
-    /// diffused through it (an even grey ceiling, no sunlit heaps). 0: lit from every side, as
-    /// Wang lights clouds.
+    /// diffused through it (an even grey ceiling, no sunlit heaps); elsewhere each sprite corner
+    /// by its depth below the top, the same at every place, under either shading model (a deck
+    /// is one cloud per lattice cell, and lit cloud by cloud each cell had a sunlit side: a grid
+    /// seen from above). 0: lit from every side, as Wang lights clouds.
     pub sunlit_depth_m: f32,
     /// A heap's shaded base, metres above its base: below it the body above hides the sun (one
     /// dark, evenly lit base), the sun coming in over it. 0: lit down to the base.

@@ -86,6 +86,7 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
         hl_sky: (0.5 * (tod.sky_zenith_rgb + tod.sky_horizon_rgb) * hl.sky_strength)
             .extend(hl.ambient * tod.ambient_percent)
             .to_array(),
+        hl_deck: [1.0 - hl.forward_fraction(), 0.0, 0.0, 0.0],
         locks: [GpuLock {
             right: [0.0; 4],
             up: [0.0; 4],
