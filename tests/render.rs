@@ -1482,7 +1482,7 @@ fn harris_lastra_darkens_a_cumulus_body_against_a_low_sun() {
         "no bright rim: {bright} vs body {hl_body}"
     );
     // The light is computed again only after the sun turned more than 1 degree.
-    let mut lit_after = |azimuth_deg: f64| {
+    let lit_after = |rig: &mut Rig, azimuth_deg: f64| {
         let sun = SunPosition {
             azimuth_deg,
             ..low_sun
@@ -1490,11 +1490,30 @@ fn harris_lastra_darkens_a_cumulus_body_against_a_low_sun() {
         let (_, stats) = rig.host.frame(&camera, &sun, 0.1, 40_000.0).unwrap();
         stats.sprites_lit
     };
-    assert_eq!(lit_after(270.5), 0, "half a degree: nothing relit");
     assert_eq!(
-        lit_after(272.0),
+        lit_after(&mut rig, 270.5),
+        0,
+        "half a degree: nothing relit"
+    );
+    assert_eq!(
+        lit_after(&mut rig, 272.0),
         180,
         "two degrees: the cloud's 180 sprites"
     );
-    assert_eq!(lit_after(272.5), 0, "half a degree from the last light");
+    assert_eq!(
+        lit_after(&mut rig, 272.5),
+        0,
+        "half a degree from the last light"
+    );
+    // A deck's cell (`sunlit_depth_m`) is lit in the shader as part of one slab: none of its
+    // sprites is lit here, neither when it arrives nor when the sun turns.
+    let mut deck = thick_cumulus(DVec3::new(-1600.0, 0.0, base));
+    deck.sunlit_depth_m = 60.0;
+    rig.set_clouds(vec![SkyBlock {
+        id: 2,
+        centre_m: DVec3::new(-1600.0, 0.0, base),
+        clouds: vec![deck],
+    }]);
+    assert_eq!(lit_after(&mut rig, 272.5), 0, "a deck arrives: nothing lit");
+    assert_eq!(lit_after(&mut rig, 275.0), 0, "the sun turns: nothing lit");
 }

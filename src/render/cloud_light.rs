@@ -6,7 +6,8 @@
 //! at a time (at least one cloud a frame): a block that arrives past the budget is written with a
 //! provisional light and lit cloud by cloud in the next frames; a whole scene written at once
 //! (the first frame) is lit at once; a block written again (the buffers grew) keeps the light it
-//! had. The skylight, which does not move with the sun, once a block. Never under Wang's model.
+//! had. The skylight, which does not move with the sun, once a block. Never under Wang's model,
+//! nor for decks (lit as one slab in the shader; their sprites cost the budget nothing).
 //! Its time is part of the frame's `cpu_update_us` and shown as `light_us`.
 
 use glam::{DVec3, Vec3};
@@ -100,10 +101,7 @@ impl CloudLight {
         let Some(settings) = self.settings else {
             return;
         };
-        if cloud.sunlit_depth_m > 0.0 {
-            // A deck (one cloud per lattice cell) is lit as one slab, corner by corner, in the
-            // shader (`deck_harris_lastra` in shaders/sprite_build.wgsl): each cell lit alone
-            // here would take the sun on its sunward side, a grid seen from above.
+        if lit_in_shader(cloud) {
             out.fill(0);
             return;
         }
@@ -179,15 +177,16 @@ impl CloudLight {
     /// and the sprites lit.
     pub fn written(&mut self, r: &mut Resident, to: LightTarget, budget: &mut u32) -> (u64, u32) {
         let n = r.sprite_count();
+        let cost = sprites_to_light(&r.block.clouds);
         let light = &mut r.light;
         let mut lit = 0;
         if light.lights.len() != n as usize {
-            if n <= *budget {
+            if cost <= *budget {
                 self.block(&r.block, &mut light.lights);
                 light.lit_for = Some(self.sun_dir);
                 light.sky_exact = true;
-                *budget -= n;
-                lit = n;
+                *budget -= cost;
+                lit = cost;
             } else {
                 self.provisional(&r.block, &mut light.lights);
                 (light.lit_for, light.sky_exact) = (None, false);
@@ -196,6 +195,23 @@ impl CloudLight {
         }
         (write_lights(to, 0, &light.lights), lit)
     }
+}
+
+/// Whether `cloud` is a deck (one cloud per lattice cell), lit as one slab corner by corner in
+/// the shader (`deck_harris_lastra` in shaders/sprite_build.wgsl): each cell lit alone here
+/// would take the sun on its sunward side, a grid seen from above. Its sprites cost the light
+/// budget nothing.
+fn lit_in_shader(cloud: &SkyCloud) -> bool {
+    cloud.sunlit_depth_m > 0.0
+}
+
+/// The sprites of `clouds` the light is computed for here (not decks').
+fn sprites_to_light<'a>(clouds: impl IntoIterator<Item = &'a SkyCloud>) -> u32 {
+    clouds
+        .into_iter()
+        .filter(|c| !lit_in_shader(c))
+        .map(|c| c.sprites.len() as u32)
+        .sum()
 }
 
 /// Writes packed lights at the block's slot `to.2` plus `offset`; returns the bytes.
@@ -264,8 +280,10 @@ impl ResidentSet {
                 Some((sun, next, with_sky)) if sun == target => (next, with_sky),
                 _ => (0, !light.sky_exact),
             };
-            // The clouds lit this frame are next to each other: one write a block.
-            let from = r.clouds.get(next).map_or(0, |c| c.sprite_base - s.start) as usize;
+            // The clouds lit this frame are next to each other: one write a run of them (a deck,
+            // lit in the shader, ends a run and is neither lit nor written).
+            let at = (queue, &self.light_buffer, s.start);
+            let mut from = r.clouds.get(next).map_or(0, |c| c.sprite_base - s.start) as usize;
             let mut to = from;
             let mut done = true;
             while next < r.block.clouds.len() {
@@ -276,16 +294,19 @@ impl ResidentSet {
                 }
                 let cloud = &r.block.clouds[next];
                 let first = (r.clouds[next].sprite_base - s.start) as usize;
-                to = first + cloud.sprites.len();
-                self.light
-                    .cloud(cloud, with_sky, &mut light.lights[first..to]);
-                lit += cloud.sprites.len() as u32;
+                let end = first + cloud.sprites.len();
                 next += 1;
+                if lit_in_shader(cloud) {
+                    bytes += write_lights(at, from as u32, &light.lights[from..to]);
+                    (from, to) = (end, end);
+                    continue;
+                }
+                self.light
+                    .cloud(cloud, with_sky, &mut light.lights[first..end]);
+                lit += cloud.sprites.len() as u32;
+                to = end;
             }
-            if to > from {
-                let at = (queue, &self.light_buffer, s.start);
-                bytes += write_lights(at, from as u32, &light.lights[from..to]);
-            }
+            bytes += write_lights(at, from as u32, &light.lights[from..to]);
             if !done {
                 break;
             }
