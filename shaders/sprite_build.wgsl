@@ -175,12 +175,16 @@ fn deck_evenness(c: Cloud, camera_z: f32, sun_z: f32) -> f32 {
     return stopped * below;
 }
 
-// The part of the direct sun that reaches `height_msl` in a deck (Beer's law along the slanted
-// path from its top, 1/e at `sunlit_depth_m` along it): 1 at and above the top. What Wang's
-// directional shading of a deck's corner goes by instead of the side of its cloud it is on.
-fn deck_sunlit(c: Cloud, height_msl: f32, sun_z: f32) -> f32 {
-    let below_top = max(c.level4_radius_flat.x - height_msl, 0.0);
-    return exp(-below_top / (c.level4_radius_flat.w * max(sun_z, 0.05)));
+// How deep `height_msl` lies in a deck: its depth below the top (0 at and above it) over the
+// deck's `sunlit_depth_m`, the depth at which the direct sun falls to 1/e along its slanted path.
+fn deck_depth(c: Cloud, height_msl: f32) -> f32 {
+    return max(c.level4_radius_flat.x - height_msl, 0.0) / c.level4_radius_flat.w;
+}
+
+// The part of the direct sun that reaches `deck_depth` (Beer's law along the slanted path). What
+// Wang's directional shading of a deck's corner goes by instead of the side of its cloud it is on.
+fn deck_sunlit(depth: f32, sun_z: f32) -> f32 {
+    return exp(-depth / max(sun_z, 0.05));
 }
 
 // Light scattered forward towards the eye: a Henyey-Greenstein lobe, strongest on the rim.
@@ -193,17 +197,16 @@ fn forward_percent(view_dir: vec3<f32>, rim: f32) -> f32 {
     return view.forward_lock.x * lobe * r * r * r * r;
 }
 
-// Harris and Lastra's light (as `lights` packs it: direct sun, total sun, sky) at `height_msl` in a
-// deck taken as a homogeneous slab, 1/e of the direct sun at `sunlit_depth_m` along its path, as
-// Wang's deck above: the same at every place and per corner, where the CPU's light through each
+// Harris and Lastra's light (as `lights` packs it: direct sun, total sun, sky) at `depth` in a
+// deck taken as a homogeneous slab (`deck_depth`), as Wang's deck above: the same at every place
+// and per corner, where the CPU's light through each
 // lattice cell alone would light the cell's sunward side. The light scattered forward on the way
 // fades at `hl_deck.x` of that rate (the recurrence of `HarrisLastra::light` through many faint
 // particles); the sky's comes straight down.
-fn deck_harris_lastra(c: Cloud, height_msl: f32, sun_z: f32) -> vec4<f32> {
-    let depth = max(c.level4_radius_flat.x - height_msl, 0.0) / c.level4_radius_flat.w;
-    let sun_depth = depth / max(sun_z, 0.05);
+fn deck_harris_lastra(depth: f32, sun_z: f32) -> vec4<f32> {
+    let direct = deck_sunlit(depth, sun_z);
     let kept = view.hl_deck.x;
-    return vec4<f32>(exp(-sun_depth), exp(-kept * sun_depth), exp(-kept * depth), 0.0);
+    return vec4<f32>(direct, pow(direct, kept), exp(-kept * depth), 0.0);
 }
 
 // Harris and Lastra 2001: the light a sprite scatters towards the eye. `light` is its packed
@@ -371,7 +374,7 @@ fn build_sprite(k: u32, at: u32) {
             // depth below its top, the same at every place, so its lattice of clouds shows no
             // sunlit and shaded side per cell (a grid seen from above). Deeper in, the sun
             // diffused through the deck is left: the even median it shows from below.
-            let sunlit = deck_sunlit(cloud, height_msl, sun.z);
+            let sunlit = deck_sunlit(deck_depth(cloud, height_msl), sun.z);
             wang = directional_percent(sunlit) + forward_percent(view_dir, sunlit);
         }
         // A heap's shaded base: the body above hides the sun from its lowest part.
@@ -384,7 +387,7 @@ fn build_sprite(k: u32, at: u32) {
         if (harris_lastra) {
             var received = hl_light;
             if (cloud.level4_radius_flat.w > 0.0) {
-                received = deck_harris_lastra(cloud, height_msl, sun.z);
+                received = deck_harris_lastra(deck_depth(cloud, height_msl), sun.z);
             }
             lit = harris_lastra_rgb(received, view_dir);
             base_rgb = view.hl_sky.rgb * received.z + vec3<f32>(view.hl_sky.w);
