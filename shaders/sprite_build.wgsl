@@ -246,12 +246,24 @@ fn lifecycle_alpha(kind: u32, progress: f32, radius_fraction: f32) -> f32 {
     return 1.0;
 }
 
-// The sheet's texture coordinate of a corner of cell `cell` (a small inset keeps mips apart).
+// The inset of a quad's texture in its cell, a fraction of the cell: keeps mips apart.
+const CELL_INSET: f32 = 1.0 / 64.0;
+
+// The sheet's texture coordinate of a point of cell `cell`'s quad (0..1 across, v down).
 fn cell_uv(cell: u32, corner: vec2<f32>) -> vec2<f32> {
     let c = min(cell, 15u);
-    let inset = 1.0 / 64.0;
-    let uv = vec2<f32>(f32(c % 4u), f32(c / 4u)) + vec2<f32>(inset) + corner * (1.0 - 2.0 * inset);
+    let uv = vec2<f32>(f32(c % 4u), f32(c / 4u)) + vec2<f32>(CELL_INSET) +
+        corner * (1.0 - 2.0 * CELL_INSET);
     return uv * 0.25;
+}
+
+// The part of cell `cell`'s quad its texture covers (x: left, y: top, z: right, w: bottom, 0..1
+// across the quad, v down): `CELL_CROP` (src/render/sheet_crop.rs, put in front of this file
+// when the pipeline is built) holds it as fractions of the cell, which the inset maps onto the
+// quad. The quad is cut to it: its transparent margins cost fragments and show nothing.
+fn cell_crop(cell: u32) -> vec4<f32> {
+    let crop = (CELL_CROP[min(cell, 15u)] - vec4<f32>(CELL_INSET)) / (1.0 - 2.0 * CELL_INSET);
+    return clamp(crop, vec4<f32>(0.0), vec4<f32>(1.0));
 }
 
 // The block of the draw list holding the frame's sprite `k`: the last whose `first` is <= k.
@@ -359,9 +371,11 @@ fn build_sprite(k: u32, at: u32) {
     let rain = (s.bits & 512u) != 0u;
     let harris_lastra = view.hl_phase.x > 0.5;
     let hl_light = unpack4x8unorm(lights[slot]);
+    let crop = cell_crop(cell);
     for (var c = 0u; c < 4u; c++) {
-        let corner = vec2<f32>(f32(c & 1u), 1.0 - f32(c >> 1u));
-        let p = offset + right * ((corner.x - 0.5) * width) + up * ((corner.y - 0.5) * height);
+        // The corner on the cut quad: texture coordinates across it (v down), and where it is.
+        let across = mix(crop.xy, crop.zw, vec2<f32>(f32(c & 1u), f32(c >> 1u)));
+        let p = offset + right * ((across.x - 0.5) * width) + up * ((0.5 - across.y) * height);
         // Wang eq. (3): (ambient + directional) x alpha_morph; the texture is the fragment's.
         let height_msl = view.sun_dir_camera_z.w + centre_rel.z + p.z;
         let ambient = level_colour(cloud, height_msl);
@@ -398,7 +412,7 @@ fn build_sprite(k: u32, at: u32) {
         // Texture v runs down the sheet: the top of the sprite is v = 0.
         built[at + c] = BuiltCorner(
             vec4<f32>(centre_rel + p, 1.0),
-            cell_uv(cell, vec2<f32>(corner.x, 1.0 - corner.y)),
+            cell_uv(cell, across),
             vec2<f32>(0.0),
             vec4<f32>(select(lit, rain_rgb, rain), ambient.a * morph * alpha),
         );

@@ -38,11 +38,13 @@ pub(super) fn chunks(sprites: u32) -> impl Iterator<Item = (u32, u32, u32)> {
 }
 
 impl SpriteBuild {
-    /// The pipeline over the view's group (`view_layout`) and the resident sprites' group.
+    /// The pipeline over the view's group (`view_layout`) and the resident sprites' group; each
+    /// sheet cell's quad cut to `cell_crops` (`sheet_crop::cell_crops`).
     pub fn new(
         device: &wgpu::Device,
         view_layout: &wgpu::BindGroupLayout,
         resident_layout: &wgpu::BindGroupLayout,
+        cell_crops: &[[f32; 4]; 16],
     ) -> Self {
         let out_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sky.sprite_build_out"),
@@ -76,7 +78,9 @@ impl SpriteBuild {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("sky.sprite_build"),
-            source: wgpu::ShaderSource::Wgsl(WGSL.into()),
+            source: wgpu::ShaderSource::Wgsl(
+                format!("{}\n{WGSL}", super::sheet_crop::crops_wgsl(cell_crops)).into(),
+            ),
         });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("sky.sprite_build"),

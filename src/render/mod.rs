@@ -40,6 +40,7 @@ mod resident;
 mod scatter;
 pub mod scene;
 pub mod settings;
+mod sheet_crop;
 pub mod sky;
 mod slots;
 mod sprite_view;

@@ -254,7 +254,8 @@ impl Sky {
         let format = config.targets.colour_format;
         let resident = ResidentSet::new(device, 0);
         let view_layout = sprite_view::layout(device);
-        let build = SpriteBuild::new(device, &view_layout, resident.layout());
+        let crops = super::sheet_crop::cell_crops(sheet);
+        let build = SpriteBuild::new(device, &view_layout, resident.layout(), &crops);
         let frame_only = [Some(&frame_layout)];
         let sprite_groups = [Some(&frame_layout), Some(&sheet_layout)];
         let over = Some(premultiplied_over());
