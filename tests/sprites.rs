@@ -1,7 +1,8 @@
 //! The sprites as the vertex shader builds them (Wang 2003 3.3, 5 and 6.1 on GPU-resident
 //! sprites), read back from the GPU (`Sky::read_back_corners` runs the shader's own corner code):
 //! the order cache, the back-to-front order, facing the camera, the facing lock and its fade,
-//! upright base sprites, the forward-scattering rim, precision far from the origin, and (in drawn
+//! upright base sprites, the forward-scattering rim, precision far from the origin, each quad cut
+//! to the visible part of its sheet cell, and (in drawn
 //! frames) the horizon haze. Small scenes on whatever adapter there is (lavapipe here).
 
 use glam::{DVec2, DVec3, Vec3};
@@ -14,13 +15,19 @@ use skycast::render::{
 use skycast::shading::{ColourLevels, ForwardScattering, SunPosition, TimeOfDayTable};
 use skycast::weather::BlockWeather;
 
-/// A rig: a tiny headless target (the corners do not depend on it) and the sky.
+/// A rig: a tiny headless target (the corners do not depend on it) and the sky, with an opaque
+/// sheet (no quad is cut).
 fn host(table: TimeOfDayTable) -> DemoHost {
-    let ground = HeightField::from_fn(DVec2::ZERO, 20_000.0, 9, |_| 0.0);
     let sheet = SpriteSheet {
         size_px: 4,
         mips: vec![vec![255; 64], vec![255; 16], vec![255; 4]],
     };
+    host_with_sheet(table, sheet)
+}
+
+/// [`host`] with the sprite sheet `sheet`.
+fn host_with_sheet(table: TimeOfDayTable, sheet: SpriteSheet) -> DemoHost {
+    let ground = HeightField::from_fn(DVec2::ZERO, 20_000.0, 9, |_| 0.0);
     DemoHost::new(
         64,
         36,
@@ -201,6 +208,72 @@ fn sprites_are_sorted_back_to_front_and_face_the_camera() {
         );
         assert!(q.iter().all(|c| c.visible));
     }
+}
+
+/// Each quad is cut to the part of its sheet cell the texture covers: on a sheet whose cell 0 is
+/// transparent in its left half, a sprite of cell 0 is as tall as before and spans only the
+/// right of its square (from the first visible texel, less the half texel a bilinear lookup
+/// reaches, to the right edge); a sprite of an opaque cell keeps its whole square.
+#[test]
+fn a_quad_is_cut_to_the_visible_part_of_its_cell() {
+    // 16 x 16 texels, cells of 4 x 4, all opaque but the two left columns of cell 0.
+    let mut pixels = vec![255u8; 16 * 16 * 4];
+    for y in 0..4 {
+        for x in 0..2 {
+            pixels[(y * 16 + x) * 4 + 3] = 0;
+        }
+    }
+    let sheet = SpriteSheet {
+        size_px: 16,
+        mips: vec![pixels],
+    };
+    let mut host = host_with_sheet(TimeOfDayTable::default(), sheet);
+    host.sky.set_clouds(one_cloud(SkyCloud {
+        centre_m: DVec3::new(0.0, 3000.0, 1000.0),
+        sprites: vec![
+            square_sprite(Vec3::ZERO, 200.0, 0, 0),
+            square_sprite(Vec3::new(500.0, 0.0, 0.0), 200.0, 1, 0),
+        ],
+        group_centres_m: vec![Vec3::ZERO],
+        colour_levels: ColourLevels::even(900.0, 1100.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+        flat: false,
+        sunlit_depth_m: 0.0,
+        shaded_base_m: 0.0,
+    }));
+    // From the south the quads face south: right is east, up is up.
+    let quads = corners(&mut host, DVec3::new(0.0, 0.0, 1000.0), 0.0);
+    assert_eq!(quads.len(), 8);
+    let extent = |quad: &[SpriteCorner], axis: usize| {
+        let values = quad.iter().map(|c| c.rel_m.to_array()[axis]);
+        let lo = values.clone().fold(f32::MAX, f32::min);
+        (lo, values.fold(f32::MIN, f32::max))
+    };
+    let (cut, whole) = if quads[0].rel_m.x < 250.0 {
+        (&quads[..4], &quads[4..])
+    } else {
+        (&quads[4..], &quads[..4])
+    };
+    // Visible from texel 2 of 4: u from (2 - 0.5) / 4, mapped past the cell's 1/64 inset.
+    let left = ((1.5 / 4.0 - 1.0 / 64.0) / (1.0 - 2.0 / 64.0) - 0.5) * 200.0;
+    let (x0, x1) = extent(cut, 0);
+    assert!(
+        (x0 - left).abs() < 0.1 && (x1 - 100.0).abs() < 0.1,
+        "{x0}..{x1}"
+    );
+    let (z0, z1) = extent(cut, 2);
+    assert!(
+        (z0 + 100.0).abs() < 0.1 && (z1 - 100.0).abs() < 0.1,
+        "{z0}..{z1}"
+    );
+    // The opaque cell's quad (turned a little towards the camera): its whole 200 m square.
+    let (width, height) = (
+        whole[1].rel_m.distance(whole[0].rel_m),
+        whole[2].rel_m.distance(whole[0].rel_m),
+    );
+    assert!(
+        (width - 200.0).abs() < 0.1 && (height - 200.0).abs() < 0.1,
+        "{width} x {height}"
+    );
 }
 
 /// Wang 3.3: inside half its radius a sprite's facing locks; it fades with the angle between
