@@ -2,8 +2,8 @@
 //! sprites), read back from the GPU (`Sky::read_back_corners` runs the shader's own corner code):
 //! the order cache, the back-to-front order, facing the camera, the facing lock and its fade,
 //! upright base sprites, the forward-scattering rim, precision far from the origin, each quad cut
-//! to the visible part of its sheet cell, and (in drawn
-//! frames) the horizon haze. Small scenes on whatever adapter there is (lavapipe here).
+//! to the visible part of its sheet cell, and (in drawn frames) the horizon haze. Small scenes on
+//! whatever adapter there is (lavapipe here).
 
 use glam::{DVec2, DVec3, Vec3};
 use skycast::demo::terrain::HeightField;
