@@ -7,7 +7,7 @@
 //! The cut keeps every texel whose alpha is above zero at the levels near sprites sample
 //! ([`EXACT_LEVELS`]), with the half texel a bilinear lookup reaches beyond it: there the quad
 //! draws what the whole square drew. A sprite small enough on screen to sample a coarser level
-//! (a few pixels) loses the faintest rim of its coarsest texels.
+//! (under about 30 pixels across) loses the faintest rim of its coarsest texels.
 
 use super::sky::SpriteSheet;
 
