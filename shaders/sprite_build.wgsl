@@ -68,6 +68,7 @@ struct SpriteView {
     hl_phase: vec4<f32>,
     hl_sky: vec4<f32>,
     hl_deck: vec4<f32>,
+    far_fade: vec4<f32>,
     locks: array<Lock, 128>,
 };
 
@@ -129,6 +130,18 @@ fn upright_facing(to_cam: vec3<f32>) -> Facing {
     let normal = normalize_or(vec3<f32>(to_cam.xy, 0.0), vec3<f32>(0.0, 1.0, 0.0));
     let right = normalize_or(cross(vec3<f32>(0.0, 0.0, 1.0), normal), vec3<f32>(1.0, 0.0, 0.0));
     return Facing(right, vec3<f32>(0.0, 0.0, 1.0), normal);
+}
+
+// Where the clouds end (the farthest any are drawn at), a layer seen above the horizon would end
+// in a line across the sky (5 degrees up for cirrus 100 km out): seen above the horizon, sprites
+// fade out over the last stretch of that distance instead. Below the horizon (a deck from above)
+// they reach it whole, the deck running on to the haze. `to_cam`: from the sprite to the view's
+// camera.
+fn far_fade(to_cam: vec3<f32>) -> f32 {
+    let dist = length(to_cam);
+    let above_horizon = smoothstep(0.0, 0.02, -to_cam.z / max(dist, 1.0));
+    let fade = view.far_fade;
+    return 1.0 - above_horizon * smoothstep(fade.x, max(fade.y, fade.x + 1.0), dist);
 }
 
 // Wang 5.1: the ambient colour of the cloud's five levels at a height above mean sea level:
@@ -352,6 +365,7 @@ fn build_sprite(k: u32, at: u32) {
         alpha *= clamp((cos_angle - lock.w) / max(lock.z - lock.w, 1e-4), 0.0, 1.0);
     }
     let morph = morph_radius.x * lifecycle_alpha(b.fade_kind, b.fade_progress, morph_radius.y);
+    alpha *= far_fade(to_cam);
     if (!(alpha > 0.0 && morph > 0.0)) {
         // Faded out: the draw puts its corners outside the clip volume.
         for (var c = 0u; c < 4u; c++) {

@@ -501,6 +501,53 @@ fn past_the_sprite_budget_the_farthest_blocks_are_left_out() {
     assert!(norths.iter().all(|&y| y < 5_000.0), "the northern one went");
 }
 
+/// Where the clouds end, a layer seen above the horizon dissolves instead of ending in a line
+/// across the sky: with the shipped settings (sprites drawn to 60 km, the last 30% fading), a
+/// sprite 8 km above the camera and 55 km out is mostly faded, one 30 km out is whole, and one
+/// 55 km out but below the horizon (a deck seen from above runs on to the haze) is whole too.
+#[test]
+fn a_layer_seen_above_the_horizon_fades_out_where_the_clouds_end() {
+    let mut host = host(TimeOfDayTable::default());
+    let block = |id: u64, at: DVec3| SkyBlock {
+        id,
+        centre_m: at,
+        clouds: vec![SkyCloud {
+            centre_m: at,
+            sprites: vec![square_sprite(Vec3::ZERO, 300.0, 0, 0)],
+            group_centres_m: vec![Vec3::ZERO],
+            colour_levels: ColourLevels::even(0.0, 12_000.0, [[0.9, 0.9, 0.9, 1.0]; 5]),
+            flat: false,
+            sunlit_depth_m: 0.0,
+            shaded_base_m: 0.0,
+        }],
+    };
+    let camera_z = 9000.0;
+    host.sky.set_clouds(vec![
+        block(1, DVec3::new(0.0, 55_000.0, camera_z + 8000.0)),
+        block(2, DVec3::new(4000.0, 30_000.0, camera_z + 8000.0)),
+        block(3, DVec3::new(-4000.0, 55_000.0, camera_z - 8000.0)),
+    ]);
+    let quads = corners(&mut host, DVec3::new(0.0, 0.0, camera_z), 0.0);
+    assert_eq!(quads.len(), 12);
+    let alpha_near = |x: f32, y: f32, z: f32| -> f32 {
+        let quad = quads
+            .chunks(4)
+            .find(|q| (centre(q) - Vec3::new(x, y, z)).length() < 1000.0)
+            .unwrap_or_else(|| panic!("no sprite near ({x}, {y}, {z}): {quads:?}"));
+        quad[0].colour.w
+    };
+    // 55.6 km from the camera: smoothstep over 42-60 km leaves about 0.1.
+    let high_far = alpha_near(0.0, 55_000.0, 8000.0);
+    let high_near = alpha_near(4000.0, 30_000.0, 8000.0);
+    let low_far = alpha_near(-4000.0, 55_000.0, -8000.0);
+    assert!(high_far < 0.25, "the far high sprite: alpha {high_far}");
+    assert!(
+        (high_near - 1.0).abs() < 1e-3,
+        "the nearer one: {high_near}"
+    );
+    assert!((low_far - 1.0).abs() < 1e-3, "below the horizon: {low_far}");
+}
+
 /// Aerial perspective (`sprites.wgsl`): a dark cloud 8 km out fades into the horizon haze. In
 /// clear air (visibility past the fog's cap: the clear-air haze, 13.3 km), against the same cloud
 /// wholly hazed (a 1 m haze distance: the horizon's colour), the cloud at a 2 km haze distance

@@ -208,10 +208,13 @@ pub struct GpuSpriteView {
     /// Harris and Lastra: x the part of a deck's optical depth that takes the sun's total
     /// light (direct and scattered forward) away: `1 - forward_fraction`; yzw unused.
     pub hl_deck: [f32; 4],
+    /// x, y: the distance from the view's camera over which sprites seen above the horizon fade
+    /// out (start, end), metres; zw unused.
+    pub far_fade: [f32; 4],
     /// The locked facings.
     pub locks: [GpuLock; MAX_LOCKS],
 }
-const _: () = assert!(std::mem::size_of::<GpuSpriteView>() == 128 + 48 * MAX_LOCKS);
+const _: () = assert!(std::mem::size_of::<GpuSpriteView>() == 144 + 48 * MAX_LOCKS);
 
 /// Per-frame uniform of the demo terrain. Keep in sync with `shaders/terrain.wgsl`.
 #[repr(C)]

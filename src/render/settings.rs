@@ -57,10 +57,20 @@ pub struct CloudSettings {
     /// colour). See [`super::cloud_target`].
     #[serde(default = "default_resolution_scale")]
     pub resolution_scale: f32,
+    /// Clouds seen above the horizon fade out over this last fraction of the farthest distance a
+    /// view draws them at (`draw_distance_m` for the camera's sprites, which hold the high and
+    /// low layers the ring leaves out; the impostors' `view_radius_m` in the ring), 0..1: a high
+    /// layer dissolves there instead of ending in a line across the sky. 0: no fade.
+    #[serde(default = "default_far_fade_fraction")]
+    pub far_fade_fraction: f32,
 }
 
 fn default_resolution_scale() -> f32 {
     0.5
+}
+
+fn default_far_fade_fraction() -> f32 {
+    0.3
 }
 
 /// In-cloud fog settings (Wang 7.1).
@@ -197,6 +207,14 @@ impl RenderSettings {
             return Err(ConfigError::at_key(path, text, field, message));
         }
         let c = &s.clouds;
+        if !(0.0..=1.0).contains(&c.far_fade_fraction) {
+            return Err(ConfigError::at_key(
+                path,
+                text,
+                "clouds.far_fade_fraction",
+                format!("must be 0..=1, is {}", c.far_fade_fraction),
+            ));
+        }
         if !(0.0 <= c.upright_fade_start_deg
             && c.upright_fade_start_deg < c.upright_fade_end_deg
             && c.upright_fade_end_deg <= 90.0)
@@ -278,6 +296,16 @@ mod tests {
             err.starts_with(&format!(
                 "r.toml:{line}: field `vertex_cache.max_sorted_sprites_per_frame`"
             )),
+            "{err}"
+        );
+        let text =
+            DEFAULT_RENDER_TOML.replace("far_fade_fraction = 0.3", "far_fade_fraction = 1.5");
+        let err = RenderSettings::parse(&text, Path::new("r.toml"))
+            .unwrap_err()
+            .to_string();
+        let line = line_of_key(DEFAULT_RENDER_TOML, "clouds.far_fade_fraction").unwrap();
+        assert!(
+            err.starts_with(&format!("r.toml:{line}: field `clouds.far_fade_fraction`")),
             "{err}"
         );
         let text = DEFAULT_RENDER_TOML.replace("resolution_scale = 0.5", "resolution_scale = 0.3");

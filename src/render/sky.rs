@@ -739,6 +739,7 @@ impl Sky {
             clouds: &self.settings.clouds,
             lifecycle: &self.lifecycle,
             camera_z_m: camera.position_m.z as f32,
+            farthest_m: self.settings.clouds.draw_distance_m,
         };
         let header = sprite_view::header(&light);
         let changed_locks = self.locks.take_changed().then_some(&locks[..]);

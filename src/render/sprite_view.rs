@@ -46,6 +46,9 @@ pub(super) struct ViewLight<'a> {
     pub clouds: &'a CloudSettings,
     pub lifecycle: &'a LifecycleConfig,
     pub camera_z_m: f32,
+    /// The farthest distance the view draws clouds at, metres: the sprites' draw distance for
+    /// the camera, the view radius for an impostor.
+    pub farthest_m: f32,
 }
 
 /// The uniform of a view (its lock table written apart).
@@ -55,6 +58,7 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
         clouds,
         lifecycle,
         camera_z_m,
+        farthest_m,
     } = *light;
     let tod = &lighting.time_of_day;
     let m = &lighting.mapping;
@@ -87,6 +91,12 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
             .extend(hl.ambient * tod.ambient_percent)
             .to_array(),
         hl_deck: [1.0 - hl.forward_fraction(), 0.0, 0.0, 0.0],
+        far_fade: [
+            farthest_m * (1.0 - clouds.far_fade_fraction),
+            farthest_m,
+            0.0,
+            0.0,
+        ],
         locks: [GpuLock {
             right: [0.0; 4],
             up: [0.0; 4],

@@ -578,6 +578,7 @@ impl ImpostorRing {
                 );
                 let light = ViewLight {
                     camera_z_m: centre.z as f32,
+                    farthest_m: self.settings.view_radius_m as f32,
                     ..*view
                 };
                 let header = sprite_view::header(&light);
