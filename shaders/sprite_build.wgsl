@@ -3,11 +3,13 @@
 // the GPU (written once per block); each frame the CPU sends only the draw list (one entry per
 // block, back to front, its centre relative to the camera) and the cloud lists and sprite orders
 // that changed. Each invocation builds one corner: the sprite's facing (camera facing, upright
-// cylindrical base sprites, flat cirrus, the facing lock of Wang 3.3 with its angle fade), Wang's
-// equation (3) shading (ambient colour levels by height, directional shading groups), the
-// forward-scattering rim, and the formation / dissipation fade of Wang 4. Built in a compute
-// pass, not in the vertex shader: on the software rasteriser storage buffers read by a vertex
-// shader cost memory every draw, and a compute pass runs on every core.
+// cylindrical base sprites, flat cirrus, the facing lock of Wang 3.3 with its angle fade), its
+// quad cut to the part of its sheet cell the texture covers, Wang's equation (3) shading (ambient
+// colour levels by height, directional shading groups; a deck by its depth as one slab), the
+// forward-scattering rim, the formation / dissipation fade of Wang 4, and the fade where the
+// clouds end. Built in a compute pass, not in the vertex shader: on the software rasteriser
+// storage buffers read by a vertex shader cost memory every draw, and a compute pass runs on
+// every core.
 
 // Keep in sync with `GpuSprite` in src/render/gpu_types.rs.
 struct Sprite {
@@ -132,9 +134,9 @@ fn upright_facing(to_cam: vec3<f32>) -> Facing {
     return Facing(right, vec3<f32>(0.0, 0.0, 1.0), normal);
 }
 
-// Where the clouds end (the farthest any are drawn at), a layer seen above the horizon would end
-// in a line across the sky (5 degrees up for cirrus 100 km out): seen above the horizon, sprites
-// fade out over the last stretch of that distance instead. Below the horizon (a deck from above)
+// Where the clouds end (the farthest the view draws any at), a layer seen above the horizon would
+// end in a line across the sky (the cirrus theme's veil, 60 km out: 6 degrees up): seen above the
+// horizon, sprites fade out over the last stretch of that distance instead. Below the horizon (a deck from above)
 // they reach it whole, the deck running on to the haze. `to_cam`: from the sprite to the view's
 // camera.
 fn far_fade(to_cam: vec3<f32>) -> f32 {
@@ -212,10 +214,10 @@ fn forward_percent(view_dir: vec3<f32>, rim: f32) -> f32 {
 
 // Harris and Lastra's light (as `lights` packs it: direct sun, total sun, sky) at `depth` in a
 // deck taken as a homogeneous slab (`deck_depth`), as Wang's deck above: the same at every place
-// and per corner, where the CPU's light through each
-// lattice cell alone would light the cell's sunward side. The light scattered forward on the way
-// fades at `hl_deck.x` of that rate (the recurrence of `HarrisLastra::light` through many faint
-// particles); the sky's comes straight down.
+// and per corner, where the CPU's light through each lattice cell alone would light the cell's
+// sunward side. The light scattered forward on the way fades at `hl_deck.x` of that rate (the
+// recurrence of `HarrisLastra::light` through many faint particles); the sky's comes straight
+// down.
 fn deck_harris_lastra(depth: f32, sun_z: f32) -> vec4<f32> {
     let direct = deck_sunlit(depth, sun_z);
     let kept = view.hl_deck.x;
