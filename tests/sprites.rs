@@ -9,8 +9,8 @@ use glam::{DVec2, DVec3, Vec3};
 use skycast::demo::terrain::HeightField;
 use skycast::demo::{DemoHost, Frame, headless};
 use skycast::render::{
-    BlockMotion, Camera, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteCorner, SpriteSheet,
-    square_sprite,
+    BlockMotion, Camera, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SkySprite, SpriteCorner,
+    SpriteSheet, square_sprite,
 };
 use skycast::shading::{ColourLevels, ForwardScattering, SunPosition, TimeOfDayTable};
 use skycast::weather::BlockWeather;
@@ -74,6 +74,20 @@ fn blocks() -> Vec<SkyBlock> {
         centre_m: DVec3::new(0.0, 5000.0, 1500.0),
         clouds: (0..10).map(|i| cloud(i as f64 * 1500.0)).collect(),
     }]
+}
+
+/// A cloud of `sprites` around `centre_m` with one shading group at its centre, lit from every
+/// side (no deck, no shaded base), in the colour levels `colour_levels`.
+fn plain_cloud(centre_m: DVec3, sprites: Vec<SkySprite>, colour_levels: ColourLevels) -> SkyCloud {
+    SkyCloud {
+        centre_m,
+        sprites,
+        group_centres_m: vec![Vec3::ZERO],
+        colour_levels,
+        flat: false,
+        sunlit_depth_m: 0.0,
+        shaded_base_m: 0.0,
+    }
 }
 
 fn one_cloud(cloud: SkyCloud) -> Vec<SkyBlock> {
@@ -228,18 +242,14 @@ fn a_quad_is_cut_to_the_visible_part_of_its_cell() {
         mips: vec![pixels],
     };
     let mut host = host_with_sheet(TimeOfDayTable::default(), sheet);
-    host.sky.set_clouds(one_cloud(SkyCloud {
-        centre_m: DVec3::new(0.0, 3000.0, 1000.0),
-        sprites: vec![
+    host.sky.set_clouds(one_cloud(plain_cloud(
+        DVec3::new(0.0, 3000.0, 1000.0),
+        vec![
             square_sprite(Vec3::ZERO, 200.0, 0, 0),
             square_sprite(Vec3::new(500.0, 0.0, 0.0), 200.0, 1, 0),
         ],
-        group_centres_m: vec![Vec3::ZERO],
-        colour_levels: ColourLevels::even(900.0, 1100.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
-        flat: false,
-        sunlit_depth_m: 0.0,
-        shaded_base_m: 0.0,
-    }));
+        ColourLevels::even(900.0, 1100.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+    )));
     // From the south the quads face south: right is east, up is up.
     let quads = corners(&mut host, DVec3::new(0.0, 0.0, 1000.0), 0.0);
     assert_eq!(quads.len(), 8);
@@ -282,15 +292,11 @@ fn a_quad_is_cut_to_the_visible_part_of_its_cell() {
 fn facing_locks_inside_half_the_radius_and_fades_with_the_angle() {
     let mut host = host(TimeOfDayTable::default());
     host.sky.set_vertex_cache(false);
-    host.sky.set_clouds(one_cloud(SkyCloud {
-        centre_m: DVec3::new(0.0, 0.0, 1000.0),
-        sprites: vec![square_sprite(Vec3::ZERO, 200.0, 0, 0)],
-        group_centres_m: vec![Vec3::ZERO],
-        colour_levels: ColourLevels::even(900.0, 1100.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
-        flat: false,
-        sunlit_depth_m: 0.0,
-        shaded_base_m: 0.0,
-    }));
+    host.sky.set_clouds(one_cloud(plain_cloud(
+        DVec3::new(0.0, 0.0, 1000.0),
+        vec![square_sprite(Vec3::ZERO, 200.0, 0, 0)],
+        ColourLevels::even(900.0, 1100.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+    )));
     // 40 m south of the centre (inside 50 m = half the 100 m radius): locks facing north.
     let locked = corners(&mut host, DVec3::new(0.0, -40.0, 1000.0), 0.0);
     assert_eq!(locked.len(), 4);
@@ -334,15 +340,11 @@ fn upright_sprites_stay_level_and_fade_seen_from_below() {
     let mut host = host(TimeOfDayTable::default());
     let mut upright = square_sprite(Vec3::ZERO, 200.0, 3, 0);
     upright.upright = true;
-    host.sky.set_clouds(one_cloud(SkyCloud {
-        centre_m: DVec3::new(0.0, 3000.0, 1500.0),
-        sprites: vec![upright, square_sprite(Vec3::X * 600.0, 200.0, 3, 0)],
-        group_centres_m: vec![Vec3::ZERO],
-        colour_levels: ColourLevels::even(1400.0, 1700.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
-        flat: false,
-        sunlit_depth_m: 0.0,
-        shaded_base_m: 0.0,
-    }));
+    host.sky.set_clouds(one_cloud(plain_cloud(
+        DVec3::new(0.0, 3000.0, 1500.0),
+        vec![upright, square_sprite(Vec3::X * 600.0, 200.0, 3, 0)],
+        ColourLevels::even(1400.0, 1700.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+    )));
     let mut quads = |elevation_deg: f64| {
         let cam = DVec3::new(0.0, 3000.0, 1500.0)
             + DVec3::new(0.0, -1.0, 0.0) * 2000.0 * elevation_deg.to_radians().cos()
@@ -511,15 +513,11 @@ fn a_layer_seen_above_the_horizon_fades_out_where_the_clouds_end() {
     let block = |id: u64, at: DVec3| SkyBlock {
         id,
         centre_m: at,
-        clouds: vec![SkyCloud {
-            centre_m: at,
-            sprites: vec![square_sprite(Vec3::ZERO, 300.0, 0, 0)],
-            group_centres_m: vec![Vec3::ZERO],
-            colour_levels: ColourLevels::even(0.0, 12_000.0, [[0.9, 0.9, 0.9, 1.0]; 5]),
-            flat: false,
-            sunlit_depth_m: 0.0,
-            shaded_base_m: 0.0,
-        }],
+        clouds: vec![plain_cloud(
+            at,
+            vec![square_sprite(Vec3::ZERO, 300.0, 0, 0)],
+            ColourLevels::even(0.0, 12_000.0, [[0.9, 0.9, 0.9, 1.0]; 5]),
+        )],
     };
     let camera_z = 9000.0;
     host.sky.set_clouds(vec![
@@ -581,15 +579,11 @@ fn a_far_cloud_fades_into_the_horizon_haze() {
         });
         let camera = host.camera(DVec3::new(0.0, 0.0, 1500.0), 0.0, 2.0);
         let (bare, _) = host.frame(&camera, &SUN, 0.0, 1e9).unwrap();
-        host.sky.set_clouds(one_cloud(SkyCloud {
-            centre_m: DVec3::new(0.0, 8000.0, 1800.0),
-            sprites: vec![square_sprite(Vec3::ZERO, 1500.0, 0, 0)],
-            group_centres_m: vec![Vec3::ZERO],
-            colour_levels: ColourLevels::even(0.0, 4000.0, [[0.05, 0.05, 0.05, 1.0]; 5]),
-            flat: false,
-            sunlit_depth_m: 0.0,
-            shaded_base_m: 0.0,
-        }));
+        host.sky.set_clouds(one_cloud(plain_cloud(
+            DVec3::new(0.0, 8000.0, 1800.0),
+            vec![square_sprite(Vec3::ZERO, 1500.0, 0, 0)],
+            ColourLevels::even(0.0, 4000.0, [[0.05, 0.05, 0.05, 1.0]; 5]),
+        )));
         let (cloud, _) = host.frame(&camera, &SUN, 0.0, 1e9).unwrap();
         (bare, cloud)
     };
