@@ -136,9 +136,9 @@ fn upright_facing(to_cam: vec3<f32>) -> Facing {
 
 // Where the clouds end (the farthest the view draws any at), a layer seen above the horizon would
 // end in a line across the sky (the cirrus theme's veil, 60 km out: 6 degrees up): seen above the
-// horizon, sprites fade out over the last stretch of that distance instead. Below the horizon (a deck from above)
-// they reach it whole, the deck running on to the haze. `to_cam`: from the sprite to the view's
-// camera.
+// horizon, sprites fade out over the last stretch of that distance instead. Below the horizon (a
+// deck from above) they reach it whole, the deck running on to the haze. `to_cam`: from the
+// sprite to the view's camera.
 fn far_fade(to_cam: vec3<f32>) -> f32 {
     let dist = length(to_cam);
     let above_horizon = smoothstep(0.0, 0.02, -to_cam.z / max(dist, 1.0));
@@ -383,6 +383,8 @@ fn build_sprite(k: u32, at: u32) {
     let sun = normalize_or(view.sun_dir_camera_z.xyz, vec3<f32>(0.0));
     let cell = s.bits & 15u;
     let evenness = deck_evenness(cloud, view.sun_dir_camera_z.w, sun.z);
+    // A deck (its `sunlit_depth_m` set) is lit as one slab by both models, below.
+    let deck = cloud.level4_radius_flat.w > 0.0;
     // Keep in sync with `SPRITE_PRECIPITATION` in src/render/gpu_types.rs.
     let rain = (s.bits & 512u) != 0u;
     let harris_lastra = view.hl_phase.x > 0.5;
@@ -398,13 +400,14 @@ fn build_sprite(k: u32, at: u32) {
         let view_dir = normalize_or(p - cam_local, vec3<f32>(0.0));
         let rim = length(p) / flat_radius.y;
         let group_dir = normalize_or(p - group, vec3<f32>(0.0));
+        // A deck is lit as one slab, not cell by cell: the direct sun falls off with the depth
+        // below its top, the same at every place, so its lattice of clouds shows no sunlit and
+        // shaded side per cell (a grid seen from above). Deeper in, the sun diffused through the
+        // deck is left: the even median it shows from below.
+        let depth = select(0.0, deck_depth(cloud, height_msl), deck);
         var wang = directional_percent(dot(group_dir, sun)) + forward_percent(view_dir, rim);
-        if (cloud.level4_radius_flat.w > 0.0) {
-            // A deck is lit as one slab, not cell by cell: the direct sun falls off with the
-            // depth below its top, the same at every place, so its lattice of clouds shows no
-            // sunlit and shaded side per cell (a grid seen from above). Deeper in, the sun
-            // diffused through the deck is left: the even median it shows from below.
-            let sunlit = deck_sunlit(deck_depth(cloud, height_msl), sun.z);
+        if (deck) {
+            let sunlit = deck_sunlit(depth, sun.z);
             wang = directional_percent(sunlit) + forward_percent(view_dir, sunlit);
         }
         // A heap's shaded base: the body above hides the sun from its lowest part.
@@ -416,8 +419,8 @@ fn build_sprite(k: u32, at: u32) {
         var base_rgb = ambient.rgb * light.w;
         if (harris_lastra) {
             var received = hl_light;
-            if (cloud.level4_radius_flat.w > 0.0) {
-                received = deck_harris_lastra(deck_depth(cloud, height_msl), sun.z);
+            if (deck) {
+                received = deck_harris_lastra(depth, sun.z);
             }
             lit = harris_lastra_rgb(received, view_dir);
             base_rgb = view.hl_sky.rgb * received.z + vec3<f32>(view.hl_sky.w);
