@@ -259,71 +259,45 @@ mod tests {
 
     #[test]
     fn bad_values_name_the_field() {
-        let text =
-            DEFAULT_RENDER_TOML.replace("soft_depth_fade_m = 120.0", "soft_depth_fade_m = -1.0");
-        let err = RenderSettings::parse(&text, Path::new("r.toml"))
-            .unwrap_err()
-            .to_string();
-        let line = line_of_key(DEFAULT_RENDER_TOML, "clouds.soft_depth_fade_m").unwrap();
-        assert!(
-            err.starts_with(&format!("r.toml:{line}: field `clouds.soft_depth_fade_m`")),
-            "{err}"
-        );
-        let text = DEFAULT_RENDER_TOML.replace("near_m = 2.0", "near_m = \"near\"");
-        let err = RenderSettings::parse(&text, Path::new("r.toml"))
-            .unwrap_err()
-            .to_string();
+        // The error of the shipped file with `from` replaced by `to`.
+        let error_with = |from: &str, to: &str| {
+            assert!(DEFAULT_RENDER_TOML.contains(from), "{from}");
+            RenderSettings::parse(&DEFAULT_RENDER_TOML.replace(from, to), Path::new("r.toml"))
+                .unwrap_err()
+                .to_string()
+        };
+        // The error names the file, the key's line in it and the key.
+        let names = |err: &str, key: &str| {
+            let line = line_of_key(DEFAULT_RENDER_TOML, key).unwrap();
+            assert!(
+                err.starts_with(&format!("r.toml:{line}: field `{key}`")),
+                "{err}"
+            );
+        };
+        let err = error_with("soft_depth_fade_m = 120.0", "soft_depth_fade_m = -1.0");
+        names(&err, "clouds.soft_depth_fade_m");
+        let err = error_with("near_m = 2.0", "near_m = \"near\"");
         assert!(err.starts_with("r.toml:7: field `near_m`"), "{err}");
-        let text = DEFAULT_RENDER_TOML
-            .replace("upright_fade_end_deg = 35.0", "upright_fade_end_deg = 10.0");
-        let err = RenderSettings::parse(&text, Path::new("r.toml"))
-            .unwrap_err()
-            .to_string();
+        let err = error_with("upright_fade_end_deg = 35.0", "upright_fade_end_deg = 10.0");
         assert!(err.contains("clouds.upright_fade_end_deg"), "{err}");
-        let text = DEFAULT_RENDER_TOML.replace(
+        let err = error_with(
             "max_sorted_sprites_per_frame = 8192",
             "max_sorted_sprites_per_frame = 0",
         );
-        let err = RenderSettings::parse(&text, Path::new("r.toml"))
-            .unwrap_err()
-            .to_string();
-        let line = line_of_key(
-            DEFAULT_RENDER_TOML,
-            "vertex_cache.max_sorted_sprites_per_frame",
-        )
-        .unwrap();
-        assert!(
-            err.starts_with(&format!(
-                "r.toml:{line}: field `vertex_cache.max_sorted_sprites_per_frame`"
-            )),
-            "{err}"
-        );
-        let text =
-            DEFAULT_RENDER_TOML.replace("far_fade_fraction = 0.3", "far_fade_fraction = 1.5");
-        let err = RenderSettings::parse(&text, Path::new("r.toml"))
-            .unwrap_err()
-            .to_string();
-        let line = line_of_key(DEFAULT_RENDER_TOML, "clouds.far_fade_fraction").unwrap();
-        assert!(
-            err.starts_with(&format!("r.toml:{line}: field `clouds.far_fade_fraction`")),
-            "{err}"
-        );
-        let text = DEFAULT_RENDER_TOML.replace("resolution_scale = 0.5", "resolution_scale = 0.3");
-        let err = RenderSettings::parse(&text, Path::new("r.toml"))
-            .unwrap_err()
-            .to_string();
-        let line = line_of_key(DEFAULT_RENDER_TOML, "clouds.resolution_scale").unwrap();
-        assert!(
-            err.starts_with(&format!("r.toml:{line}: field `clouds.resolution_scale`"))
-                && err.contains("must be 1, 0.5 or 0.25"),
-            "{err}"
-        );
-        // Files written before the upright fade existed still load, with its defaults.
+        names(&err, "vertex_cache.max_sorted_sprites_per_frame");
+        let err = error_with("far_fade_fraction = 0.3", "far_fade_fraction = 1.5");
+        names(&err, "clouds.far_fade_fraction");
+        let err = error_with("resolution_scale = 0.5", "resolution_scale = 0.3");
+        names(&err, "clouds.resolution_scale");
+        assert!(err.contains("must be 1, 0.5 or 0.25"), "{err}");
+        // Files written before the upright fade (and the later keys left out here) existed still
+        // load, with their defaults.
         let old = DEFAULT_RENDER_TOML
             .lines()
             .filter(|l| {
                 !l.starts_with("upright_fade")
                     && !l.starts_with("resolution_scale")
+                    && !l.starts_with("far_fade_fraction")
                     && !l.starts_with("max_sorted")
                     && !l.starts_with("max_uploaded")
             })
