@@ -258,7 +258,7 @@ pub fn typical_weather(cloud_type: CloudType) -> (BlockWeather, f64) {
         Altocumulus => (12000.0, 1500.0, 4.0, 20.0),
         Altostratus => (12000.0, 3000.0, 8.0, -25.0),
         Cirrus => (28000.0, 800.0, 3.0, -60.0),
-        Cirrocumulus => (24000.0, 600.0, 4.0, 25.0),
+        Cirrocumulus => (24000.0, 600.0, 4.0, -60.0),
         Cirrostratus => (28000.0, 1000.0, 8.0, -60.0),
         Fog => (0.0, 400.0, 8.0, 12.0),
     };
