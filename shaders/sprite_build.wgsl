@@ -415,16 +415,23 @@ fn build_sprite(k: u32, at: u32) {
         let above_base = height_msl - cloud.level_height.x;
         let sun_here = select(1.0, smoothstep(0.0, shaded_base, above_base), shaded_base > 0.0);
         let directional = mix(wang, view.mapping_g.y, evenness) * light.rgb * sun_here;
-        var lit = ambient.rgb * light.w + directional;
-        var base_rgb = ambient.rgb * light.w;
-        if (harris_lastra) {
-            var received = hl_light;
-            if (deck) {
-                received = deck_harris_lastra(depth, sun.z);
-            }
-            lit = harris_lastra_rgb(received, view_dir);
-            base_rgb = view.hl_sky.rgb * received.z + vec3<f32>(view.hl_sky.w);
+        // Both models' light, one chosen by `select`, not by an `if` on the view uniform:
+        // lavapipe (Mesa 22) specialises a shader on the uniforms that decide a branch as it
+        // runs it, and kept every copy: about 0.9 MB a frame without bound (tests/memory.rs).
+        var received = hl_light;
+        if (deck) {
+            received = deck_harris_lastra(depth, sun.z);
         }
+        let lit = select(
+            ambient.rgb * light.w + directional,
+            harris_lastra_rgb(received, view_dir),
+            harris_lastra,
+        );
+        let base_rgb = select(
+            ambient.rgb * light.w,
+            view.hl_sky.rgb * received.z + vec3<f32>(view.hl_sky.w),
+            harris_lastra,
+        );
         // Rain and snow hang in the cloud's shadow: its base colour, dimmer and greyer, no sun.
         let shade = base_rgb * 0.6;
         let rain_rgb = mix(shade, vec3<f32>(dot(shade, vec3<f32>(0.3, 0.59, 0.11))), 0.5);
