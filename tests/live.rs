@@ -3,6 +3,11 @@
 //! the old sky, a 5,000-station file loads while frames go on. The soak test (`make soak`,
 //! ignored by default) flies one simulated hour with a change every five minutes.
 
+#[path = "support/rss.rs"]
+mod rss;
+
+use rss::rss_bytes;
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -435,23 +440,6 @@ fn the_same_change_without_a_fade_pops() {
     let plain = motion.max(motion_after);
     eprintln!("without a fade: plain motion {plain:.5}, worst frame during the change {worst:.5}");
     assert!(worst > 1.5 * plain, "{worst} <= 1.5 x {plain}");
-}
-
-/// Resident memory, bytes; panics where /proc cannot say (a soak that measures nothing must not
-/// pass).
-fn rss_bytes() -> u64 {
-    let statm = std::fs::read_to_string("/proc/self/statm")
-        .unwrap_or_else(|e| panic!("the soak measures memory through /proc/self/statm: {e}"));
-    let pages: u64 = statm
-        .split_whitespace()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("no resident page count in /proc/self/statm: {statm:?}"));
-    assert!(
-        pages > 0,
-        "/proc/self/statm says no resident pages: {statm:?}"
-    );
-    pages * 4096
 }
 
 /// One simulated hour at a tiny size, a weather change every five minutes (through the timed

@@ -7,6 +7,11 @@
 //! of the uniforms that decide a branch as it runs a dispatch or draw, and here kept every copy;
 //! the sprite build's `if` on the shading model grew the process by about 0.9 MB a frame.
 
+#[path = "support/rss.rs"]
+mod rss;
+
+use rss::rss_bytes;
+
 use std::path::Path;
 
 use glam::DVec3;
@@ -22,20 +27,6 @@ const AT: (f64, f64) = (28.5, -81.45);
 const UNIX_S: f64 = 1_738_004_400.0;
 const W: u32 = 96;
 const H: u32 = 54;
-
-/// Resident memory of this process, bytes (panics where /proc cannot say: a test of memory that
-/// measures nothing must not pass).
-fn rss_bytes() -> u64 {
-    let statm = std::fs::read_to_string("/proc/self/statm")
-        .unwrap_or_else(|e| panic!("memory is measured through /proc/self/statm: {e}"));
-    let pages: u64 = statm
-        .split_whitespace()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("no resident page count in /proc/self/statm: {statm:?}"));
-    assert!(pages > 0, "/proc/self/statm says no resident pages");
-    pages * 4096
-}
 
 /// Draws `warm_up` frames, then `frames` more, flying east at 60 m a frame; returns the
 /// resident memory after the warm-up and the most after it, bytes.
