@@ -129,24 +129,18 @@ mod tests {
 
     #[test]
     fn an_opaque_or_empty_cell_is_kept_whole() {
-        let opaque = SpriteSheet {
-            size_px: 8,
-            mips: vec![vec![255; 8 * 8 * 4]],
-        };
-        assert!(
-            cell_crops(&opaque)
-                .iter()
-                .all(|c| *c == [0.0, 0.0, 1.0, 1.0])
-        );
-        let empty = SpriteSheet {
-            size_px: 8,
-            mips: vec![vec![0; 8 * 8 * 4]],
-        };
-        assert!(
-            cell_crops(&empty)
-                .iter()
-                .all(|c| *c == [0.0, 0.0, 1.0, 1.0])
-        );
+        // Every texel opaque, then every texel transparent.
+        for fill in [255u8, 0] {
+            let sheet = SpriteSheet {
+                size_px: 8,
+                mips: vec![vec![fill; 8 * 8 * 4]],
+            };
+            let crops = cell_crops(&sheet);
+            assert!(
+                crops.iter().all(|c| *c == [0.0, 0.0, 1.0, 1.0]),
+                "texels of {fill}: {crops:?}"
+            );
+        }
     }
 
     #[test]
