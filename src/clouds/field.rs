@@ -9,7 +9,8 @@
 //!   = surface wind x `wind_factor`, integrated over time), so clouds glide across block borders
 //!   and a block keeps its identity and content while it drifts (no jumps). When a block's weather
 //!   changes noticeably, its old clouds dissipate while the new ones form (Wang 2003 §4); a block
-//!   is never swapped at once. Blocks entering the field at its rim appear fully formed.
+//!   is never swapped at once. Blocks entering the field at its rim appear fully formed, unless
+//!   the blocks beside them are still forming after a weather change: then they form with them.
 //!
 //! Units: metres east/north in the local frame, seconds of field time.
 
@@ -290,9 +291,26 @@ impl CloudField {
         self.take_in(done);
     }
 
+    /// The phase a block's first generation starts in. Entering the field at its rim it
+    /// appears formed (it was there all along, only out of reach), unless a block beside it is
+    /// still forming after a weather change: then it forms with it, from the latest of their
+    /// changes, so a block that joins mid-change does not stand whole among half-formed ones.
+    fn joining_phase(&self, index: BlockIndex) -> Phase {
+        let latest_change = (-1..=1)
+            .flat_map(|dj| (-1..=1).map(move |di| BlockIndex::new(index.i + di, index.j + dj)))
+            .filter_map(|beside| self.slots.get(&beside)?.generations.last())
+            .filter_map(|g| match g.phase {
+                Phase::Forming { since_s } => Some(since_s),
+                _ => None,
+            })
+            .reduce(f64::max);
+        latest_change.map_or(Phase::Steady, |since_s| Phase::Forming { since_s })
+    }
+
     fn take_in(&mut self, finished: Vec<Generated>) {
         let now = self.time_s;
         for done in finished {
+            let joining = self.joining_phase(done.index);
             let Some(slot) = self.slots.get_mut(&done.index) else {
                 continue;
             };
@@ -300,7 +318,7 @@ impl CloudField {
                 continue; // superseded by a newer request
             }
             let phase = if slot.generations.is_empty() {
-                Phase::Steady
+                joining
             } else {
                 Phase::Forming { since_s: now }
             };
@@ -552,6 +570,55 @@ mod tests {
         }
         assert_eq!(field.generations(index).len(), 1, "old generations stay");
         assert_eq!(field.generations(index)[0].phase, Phase::Steady);
+    }
+
+    #[test]
+    fn blocks_joining_during_a_weather_change_form_with_their_neighbours() {
+        let mut field = small_field();
+        let calm = |oktas| BlockWeather {
+            wind: Wind::default(),
+            ..weather(oktas)
+        };
+        field.update(DVec2::ZERO, &|_| calm(2.0));
+        field.wait_for_pending();
+        field.advance(100.0);
+        field.update(DVec2::ZERO, &|_| calm(6.0));
+        field.wait_for_pending();
+        let since_s = 100.0;
+        assert_eq!(
+            field.generations(BlockIndex::new(0, 0))[1].phase,
+            Phase::Forming { since_s }
+        );
+        // Half-way through the formation the camera has flown 8 km east: the blocks that join
+        // at the rim form from the same moment as those beside them, not whole among them.
+        field.advance(60.0);
+        let before: Vec<BlockIndex> = field.blocks().map(|(i, _)| i).collect();
+        let east = DVec2::new(8_000.0, 0.0);
+        field.update(east, &|_| calm(6.0));
+        field.wait_for_pending();
+        let joined: Vec<BlockIndex> = field
+            .blocks()
+            .map(|(i, _)| i)
+            .filter(|i| !before.contains(i))
+            .collect();
+        assert!(joined.len() >= 3, "{joined:?}");
+        for index in &joined {
+            let gens = field.generations(*index);
+            assert_eq!(gens.len(), 1, "{index:?}");
+            assert_eq!(gens[0].phase, Phase::Forming { since_s }, "{index:?}");
+        }
+        // Once the change has settled, blocks join formed again.
+        field.advance(2_000.0);
+        let before: Vec<BlockIndex> = field.blocks().map(|(i, _)| i).collect();
+        field.update(east * 2.0, &|_| calm(6.0));
+        field.wait_for_pending();
+        let joined: Vec<&FieldBlock> = field
+            .blocks()
+            .filter(|(i, _)| !before.contains(i))
+            .map(|(_, g)| g)
+            .collect();
+        assert!(joined.len() >= 3);
+        assert!(joined.iter().all(|g| g.phase == Phase::Steady));
     }
 
     #[test]
