@@ -19,7 +19,8 @@ use skycast::demo::{DemoHost, Frame, GroundSettings, demo_ground};
 use skycast::flight::{SkySystemConfig, Weather};
 use skycast::weather::live::Prepare;
 use skycast::weather::{
-    BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, StationTable, WeatherField, WeatherInput,
+    BLOCK_SIZE_M, BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, StationTable, WeatherField,
+    WeatherInput,
 };
 
 // Frames big enough that the clouds' off-screen target at the default half resolution (96 x 54)
@@ -88,9 +89,19 @@ struct Flight {
 const UTC_S: f64 = 1_738_015_200.0;
 
 impl Flight {
-    fn new(field: WeatherField, radius_m: f64, formation_s: f32) -> Flight {
+    /// A flight over a field of blocks within `radius_m`, sprites drawn out to `draw_distance_m`
+    /// (`None`: the shipped settings' distance), clouds forming over `formation_s`.
+    fn new(
+        field: WeatherField,
+        radius_m: f64,
+        draw_distance_m: Option<f32>,
+        formation_s: f32,
+    ) -> Flight {
         let mut config = SkySystemConfig::new(skycast::demo::headless::TARGETS, ORIGIN);
         config.world.cloud_radius_m = radius_m;
+        if let Some(d) = draw_distance_m {
+            config.sky.settings.clouds.draw_distance_m = d;
+        }
         config.stations = Some(stations());
         let ground = GroundSettings {
             size_m: 60_000.0,
@@ -184,6 +195,16 @@ fn fly_until_change(
     panic!("no weather change within {limit} frames");
 }
 
+/// The field and sprite distances of the eastbound flights that measure pops, metres. The field
+/// is asked for the blocks within its radius when the camera enters another block, so on a
+/// straight flight blocks join as near as a block inside the radius, and their sprites reach half
+/// a block's diagonal nearer still: the sprites end short of that, so blocks join out of sight
+/// (the shipped 60 km field's join in the impostor ring and the haze). Drawn, a deck's block
+/// appearing whole 4 km ahead of a 10 km field was a jump of its own in every flight, weather
+/// change or not (1.6x plain motion under a closed deck), which is not what these tests measure.
+const FIELD_RADIUS_M: f64 = 20_000.0;
+const DRAW_DISTANCE_M: f32 = (FIELD_RADIUS_M - 1.71 * BLOCK_SIZE_M) as f32;
+
 /// Formation time of the rewrite test, seconds: a fifth of the shipped ten minutes, so the whole
 /// change fits a short test while each frame's fade stays as gentle as a simulator would see.
 const FORMATION_S: f32 = 120.0;
@@ -195,7 +216,12 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
     let path = dir.join("metars.txt");
     std::fs::write(&path, reports("FEW045")).unwrap();
     let old_field = field_of(&path);
-    let mut flight = Flight::new(field_of(&path), 10_000.0, FORMATION_S);
+    let mut flight = Flight::new(
+        field_of(&path),
+        FIELD_RADIUS_M,
+        Some(DRAW_DISTANCE_M),
+        FORMATION_S,
+    );
     flight
         .host
         .sky
@@ -422,7 +448,7 @@ fn the_same_change_without_a_fade_pops() {
     let (old, new) = (dir.join("old.txt"), dir.join("new.txt"));
     std::fs::write(&old, reports("FEW045")).unwrap();
     std::fs::write(&new, reports("OVC035")).unwrap();
-    let mut flight = Flight::new(field_of(&old), 10_000.0, 1.0);
+    let mut flight = Flight::new(field_of(&old), FIELD_RADIUS_M, Some(DRAW_DISTANCE_M), 1.0);
     let mut last = flight.step(0.0, true).0.unwrap();
     let mut fly = |flight: &mut Flight, frames: usize| {
         let mut most = 0.0f32;
@@ -458,7 +484,7 @@ fn soak_one_hour_of_weather_changes_does_not_grow() {
             p
         })
         .collect();
-    let mut flight = Flight::new(field_of(&files[0]), 8_000.0, 60.0);
+    let mut flight = Flight::new(field_of(&files[0]), 8_000.0, None, 60.0);
     flight.circle = true;
     for k in 1..12 {
         flight
