@@ -59,6 +59,7 @@ pictures: vulkan
 	$(FRAME) --weather weather/themes/low_stratus_and_fog.toml --at 28.5,-81.45 --time 2025-01-27T13:30:00Z --alt-ft 450 --heading 90 --pitch -4 --out tests/pictures/airports/fog_morning.png
 	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 283 --heading 315 --pitch 10 --out tests/pictures/pilot/deck_below.png
 	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 3083 --heading 135 --pitch -10 --out tests/pictures/pilot/deck_above.png
+	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 4000 --heading 10 --pitch -89 --out tests/pictures/pilot/deck_nadir.png
 	$(FRAME) --weather weather/views/high_broken_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 1000 --heading 0 --pitch 45 --out tests/pictures/pilot/cirrocumulus_below.png
 	cargo test --quiet --test pilot rain_falls_out_of_a_storm && cp target/tmp/pilot/storm/rain.png tests/pictures/pilot/storm_20km.png
 	for m in wang harris_lastra; do \

@@ -70,7 +70,7 @@ struct SpriteView {
     hl_phase: vec4<f32>,
     hl_sky: vec4<f32>,
     hl_deck: vec4<f32>,
-    far_fade: vec4<f32>,
+    far_fade_layer_turn: vec4<f32>,
     locks: array<Lock, 128>,
 };
 
@@ -142,8 +142,30 @@ fn upright_facing(to_cam: vec3<f32>) -> Facing {
 fn far_fade(to_cam: vec3<f32>) -> f32 {
     let dist = length(to_cam);
     let above_horizon = smoothstep(0.0, 0.02, -to_cam.z / max(dist, 1.0));
-    let fade = view.far_fade;
+    let fade = view.far_fade_layer_turn;
     return 1.0 - above_horizon * smoothstep(fade.x, max(fade.y, fade.x + 1.0), dist);
+}
+
+// A layer sprite (not flat, wider than tall: the puffs of stratus, nimbostratus, altostratus,
+// stratocumulus and fog) is a pancake, wide across and thin in height. Its quad's height and
+// its turn about the view ray, seen from `to_cam` (from the sprite to the camera): from the side
+// the short strip it was made as; from steeply above or below its outline rounds to its width
+// (an oblate puff's silhouette), and its turn goes over to one of its own (hashed from its place
+// in the cloud). A camera-facing quad turned by the camera alone lays every puff across the line
+// to the nadir, and a deck seen from above showed rings around it. The turn is weighted by the
+// view angle alone, so a sprite turns smoothly as the camera moves.
+fn layer_quad(width: f32, height: f32, rotation: f32, offset: vec3<f32>, to_cam: vec3<f32>)
+    -> vec2<f32> {
+    let sin_e = abs(to_cam.z) / max(length(to_cam), 1e-3);
+    let cos_e = sqrt(max(1.0 - sin_e * sin_e, 0.0));
+    let quad_height = length(vec2<f32>(height * cos_e, width * sin_e));
+    var h = bitcast<u32>(offset.x) * 747796405u ^ bitcast<u32>(offset.y) * 2891336453u;
+    h = (h ^ (h >> 16u)) * 73244475u;
+    // Within a quarter turn either way: enough to lay the puffs every way (a pancake's outline
+    // is the same turned half round), and a puff passing overhead turns by at most that.
+    let own_turn = (f32((h ^ (h >> 16u)) & 0xffffu) / 65536.0 - 0.5) * 3.141592654;
+    let turn = view.far_fade_layer_turn;
+    return vec2<f32>(quad_height, rotation + own_turn * smoothstep(turn.z, turn.w, sin_e));
 }
 
 // Wang 5.1: the ambient colour of the cloud's five levels at a height above mean sea level:
@@ -376,7 +398,14 @@ fn build_sprite(k: u32, at: u32) {
         return;
     }
 
-    let sc = vec2<f32>(sin(rotation), cos(rotation));
+    var quad_height = height;
+    var turn = rotation;
+    if (flat_radius.z <= 0.5 && (s.bits & 256u) == 0u && width > height) {
+        let layer = layer_quad(width, height, rotation, offset, to_cam);
+        quad_height = layer.x;
+        turn = layer.y;
+    }
+    let sc = vec2<f32>(sin(turn), cos(turn));
     let right = face.right * sc.y + face.up * sc.x;
     let up = face.up * sc.y - face.right * sc.x;
     let light = view.directional_ambient;
@@ -393,7 +422,7 @@ fn build_sprite(k: u32, at: u32) {
     for (var c = 0u; c < 4u; c++) {
         // The corner on the cut quad: texture coordinates across it (v down), and where it is.
         let across = mix(crop.xy, crop.zw, vec2<f32>(f32(c & 1u), f32(c >> 1u)));
-        let p = offset + right * ((across.x - 0.5) * width) + up * ((0.5 - across.y) * height);
+        let p = offset + right * ((across.x - 0.5) * width) + up * ((0.5 - across.y) * quad_height);
         // Wang eq. (3): (ambient + directional) x alpha_morph; the texture is the fragment's.
         let height_msl = view.sun_dir_camera_z.w + centre_rel.z + p.z;
         let ambient = level_colour(cloud, height_msl);

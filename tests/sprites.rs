@@ -1,9 +1,9 @@
 //! The sprites as the vertex shader builds them (Wang 2003 3.3, 5 and 6.1 on GPU-resident
 //! sprites), read back from the GPU (`Sky::read_back_corners` runs the shader's own corner code):
 //! the order cache, the back-to-front order, facing the camera, the facing lock and its fade,
-//! upright base sprites, the forward-scattering rim, precision far from the origin, each quad cut
-//! to the visible part of its sheet cell, and (in drawn frames) the horizon haze. Small scenes on
-//! whatever adapter there is (lavapipe here).
+//! upright base sprites, layer sprites seen from above, the forward-scattering rim, precision far
+//! from the origin, each quad cut to the visible part of its sheet cell, and (in drawn frames) the
+//! horizon haze. Small scenes on whatever adapter there is (lavapipe here).
 
 use glam::{DVec2, DVec3, Vec3};
 use skycast::demo::terrain::HeightField;
@@ -380,6 +380,88 @@ fn upright_sprites_stay_level_and_fade_seen_from_below() {
         gone.iter().all(|c| !c.visible),
         "from 40 degrees below: {gone:?}"
     );
+}
+
+/// A layer's wide, short sprite (a stratus deck's puff) is a pancake: seen from the side it is
+/// the level strip it was made as; seen from straight above its outline is round and each one
+/// lies its own way. Turned by the camera alone, every puff of a deck seen from above lay across
+/// the line to the nadir, and the deck showed rings around it.
+#[test]
+fn layer_sprites_seen_from_above_are_round_and_lie_their_own_way() {
+    let mut host = host(TimeOfDayTable::default());
+    let centre_m = DVec3::new(0.0, 3000.0, 1500.0);
+    // Nine puffs 400 m wide and 200 m tall, none straight under the camera above.
+    let puffs = (0..9)
+        .map(|k| SkySprite {
+            height_m: 200.0,
+            ..square_sprite(
+                Vec3::new(
+                    k as f32 * 150.0 - 525.0,
+                    (k % 3) as f32 * 170.0 - 170.0,
+                    0.0,
+                ),
+                400.0,
+                3,
+                0,
+            )
+        })
+        .collect();
+    host.sky.set_clouds(one_cloud(plain_cloud(
+        centre_m,
+        puffs,
+        ColourLevels::even(1400.0, 1600.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+    )));
+    let width = |q: &[SpriteCorner]| (q[1].rel_m - q[0].rel_m).length();
+    let height = |q: &[SpriteCorner]| (q[0].rel_m - q[2].rel_m).length();
+    // From 20 km south at the layer's height: 400 x 200, the bottom edge level.
+    let side = corners(&mut host, centre_m - DVec3::Y * 20_000.0, 0.0);
+    assert_eq!(side.len(), 36);
+    for q in side.chunks(4) {
+        assert!(q.iter().all(|c| c.visible), "{q:?}");
+        assert!((width(q) - 400.0).abs() < 0.5, "{q:?}");
+        assert!((height(q) - 200.0).abs() < 0.5, "{q:?}");
+        assert!((q[2].rel_m.z - q[3].rel_m.z).abs() < 1e-2, "level: {q:?}");
+    }
+    // From 3 km straight above (every puff 76 to 89 degrees down): round within 2%, and the
+    // angle of each one's width off the line across the nadir its own.
+    let down = host.camera(centre_m + DVec3::Z * 3000.0, 0.0, -89.0);
+    host.sky.prepare(&host.gpu.queue, down, &SUN, 0.1);
+    let top = host
+        .sky
+        .read_back_corners(&host.gpu.queue)
+        .expect("corners read back");
+    assert_eq!(top.len(), 36);
+    let mut off_the_tangent_deg = Vec::new();
+    for q in top.chunks(4) {
+        assert!(q.iter().all(|c| c.visible), "{q:?}");
+        assert!((width(q) - 400.0).abs() < 0.5, "{q:?}");
+        assert!(
+            height(q) > 392.0 && height(q) <= 400.5,
+            "{}: {q:?}",
+            height(q)
+        );
+        let at = centre(q);
+        let tangent = Vec3::new(-at.y, at.x, 0.0).normalize();
+        let across = (q[1].rel_m - q[0].rel_m).normalize();
+        off_the_tangent_deg.push(across.dot(tangent).abs().min(1.0).acos().to_degrees());
+    }
+    let turned = off_the_tangent_deg.iter().filter(|&&a| a > 10.0).count();
+    assert!(turned >= 5, "{off_the_tangent_deg:?}");
+    // Seen from 45 degrees, in between.
+    let slant = host.camera(centre_m + DVec3::new(0.0, -3000.0, 3000.0), 0.0, -45.0);
+    host.sky.prepare(&host.gpu.queue, slant, &SUN, 0.2);
+    let between = host
+        .sky
+        .read_back_corners(&host.gpu.queue)
+        .expect("corners read back");
+    assert_eq!(between.len(), 36);
+    for q in between.chunks(4) {
+        assert!(
+            height(q) > 250.0 && height(q) < 350.0,
+            "{}: {q:?}",
+            height(q)
+        );
+    }
 }
 
 /// Seen with the sun behind it, a cloud's rim is brighter than with the sun behind the camera

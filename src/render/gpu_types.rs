@@ -209,8 +209,9 @@ pub struct GpuSpriteView {
     /// light (direct and scattered forward) away: `1 - forward_fraction`; yzw unused.
     pub hl_deck: [f32; 4],
     /// x, y: the distance from the view's camera over which sprites seen above the horizon fade
-    /// out (start, end), metres; zw unused.
-    pub far_fade: [f32; 4],
+    /// out (start, end), metres; z, w: sines of the angles over which layer sprites take their
+    /// own turn (start, end).
+    pub far_fade_layer_turn: [f32; 4],
     /// The locked facings.
     pub locks: [GpuLock; MAX_LOCKS],
 }

@@ -19,7 +19,10 @@ pub struct SkySprite {
     pub width_m: f32,
     /// Height, metres.
     pub height_m: f32,
-    /// Rotation in the sprite plane, degrees (0 for non-square sprites).
+    /// Rotation in the sprite plane, degrees (0 for non-square sprites). A sprite wider than
+    /// tall, not upright, in a cloud that is not flat is a layer's puff (a pancake): seen from
+    /// steeply above or below its quad rounds to its width and turns its own way on top of this
+    /// (`[clouds] layer_turn_start_deg` and `layer_turn_end_deg`).
     pub rotation_deg: f32,
     /// Cell of the 4 x 4 texture sheet, 0..16 (row-major from the top left).
     pub cell: u8,

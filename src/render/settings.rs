@@ -48,6 +48,16 @@ pub struct CloudSettings {
     /// Upright sprites are fully transparent seen from beyond this angle, degrees.
     #[serde(default = "default_upright_fade_end_deg")]
     pub upright_fade_end_deg: f32,
+    /// Layer sprites (the wide, short puffs of stratus, nimbostratus, altostratus, stratocumulus
+    /// and fog) are pancakes: seen from steeply above or below, their outline rounds to their
+    /// width, and from this angle above or below their level they start to take a turn of their
+    /// own about the view ray instead of the camera's (a deck seen from above otherwise lays
+    /// every puff across the line to the nadir, in rings around it), degrees.
+    #[serde(default = "default_layer_turn_start_deg")]
+    pub layer_turn_start_deg: f32,
+    /// Layer sprites have all of their own turn seen from beyond this angle, degrees.
+    #[serde(default = "default_layer_turn_end_deg")]
+    pub layer_turn_end_deg: f32,
     /// Sprites farther than this from the camera are not drawn, metres.
     pub draw_distance_m: f32,
     /// Distant sprites fade into the horizon haze: 63% at this distance, metres.
@@ -63,6 +73,14 @@ pub struct CloudSettings {
     /// layer dissolves there instead of ending in a line across the sky. 0: no fade.
     #[serde(default = "default_far_fade_fraction")]
     pub far_fade_fraction: f32,
+}
+
+fn default_layer_turn_start_deg() -> f32 {
+    30.0
+}
+
+fn default_layer_turn_end_deg() -> f32 {
+    72.0
 }
 
 fn default_resolution_scale() -> f32 {
@@ -226,6 +244,17 @@ impl RenderSettings {
                 "needs 0 <= upright_fade_start_deg < upright_fade_end_deg <= 90",
             ));
         }
+        if !(0.0 <= c.layer_turn_start_deg
+            && c.layer_turn_start_deg < c.layer_turn_end_deg
+            && c.layer_turn_end_deg <= 90.0)
+        {
+            return Err(ConfigError::at_key(
+                path,
+                text,
+                "clouds.layer_turn_end_deg",
+                "needs 0 <= layer_turn_start_deg < layer_turn_end_deg <= 90",
+            ));
+        }
         if s.camera.far_m <= s.camera.near_m {
             return Err(ConfigError::at_key(
                 path,
@@ -285,6 +314,11 @@ mod tests {
             "max_sorted_sprites_per_frame = 0",
         );
         names(&err, "vertex_cache.max_sorted_sprites_per_frame");
+        let err = error_with("layer_turn_end_deg = 72.0", "layer_turn_end_deg = 95.0");
+        names(&err, "clouds.layer_turn_end_deg");
+        assert!(err.contains("<= 90"), "{err}");
+        let err = error_with("layer_turn_start_deg = 30.0", "layer_turn_start_deg = 80.0");
+        names(&err, "clouds.layer_turn_end_deg");
         let err = error_with("far_fade_fraction = 0.3", "far_fade_fraction = 1.5");
         names(&err, "clouds.far_fade_fraction");
         let err = error_with("resolution_scale = 0.5", "resolution_scale = 0.3");
@@ -298,6 +332,7 @@ mod tests {
                 !l.starts_with("upright_fade")
                     && !l.starts_with("resolution_scale")
                     && !l.starts_with("far_fade_fraction")
+                    && !l.starts_with("layer_turn")
                     && !l.starts_with("max_sorted")
                     && !l.starts_with("max_uploaded")
             })

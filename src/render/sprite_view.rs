@@ -91,11 +91,11 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
             .extend(hl.ambient * tod.ambient_percent)
             .to_array(),
         hl_deck: [1.0 - hl.forward_fraction(), 0.0, 0.0, 0.0],
-        far_fade: [
+        far_fade_layer_turn: [
             farthest_m * (1.0 - clouds.far_fade_fraction),
             farthest_m,
-            0.0,
-            0.0,
+            sin(clouds.layer_turn_start_deg),
+            sin(clouds.layer_turn_end_deg),
         ],
         locks: [GpuLock {
             right: [0.0; 4],
