@@ -191,6 +191,8 @@ struct Slot {
     weather: BlockWeather,
     /// Oldest first; during a weather change the old one dissipates while the new one forms.
     generations: Vec<FieldBlock>,
+    /// The phase its first generation starts in (`CloudField::joining_phase` when it joined).
+    joins: Phase,
 }
 
 /// The blocks around a point, advancing in time. See the module docs.
@@ -247,7 +249,16 @@ impl CloudField {
         let radius = self.config.field.radius_m;
         let seed = self.config.field.seed;
         let wanted = blocks_within(air_centre, radius);
-        for &index in &wanted {
+        // How the blocks that join now will start, from the blocks that were there before
+        // (not from each other: the same in any order).
+        let joins: Vec<Phase> = wanted
+            .iter()
+            .map(|&i| match self.slots.contains_key(&i) {
+                true => Phase::Steady,
+                false => self.joining_phase(i),
+            })
+            .collect();
+        for (&index, joins) in wanted.iter().zip(joins) {
             let ground = BlockIndex::containing(index.centre_m() + self.drift_m);
             let w = weather(ground);
             match self.slots.get_mut(&index) {
@@ -258,6 +269,7 @@ impl CloudField {
                         Slot {
                             weather: w,
                             generations: Vec::new(),
+                            joins,
                         },
                     );
                 }
@@ -310,7 +322,6 @@ impl CloudField {
     fn take_in(&mut self, finished: Vec<Generated>) {
         let now = self.time_s;
         for done in finished {
-            let joining = self.joining_phase(done.index);
             let Some(slot) = self.slots.get_mut(&done.index) else {
                 continue;
             };
@@ -318,17 +329,24 @@ impl CloudField {
                 continue; // superseded by a newer request
             }
             let phase = if slot.generations.is_empty() {
-                joining
+                slot.joins
             } else {
                 Phase::Forming { since_s: now }
             };
+            let lifecycle = self.config.lifecycle;
             for g in &mut slot.generations {
-                if g.phase == Phase::Steady {
-                    self.unsettled += 1;
-                }
-                if !matches!(g.phase, Phase::Dissipating { .. }) {
-                    g.phase = Phase::Dissipating { since_s: now };
-                }
+                g.phase = match g.phase {
+                    Phase::Steady => {
+                        self.unsettled += 1;
+                        Phase::Dissipating { since_s: now }
+                    }
+                    // Still forming: back the way it came, from as far as it had formed.
+                    Phase::Forming { .. } => Phase::Unforming {
+                        since_s: now,
+                        from: super::lifecycle::progress(g.phase, now, &lifecycle),
+                    },
+                    going => going,
+                };
             }
             if phase != Phase::Steady {
                 self.unsettled += 1;
@@ -589,11 +607,11 @@ mod tests {
             field.generations(BlockIndex::new(0, 0))[1].phase,
             Phase::Forming { since_s }
         );
-        // Half-way through the formation the camera has flown 8 km east: the blocks that join
-        // at the rim form from the same moment as those beside them, not whole among them.
+        // Half-way through the formation the camera has flown a block east: the blocks that
+        // join at the rim form from the same moment as those beside them, not whole among them.
         field.advance(60.0);
         let before: Vec<BlockIndex> = field.blocks().map(|(i, _)| i).collect();
-        let east = DVec2::new(8_000.0, 0.0);
+        let east = DVec2::new(BLOCK_SIZE_M, 0.0);
         field.update(east, &|_| calm(6.0));
         field.wait_for_pending();
         let joined: Vec<BlockIndex> = field
@@ -619,6 +637,73 @@ mod tests {
             .collect();
         assert!(joined.len() >= 3);
         assert!(joined.iter().all(|g| g.phase == Phase::Steady));
+    }
+
+    #[test]
+    fn a_generation_superseded_while_forming_goes_back_without_a_jump() {
+        let mut field = small_field();
+        let calm = |oktas| BlockWeather {
+            wind: Wind::default(),
+            ..weather(oktas)
+        };
+        field.update(DVec2::ZERO, &|_| calm(2.0));
+        field.wait_for_pending();
+        field.advance(10.0);
+        field.update(DVec2::ZERO, &|_| calm(6.0));
+        field.wait_for_pending();
+        let config = CloudsConfig::builtin().lifecycle;
+        let index = BlockIndex::new(0, 0);
+        let opacity = |g: &FieldBlock, now: f64| -> f32 {
+            g.block
+                .clouds
+                .iter()
+                .flat_map(|c| &c.sprites)
+                .map(|s| {
+                    crate::clouds::lifecycle::alpha_at(g.phase, now, s.radius_fraction, &config)
+                })
+                .sum::<f32>()
+        };
+        // 30% formed when the weather changes again.
+        field.advance(0.3 * f64::from(config.formation_s));
+        let forming = field.generations(index)[1].clone();
+        let before = opacity(&forming, field.time_s());
+        assert!(before > 0.0);
+        field.update(DVec2::ZERO, &|_| calm(4.0));
+        field.wait_for_pending();
+        let gens = field.generations(index);
+        assert_eq!(gens.len(), 3);
+        // The same clouds show as the moment before, then less and less, gone after 30% of
+        // the formation time (dissipating from whole, they had shown whole at once).
+        let after = opacity(&gens[1], field.time_s());
+        let superseded = gens[1].serial;
+        assert!(
+            (after - before).abs() < 1e-3 * before.max(1.0),
+            "{before} then {after}"
+        );
+        assert!(
+            matches!(gens[1].phase, Phase::Unforming { from, .. } if (from - 0.3).abs() < 1e-3),
+            "{:?}",
+            gens[1].phase
+        );
+        let mut last = after;
+        for _ in 0..10 {
+            field.advance(0.031 * f64::from(config.formation_s));
+            match field.generations(index).get(1) {
+                Some(g) if g.serial == superseded => {
+                    let now = opacity(g, field.time_s());
+                    assert!(now <= last, "{last} then {now}");
+                    last = now;
+                }
+                _ => break,
+            }
+        }
+        assert!(
+            field
+                .generations(index)
+                .iter()
+                .all(|g| g.serial != forming.serial),
+            "the superseded generation is gone"
+        );
     }
 
     #[test]

@@ -28,6 +28,16 @@ pub enum Phase {
         /// Start time, seconds.
         since_s: f64,
     },
+    /// Superseded while still forming: going back the way it formed, from formation progress
+    /// `from` at `since_s` down to nothing at the formation's rate (its outer sprites first, as
+    /// when dissipating). Dissipating from whole instead showed its half-formed clouds whole
+    /// in one frame.
+    Unforming {
+        /// Start time, seconds.
+        since_s: f64,
+        /// The formation progress it had then, 0..=1.
+        from: f32,
+    },
     /// Dissipated completely: nothing left to draw.
     Gone,
 }
@@ -62,16 +72,22 @@ pub fn phase_at(phase: Phase, now_s: f64, config: &LifecycleConfig) -> Phase {
         Phase::Dissipating { since_s } if now_s - since_s >= config.dissipation_s as f64 => {
             Phase::Gone
         }
+        Phase::Unforming { .. } if progress(phase, now_s, config) <= 0.0 => Phase::Gone,
         other => other,
     }
 }
 
-/// Progress of a formation or dissipation at field time `now_s`, 0..=1 (1 for Steady and Gone).
+/// Progress of a formation or dissipation at field time `now_s`, 0..=1 (1 for Steady and Gone);
+/// of an unforming generation, the formation progress it is back at.
 pub fn progress(phase: Phase, now_s: f64, config: &LifecycleConfig) -> f32 {
     let frac = |since_s: f64, span_s: f32| ((now_s - since_s) / span_s as f64).clamp(0.0, 1.0);
     match phase {
         Phase::Forming { since_s } => frac(since_s, config.formation_s) as f32,
         Phase::Dissipating { since_s } => frac(since_s, config.dissipation_s) as f32,
+        Phase::Unforming { since_s, from } => {
+            let back = ((now_s - since_s) / config.formation_s as f64).max(0.0);
+            (from as f64 - back).clamp(0.0, 1.0) as f32
+        }
         Phase::Steady | Phase::Gone => 1.0,
     }
 }
@@ -83,7 +99,9 @@ pub fn alpha_at(phase: Phase, now_s: f64, radius_fraction: f32, config: &Lifecyc
     match phase {
         Phase::Steady => 1.0,
         Phase::Gone => 0.0,
-        Phase::Forming { .. } => formation_alpha(p, radius_fraction, config),
+        Phase::Forming { .. } | Phase::Unforming { .. } => {
+            formation_alpha(p, radius_fraction, config)
+        }
         Phase::Dissipating { .. } => dissipation_alpha(p, radius_fraction, config),
     }
 }
@@ -114,6 +132,13 @@ pub fn apply(cloud: &mut Cloud, phase: Phase, now_s: f64, config: &LifecycleConf
                 s.alpha_morph = dissipation_alpha(q, s.radius_fraction, config);
             }
             if q >= 1.0 { Phase::Gone } else { phase }
+        }
+        Phase::Unforming { .. } => {
+            let p = progress(phase, now_s, config);
+            for s in &mut cloud.sprites {
+                s.alpha_morph = formation_alpha(p, s.radius_fraction, config);
+            }
+            if p <= 0.0 { Phase::Gone } else { phase }
         }
     }
 }

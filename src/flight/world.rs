@@ -323,7 +323,9 @@ impl World {
             count += 1;
             let fade = match fb.phase {
                 Phase::Steady => Fade::Steady,
-                Phase::Forming { .. } => Fade::Forming(progress(fb.phase, now, &lifecycle)),
+                Phase::Forming { .. } | Phase::Unforming { .. } => {
+                    Fade::Forming(progress(fb.phase, now, &lifecycle))
+                }
                 Phase::Dissipating { .. } => Fade::Dissipating(progress(fb.phase, now, &lifecycle)),
                 Phase::Gone => Fade::Dissipating(1.0),
             };
