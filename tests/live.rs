@@ -528,3 +528,58 @@ fn soak_one_hour_of_weather_changes_does_not_grow() {
         "GPU buffers grew from {gpu_settled} to {gpu_max}"
     );
 }
+
+/// A new report's fog and cloud cover come in with its clouds, not in the frame it arrives: the
+/// visibility the host fogs its ground with and the sky's horizon go over across the formation
+/// time (the demo's ground went 93/255 brighter into fog in one frame when a rain report came).
+#[test]
+fn a_new_report_fogs_and_darkens_the_sky_as_its_clouds_form() {
+    let everywhere = |sky: &str| {
+        ["KSAT", "KSSF", "KSKF", "KHDO", "KERV", "KRND", "KBAZ"]
+            .map(|id| format!("{id} 271700Z 00000KT {sky} 23/15 A2998\n"))
+            .concat()
+    };
+    let dir = temp_dir("ease");
+    let (clear, foggy) = (dir.join("clear.txt"), dir.join("foggy.txt"));
+    std::fs::write(&clear, everywhere("10SM FEW045")).unwrap();
+    // A deck over the camera (900 m) in mist: the horizon turns grey, the ground fogs.
+    std::fs::write(&foggy, everywhere("1SM BR OVC035")).unwrap();
+    let formation_s = 60.0;
+    let mut flight = Flight::new(field_of(&clear), 10_000.0, None, formation_s);
+    for _ in 0..4 {
+        flight.step(0.5, false);
+    }
+    let sky = |f: &Flight| {
+        let light = f.host.sky.lighting();
+        (light.fog_distance_m, light.horizon_rgb)
+    };
+    let (clear_m, clear_horizon) = sky(&flight);
+    flight.host.sky.set_weather_field(field_of(&foggy));
+    flight.step(1.0, false);
+    let (first_m, first_horizon) = sky(&flight);
+    // Eased in density (1 / visibility): one second of sixty.
+    let density = |m: f32| 1.0 / m;
+    let total = density(1_609.0) - density(clear_m);
+    assert!(clear_m > 9_000.0, "{clear_m}");
+    assert!(
+        density(first_m) - density(clear_m) < 0.05 * total,
+        "{clear_m} m, then {first_m} m"
+    );
+    assert!(
+        (first_horizon - clear_horizon).length() < 0.05,
+        "{first_horizon}"
+    );
+    let mut last_m = first_m;
+    for _ in 0..70 {
+        flight.step(1.0, false);
+        let (m, _) = sky(&flight);
+        assert!(m <= last_m + 1e-3, "the fog thinned: {last_m} then {m}");
+        last_m = m;
+    }
+    let (end_m, end_horizon) = sky(&flight);
+    assert!((end_m - 1_609.0).abs() < 50.0, "{end_m}");
+    assert!(
+        (end_horizon - clear_horizon).length() > 0.05,
+        "{end_horizon}"
+    );
+}

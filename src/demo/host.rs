@@ -138,9 +138,10 @@ impl DemoHost {
             t.stamp(&self.gpu, 1);
         }
         let sun_dir = self.sky.lighting().sun_direction;
-        let visibility_m = self.sky.world().visibility_m();
+        // The ground's visibility is the sky's fog alone: the weather over the camera, eased
+        // through a change of the report as its clouds form (`Sky::ease_weather_overhead`).
         Ok((
-            self.draw_prepared(camera, sun_dir, visibility_m, stats),
+            self.draw_prepared(camera, sun_dir, f32::INFINITY, stats),
             changes,
         ))
     }

@@ -214,7 +214,8 @@ impl SkySystem {
     /// Takes new weather. A file or bytes are read now (an error names file, line and field,
     /// and the sky keeps its last good weather); a watched file is read off the frame thread and
     /// applied by the frames that follow. The clouds of every block whose weather changed
-    /// dissipate while the new ones form.
+    /// dissipate while the new ones form, and the light and fog under them go over with them
+    /// ([`Sky::ease_weather_overhead`]).
     pub fn set_weather(&mut self, weather: Weather) -> Result<(), SkyError> {
         let stations = self.stations.as_deref();
         let input = match weather {
@@ -233,12 +234,14 @@ impl SkySystem {
             }
         };
         self.world.set_field((self.prepare_field)(input));
+        self.sky.ease_weather_overhead();
         Ok(())
     }
 
     /// Takes a weather field the host built itself (same as [`Self::set_weather`] otherwise).
     pub fn set_weather_field(&mut self, field: WeatherField) {
         self.world.set_field(field);
+        self.sky.ease_weather_overhead();
     }
 
     /// Schedules a weather file for `at_s` seconds of frames from now (a front passing in a
@@ -275,6 +278,7 @@ impl SkySystem {
             changes.push(match change {
                 LiveChange::Loaded { source, weather } => {
                     self.world.set_field(weather);
+                    self.sky.ease_weather_overhead();
                     Ok(source)
                 }
                 LiveChange::Rejected(why) => Err(why),

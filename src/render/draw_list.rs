@@ -199,6 +199,15 @@ fn order_into(
     }
 }
 
+/// How much of a block a fade shows, 0..=1: its progress forming, what is left dissipating.
+fn fade_opacity(fade: Fade) -> f32 {
+    match fade {
+        Fade::Steady => 1.0,
+        Fade::Forming(p) => p.clamp(0.0, 1.0),
+        Fade::Dissipating(q) => 1.0 - q.clamp(0.0, 1.0),
+    }
+}
+
 fn fade_code(fade: Fade) -> (u32, f32) {
     match fade {
         Fade::Steady => (0, 1.0),
@@ -303,8 +312,11 @@ pub(super) fn main_view(
         let rel = camera_m - r.centre_m();
         if d2.sqrt() < r.radius_m {
             let here = inside_clouds(r, camera_m, settings, locks);
-            inside.cloud = inside.cloud.max(here.cloud);
-            inside.rain = inside.rain.max(here.rain);
+            // A forming or dissipating block's inside is as thick as it has formed: a new
+            // report's deck around the camera thickens with its clouds, not in one frame.
+            let shown = fade_opacity(r.motion.fade);
+            inside.cloud = inside.cloud.max(here.cloud * shown);
+            inside.rain = inside.rain.max(here.rain * shown);
         }
         let (fade_kind, fade_progress) = fade_code(r.motion.fade);
         out.push(GpuDrawBlock {

@@ -33,6 +33,7 @@ pub mod cloud_target;
 pub mod draw_list;
 pub mod gpu_types;
 pub mod impostor;
+mod overhead_ease;
 mod pass_timing;
 mod pipeline;
 mod readback;

@@ -28,6 +28,7 @@ use super::cloud_target::{CloudShared, CloudTarget, can_test_against, cloud_targ
 use super::draw_list::{Copies, Locks, main_view};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuSpriteVertex};
 use super::impostor::{ImpostorRing, RingFrame, RingShared};
+use super::overhead_ease::OverheadEase;
 use super::pass_timing::{STAMPS, Stamp};
 use super::pipeline::{
     PassDesc, SceneDepth, background_test, pipeline, pipeline_with_depth, premultiplied_over,
@@ -140,6 +141,8 @@ pub struct Sky {
     overhead: (Vec<BlockLayer>, f32),
     /// The fog settings and the weather over the camera they read (visibility, obscuration).
     fog: (crate::shading::FogSettings, BlockWeather),
+    /// The cover and visibility frames show, eased through a change of the weather in time.
+    overhead_ease: OverheadEase,
     ring: ImpostorRing,
     /// Where the clouds are drawn: the host's colour (scale 1) or the off-screen cloud target.
     clouds: CloudTarget,
@@ -380,6 +383,7 @@ impl Sky {
                     ..Default::default()
                 },
             ),
+            overhead_ease: OverheadEase::default(),
             ring,
             clouds,
         })
@@ -606,11 +610,25 @@ impl Sky {
         self.fog.1 = weather.clone();
     }
 
+    /// The weather overhead changes in time from now (a new report, not the camera moving
+    /// through the weather): the cover's light and the fog's visibility go over to the next
+    /// [`Self::set_weather_overhead`]'s across the clouds' formation time, as its clouds form,
+    /// instead of at once. Called by [`crate::flight::SkySystem`] when it applies a new weather
+    /// field; a host handing the weather itself calls it when the weather it hands is new.
+    pub fn ease_weather_overhead(&mut self) {
+        self.overhead_ease
+            .begin(self.elapsed_s, f64::from(self.lifecycle.formation_s));
+    }
+
     /// The fog a host draws over its scene: the visibility and obscuration of the weather over
-    /// the camera ([`crate::shading::fog`]) under the last frame's horizon sky, thicker where the
-    /// last frame found the camera in a rain or snow shaft.
+    /// the camera ([`crate::shading::fog`]) under the last frame's horizon sky, the visibility
+    /// the last frame showed ([`Self::ease_weather_overhead`]), thicker where the last frame
+    /// found the camera in a rain or snow shaft.
     pub fn fog(&self) -> crate::shading::Fog {
-        let air = self.fog.0.fog(&self.fog.1, self.seen_light.sky_horizon_rgb);
+        let mut air = self.fog.0.fog(&self.fog.1, self.seen_light.sky_horizon_rgb);
+        if let Some(shown) = self.overhead_ease.visibility_m() {
+            air.distance_m = shown;
+        }
         self.fog.0.in_rain(air, self.in_rain)
     }
 
@@ -673,10 +691,14 @@ impl Sky {
         }
         self.elapsed_s += dt_s.max(0.0);
         self.clear_light = self.time_of_day.at(sun.elevation_deg as f32);
-        self.seen_light = self.clear_light.under_cover(
+        let (hidden, _) = self.overhead_ease.show(
             self.sky_hidden_at(camera.position_m.z),
-            &self.time_of_day.overcast,
+            self.fog.0.visibility_m(&self.fog.1),
+            self.elapsed_s,
         );
+        self.seen_light = self
+            .clear_light
+            .under_cover(hidden, &self.time_of_day.overcast);
         let sun_dir = sun.direction_enu().as_vec3();
         let lighting = Lighting {
             sun_dir,
