@@ -104,7 +104,12 @@ fn camera(host: &DemoHost, at: DVec3) -> Camera {
 
 /// Prepares a frame from `at` at sky time step `dt_s` and reads its corners back.
 fn corners(host: &mut DemoHost, at: DVec3, dt_s: f64) -> Vec<SpriteCorner> {
-    let cam = camera(host, at);
+    corners_looking(host, at, 0.0, dt_s)
+}
+
+/// [`corners`] with the camera looking north `pitch_deg` above the horizon.
+fn corners_looking(host: &mut DemoHost, at: DVec3, pitch_deg: f64, dt_s: f64) -> Vec<SpriteCorner> {
+    let cam = host.camera(at, 0.0, pitch_deg);
     host.sky.prepare(&host.gpu.queue, cam, &SUN, dt_s);
     host.sky
         .read_back_corners(&host.gpu.queue)
@@ -424,12 +429,7 @@ fn layer_sprites_seen_from_above_are_round_and_lie_their_own_way() {
     }
     // From 3 km straight above (every puff 76 to 89 degrees down): round within 2%, and the
     // angle of each one's width off the line across the nadir its own.
-    let down = host.camera(centre_m + DVec3::Z * 3000.0, 0.0, -89.0);
-    host.sky.prepare(&host.gpu.queue, down, &SUN, 0.1);
-    let top = host
-        .sky
-        .read_back_corners(&host.gpu.queue)
-        .expect("corners read back");
+    let top = corners_looking(&mut host, centre_m + DVec3::Z * 3000.0, -89.0, 0.1);
     assert_eq!(top.len(), 36);
     let mut off_the_tangent_deg = Vec::new();
     for q in top.chunks(4) {
@@ -448,12 +448,8 @@ fn layer_sprites_seen_from_above_are_round_and_lie_their_own_way() {
     let turned = off_the_tangent_deg.iter().filter(|&&a| a > 10.0).count();
     assert!(turned >= 5, "{off_the_tangent_deg:?}");
     // Seen from 45 degrees, in between.
-    let slant = host.camera(centre_m + DVec3::new(0.0, -3000.0, 3000.0), 0.0, -45.0);
-    host.sky.prepare(&host.gpu.queue, slant, &SUN, 0.2);
-    let between = host
-        .sky
-        .read_back_corners(&host.gpu.queue)
-        .expect("corners read back");
+    let slant_m = centre_m + DVec3::new(0.0, -3000.0, 3000.0);
+    let between = corners_looking(&mut host, slant_m, -45.0, 0.2);
     assert_eq!(between.len(), 36);
     for q in between.chunks(4) {
         assert!(

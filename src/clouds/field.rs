@@ -474,6 +474,36 @@ mod tests {
         Arc::clone(TYPES.get_or_init(|| Arc::new(CloudTypes::builtin())))
     }
 
+    /// `weather(oktas)` without wind: the blocks stay where they are.
+    fn calm(oktas: f32) -> BlockWeather {
+        BlockWeather {
+            wind: Wind::default(),
+            ..weather(oktas)
+        }
+    }
+
+    /// The summed opacity of a generation's sprites at field time `now`.
+    fn opacity(g: &FieldBlock, now: f64) -> f32 {
+        let config = CloudsConfig::builtin().lifecycle;
+        g.block
+            .clouds
+            .iter()
+            .flat_map(|c| &c.sprites)
+            .map(|s| crate::clouds::lifecycle::alpha_at(g.phase, now, s.radius_fraction, &config))
+            .sum::<f32>()
+    }
+
+    /// A calm field at 2 oktas whose weather goes to 6 oktas `after_s` in, taken in.
+    fn changed_field(after_s: f64) -> CloudField {
+        let mut field = small_field();
+        field.update(DVec2::ZERO, &|_| calm(2.0));
+        field.wait_for_pending();
+        field.advance(after_s);
+        field.update(DVec2::ZERO, &|_| calm(6.0));
+        field.wait_for_pending();
+        field
+    }
+
     fn small_field() -> CloudField {
         let mut config = CloudsConfig::builtin();
         config.field.radius_m = 9_000.0;
@@ -576,10 +606,6 @@ mod tests {
         field.update(DVec2::ZERO, &|_| clear.clone());
         field.wait_for_pending();
         let index = BlockIndex::new(0, 0);
-        let calm = |oktas| BlockWeather {
-            wind: Wind::default(),
-            ..weather(oktas)
-        };
         // Clear, cloudy, clear again, cloudy: each change leaves a generation to dissipate.
         for w in [calm(4.0), clear.clone(), calm(6.0)] {
             field.update(DVec2::ZERO, &|_| w.clone());
@@ -592,16 +618,7 @@ mod tests {
 
     #[test]
     fn blocks_joining_during_a_weather_change_form_with_their_neighbours() {
-        let mut field = small_field();
-        let calm = |oktas| BlockWeather {
-            wind: Wind::default(),
-            ..weather(oktas)
-        };
-        field.update(DVec2::ZERO, &|_| calm(2.0));
-        field.wait_for_pending();
-        field.advance(100.0);
-        field.update(DVec2::ZERO, &|_| calm(6.0));
-        field.wait_for_pending();
+        let mut field = changed_field(100.0);
         let since_s = 100.0;
         assert_eq!(
             field.generations(BlockIndex::new(0, 0))[1].phase,
@@ -641,28 +658,9 @@ mod tests {
 
     #[test]
     fn a_generation_superseded_while_forming_goes_back_without_a_jump() {
-        let mut field = small_field();
-        let calm = |oktas| BlockWeather {
-            wind: Wind::default(),
-            ..weather(oktas)
-        };
-        field.update(DVec2::ZERO, &|_| calm(2.0));
-        field.wait_for_pending();
-        field.advance(10.0);
-        field.update(DVec2::ZERO, &|_| calm(6.0));
-        field.wait_for_pending();
+        let mut field = changed_field(10.0);
         let config = CloudsConfig::builtin().lifecycle;
         let index = BlockIndex::new(0, 0);
-        let opacity = |g: &FieldBlock, now: f64| -> f32 {
-            g.block
-                .clouds
-                .iter()
-                .flat_map(|c| &c.sprites)
-                .map(|s| {
-                    crate::clouds::lifecycle::alpha_at(g.phase, now, s.radius_fraction, &config)
-                })
-                .sum::<f32>()
-        };
         // 30% formed when the weather changes again.
         field.advance(0.3 * f64::from(config.formation_s));
         let forming = field.generations(index)[1].clone();
@@ -725,16 +723,6 @@ mod tests {
         assert_eq!(gens.len(), 2);
         assert!(matches!(gens[0].phase, Phase::Dissipating { .. }));
         assert!(matches!(gens[1].phase, Phase::Forming { .. }));
-        let opacity = |g: &FieldBlock, now: f64| -> f32 {
-            g.block
-                .clouds
-                .iter()
-                .flat_map(|c| &c.sprites)
-                .map(|s| {
-                    crate::clouds::lifecycle::alpha_at(g.phase, now, s.radius_fraction, &config)
-                })
-                .sum::<f32>()
-        };
         let (mut old_last, mut new_last) = (f32::MAX, -1.0);
         let total = config.formation_s.max(config.dissipation_s) as f64;
         let mut t = 0.0;

@@ -233,27 +233,24 @@ impl RenderSettings {
                 format!("must be 0..=1, is {}", c.far_fade_fraction),
             ));
         }
-        if !(0.0 <= c.upright_fade_start_deg
-            && c.upright_fade_start_deg < c.upright_fade_end_deg
-            && c.upright_fade_end_deg <= 90.0)
-        {
-            return Err(ConfigError::at_key(
-                path,
-                text,
-                "clouds.upright_fade_end_deg",
-                "needs 0 <= upright_fade_start_deg < upright_fade_end_deg <= 90",
-            ));
-        }
-        if !(0.0 <= c.layer_turn_start_deg
-            && c.layer_turn_start_deg < c.layer_turn_end_deg
-            && c.layer_turn_end_deg <= 90.0)
-        {
-            return Err(ConfigError::at_key(
-                path,
-                text,
-                "clouds.layer_turn_end_deg",
-                "needs 0 <= layer_turn_start_deg < layer_turn_end_deg <= 90",
-            ));
+        // Angle ranges above or below a sprite's level: 0 <= start < end <= 90 degrees.
+        let angle_ranges = [
+            (
+                "upright_fade",
+                c.upright_fade_start_deg,
+                c.upright_fade_end_deg,
+            ),
+            ("layer_turn", c.layer_turn_start_deg, c.layer_turn_end_deg),
+        ];
+        for (name, start, end) in angle_ranges {
+            if !(0.0 <= start && start < end && end <= 90.0) {
+                return Err(ConfigError::at_key(
+                    path,
+                    text,
+                    &format!("clouds.{name}_end_deg"),
+                    format!("needs 0 <= {name}_start_deg < {name}_end_deg <= 90"),
+                ));
+            }
         }
         if s.camera.far_m <= s.camera.near_m {
             return Err(ConfigError::at_key(
