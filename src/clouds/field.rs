@@ -249,21 +249,15 @@ impl CloudField {
         let radius = self.config.field.radius_m;
         let seed = self.config.field.seed;
         let wanted = blocks_within(air_centre, radius);
-        // How the blocks that join now will start, from the blocks that were there before
-        // (not from each other: the same in any order).
-        let joins: Vec<Phase> = wanted
-            .iter()
-            .map(|&i| match self.slots.contains_key(&i) {
-                true => Phase::Steady,
-                false => self.joining_phase(i),
-            })
-            .collect();
-        for (&index, joins) in wanted.iter().zip(joins) {
+        for &index in &wanted {
             let ground = BlockIndex::containing(index.centre_m() + self.drift_m);
             let w = weather(ground);
             match self.slots.get_mut(&index) {
                 None => {
                     self.generator.submit(index, w.clone(), seed);
+                    // From the blocks with clouds beside it: not from those joining with it,
+                    // which have none yet, so the same in any order.
+                    let joins = self.joining_phase(index);
                     self.slots.insert(
                         index,
                         Slot {
@@ -321,6 +315,7 @@ impl CloudField {
 
     fn take_in(&mut self, finished: Vec<Generated>) {
         let now = self.time_s;
+        let lifecycle = self.config.lifecycle;
         for done in finished {
             let Some(slot) = self.slots.get_mut(&done.index) else {
                 continue;
@@ -333,7 +328,6 @@ impl CloudField {
             } else {
                 Phase::Forming { since_s: now }
             };
-            let lifecycle = self.config.lifecycle;
             for g in &mut slot.generations {
                 g.phase = match g.phase {
                     Phase::Steady => {

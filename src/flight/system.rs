@@ -233,8 +233,7 @@ impl SkySystem {
                 input
             }
         };
-        self.world.set_field((self.prepare_field)(input));
-        self.sky.ease_weather_overhead();
+        self.set_weather_field((self.prepare_field)(input));
         Ok(())
     }
 
@@ -277,8 +276,7 @@ impl SkySystem {
         for change in self.live.poll(self.clock_s) {
             changes.push(match change {
                 LiveChange::Loaded { source, weather } => {
-                    self.world.set_field(weather);
-                    self.sky.ease_weather_overhead();
+                    self.set_weather_field(weather);
                     Ok(source)
                 }
                 LiveChange::Rejected(why) => Err(why),
