@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use serde::Serialize;
+use skycast::weather::block::{BlockLayer, TypeSource, ceiling_ft, cover_seen_from_below_oktas};
 use skycast::weather::field::{CloudTypeRule, FieldSettings};
 use skycast::weather::files::WeatherFile;
 use skycast::weather::metar::{ConvectiveKind, Cover, SkyCode};
@@ -334,22 +335,38 @@ pub fn describe_block(at: &AtBlock) -> String {
     if w.layers.is_empty() {
         let _ = writeln!(out, "  no cloud");
     } else {
-        let ceiling = skycast::weather::block::ceiling_ft(&w.layers, 5.0)
-            .map_or("none".to_string(), |c| format!("{c:.0} ft AGL"));
+        let ceiling =
+            ceiling_ft(&w.layers, 5.0).map_or("none".to_string(), |c| format!("{c:.0} ft AGL"));
         let _ = writeln!(out, "  ceiling {ceiling}");
     }
+    // The layers a report's covers sum over: CB and TCU are reported with their own amount
+    // (ICAO Annex 3), outside the summation principle.
+    let convective = |l: &BlockLayer| l.type_source == TypeSource::Reported;
+    let summed: Vec<BlockLayer> = w
+        .layers
+        .iter()
+        .filter(|l| !convective(l))
+        .copied()
+        .collect();
     for l in &w.layers {
         let source = serde_json::to_value(l.type_source)
             .ok()
             .and_then(|v| v.as_str().map(str::to_string))
             .unwrap_or_default();
+        let cover = if convective(l) {
+            "its own amount, not summed".to_string()
+        } else {
+            format!(
+                "{:.1} seen from below",
+                cover_seen_from_below_oktas(&summed, l.base_ft_agl)
+            )
+        };
         let _ = writeln!(
             out,
-            "  {:<18} {:<11} {:.1} oktas ({:.1} seen from below), base {:.0} ft AGL, {:.0} ft thick",
+            "  {:<18} {:<11} {:.1} oktas ({cover}), base {:.0} ft AGL, {:.0} ft thick",
             l.cloud_type.name(),
             source,
             l.coverage_oktas,
-            skycast::weather::block::cover_seen_from_below_oktas(&w.layers, l.base_ft_agl),
             l.base_ft_agl,
             l.thickness_ft
         );
