@@ -663,7 +663,7 @@ impl Sky {
     }
 
     /// Bytes of the GPU buffers the sky holds now (frame uniforms, the resident sprites, the
-    /// draw list, the ring): what a long flight watches for growth.
+    /// draw list, the ring); [`Self::memory`] counts the textures too.
     pub fn gpu_buffer_bytes(&self) -> u64 {
         self.frame_buffer.size()
             + self.resident.gpu_bytes()
