@@ -243,6 +243,12 @@ impl SkySystem {
         self.sky.ease_weather_overhead();
     }
 
+    /// Timed weather events ([`Self::schedule_weather`]) not applied yet: a queue a long flight
+    /// watches (it empties as their times come).
+    pub fn weather_events_pending(&self) -> usize {
+        self.live.scheduled()
+    }
+
     /// Schedules a weather file for `at_s` seconds of frames from now (a front passing in a
     /// scripted flight): read and built off the frame thread, applied on the first frame at or
     /// after its time.

@@ -38,7 +38,7 @@ use super::scatter::Scatter;
 use super::scene::{BlockMotion, SkyBlock};
 use super::settings::RenderSettings;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
-use super::stats::{FrameStats, Lighting};
+use super::stats::{FrameStats, Lighting, SkyMemory};
 use super::targets::{self, HostTargets, SkyView};
 use crate::clouds::{CloudsConfig, LifecycleConfig};
 use crate::shading::{SunPosition, TimeOfDay, TimeOfDayTable, hidden_above};
@@ -102,6 +102,8 @@ pub struct Sky {
     frame_layout: wgpu::BindGroupLayout,
     targets: HostTargets,
     sheet_group: wgpu::BindGroup,
+    /// Bytes of the sheet texture (every mip level), for [`Self::memory`].
+    sheet_bytes: u64,
     sky_pipeline: wgpu::RenderPipeline,
     /// The sky background kept by a depth test against the host's depth as a read-only
     /// attachment (in a pass of its own); `None` where the host's depth format has a stencil
@@ -350,6 +352,7 @@ impl Sky {
             frame_layout,
             targets: config.targets,
             sheet_group,
+            sheet_bytes: sheet.mips.iter().map(|m| m.len() as u64).sum(),
             sky_pipeline,
             sky_tested_pipeline,
             sprite_pipeline,
@@ -660,7 +663,7 @@ impl Sky {
     }
 
     /// Bytes of the GPU buffers the sky holds now (frame uniforms, the resident sprites, the
-    /// draw list, the ring): what a long flight watches for growth.
+    /// draw list, the ring); [`Self::memory`] counts the textures too.
     pub fn gpu_buffer_bytes(&self) -> u64 {
         self.frame_buffer.size()
             + self.resident.gpu_bytes()
@@ -669,6 +672,30 @@ impl Sky {
             + self.scatter.gpu_bytes()
             + self.view.gpu_bytes()
             + self.ring.gpu_bytes()
+    }
+
+    /// Every buffer and texture the sky holds now (the ring and the off-screen cloud target
+    /// included), and the blocks and slots behind the resident buffers: what a long flight
+    /// watches for growth.
+    pub fn memory(&self) -> SkyMemory {
+        let (blocks, sprites, sprite_slots, cloud_slots) = self.resident.occupancy();
+        SkyMemory {
+            resident_bytes: self.resident.gpu_bytes(),
+            draw_bytes: self.frame_buffer.size()
+                + self.quads.0.size()
+                + self.build.gpu_bytes()
+                + self.scatter.gpu_bytes()
+                + self.view.gpu_bytes(),
+            ring_bytes: self.ring.gpu_bytes(),
+            cloud_target_bytes: self.clouds.gpu_bytes(),
+            sheet_bytes: self.sheet_bytes,
+            blocks,
+            sprites,
+            sprite_slots: sprite_slots.0,
+            sprite_slots_used: sprite_slots.1,
+            cloud_slots: cloud_slots.0,
+            cloud_slots_used: cloud_slots.1,
+        }
     }
 
     /// CPU work of a frame: advances time by `dt_s`, uploads blocks that arrived, sorts blocks

@@ -90,3 +90,44 @@ pub struct Lighting {
     /// The Harris and Lastra model's constants.
     pub harris_lastra: HarrisLastra,
 }
+
+/// Everything the sky holds on the GPU, and the blocks and slots behind it: what a long flight
+/// watches for growth (`tests/soak.rs`). Bytes are the sizes the buffers and textures were
+/// created with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SkyMemory {
+    /// The resident sprite, cloud, light, order and cloud-list buffers.
+    pub resident_bytes: u64,
+    /// What a frame draws with: the frame uniform, the camera view's uniform and draw list, the
+    /// build pass's corners and chunk uniforms, the quad indices and the order patch.
+    pub draw_bytes: u64,
+    /// The impostor ring's textures and buffers (0 with the ring off).
+    pub ring_bytes: u64,
+    /// The off-screen cloud target's textures at the last recorded frame size (0 at scale 1).
+    pub cloud_target_bytes: u64,
+    /// The sprite sheet texture, every mip level.
+    pub sheet_bytes: u64,
+    /// Blocks (cloud generations) the sky holds.
+    pub blocks: u32,
+    /// Sprites of those blocks.
+    pub sprites: u32,
+    /// Sprite slots of the resident buffers, in all.
+    pub sprite_slots: u32,
+    /// Sprite slots in use (by blocks placed on the GPU).
+    pub sprite_slots_used: u32,
+    /// Cloud slots of the resident buffers, in all.
+    pub cloud_slots: u32,
+    /// Cloud slots in use.
+    pub cloud_slots_used: u32,
+}
+
+impl SkyMemory {
+    /// Bytes of every buffer and texture the sky holds.
+    pub fn gpu_bytes(&self) -> u64 {
+        self.resident_bytes
+            + self.draw_bytes
+            + self.ring_bytes
+            + self.cloud_target_bytes
+            + self.sheet_bytes
+    }
+}
