@@ -72,7 +72,8 @@ pictures: vulkan
 	done
 
 # Builds the book (docs/book.toml, docs/src/) into docs/book/ with mdBook, installed when missing
-# (`cargo install` compiles it: several minutes on 2 cores). `make test` does not need it: the
+# (`cargo install` compiles it: half an hour on the shared 2-core VM under load; the build itself
+# takes under a second). `make test` does not need it: the
 # book's links, pictures and quoted commands are checked by tests/docs.rs.
 docs:
 	@command -v mdbook >/dev/null || { echo "installing mdbook: cargo install --locked mdbook"; cargo install --locked mdbook; }

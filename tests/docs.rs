@@ -5,6 +5,7 @@
 //! - every command quoted for a figure still parses: its subcommand is in `skycast --help` and
 //!   each of its `--flags` in `skycast <subcommand> --help`; `cargo test --test NAME` and
 //!   `cargo bench --bench NAME` name a file of `tests/` or `benches/`;
+//! - every subcommand has its line in the README and in `docs/src/command-line.md`;
 //! - every picture the README shows is one `make pictures` writes.
 //!
 //! Which lines count as quoted commands is the convention written in `docs/src/testing.md` ("The
@@ -169,10 +170,10 @@ fn link_targets(prose: &str) -> Vec<(usize, String)> {
     }
     for (i, line) in prose.lines().enumerate() {
         let t = line.trim_start();
-        if let (true, Some(close)) = (t.starts_with('['), t.find("]:")) {
-            if let Some(target) = t[close + 2..].split_whitespace().next() {
-                targets.push((i + 1, target.to_string()));
-            }
+        if let (true, Some(close)) = (t.starts_with('['), t.find("]:"))
+            && let Some(target) = t[close + 2..].split_whitespace().next()
+        {
+            targets.push((i + 1, target.to_string()));
         }
     }
     targets
@@ -224,13 +225,13 @@ fn broken_link(file: &Path, text: &str, target: &str) -> Option<String> {
         let text = std::fs::read_to_string(&resolved).unwrap_or_default();
         (resolved, text)
     };
-    if let (Some(fragment), true) = (fragment, resolved.extension().is_some_and(|e| e == "md")) {
-        if !heading_ids(&target_text).contains(fragment) {
-            return Some(format!(
-                "`{target}`: {} has no heading `#{fragment}`",
-                resolved.display()
-            ));
-        }
+    if let (Some(fragment), true) = (fragment, resolved.extension().is_some_and(|e| e == "md"))
+        && !heading_ids(&target_text).contains(fragment)
+    {
+        return Some(format!(
+            "`{target}`: {} has no heading `#{fragment}`",
+            resolved.display()
+        ));
     }
     None
 }
@@ -438,6 +439,21 @@ fn every_quoted_command_parses() {
         "quoted commands that no longer parse:\n{}",
         broken.join("\n")
     );
+}
+
+/// Every subcommand of `skycast --help` has its line in the README and in the book's chapter on
+/// the command line.
+#[test]
+fn every_subcommand_is_listed() {
+    let help = Help::new();
+    for page in ["README.md", "docs/src/command-line.md"] {
+        let text = read(&root().join(page));
+        let (spans, _) = code_spans(&parse(&text).prose);
+        for sub in &help.subcommands {
+            let listed = spans.iter().any(|(_, s)| *s == format!("skycast {sub}"));
+            assert!(listed, "{page} does not list `skycast {sub}`");
+        }
+    }
 }
 
 /// The README shows pictures that `make pictures` writes (Makefile: `$(PICTURES)/...`; `$$m`
