@@ -34,7 +34,9 @@ pub enum SkyError {
     Weather(#[from] WeatherError),
 }
 
-/// How a [`SkySystem`] is set up. [`SkySystemConfig::new`] needs no files.
+/// How a [`SkySystem`] is set up. [`SkySystemConfig::new`] needs no files; a host that keeps
+/// settings of its own (loaded from its files, a wider cloud radius) changes the fields and hands
+/// the result to [`SkySystem::with_config`].
 #[derive(Debug, Clone)]
 pub struct SkySystemConfig {
     /// The sky's look and the host's targets (formats, reversed Z, samples).

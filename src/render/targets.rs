@@ -89,7 +89,9 @@ impl HostTargets {
 }
 
 /// Where the sky is seen from this frame: the camera's position in the sky's east-north-up frame
-/// (f64 metres, z above mean sea level) and the host's own matrices.
+/// (f64 metres, z above mean sea level) and the host's own matrices. A host that drives the
+/// [`super::Sky`] itself gives one to [`super::Sky::prepare`] every frame; [`crate::SkySystem`]
+/// makes it from the host's [`crate::HostCamera`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SkyView {
     /// Camera position, metres east, north and above mean sea level.
