@@ -33,6 +33,13 @@
 //! with standard Z, reversed Z and 4x MSAA. A host that writes `default-features = false`
 //! compiles none of the command line's crates.
 //!
+//! The types a host touches: [`SkySystem`] (the sky), [`HostTargets`] (its colour and depth
+//! targets), [`Weather`] (what the sky is given), [`HostCamera`] and [`HostPosition`] (its camera
+//! each frame), [`FrameStats`] (what a frame cost), [`HostLighting`] (the light to draw its own
+//! scene with) and [`SkyError`]. [`SkySystemConfig`] holds settings of the host's own; [`Sky`]
+//! and [`SkyView`] are the renderer underneath, for a host with its own weather and cloud
+//! handling. The book (`docs/src/embedding.md` in the repository) has the host's terms in full.
+//!
 //! # Stages
 //!
 //! Data flows one way, one module per stage: [`weather`] (reports, the weather field) ->
@@ -57,3 +64,9 @@ pub use flight::{
     HostCamera, HostLighting, HostPosition, SkyError, SkySystem, SkySystemConfig, Weather,
 };
 pub use render::{FrameStats, HostTargets, Sky, SkyView};
+
+/// The README's embedding snippet, compiled by `cargo test --doc` so that it cannot drift from
+/// the API (the README's only Rust block; its shell blocks are checked by `tests/docs.rs`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

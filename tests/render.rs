@@ -1235,7 +1235,7 @@ fn gpu_sprites_draw_the_frames_of_the_cpu_path() {
             .to_rgba8();
         // Full resolution draws the kept frames; the default cloud scale (1/2) draws the full
         // resolution frames but for the clouds' finest detail: within 0.015 a channel (the
-        // README views differ by under 0.01 at 640 x 360).
+        // the book's views differ by under 0.01 at 640 x 360).
         let (full, sky) = render(name, Some("1"), weather, at, (alt, heading, pitch));
         let (default, _) = render(name, None, weather, at, (alt, heading, pitch));
         let every = vec![true; sky.len()];

@@ -155,7 +155,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
     let (mut written, mut inside_cloud) = (0u32, 0u32);
-    // For the closing summary: what the README quotes, from this run.
+    // For the closing summary: what the book quotes (docs/src/performance.md), from this run.
     let mut summary = Summary::default();
     // On a terminal only (indicatif hides it when stderr is a file or a pipe).
     let progress = indicatif::ProgressBar::new(frames);

@@ -34,7 +34,9 @@ pub enum SkyError {
     Weather(#[from] WeatherError),
 }
 
-/// How a [`SkySystem`] is set up. [`SkySystemConfig::new`] needs no files.
+/// How a [`SkySystem`] is set up. [`SkySystemConfig::new`] needs no files; a host that keeps
+/// settings of its own (loaded from its files, a wider cloud radius) changes the fields and hands
+/// the result to [`SkySystem::with_config`].
 #[derive(Debug, Clone)]
 pub struct SkySystemConfig {
     /// The sky's look and the host's targets (formats, reversed Z, samples).
@@ -76,7 +78,25 @@ impl SkySystemConfig {
     }
 }
 
-/// Weather for the sky.
+/// Weather for the sky, given to [`SkySystem::set_weather`]: a file read once (a simulator's
+/// scenario), the same already in memory (downloaded by the host), or a file the sky keeps
+/// watching (one the host replaces every few minutes with fresh reports).
+///
+/// ```
+/// use skycast::Weather;
+/// use std::{path::Path, time::Duration};
+///
+/// let once = Weather::File(Path::new("weather/themes/fair_weather_cumulus.toml"));
+/// let downloaded = Weather::Bytes {
+///     name: Path::new("metars.txt"), // tells a theme (.toml) from reports, and names errors
+///     bytes: b"KLAX 272153Z 25010KT 10SM FEW025 SCT040 18/09 A2992\n",
+/// };
+/// let live = Weather::Watch {
+///     path: Path::new("metars.cache.csv"),
+///     settle: Duration::from_millis(500),
+/// };
+/// # let _ = (once, downloaded, live);
+/// ```
 #[derive(Debug, Clone, Copy)]
 pub enum Weather<'a> {
     /// A report file (the aviation weather service's `metars.cache.csv`, a NOAA cycle file,
@@ -100,7 +120,8 @@ pub enum Weather<'a> {
     },
 }
 
-/// Where the host's camera is.
+/// Where the host's camera is: latitude, longitude and altitude for a host that flies the globe,
+/// or metres from the origin given to [`SkySystem::new`] for one that works in a local frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum HostPosition {
     /// Latitude and longitude in degrees, altitude in metres above mean sea level.
@@ -116,7 +137,26 @@ pub enum HostPosition {
     Local(DVec3),
 }
 
-/// The host's camera this frame, as the host has it.
+/// The host's camera this frame, as the host has it, given to [`SkySystem::update`] every
+/// frame. The sky reads the host's depth through `projection`, so it must be the projection the
+/// host drew its scene with.
+///
+/// ```
+/// use glam::camera::rh::{proj::directx as proj, view::look_to_mat4};
+/// use glam::{DVec3, Vec3};
+/// use skycast::{HostCamera, HostPosition};
+///
+/// // Looking north, level, from 1,500 m above the origin; east-north-up axes (z up); clip
+/// // depth 0 to 1, reversed Z with an infinite far plane (the host's targets say reversed).
+/// let view = look_to_mat4(Vec3::ZERO, Vec3::Y, Vec3::Z);
+/// let projection = proj::perspective_infinite_reverse(60f32.to_radians(), 16.0 / 9.0, 1.0);
+/// let camera = HostCamera {
+///     position: HostPosition::Local(DVec3::new(0.0, 0.0, 1500.0)),
+///     view,
+///     projection,
+/// };
+/// # let _ = camera;
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HostCamera {
     /// Where it is.
@@ -158,7 +198,11 @@ pub struct HostLighting {
     pub fog_rgb: Vec3,
 }
 
-/// The sky a simulator embeds. See the module docs.
+/// The sky a simulator embeds: one per view, built once on the host's device with
+/// [`SkySystem::new`] (or [`SkySystem::with_config`] for settings of the host's own), given
+/// weather with [`SkySystem::set_weather`], then every frame [`SkySystem::update`] and
+/// [`SkySystem::record`] after the host drew its scene. The crate's front page shows the frame in
+/// code; `examples/host.rs` is a complete host.
 pub struct SkySystem {
     sky: Sky,
     world: World,

@@ -93,6 +93,9 @@ impl SpriteSheet {
 }
 
 /// The sky subsystem: pipelines, the GPU-resident clouds, their sprite orders and the ring.
+/// A host drives it directly only when it has its own weather and cloud handling (it hands the
+/// sky blocks of clouds, the sun and its view); otherwise [`crate::SkySystem`] does all of that
+/// around it.
 pub struct Sky {
     device: wgpu::Device,
     settings: RenderSettings,

@@ -7,7 +7,16 @@ use crate::shading::{
     DirectionalMapping, ForwardScattering, HarrisLastra, ShadingModel, TimeOfDay,
 };
 
-/// What one frame's update did and cost.
+/// What one frame's update did and cost, returned by [`crate::SkySystem::update`] and
+/// [`crate::Sky::prepare`]: a host logs it or shows it in an overlay (`skycast fly` writes it to
+/// `frames.csv`, one row a frame).
+///
+/// ```
+/// use skycast::FrameStats;
+///
+/// let stats = FrameStats { field_us: 23, cpu_update_us: 338, record_us: 31, ..FrameStats::default() };
+/// assert_eq!(stats.sky_cpu_us(), 392); // what the sky cost the frame thread
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct FrameStats {
     /// Sprites drawn as sprites this frame (the impostors' not counted).

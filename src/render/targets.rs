@@ -11,7 +11,23 @@ use super::RenderError;
 use super::camera::{Camera, Frustum};
 
 /// What the host's colour and depth targets are. The defaults are a single-sample
-/// `Rgba8UnormSrgb` colour target over a standard-Z `Depth32Float` depth.
+/// `Rgba8UnormSrgb` colour target over a standard-Z `Depth32Float` depth. Give the sky the
+/// host's own; [`HostTargets::validate`] says what it cannot use.
+///
+/// ```
+/// use skycast::HostTargets;
+///
+/// // A simulator with reversed Z and 4x MSAA on a depth-stencil buffer:
+/// let targets = HostTargets {
+///     depth_format: wgpu::TextureFormat::Depth24PlusStencil8,
+///     reversed_z: true,
+///     sample_count: 4,
+///     ..HostTargets::default()
+/// };
+/// assert!(targets.validate().is_ok());
+/// assert_eq!(targets.background_depth(), 0.0); // what the host clears its depth to
+/// assert!(HostTargets { sample_count: 2, ..targets }.validate().is_err());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct HostTargets {
     /// Format of the colour target the sky draws into.
@@ -73,7 +89,9 @@ impl HostTargets {
 }
 
 /// Where the sky is seen from this frame: the camera's position in the sky's east-north-up frame
-/// (f64 metres, z above mean sea level) and the host's own matrices.
+/// (f64 metres, z above mean sea level) and the host's own matrices. A host that drives the
+/// [`super::Sky`] itself gives one to [`super::Sky::prepare`] every frame; [`crate::SkySystem`]
+/// makes it from the host's [`crate::HostCamera`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SkyView {
     /// Camera position, metres east, north and above mean sea level.
