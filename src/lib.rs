@@ -24,7 +24,7 @@
 //!     projection, // the host's projection, as its depth convention has it
 //! };
 //! let (stats, _applied) = sky.update(queue, &camera, 1_738_015_200.0, 1.0 / 60.0)?;
-//! sky.record(encoder, colour, depth); // reads the host's depth, never writes it
+//! sky.record(encoder, colour, depth)?; // checks the targets; reads the host's depth, never writes it
 //! let light = sky.lighting();         // sun, ambient, horizon and fog for the host's scene
 //! # let _ = (stats, light); Ok(()) }
 //! ```

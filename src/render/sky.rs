@@ -144,6 +144,9 @@ pub struct Sky {
     /// The cover and visibility frames show, eased through a change of the weather in time.
     overhead_ease: OverheadEase,
     ring: ImpostorRing,
+    /// The projection of the last prepared frame: checked against the targets' depth
+    /// convention when it is recorded.
+    projection: Option<glam::Mat4>,
     /// Where the clouds are drawn: the host's colour (scale 1) or the off-screen cloud target.
     clouds: CloudTarget,
 }
@@ -385,6 +388,7 @@ impl Sky {
             ),
             overhead_ease: OverheadEase::default(),
             ring,
+            projection: None,
             clouds,
         })
     }
@@ -579,6 +583,11 @@ impl Sky {
         self.record_us.get()
     }
 
+    /// The host's targets the sky was made for.
+    pub fn targets(&self) -> &HostTargets {
+        &self.targets
+    }
+
     /// The settings the sky was made with.
     pub fn settings(&self) -> &RenderSettings {
         &self.settings
@@ -685,6 +694,7 @@ impl Sky {
     ) -> FrameStats {
         let start = Instant::now();
         let camera: SkyView = view.into();
+        self.projection = Some(camera.projection);
         if !self.recorded.replace(false) {
             // The last frame's writes never reached a submit: send them, so they are freed.
             queue.submit([]);
@@ -880,14 +890,25 @@ impl Sky {
     /// Records the sky's passes into the host's encoder: sky background, then the ring, sprites
     /// and in-cloud fog, straight into the host's colour or, below full resolution, into the
     /// sky's cloud target composited over it (`cloud_target`; it follows the host's frame size).
-    /// `depth_view` is the host's depth (Depth32Float with `TEXTURE_BINDING`), only read.
+    /// `depth_view` is the host's depth (the format of [`HostTargets::depth_format`], with
+    /// `TEXTURE_BINDING`), only read.
+    ///
+    /// Before anything is recorded the host's textures are checked against the targets the sky
+    /// was made for, and the last prepared projection against their depth convention
+    /// ([`HostTargets::check_textures`], [`HostTargets::check_projection`]): a mismatch is
+    /// [`RenderError::Targets`] naming both sides, and nothing is recorded.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         colour_view: &wgpu::TextureView,
         depth_view: &wgpu::TextureView,
-    ) {
+    ) -> Result<(), RenderError> {
         let start = Instant::now();
+        self.targets
+            .check_textures(colour_view.texture(), depth_view.texture())?;
+        if let Some(projection) = self.projection {
+            self.targets.check_projection(projection)?;
+        }
         let frame_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sky.frame_group"),
             layout: &self.frame_layout,
@@ -1007,6 +1028,7 @@ impl Sky {
         }
         self.recorded.set(true);
         self.record_us.set(start.elapsed().as_micros() as u64);
+        Ok(())
     }
 
     /// A pass over the host's colour (kept), with the frame's group 0 bound, and the host's
