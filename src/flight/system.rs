@@ -405,3 +405,25 @@ impl std::ops::DerefMut for SkySystem {
         &mut self.sky
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::camera::rh::view::look_at_mat4;
+    use glam::{Mat4, Vec3, Vec4};
+
+    /// What the embedding chapter (docs/src/host-errors.md) tells a y-up host: its view times
+    /// the axis swap is the view for east-north-up axes.
+    #[test]
+    fn a_y_up_hosts_view_times_the_axis_swap_is_the_east_north_up_view() {
+        // East, north, up to a y-up right-handed world's (x east, y up, z south).
+        let enu_to_host = Mat4::from_cols(Vec4::X, Vec4::NEG_Z, Vec4::Y, Vec4::W);
+        // Looking north-east and a little up, in each world's own axes.
+        let forward_enu = Vec3::new(0.6, 0.7, 0.2).normalize();
+        let forward_host = Vec3::new(forward_enu.x, forward_enu.z, -forward_enu.y);
+        let enu = look_at_mat4(Vec3::ZERO, forward_enu, Vec3::Z);
+        let host = look_at_mat4(Vec3::ZERO, forward_host, Vec3::Y);
+        assert!((host * enu_to_host).abs_diff_eq(enu, 1e-6));
+        // Without the swap it is another view.
+        assert!(!host.abs_diff_eq(enu, 1e-3));
+    }
+}

@@ -88,7 +88,7 @@ impl HostTargets {
             }
         };
         Err(RenderError::Targets(format!(
-            "HostTargets::reversed_z is {} ({} Z) but the projection is {}",
+            "HostTargets::reversed_z is {}: the sky expects depth {}, but the projection is {}",
             self.reversed_z,
             says(self.reversed_z),
             says(reversed)
