@@ -56,4 +56,4 @@ pub mod weather;
 pub use flight::{
     HostCamera, HostLighting, HostPosition, SkyError, SkySystem, SkySystemConfig, Weather,
 };
-pub use render::{FrameStats, HostTargets, Sky, SkyView};
+pub use render::{FrameStats, HostTargets, Sky, SkyView, ViewId};

@@ -523,3 +523,54 @@ fn the_first_frames_do_not_wait_and_clouds_fade_in_as_they_arrive() {
         "settled clouds agree with the warm-up's on {agree:.3}"
     );
 }
+
+/// Mean absolute difference of two RGBA8 frames' colour, 0..1.
+fn mean_difference(a: &[u8], b: &[u8]) -> f64 {
+    let sum: u64 = a
+        .chunks(4)
+        .zip(b.chunks(4))
+        .map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c]) as u64).sum::<u64>())
+        .sum();
+    sum as f64 / (a.len() / 4 * 3) as f64 / 255.0
+}
+
+#[test]
+fn two_views_recorded_into_one_encoder_each_show_their_own_clouds() {
+    let mut h = host::Host::new("standard", Some(Path::new(host::THEME))).expect("host");
+    let front_alone = h.frame().expect("front");
+    let sky_bytes = h.sky.gpu_buffer_bytes();
+    // A second monitor from the same seat, looking back over the tail.
+    let back = h.add_view(host::HEADING_DEG + 180.0, 8.0);
+    let read = |h: &host::Host, encoder, texture: &wgpu::Texture| {
+        host::read_back(&h.device, &h.queue, encoder, texture).expect("read back")
+    };
+    let encoder = |h: &host::Host| h.device.create_command_encoder(&Default::default());
+    // Each view drawn alone, in a submission of its own.
+    let mut e = encoder(&h);
+    h.draw_view(&back, &mut e).expect("back");
+    let back_alone = read(&h, e, &back.colour);
+    // Both updated, then both recorded into one encoder, one submit.
+    let mut e = encoder(&h);
+    h.draw_ground(&mut e);
+    h.draw_sky(&mut e).expect("front");
+    h.draw_view(&back, &mut e).expect("back");
+    let front_both = read(&h, e, &h.colour);
+    let back_both = read(&h, encoder(&h), &back.colour);
+    // The two views show different skies: the comparison can tell them apart.
+    let apart = mean_difference(&front_alone, &back_alone);
+    assert!(apart > 0.05, "the views look alike: {apart:.4}");
+    for (name, both, alone) in [
+        ("front", &front_both, &front_alone),
+        ("back", &back_both, &back_alone),
+    ] {
+        let d = mean_difference(both, alone);
+        eprintln!("{name}: one encoder against alone, mean absolute difference {d:.5}");
+        assert!(d < 0.01, "{name}: {d:.4}");
+    }
+    // What a view adds: its frame uniform, draw list, ring and cloud target, no more (the
+    // resident sprites are the sky's: its buffers grew by the view's own at most).
+    let bytes = h.sky.view_gpu_bytes(back.id);
+    let grown = h.sky.gpu_buffer_bytes() - sky_bytes;
+    eprintln!("a view adds {bytes} bytes of GPU memory; the sky's buffers grew by {grown}");
+    assert!(bytes > 0 && grown <= bytes, "{grown} > {bytes}");
+}

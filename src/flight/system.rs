@@ -17,7 +17,9 @@ use std::time::{Duration, Instant};
 use glam::{DVec3, Mat4, Vec3};
 
 use super::world::{World, WorldSettings};
-use crate::render::{Camera, FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView};
+use crate::render::{
+    Camera, FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView, ViewId,
+};
 use crate::shading::sun_position;
 use crate::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
 use crate::weather::live::{LiveChange, LiveWeather, Prepare};
@@ -173,6 +175,8 @@ pub struct SkySystem {
     /// Seconds of frames so far (the clock of weather changes).
     clock_s: f64,
     sun_direction: Vec3,
+    /// The sun of the last [`Self::update`], for the other views of its frame.
+    sun: Option<crate::shading::SunPosition>,
 }
 
 impl SkySystem {
@@ -215,6 +219,7 @@ impl SkySystem {
             stations: config.stations,
             clock_s: 0.0,
             sun_direction: Vec3::Z,
+            sun: None,
         })
     }
 
@@ -318,20 +323,14 @@ impl SkySystem {
         }
         let weather_us = start.elapsed().as_micros() as u64;
         self.sky.add_field_cpu_us(weather_us);
-        let position_m = match camera.position {
-            HostPosition::Local(p) => p,
-            HostPosition::LatLonAlt {
-                lat_deg,
-                lon_deg,
-                alt_m,
-            } => self.frame.to_local_m(lat_deg, lon_deg).extend(alt_m),
-        };
+        let position_m = self.local_m(camera.position);
         self.world.update_sky(&mut self.sky, position_m, dt_s)?;
         self.sky
             .set_weather_overhead(&self.world.weather_over(position_m));
         let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
         let sun = sun_position(utc_unix_s, lat, lon);
         self.sun_direction = sun.direction_enu().as_vec3();
+        self.sun = Some(sun);
         let view = SkyView {
             position_m,
             view: camera.view,
@@ -356,6 +355,72 @@ impl SkySystem {
         depth: &wgpu::TextureView,
     ) -> Result<(), SkyError> {
         Ok(self.sky.record(encoder, colour, depth)?)
+    }
+
+    /// Adds a view of the same sky: another camera with its own targets (of the same formats
+    /// and samples as the [`HostTargets`] the sky was made for; any size), e.g. a second
+    /// monitor, a mirror, an outside camera near the aircraft. It has its own draw list,
+    /// impostor ring and off-screen cloud target; the clouds, the weather and the resident
+    /// sprites are shared (the clouds live around the camera of [`Self::update`]). Each frame:
+    /// [`Self::update`] for the main camera, then [`Self::update_view`] for each other view,
+    /// then [`Self::record`] and [`Self::record_view`], into one encoder or several. A view
+    /// costs [`Sky::view_gpu_bytes`] of GPU memory.
+    pub fn add_view(&mut self) -> ViewId {
+        self.sky.add_view()
+    }
+
+    /// A view's share of the frame step, after [`Self::update`] (whose time, sun and clouds
+    /// it uses): its draw list, ring and uniforms from `camera`. The projection is checked
+    /// against the targets as in `update`. Returns the view's stats (`record_us`: its previous
+    /// recording). [`Self::lighting`] is then this view's.
+    pub fn update_view(
+        &mut self,
+        id: ViewId,
+        queue: &wgpu::Queue,
+        camera: &HostCamera,
+    ) -> Result<FrameStats, SkyError> {
+        self.sky.targets().check_projection(camera.projection)?;
+        if !self.sky.has_view(id) {
+            return Err(RenderError::Targets(format!(
+                "{id:?} does not exist (the sky has {} views)",
+                self.sky.view_count()
+            ))
+            .into());
+        }
+        let position_m = self.local_m(camera.position);
+        let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
+        let sun = self.sun.unwrap_or_else(|| sun_position(0.0, lat, lon));
+        let view = SkyView {
+            position_m,
+            view: camera.view,
+            projection: camera.projection,
+        };
+        let mut stats = self.sky.prepare_view(id, queue, view, &sun, 0.0);
+        stats.record_us = self.sky.view_record_us(id);
+        Ok(stats)
+    }
+
+    /// [`Self::record`] for a view of [`Self::add_view`], into its own targets.
+    pub fn record_view(
+        &self,
+        id: ViewId,
+        encoder: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) -> Result<(), SkyError> {
+        Ok(self.sky.record_view(id, encoder, colour, depth)?)
+    }
+
+    /// A host position in the local frame's metres.
+    fn local_m(&self, position: HostPosition) -> DVec3 {
+        match position {
+            HostPosition::Local(p) => p,
+            HostPosition::LatLonAlt {
+                lat_deg,
+                lon_deg,
+                alt_m,
+            } => self.frame.to_local_m(lat_deg, lon_deg).extend(alt_m),
+        }
     }
 
     /// The light and fog of the last [`Self::update`], for the host's own scene.

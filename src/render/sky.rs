@@ -375,6 +375,11 @@ impl Sky {
         ViewId(self.views.len() - 1)
     }
 
+    /// Whether the sky has this view.
+    pub fn has_view(&self, id: ViewId) -> bool {
+        id.0 < self.views.len()
+    }
+
     /// The views the sky has, [`ViewId::MAIN`] included.
     pub fn view_count(&self) -> usize {
         self.views.len()
@@ -580,6 +585,11 @@ impl Sky {
     /// CPU time of the last [`Self::record`], microseconds.
     pub fn last_record_us(&self) -> u64 {
         self.views[0].record_us.get()
+    }
+
+    /// CPU time of the last [`Self::record_view`] of `id`, microseconds (0 for an unknown view).
+    pub fn view_record_us(&self, id: ViewId) -> u64 {
+        self.views.get(id.0).map_or(0, |v| v.record_us.get())
     }
 
     /// The host's targets the sky was made for.
