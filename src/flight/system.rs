@@ -175,8 +175,9 @@ pub struct SkySystem {
     /// Seconds of frames so far (the clock of weather changes).
     clock_s: f64,
     sun_direction: Vec3,
-    /// The sun of the last [`Self::update`], for the other views of its frame.
+    /// The sun and time step of the last [`Self::update`], for the other views of its frame.
     sun: Option<crate::shading::SunPosition>,
+    dt_s: f64,
 }
 
 impl SkySystem {
@@ -220,6 +221,7 @@ impl SkySystem {
             clock_s: 0.0,
             sun_direction: Vec3::Z,
             sun: None,
+            dt_s: 0.0,
         })
     }
 
@@ -303,6 +305,7 @@ impl SkySystem {
         self.sky.targets().check_projection(camera.projection)?;
         let start = Instant::now();
         let dt_s = dt_s.max(0.0);
+        self.dt_s = dt_s;
         self.clock_s += dt_s;
         let mut changes = Vec::new();
         for change in self.live.poll(self.clock_s) {
@@ -395,7 +398,7 @@ impl SkySystem {
             view: camera.view,
             projection: camera.projection,
         };
-        let mut stats = self.sky.prepare_view(id, queue, view, &sun, 0.0);
+        let mut stats = self.sky.prepare_view(id, queue, view, &sun, self.dt_s);
         stats.record_us = self.sky.view_record_us(id);
         Ok(stats)
     }

@@ -711,8 +711,9 @@ impl Sky {
     }
 
     /// [`Self::prepare`] for one view (see [`Self::add_view`]): its draw list, ring and
-    /// uniforms from its camera. The views of a frame share its time step: give `dt_s` to one
-    /// of them (the main view) and 0 to the others. An unknown view prepares the main one.
+    /// uniforms from its camera. Every view of a frame is given the frame's `dt_s`: the main
+    /// view's advances the sky's clock, the others' only their ring's crossfade. An unknown
+    /// view prepares the main one (see [`Self::has_view`]).
     pub fn prepare_view(
         &mut self,
         id: ViewId,
@@ -729,7 +730,11 @@ impl Sky {
             // The last frame's writes never reached a submit: send them, so they are freed.
             queue.submit([]);
         }
-        self.elapsed_s += dt_s.max(0.0);
+        // The frame's clock is the main view's; the others use `dt_s` for their ring's
+        // crossfade only.
+        if i == ViewId::MAIN.0 {
+            self.elapsed_s += dt_s.max(0.0);
+        }
         self.clear_light = self.time_of_day.at(sun.elevation_deg as f32);
         let (hidden, _) = self.overhead_ease.show(
             self.sky_hidden_at(camera.position_m.z),
