@@ -409,6 +409,7 @@ impl World {
             let gone: Vec<u64> = living.in_sky.difference(&living.seen).copied().collect();
             for id in gone {
                 living.in_sky.remove(&id);
+                living.arriving.remove(&id);
                 sky.remove_block(id);
             }
         }
