@@ -24,7 +24,7 @@
 //!     projection, // the host's projection, as its depth convention has it
 //! };
 //! let (stats, _applied) = sky.update(queue, &camera, 1_738_015_200.0, 1.0 / 60.0)?;
-//! sky.record(encoder, colour, depth); // reads the host's depth, never writes it
+//! sky.record(encoder, colour, depth)?; // checks the targets; reads the host's depth, never writes it
 //! let light = sky.lighting();         // sun, ambient, horizon and fog for the host's scene
 //! # let _ = (stats, light); Ok(()) }
 //! ```
@@ -63,7 +63,7 @@ pub mod weather;
 pub use flight::{
     HostCamera, HostLighting, HostPosition, SkyError, SkySystem, SkySystemConfig, Weather,
 };
-pub use render::{FrameStats, HostTargets, Sky, SkyView};
+pub use render::{FrameStats, HostTargets, Sky, SkyView, ViewId};
 
 /// The README's embedding snippet, compiled by `cargo test --doc` so that it cannot drift from
 /// the API (the README's only Rust block; its shell blocks are checked by `tests/docs.rs`).

@@ -172,6 +172,9 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         // The frame step: new weather that is ready (the frame never waits for a file), the
         // living clouds, the sun, the sky's CPU share; drawn on written frames.
         let step_s = if k == 0 { 0.0 } else { dt_s };
+        // The first frame is the warm-up: it waits for the clouds around, so the flight starts
+        // under its whole sky; after it blocks arrive as they are generated.
+        host.sky.world_mut().set_synchronous_clouds(k == 0);
         let (stats, changes) = host.step(&camera, start_unix_s + time_s, step_s, write)?;
         let mut applied = String::new();
         for change in changes {

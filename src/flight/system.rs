@@ -17,11 +17,13 @@ use std::time::{Duration, Instant};
 use glam::{DVec3, Mat4, Vec3};
 
 use super::world::{World, WorldSettings};
-use crate::render::{Camera, FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView};
+use crate::render::{
+    Camera, FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView, ViewId,
+};
 use crate::shading::sun_position;
 use crate::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
 use crate::weather::live::{LiveChange, LiveWeather, Prepare};
-use crate::weather::{LocalFrame, StationTable, WeatherError, WeatherInput};
+use crate::weather::{LocalFrame, Skipped, StationTable, WeatherError, WeatherInput};
 
 /// Why the sky could not be built or given its weather.
 #[derive(Debug, thiserror::Error)]
@@ -50,7 +52,9 @@ pub struct SkySystemConfig {
     pub field: FieldSettings,
     /// Which cloud type a reported layer is, where the report does not say.
     pub rule: CloudTypeRule,
-    /// Places the reports of files that give no positions (NOAA's station table).
+    /// Places the reports of files that give no positions (plain METAR lines, NOAA cycle
+    /// files). `None`: NOAA's table shipped inside the library ([`StationTable::builtin`]); a
+    /// host with a newer table passes its own.
     pub stations: Option<Arc<StationTable>>,
 }
 
@@ -207,12 +211,17 @@ pub struct SkySystem {
     sky: Sky,
     world: World,
     frame: LocalFrame,
-    live: LiveWeather<WeatherField>,
-    prepare_field: Prepare<WeatherField>,
+    live: LiveWeather<(WeatherField, Skipped)>,
+    prepare_field: Prepare<(WeatherField, Skipped)>,
+    /// What the weather in use left out, counted.
+    skipped: Skipped,
     stations: Option<Arc<StationTable>>,
     /// Seconds of frames so far (the clock of weather changes).
     clock_s: f64,
     sun_direction: Vec3,
+    /// The sun and time step of the last [`Self::update`], for the other views of its frame.
+    sun: Option<crate::shading::SunPosition>,
+    dt_s: f64,
 }
 
 impl SkySystem {
@@ -240,8 +249,10 @@ impl SkySystem {
         let (lat, lon) = config.origin_lat_lon_deg;
         let frame = LocalFrame::new(lat, lon);
         let (settings, rule) = (config.field.clone(), config.rule.clone());
-        let prepare_field: Prepare<WeatherField> =
-            Arc::new(move |input| input.field(LocalFrame::new(lat, lon), &settings, &rule));
+        let prepare_field: Prepare<(WeatherField, Skipped)> = Arc::new(move |input| {
+            let field = input.field(LocalFrame::new(lat, lon), &settings, &rule);
+            (field, input.skipped())
+        });
         let clear = WeatherField::build(frame, &[], &config.field, &config.rule);
         Ok(Self {
             sky: Sky::new(device, queue, config.sky)?,
@@ -249,9 +260,12 @@ impl SkySystem {
             frame,
             live: LiveWeather::new(),
             prepare_field,
+            skipped: Skipped::default(),
             stations: config.stations,
             clock_s: 0.0,
             sun_direction: Vec3::Z,
+            sun: None,
+            dt_s: 0.0,
         })
     }
 
@@ -260,29 +274,40 @@ impl SkySystem {
     /// applied by the frames that follow. The clouds of every block whose weather changed
     /// dissipate while the new ones form, and the light and fog under them go over with them
     /// ([`Sky::ease_weather_overhead`]).
-    pub fn set_weather(&mut self, weather: Weather) -> Result<(), SkyError> {
-        let stations = self.stations.as_deref();
+    ///
+    /// Returns what the input left out and why, counted ("31 reports without a position,
+    /// lines ..."; also [`Self::weather_skipped`]). An input none of whose reports can be used
+    /// is [`WeatherError::NoUsableReport`], not an empty sky.
+    pub fn set_weather(&mut self, weather: Weather) -> Result<Skipped, SkyError> {
+        let table = self.stations();
+        let stations = Some(&*table);
         let input = match weather {
             Weather::File(path) => WeatherInput::load(path, stations)?,
             Weather::Bytes { name, bytes } => WeatherInput::parse(name, bytes, stations)?,
-            Weather::Watch { path, settle } => {
-                // Read now, so the sky has this weather from the next frame; then watched.
-                let input = WeatherInput::load(path, stations)?;
-                self.live.watch(
-                    path,
-                    self.stations.clone(),
-                    settle,
-                    Arc::clone(&self.prepare_field),
-                )?;
-                input
-            }
+            // Read now, so the sky has this weather from the next frame; then watched.
+            Weather::Watch { path, .. } => WeatherInput::load(path, stations)?,
         };
-        self.set_weather_field((self.prepare_field)(input));
-        Ok(())
+        // Checked before the watch starts, so a file with nothing usable is not watched either.
+        let input = input.usable()?;
+        if let Weather::Watch { path, settle } = weather {
+            self.live
+                .watch(path, Some(table), settle, Arc::clone(&self.prepare_field))?;
+        }
+        let (field, skipped) = (self.prepare_field)(input);
+        self.set_weather_field(field);
+        self.skipped = skipped.clone();
+        Ok(skipped)
+    }
+
+    /// What the weather in use left out and why, counted: of the last [`Self::set_weather`],
+    /// or of the last file a watch or schedule applied (an update's applied files).
+    pub fn weather_skipped(&self) -> &Skipped {
+        &self.skipped
     }
 
     /// Takes a weather field the host built itself (same as [`Self::set_weather`] otherwise).
     pub fn set_weather_field(&mut self, field: WeatherField) {
+        self.skipped = Skipped::default();
         self.world.set_field(field);
         self.sky.ease_weather_overhead();
     }
@@ -300,16 +325,23 @@ impl SkySystem {
         self.live.schedule(
             self.clock_s + at_s,
             path,
-            self.stations.clone(),
+            Some(self.stations()),
             Arc::clone(&self.prepare_field),
         )?;
         Ok(())
     }
 
+    /// The station table reports without a position are placed with: the host's, or the one
+    /// shipped inside the library.
+    fn stations(&self) -> Arc<StationTable> {
+        self.stations.clone().unwrap_or_else(StationTable::builtin)
+    }
+
     /// The frame step, CPU side: applies weather that is ready, advances the living clouds by
     /// `dt_s` around the camera and hands the sky what changed, places the sun for `utc_unix_s`,
     /// and prepares the sky's frame. Returns the frame's stats (its CPU cost included, the
-    /// weather's in `weather_us`) and the weather files that arrived this frame: applied, or
+    /// weather's in `weather_us`, the previous frame's [`Self::record`] in `record_us`, all of
+    /// it in [`FrameStats::sky_cpu_us`]) and the weather files that arrived this frame: applied, or
     /// rejected with the one line that says why (the last good sky stays). Call
     /// [`Self::record`] after it, in the frame's encoder.
     pub fn update(
@@ -319,14 +351,24 @@ impl SkySystem {
         utc_unix_s: f64,
         dt_s: f64,
     ) -> Result<(FrameStats, Vec<Result<PathBuf, String>>), SkyError> {
+        // A wrong depth convention is refused before the frame does any work.
+        self.sky.targets().check_projection(camera.projection)?;
         let start = Instant::now();
         let dt_s = dt_s.max(0.0);
+        self.dt_s = dt_s;
         self.clock_s += dt_s;
         let mut changes = Vec::new();
         for change in self.live.poll(self.clock_s) {
             changes.push(match change {
-                LiveChange::Loaded { source, weather } => {
-                    self.set_weather_field(weather);
+                LiveChange::Loaded {
+                    source,
+                    weather: (field, skipped),
+                } => {
+                    self.set_weather_field(field);
+                    if !skipped.is_empty() {
+                        log::info!("{}: {skipped}", source.display());
+                    }
+                    self.skipped = skipped;
                     Ok(source)
                 }
                 LiveChange::Rejected(why) => Err(why),
@@ -334,20 +376,14 @@ impl SkySystem {
         }
         let weather_us = start.elapsed().as_micros() as u64;
         self.sky.add_field_cpu_us(weather_us);
-        let position_m = match camera.position {
-            HostPosition::Local(p) => p,
-            HostPosition::LatLonAlt {
-                lat_deg,
-                lon_deg,
-                alt_m,
-            } => self.frame.to_local_m(lat_deg, lon_deg).extend(alt_m),
-        };
+        let position_m = self.local_m(camera.position);
         self.world.update_sky(&mut self.sky, position_m, dt_s)?;
         self.sky
             .set_weather_overhead(&self.world.weather_over(position_m));
         let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
         let sun = sun_position(utc_unix_s, lat, lon);
         self.sun_direction = sun.direction_enu().as_vec3();
+        self.sun = Some(sun);
         let view = SkyView {
             position_m,
             view: camera.view,
@@ -355,19 +391,89 @@ impl SkySystem {
         };
         let mut stats = self.sky.prepare(queue, view, &sun, dt_s);
         stats.weather_us = weather_us;
+        // This frame is not recorded yet: the last recording is the previous frame's.
+        stats.record_us = self.sky.last_record_us();
         Ok((stats, changes))
     }
 
     /// Records the sky's passes into the host's encoder after the host drew its scene: the sky
     /// behind everything, the clouds faded softly into the host's depth (read, never written),
-    /// the fog inside a cloud.
+    /// the fog inside a cloud. The host's textures are checked first ([`Sky::record`]): colour
+    /// and depth formats, samples, the depth's `TEXTURE_BINDING`, the depth convention against
+    /// the projection; a mismatch is an error naming both sides, and nothing is recorded.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         colour: &wgpu::TextureView,
         depth: &wgpu::TextureView,
-    ) {
-        self.sky.record(encoder, colour, depth);
+    ) -> Result<(), SkyError> {
+        Ok(self.sky.record(encoder, colour, depth)?)
+    }
+
+    /// Adds a view of the same sky: another camera with its own targets (of the same formats
+    /// and samples as the [`HostTargets`] the sky was made for; any size), e.g. a second
+    /// monitor, a mirror, an outside camera near the aircraft. It has its own draw list,
+    /// impostor ring and off-screen cloud target; the clouds, the weather and the resident
+    /// sprites are shared (the clouds live around the camera of [`Self::update`]). Each frame:
+    /// [`Self::update`] for the main camera, then [`Self::update_view`] for each other view,
+    /// then [`Self::record`] and [`Self::record_view`], into one encoder or several. A view
+    /// costs [`Sky::view_gpu_bytes`] of GPU memory.
+    pub fn add_view(&mut self) -> ViewId {
+        self.sky.add_view()
+    }
+
+    /// A view's share of the frame step, after [`Self::update`] (whose time, sun and clouds
+    /// it uses): its draw list, ring and uniforms from `camera`. The projection is checked
+    /// against the targets as in `update`. Returns the view's stats (`record_us`: its previous
+    /// recording). [`Self::lighting`] is then this view's.
+    pub fn update_view(
+        &mut self,
+        id: ViewId,
+        queue: &wgpu::Queue,
+        camera: &HostCamera,
+    ) -> Result<FrameStats, SkyError> {
+        self.sky.targets().check_projection(camera.projection)?;
+        if !self.sky.has_view(id) {
+            return Err(RenderError::Targets(format!(
+                "{id:?} does not exist (the sky has {} views)",
+                self.sky.view_count()
+            ))
+            .into());
+        }
+        let position_m = self.local_m(camera.position);
+        let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
+        let sun = self.sun.unwrap_or_else(|| sun_position(0.0, lat, lon));
+        let view = SkyView {
+            position_m,
+            view: camera.view,
+            projection: camera.projection,
+        };
+        let mut stats = self.sky.prepare_view(id, queue, view, &sun, self.dt_s);
+        stats.record_us = self.sky.view_record_us(id);
+        Ok(stats)
+    }
+
+    /// [`Self::record`] for a view of [`Self::add_view`], into its own targets.
+    pub fn record_view(
+        &self,
+        id: ViewId,
+        encoder: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) -> Result<(), SkyError> {
+        Ok(self.sky.record_view(id, encoder, colour, depth)?)
+    }
+
+    /// A host position in the local frame's metres.
+    fn local_m(&self, position: HostPosition) -> DVec3 {
+        match position {
+            HostPosition::Local(p) => p,
+            HostPosition::LatLonAlt {
+                lat_deg,
+                lon_deg,
+                alt_m,
+            } => self.frame.to_local_m(lat_deg, lon_deg).extend(alt_m),
+        }
     }
 
     /// The light and fog of the last [`Self::update`], for the host's own scene.
@@ -415,5 +521,27 @@ impl std::ops::Deref for SkySystem {
 impl std::ops::DerefMut for SkySystem {
     fn deref_mut(&mut self) -> &mut Sky {
         &mut self.sky
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::camera::rh::view::look_at_mat4;
+    use glam::{Mat4, Vec3, Vec4};
+
+    /// What the embedding chapter (docs/src/host-errors.md) tells a y-up host: its view times
+    /// the axis swap is the view for east-north-up axes.
+    #[test]
+    fn a_y_up_hosts_view_times_the_axis_swap_is_the_east_north_up_view() {
+        // East, north, up to a y-up right-handed world's (x east, y up, z south).
+        let enu_to_host = Mat4::from_cols(Vec4::X, Vec4::NEG_Z, Vec4::Y, Vec4::W);
+        // Looking north-east and a little up, in each world's own axes.
+        let forward_enu = Vec3::new(0.6, 0.7, 0.2).normalize();
+        let forward_host = Vec3::new(forward_enu.x, forward_enu.z, -forward_enu.y);
+        let enu = look_at_mat4(Vec3::ZERO, forward_enu, Vec3::Z);
+        let host = look_at_mat4(Vec3::ZERO, forward_host, Vec3::Y);
+        assert!((host * enu_to_host).abs_diff_eq(enu, 1e-6));
+        // Without the swap it is another view.
+        assert!(!host.abs_diff_eq(enu, 1e-3));
     }
 }

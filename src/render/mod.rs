@@ -47,6 +47,7 @@ mod slots;
 mod sprite_view;
 pub mod stats;
 pub mod targets;
+mod view;
 
 pub use camera::{Camera, Frustum};
 pub use pass_timing::{PassTimes, Timestamps};
@@ -57,6 +58,7 @@ pub use settings::RenderSettings;
 pub use sky::{Sky, SkyConfig, SpriteSheet};
 pub use stats::{FrameStats, Lighting, SkyMemory};
 pub use targets::{HostTargets, SkyView};
+pub use view::ViewId;
 
 /// How to install a software Vulkan driver where there is no GPU (Debian, Ubuntu).
 pub const INSTALL_HINT: &str = "sudo apt-get install -y mesa-vulkan-drivers libvulkan1";

@@ -39,8 +39,10 @@ pub struct FrameStats {
     /// The host's weather step this frame (polling a watched file, switching in a new field;
     /// never reading one), microseconds; part of `field_us`.
     pub weather_us: u64,
-    /// CPU time of the last [`crate::render::Sky::record`], microseconds (filled in by hosts that
-    /// record after they prepare, like the demo host).
+    /// CPU time of the last [`crate::render::Sky::record`], microseconds. Through
+    /// [`crate::SkySystem::update`] it is the previous frame's recording (this frame's has not
+    /// happened when `update` returns); a host driving [`crate::render::Sky`] itself that
+    /// records after it prepares fills in this frame's, as the demo host does.
     pub record_us: u64,
     /// Bytes written to the GPU by this frame's update (new blocks, changed sprite orders, the
     /// draw list, uniforms, impostor builds).

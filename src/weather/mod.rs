@@ -23,7 +23,7 @@ pub use block::{
     BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, METRES_PER_FOOT, TypeSource, Wind,
 };
 pub use cloud_type::CloudType;
-pub use error::{LineWarning, WeatherError};
+pub use error::{LineWarning, SkipCount, Skipped, WarningKind, WeatherError};
 pub use field::{CloudTypeRule, FieldSettings, WeatherField};
 pub use files::{FileFormat, PlacedReport, Position, WeatherFile};
 pub use frame::LocalFrame;
