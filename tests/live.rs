@@ -428,8 +428,8 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
     assert!(frames_during_load >= 2, "the frames waited for the load");
     // A frame of this tiny flight measured 16-29 ms of CPU (synchronous clouds); one that waited
     // for the load (decoding 5,000 reports and triangulating them, 450 ms here) would take the
-    // load's time.
-    assert!(max_cpu < Duration::from_millis(60), "{max_cpu:?}");
+    // load's time. Compared as a ratio, not against a wall time: on a loaded machine a frame
+    // measured 80-146 ms while the load took longer still.
     assert!(
         max_cpu * 2 < load,
         "a frame took {max_cpu:?} of the load's {load:?}"
