@@ -112,6 +112,8 @@ pub struct World {
     synchronous_clouds: bool,
     /// Counts weather fields taken ([`World::set_field`]).
     field_version: u64,
+    /// Settings and caches of the air data ([`super::air`]).
+    pub(super) air: super::air::AirState,
 }
 
 impl World {
@@ -126,6 +128,7 @@ impl World {
             clouds_config: CloudsConfig::builtin(),
             synchronous_clouds: false,
             field_version: 0,
+            air: Default::default(),
         }
     }
 
@@ -237,6 +240,46 @@ impl World {
 }
 
 impl World {
+    /// Makes the living clouds if there are none yet; true when it did.
+    fn start_living(&mut self) -> Result<bool, RenderError> {
+        if self.living.is_some() {
+            return Ok(false);
+        }
+        let mut config = self.clouds_config;
+        config.field.radius_m = self.settings.cloud_radius_m;
+        config.field.seed = self.settings.seed;
+        let field = CloudField::new(config, Arc::new(self.types.clone()), 0)
+            .map_err(|e| RenderError::Clouds(e.to_string()))?;
+        self.clouds_config = config;
+        self.living = Some(LivingClouds {
+            field,
+            weather: HashMap::new(),
+            asked: None,
+            in_sky: HashSet::new(),
+            seen: HashSet::new(),
+            newest_serial: 0,
+            membership: None,
+            fading: Vec::new(),
+            was_fading: Vec::new(),
+        });
+        Ok(true)
+    }
+
+    /// Generates the living clouds around `point_m` and waits for them, without a sky: for
+    /// asking about the air ([`Self::air_at`]) where nothing is drawn (the command line, tests).
+    pub fn settle_clouds_around(&mut self, point_m: DVec3) -> Result<(), RenderError> {
+        self.start_living()?;
+        let weather_field = &self.field;
+        if let Some(living) = self.living.as_mut() {
+            living
+                .field
+                .update(point_m.truncate(), &|i| weather_field.block_weather(i));
+            living.field.wait_for_pending();
+            living.field.advance(0.0);
+        }
+        Ok(())
+    }
+
     /// Advances the clouds stage's [`CloudField`] around `camera_m` by `dt_s` seconds (blocks
     /// generated in the background, the first call waits for them; drifting with the wind;
     /// forming and dissipating when the weather changes) and hands `sky` what changed: new
@@ -250,24 +293,8 @@ impl World {
         dt_s: f64,
     ) -> Result<(), RenderError> {
         let start = Instant::now();
-        if self.living.is_none() {
-            let mut config = self.clouds_config;
-            config.field.radius_m = self.settings.cloud_radius_m;
-            config.field.seed = self.settings.seed;
-            let field = CloudField::new(config, Arc::new(self.types.clone()), 0)
-                .map_err(|e| RenderError::Clouds(e.to_string()))?;
-            sky.set_lifecycle(config.lifecycle);
-            self.living = Some(LivingClouds {
-                field,
-                weather: HashMap::new(),
-                asked: None,
-                in_sky: HashSet::new(),
-                seen: HashSet::new(),
-                newest_serial: 0,
-                membership: None,
-                fading: Vec::new(),
-                was_fading: Vec::new(),
-            });
+        if self.start_living()? {
+            sky.set_lifecycle(self.clouds_config.lifecycle);
         }
         let weather_field = &self.field;
         let Some(living) = self.living.as_mut() else {
