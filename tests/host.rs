@@ -187,7 +187,10 @@ fn host_frame(mode: &str) -> (Vec<u8>, bool) {
     h.draw_sky(&mut sky).expect("sky");
     // The host read the air where it is (250/8 kt at the surface, 24 C): above the boundary
     // layer, veered 30 degrees and cooler.
-    let air = h.air.as_ref().expect("the host reads the air data each frame");
+    let air = h
+        .air
+        .as_ref()
+        .expect("the host reads the air data each frame");
     assert!(
         (air.wind_from_deg - 280.0).abs() < 1.0 && air.temperature_c < 24.0,
         "{mode}: {air:?}"

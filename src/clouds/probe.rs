@@ -179,17 +179,6 @@ pub struct BoxCache {
 }
 
 impl BoxCache {
-    /// The boxes of a generation (worked out on first use).
-    fn get(&self, g: &FieldBlock) -> Arc<GenerationBoxes> {
-        let Ok(mut map) = self.map.lock() else {
-            return Arc::new(GenerationBoxes::of(&g.block.clouds));
-        };
-        Arc::clone(
-            map.entry(g.serial)
-                .or_insert_with(|| Arc::new(GenerationBoxes::of(&g.block.clouds))),
-        )
-    }
-
     /// Forgets the generations the field no longer holds, once it holds many more than it has.
     fn prune(&self, field: &CloudField) {
         let Ok(mut map) = self.map.lock() else {
@@ -259,26 +248,45 @@ impl<'a> CloudProbe<'a> {
     }
 
     /// Every generation of the blocks whose square reaches within `reach_m` of the air-frame
-    /// box `lo..hi` (horizontally), with its boxes and its fade.
+    /// box `lo..hi` (horizontally) and passes `wanted` (its square padded by a block, for the
+    /// clouds that overhang it), with its boxes. The cache is locked once for the query.
     fn generations(
         &self,
         lo: DVec2,
         hi: DVec2,
         reach_m: f64,
+        wanted: impl Fn(DVec2, DVec2) -> bool,
         mut each: impl FnMut(&FieldBlock, &GenerationBoxes),
     ) {
         // Clouds overhang their block by up to a block.
         let pad = reach_m + BLOCK_SIZE_M;
         let a = BlockIndex::containing(lo - DVec2::splat(pad));
         let b = BlockIndex::containing(hi + DVec2::splat(pad));
+        let mut map = self.cache.map.lock().ok();
         for j in a.j..=b.j {
             for i in a.i..=b.i {
-                for g in self.field.generations(BlockIndex::new(i, j)) {
+                let index = BlockIndex::new(i, j);
+                let corner = index.min_corner_m();
+                let square = (
+                    corner - DVec2::splat(BLOCK_SIZE_M),
+                    corner + DVec2::splat(2.0 * BLOCK_SIZE_M),
+                );
+                if !wanted(square.0, square.1) {
+                    continue;
+                }
+                for g in self.field.generations(index) {
                     if g.phase == Phase::Gone || g.block.clouds.is_empty() {
                         continue;
                     }
-                    let boxes = self.cache.get(g);
-                    each(g, &boxes);
+                    match map.as_mut() {
+                        Some(map) => {
+                            let boxes = map
+                                .entry(g.serial)
+                                .or_insert_with(|| Arc::new(GenerationBoxes::of(&g.block.clouds)));
+                            each(g, boxes);
+                        }
+                        None => each(g, &GenerationBoxes::of(&g.block.clouds)),
+                    }
                 }
             }
         }
@@ -306,7 +314,8 @@ impl<'a> CloudProbe<'a> {
         let mut out = CloudsAtPoint::default();
         let mut nearest = f64::INFINITY;
         let mut nearest_cb = f64::INFINITY;
-        self.generations(q.truncate(), q.truncate(), reach, |g, boxes| {
+        let all = |_: DVec2, _: DVec2| true;
+        self.generations(q.truncate(), q.truncate(), reach, all, |g, boxes| {
             if boxes.distance_m(q) > reach.min(nearest.max(nearest_cb)) {
                 return;
             }
@@ -349,7 +358,17 @@ impl<'a> CloudProbe<'a> {
         let (lo, hi) = (qa.min(qb), qa.max(qb));
         let mut first: Option<(f64, f64, CloudType)> = None;
         let mut total = 0.0;
-        self.generations(lo.truncate(), hi.truncate(), 0.0, |g, boxes| {
+        // Only the blocks whose padded square the segment crosses.
+        let crosses = |lo: DVec2, hi: DVec2| {
+            slab(
+                qa.with_z(0.0),
+                qb.with_z(0.0),
+                lo.extend(-1.0),
+                hi.extend(1.0),
+            )
+            .is_some()
+        };
+        self.generations(lo.truncate(), hi.truncate(), 0.0, crosses, |g, boxes| {
             if slab(qa, qb, boxes.lo_m, boxes.hi_m).is_none() {
                 return;
             }
