@@ -314,7 +314,7 @@ fn air_data(
 }
 
 /// The rate of a reported intensity `p`, linear through (0, 0) and the intensity levels.
-fn rate_mm_h(p: f64, levels: [f64; 3], rates: [f32; 3]) -> f32 {
+pub(super) fn rate_mm_h(p: f64, levels: [f64; 3], rates: [f32; 3]) -> f32 {
     let mut prev = (0.0, 0.0f32);
     for (l, r) in levels.into_iter().zip(rates) {
         if p <= l {
@@ -411,6 +411,18 @@ impl super::SkySystem {
     pub fn sun_occlusion(&self, position: super::HostPosition) -> f32 {
         let sun = self.lighting().sun_direction.as_dvec3();
         self.world().sun_occlusion(self.local_m(position), sun)
+    }
+
+    /// The precipitation map around a position out to `range_m`, cells of `cell_m`, for a
+    /// weather-radar display ([`super::radar`]).
+    pub fn precipitation_map(
+        &self,
+        position: super::HostPosition,
+        range_m: f64,
+        cell_m: f64,
+    ) -> super::radar::PrecipitationMap {
+        self.world()
+            .precipitation_map(self.local_m(position), range_m, cell_m)
     }
 
     /// The share of the sky the layers above a position cover, 0..=1.

@@ -12,6 +12,7 @@
 
 pub mod air;
 mod path;
+pub mod radar;
 mod spline;
 pub mod system;
 pub mod world;
