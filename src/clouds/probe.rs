@@ -256,13 +256,14 @@ impl<'a> CloudProbe<'a> {
         hi: DVec2,
         reach_m: f64,
         wanted: impl Fn(DVec2, DVec2) -> bool,
-        mut each: impl FnMut(&FieldBlock, &GenerationBoxes),
-    ) {
+    ) -> Vec<(&'a FieldBlock, Arc<GenerationBoxes>)> {
         // Clouds overhang their block by up to a block.
         let pad = reach_m + BLOCK_SIZE_M;
         let a = BlockIndex::containing(lo - DVec2::splat(pad));
         let b = BlockIndex::containing(hi + DVec2::splat(pad));
         let mut map = self.cache.map.lock().ok();
+        let mut out = Vec::new();
+        let field: &'a CloudField = self.field;
         for j in a.j..=b.j {
             for i in a.i..=b.i {
                 let index = BlockIndex::new(i, j);
@@ -274,22 +275,22 @@ impl<'a> CloudProbe<'a> {
                 if !wanted(square.0, square.1) {
                     continue;
                 }
-                for g in self.field.generations(index) {
+                for g in field.generations(index) {
                     if g.phase == Phase::Gone || g.block.clouds.is_empty() {
                         continue;
                     }
-                    match map.as_mut() {
-                        Some(map) => {
-                            let boxes = map
-                                .entry(g.serial)
-                                .or_insert_with(|| Arc::new(GenerationBoxes::of(&g.block.clouds)));
-                            each(g, boxes);
-                        }
-                        None => each(g, &GenerationBoxes::of(&g.block.clouds)),
-                    }
+                    let boxes = match map.as_mut() {
+                        Some(map) => Arc::clone(
+                            map.entry(g.serial)
+                                .or_insert_with(|| Arc::new(GenerationBoxes::of(&g.block.clouds))),
+                        ),
+                        None => Arc::new(GenerationBoxes::of(&g.block.clouds)),
+                    };
+                    out.push((g, boxes));
                 }
             }
         }
+        out
     }
 
     fn fade(&self, g: &FieldBlock, b: &CloudBox, p_air: DVec3) -> f32 {
@@ -315,18 +316,24 @@ impl<'a> CloudProbe<'a> {
         let mut nearest = f64::INFINITY;
         let mut nearest_cb = f64::INFINITY;
         let all = |_: DVec2, _: DVec2| true;
-        self.generations(q.truncate(), q.truncate(), reach, all, |g, boxes| {
+        for (g, boxes) in self.generations(q.truncate(), q.truncate(), reach, all) {
             if boxes.distance_m(q) > reach.min(nearest.max(nearest_cb)) {
-                return;
+                continue;
             }
             for b in &boxes.boxes {
+                let d = b.distance_m(q);
+                let in_sphere = (q - b.cloud_centre_m).length_squared() < b.sphere_m * b.sphere_m;
+                let cb = b.cloud_type == CloudType::Cumulonimbus;
+                // Only what can change an answer needs its fade.
+                if d > 0.0 && d >= nearest && !(cb && d < nearest_cb) && !in_sphere {
+                    continue;
+                }
                 let fade = self.fade(g, b, q);
                 if fade <= 0.0 {
                     continue;
                 }
-                let d = b.distance_m(q);
                 nearest = nearest.min(d);
-                if b.cloud_type == CloudType::Cumulonimbus && fade >= 0.5 {
+                if cb && fade >= 0.5 {
                     nearest_cb = nearest_cb.min(d);
                 }
                 if d == 0.0 {
@@ -339,11 +346,11 @@ impl<'a> CloudProbe<'a> {
                         out.cloud_type = Some(b.cloud_type);
                     }
                 }
-                if (q - b.cloud_centre_m).length() < b.sphere_m {
+                if in_sphere {
                     out.in_rain = out.in_rain.max(in_rain(&g.block.clouds[b.cloud], q) * fade);
                 }
             }
-        });
+        }
         out.nearest_cloud_m = (nearest <= reach).then_some(nearest);
         out.nearest_cb_m = (nearest_cb <= reach).then_some(nearest_cb);
         out
@@ -352,13 +359,24 @@ impl<'a> CloudProbe<'a> {
     /// The first cloud met along the segment from ground point `a` to `b`, with the optical
     /// depth through it and through every cloud along it; `None` in clear air.
     pub fn line_of_sight(&self, a: DVec3, b: DVec3) -> Option<SightHit> {
+        self.sight(a, b, true)
+    }
+
+    /// The first cloud met along the segment and the optical depth through it; its
+    /// `total_optical_depth` counts only the clouds looked at before the first was certain (the
+    /// cheap query a host casts many of).
+    pub fn first_cloud(&self, a: DVec3, b: DVec3) -> Option<SightHit> {
+        self.sight(a, b, false)
+    }
+
+    fn sight(&self, a: DVec3, b: DVec3, whole: bool) -> Option<SightHit> {
         let (qa, qb) = (self.air_point(a), self.air_point(b));
         let length = (qb - qa).length();
         let sigma = 3.0 / f64::from(self.settings.visibility_m);
         let (lo, hi) = (qa.min(qb), qa.max(qb));
         let mut first: Option<(f64, f64, CloudType)> = None;
         let mut total = 0.0;
-        // Only the blocks whose padded square the segment crosses.
+        // Only the blocks whose padded square the segment crosses, nearest along it first.
         let crosses = |lo: DVec2, hi: DVec2| {
             slab(
                 qa.with_z(0.0),
@@ -368,9 +386,17 @@ impl<'a> CloudProbe<'a> {
             )
             .is_some()
         };
-        self.generations(lo.truncate(), hi.truncate(), 0.0, crosses, |g, boxes| {
-            if slab(qa, qb, boxes.lo_m, boxes.hi_m).is_none() {
-                return;
+        let mut near: Vec<(f64, &FieldBlock, Arc<GenerationBoxes>)> = self
+            .generations(lo.truncate(), hi.truncate(), 0.0, crosses)
+            .into_iter()
+            .filter_map(|(g, boxes)| {
+                slab(qa, qb, boxes.lo_m, boxes.hi_m).map(|(t0, _)| (t0, g, boxes))
+            })
+            .collect();
+        near.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for (enter, g, boxes) in near {
+            if !whole && first.is_some_and(|f| enter > f.0) {
+                break;
             }
             for bx in &boxes.boxes {
                 let Some((t0, t1)) = bx.segment(qa, qb) else {
@@ -387,7 +413,7 @@ impl<'a> CloudProbe<'a> {
                     first = Some((t0, depth, bx.cloud_type));
                 }
             }
-        });
+        }
         first.map(|(t, depth, cloud_type)| SightHit {
             distance_m: t * length,
             point_m: a.lerp(b, t),

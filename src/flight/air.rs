@@ -148,16 +148,18 @@ impl World {
         self.probe().map(|p| p.at(point_m)).unwrap_or_default()
     }
 
-    /// The first cloud the segment `from_m`..`to_m` meets, and the optical depth through it;
-    /// `None` in clear air (and before the living clouds exist).
+    /// The first cloud the segment `from_m`..`to_m` meets, and the optical depth through it
+    /// (`total_optical_depth`: of the clouds looked at, not all along; `sun_occlusion` has
+    /// that); `None` in clear air (and before the living clouds exist).
     pub fn line_of_sight(&self, from_m: DVec3, to_m: DVec3) -> Option<SightHit> {
-        self.probe()?.line_of_sight(from_m, to_m)
+        self.probe()?.first_cloud(from_m, to_m)
     }
 
     /// How much of the sun (towards unit `sun_direction`) the clouds hide from `point_m`,
     /// 0..=1: `1 - exp(-optical depth)` through every cloud along 30 km towards it.
     pub fn sun_occlusion(&self, point_m: DVec3, sun_direction: DVec3) -> f32 {
-        let Some(hit) = self.line_of_sight(point_m, point_m + sun_direction * SUN_SIGHT_M) else {
+        let to = point_m + sun_direction * SUN_SIGHT_M;
+        let Some(hit) = self.probe().and_then(|p| p.line_of_sight(point_m, to)) else {
             return 0.0;
         };
         (1.0 - (-hit.total_optical_depth).exp()) as f32
