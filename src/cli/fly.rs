@@ -152,6 +152,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "light_us",
         "sprites_lit",
         "air_us",
+        "air_at_us",
         "wind_from_deg",
         "wind_kt",
         "gust_kt",
@@ -214,6 +215,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         let mut stats = stats;
         let air_start = Instant::now();
         let air = host.sky.air_at(HostPosition::Local(pose.position_m));
+        let air_at_us = air_start.elapsed().as_micros() as u64;
         let sight_hits = sight_fan(&host.sky, pose.position_m, pose.heading_deg);
         stats.air_us = air_start.elapsed().as_micros() as u64;
         summary.add(&stats);
@@ -248,6 +250,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             stats.light_us.to_string(),
             stats.sprites_lit.to_string(),
             stats.air_us.to_string(),
+            air_at_us.to_string(),
             format!("{:.0}", air.wind_from_deg),
             format!("{:.1}", air.wind_kt),
             format!("{:.1}", air.gust_kt),

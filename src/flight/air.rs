@@ -126,6 +126,10 @@ pub struct AirData {
 /// Lengths of the line of sight towards the sun, metres.
 const SUN_SIGHT_M: f64 = 30_000.0;
 
+/// How far above the weather's highest cloud top the air data's sun line goes, metres (the
+/// clouds' boxes reach a little above the layer tops).
+const SUN_TOP_MARGIN_M: f64 = 1_000.0;
+
 impl World {
     /// The settings the air data is read with.
     pub fn air_settings(&self) -> &AirSettings {
@@ -170,7 +174,26 @@ impl World {
     pub fn air_at(&self, point_m: DVec3, sun_direction: DVec3) -> AirData {
         let weather = self.field().weather_at(point_m.truncate());
         let clouds = self.clouds_at(point_m);
-        let sun_occlusion = self.sun_occlusion(point_m, sun_direction);
+        // Towards the sun only as far as the highest cloud top over the point (plus a margin):
+        // above it nothing hides the sun, and a low sun's 30 km ray would cross many blocks.
+        let ground_m = f64::from(weather.ground_elevation_m);
+        let top_m = weather
+            .layers
+            .iter()
+            .map(|l| ground_m + f64::from(l.base_ft_agl + l.thickness_ft) * METRES_PER_FOOT)
+            .fold(f64::MIN, f64::max);
+        let ceiling_m = top_m + SUN_TOP_MARGIN_M;
+        let sun_occlusion = if point_m.z >= ceiling_m {
+            0.0
+        } else if sun_direction.z <= 0.0 {
+            self.sun_occlusion(point_m, sun_direction)
+        } else {
+            let climb_m = ((ceiling_m - point_m.z) / sun_direction.z).min(SUN_SIGHT_M);
+            let to = point_m + sun_direction * climb_m;
+            self.probe()
+                .and_then(|p| p.line_of_sight(point_m, to))
+                .map_or(0.0, |hit| (1.0 - (-hit.total_optical_depth).exp()) as f32)
+        };
         let lat_deg = self.field().frame().to_lat_lon_deg(point_m.truncate()).0;
         let s = &self.air.settings;
         let (gust, qnh) = self

@@ -258,8 +258,11 @@ impl AirSettings {
             ));
         }
         let u = &s.turbulence;
-        if !positive(u.cb_near_m) {
-            return Err(bad("turbulence.cb_near_m", "must be above 0"));
+        if !(positive(u.cb_near_m) && u.cb_near_m <= c.search_radius_m) {
+            return Err(bad(
+                "turbulence.cb_near_m",
+                "must be above 0 and at most in_cloud.search_radius_m",
+            ));
         }
         if !(0.0 < u.light && u.light < u.moderate && u.moderate < u.severe && u.severe <= 1.0) {
             return Err(bad(
