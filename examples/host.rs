@@ -35,6 +35,9 @@ pub struct Host {
     pub resolved: wgpu::Texture,
     ground: (wgpu::RenderPipeline, wgpu::BindGroup),
     pub camera: HostCamera,
+    /// The air where the camera is, read every frame after the sky's update (what a flight
+    /// model and its systems take: wind, temperature, pressure, in-cloud, turbulence, icing).
+    pub air: Option<skycast::flight::AirData>,
 }
 
 impl Host {
@@ -110,6 +113,7 @@ impl Host {
             resolved,
             ground,
             camera,
+            air: None,
         })
     }
 
@@ -148,6 +152,7 @@ impl Host {
     /// The sky's frame step, then its passes over the host's colour, reading its depth.
     pub fn draw_sky(&mut self, encoder: &mut wgpu::CommandEncoder) -> Result<skycast::FrameStats> {
         let (stats, _) = self.sky.update(&self.queue, &self.camera, UNIX_S, 0.0)?;
+        self.air = Some(self.sky.air_at(self.camera.position));
         let (colour, depth) = (
             self.colour.create_view(&Default::default()),
             self.depth.create_view(&Default::default()),
@@ -481,5 +486,16 @@ fn main() -> Result<()> {
         "{mode}: {out}; light for the host's own scene: {:?}",
         host.sky.lighting()
     );
+    if let Some(air) = &host.air {
+        println!(
+            "air: wind {:03.0}/{:.0} kt, {:.1} C, {:.1} hPa, in cloud {:.2}, turbulence {:?}",
+            air.wind_from_deg,
+            air.wind_kt,
+            air.temperature_c,
+            air.pressure_hpa,
+            air.in_cloud,
+            air.turbulence_category
+        );
+    }
     Ok(())
 }

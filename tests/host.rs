@@ -185,6 +185,16 @@ fn host_frame(mode: &str) -> (Vec<u8>, bool) {
     };
     let mut sky = encoder(&h);
     h.draw_sky(&mut sky).expect("sky");
+    // The host read the air where it is (250/8 kt at the surface, 24 C): above the boundary
+    // layer, veered 30 degrees and cooler.
+    let air = h
+        .air
+        .as_ref()
+        .expect("the host reads the air data each frame");
+    assert!(
+        (air.wind_from_deg - 280.0).abs() < 1.0 && air.temperature_c < 24.0,
+        "{mode}: {air:?}"
+    );
     let after = if copyable {
         host::read_back(&h.device, &h.queue, sky, &h.depth).expect("depth")
     } else {

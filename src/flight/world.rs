@@ -126,6 +126,8 @@ pub struct World {
     synchronous_clouds: bool,
     /// Counts weather fields taken ([`World::set_field`]).
     field_version: u64,
+    /// Settings and caches of the air data ([`super::air`]).
+    pub(super) air: super::air::AirState,
 }
 
 impl World {
@@ -140,6 +142,7 @@ impl World {
             clouds_config: CloudsConfig::builtin(),
             synchronous_clouds: false,
             field_version: 0,
+            air: Default::default(),
         }
     }
 
@@ -253,6 +256,54 @@ impl World {
 }
 
 impl World {
+    /// Makes the living clouds if there are none yet; true when it did.
+    fn start_living(&mut self) -> Result<bool, RenderError> {
+        if self.living.is_some() {
+            return Ok(false);
+        }
+        let mut config = self.clouds_config;
+        config.field.radius_m = self.settings.cloud_radius_m;
+        config.field.seed = self.settings.seed;
+        // Generating while frames go on: one thread per core but one, so the frame thread
+        // keeps a core of its own (on 2 busy cores the first update's median went from 11
+        // to 3 ms). Synchronous (the warm-up, tests, offline): every core (0).
+        let threads = match self.synchronous_clouds {
+            true => 0,
+            false => std::thread::available_parallelism().map_or(1, |n| n.get().max(2) - 1),
+        };
+        let field = CloudField::new(config, Arc::new(self.types.clone()), threads)
+            .map_err(|e| RenderError::Clouds(e.to_string()))?;
+        self.clouds_config = config;
+        self.living = Some(LivingClouds {
+            field,
+            weather: HashMap::new(),
+            asked: None,
+            in_sky: HashSet::new(),
+            seen: HashSet::new(),
+            newest_serial: 0,
+            membership: None,
+            arriving: HashMap::new(),
+            fading: Vec::new(),
+            was_fading: Vec::new(),
+        });
+        Ok(true)
+    }
+
+    /// Generates the living clouds around `point_m` and waits for them, without a sky: for
+    /// asking about the air ([`Self::air_at`]) where nothing is drawn (the command line, tests).
+    pub fn settle_clouds_around(&mut self, point_m: DVec3) -> Result<(), RenderError> {
+        self.start_living()?;
+        let weather_field = &self.field;
+        if let Some(living) = self.living.as_mut() {
+            living
+                .field
+                .update(point_m.truncate(), &|i| weather_field.block_weather(i));
+            living.field.wait_for_pending();
+            living.field.advance(0.0);
+        }
+        Ok(())
+    }
+
     /// Advances the clouds stage's [`CloudField`] around `camera_m` by `dt_s` seconds (blocks
     /// generated in the background, no call waits for them unless clouds are synchronous;
     /// arriving into an empty sky, they fade in; drifting with the wind;
@@ -267,32 +318,8 @@ impl World {
         dt_s: f64,
     ) -> Result<(), RenderError> {
         let start = Instant::now();
-        if self.living.is_none() {
-            let mut config = self.clouds_config;
-            config.field.radius_m = self.settings.cloud_radius_m;
-            config.field.seed = self.settings.seed;
-            // Generating while frames go on: one thread per core but one, so the frame thread
-            // keeps a core of its own (on 2 busy cores the first update's median went from 11
-            // to 3 ms). Synchronous (the warm-up, tests, offline): every core (0).
-            let threads = match self.synchronous_clouds {
-                true => 0,
-                false => std::thread::available_parallelism().map_or(1, |n| n.get().max(2) - 1),
-            };
-            let field = CloudField::new(config, Arc::new(self.types.clone()), threads)
-                .map_err(|e| RenderError::Clouds(e.to_string()))?;
-            sky.set_lifecycle(config.lifecycle);
-            self.living = Some(LivingClouds {
-                field,
-                weather: HashMap::new(),
-                asked: None,
-                in_sky: HashSet::new(),
-                seen: HashSet::new(),
-                newest_serial: 0,
-                membership: None,
-                arriving: HashMap::new(),
-                fading: Vec::new(),
-                was_fading: Vec::new(),
-            });
+        if self.start_living()? {
+            sky.set_lifecycle(self.clouds_config.lifecycle);
         }
         let weather_field = &self.field;
         let Some(living) = self.living.as_mut() else {

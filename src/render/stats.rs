@@ -75,13 +75,16 @@ pub struct FrameStats {
     pub sprites_lit: u32,
     /// CPU time of that light, microseconds (part of `cpu_update_us`).
     pub light_us: u64,
+    /// CPU time of the host's air-data queries this frame (`SkySystem::air_at`, lines of
+    /// sight), microseconds: set by the host that asks (`skycast fly` does), 0 otherwise.
+    pub air_us: u64,
 }
 
 impl FrameStats {
-    /// All the CPU time the sky cost the frame thread: the cloud field, the update and the
-    /// recording, microseconds.
+    /// All the CPU time the sky cost the frame thread: the cloud field, the update, the
+    /// recording and the host's air-data queries, microseconds.
     pub fn sky_cpu_us(&self) -> u64 {
-        self.field_us + self.cpu_update_us + self.record_us
+        self.field_us + self.cpu_update_us + self.record_us + self.air_us
     }
 }
 

@@ -5,6 +5,7 @@
 //! `field` triangulates the placed reports (spade, Delaunay) and interpolates by natural
 //! neighbours; `block` holds the per-block result the clouds stage consumes.
 
+pub mod air;
 pub mod block;
 pub mod cloud_type;
 pub mod error;

@@ -76,6 +76,11 @@ pub struct StationSample {
     pub precipitation: f64,
     /// Station elevation, metres.
     pub elevation_m: Option<f64>,
+    /// Gusts above the mean wind, knots: 0 for a reported wind without gusts, `None` without
+    /// a wind.
+    pub gust_excess_kt: Option<f64>,
+    /// Altimeter setting (QNH), hPa.
+    pub qnh_hpa: Option<f64>,
 }
 
 impl StationSample {
@@ -107,6 +112,11 @@ impl StationSample {
             dewpoint_c: r.dewpoint_c.map(f64::from),
             precipitation: precipitation(r, settings),
             elevation_m: placed.position.elevation_m,
+            gust_excess_kt: r.wind.and_then(|w| {
+                let speed = f64::from(w.speed_kt?);
+                Some(w.gust_kt.map_or(0.0, |g| (f64::from(g) - speed).max(0.0)))
+            }),
+            qnh_hpa: r.altimeter_hpa.map(f64::from),
         })
     }
 
@@ -153,6 +163,8 @@ impl StationSample {
                 ThemePrecipitation::Heavy => p.heavy,
             },
             elevation_m: Some(f64::from(weather.ground_elevation_m)),
+            gust_excess_kt: Some(0.0),
+            qnh_hpa: None,
         }
     }
 
