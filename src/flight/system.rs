@@ -464,18 +464,6 @@ impl SkySystem {
         Ok(self.sky.record_view(id, encoder, colour, depth)?)
     }
 
-    /// A host position in the local frame's metres.
-    fn local_m(&self, position: HostPosition) -> DVec3 {
-        match position {
-            HostPosition::Local(p) => p,
-            HostPosition::LatLonAlt {
-                lat_deg,
-                lon_deg,
-                alt_m,
-            } => self.frame.to_local_m(lat_deg, lon_deg).extend(alt_m),
-        }
-    }
-
     /// The light and fog of the last [`Self::update`], for the host's own scene.
     pub fn lighting(&self) -> HostLighting {
         let light = self.sky.light();
