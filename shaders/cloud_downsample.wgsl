@@ -27,5 +27,7 @@ fn fs_downsample(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f3
             farthest = farther_depth(farthest, textureLoad(scene_depth, at, 0).r);
         }
     }
-    return vec4<f32>(linear_depth_m(farthest), 0.0, 0.0, 0.0);
+    // Where the host drew nothing in the whole block, nothing is in front of the far field's
+    // clouds beyond its far plane either (`far_field.wgsl`).
+    return vec4<f32>(select(linear_depth_m(farthest), 1.0e9, is_background(farthest)), 0.0, 0.0, 0.0);
 }

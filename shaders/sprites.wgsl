@@ -39,9 +39,11 @@ fn vs_sprite(v: VertexIn) -> VertexOut {
         return o;
     }
     o.colour = v.colour;
-    o.position = frame.view_proj * vec4<f32>(v.position_visible.xyz, 1.0);
-    // Aerial perspective: distant clouds fade into the horizon haze.
-    let haze = 1.0 - exp(-max(o.position.w, 0.0) / frame.haze.x);
+    // On the round Earth (`earth_curved`): at 100 km a sprite sits 0.8 km below the flat frame.
+    let rel = earth_curved(v.position_visible.xyz);
+    o.position = frame.view_proj * vec4<f32>(rel, 1.0);
+    // Aerial perspective: distant clouds fade into the horizon haze, thinner with height.
+    let haze = 1.0 - haze_transmittance(length(rel), v.position_visible.z);
     o.uv_haze = vec3<f32>(v.uv, haze);
     return o;
 }

@@ -7,7 +7,11 @@ struct TerrainFrame {
     origin_rel: vec4<f32>,
     sun_dir: vec4<f32>,
     sun_rgb: vec4<f32>,
+    // w: the camera's distance from the Earth's centre, metres (0: flat).
     fog_rgb: vec4<f32>,
+    // The altitude haze (shared/frame.wgsl `haze`); origin_rel.w: the camera's height above its
+    // base.
+    haze: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> terrain: TerrainFrame;
@@ -26,14 +30,41 @@ struct TerrainOut {
     @location(2) normal: vec3<f32>,
     // Metres from the mesh origin, horizontal: where the ground's patterns are anchored.
     @location(3) ground_xy: vec2<f32>,
+    // The ground's height above the camera, metres (the flat frame's: the true one).
+    @location(4) dz_m: f32,
 };
+
+// The round Earth (shared/frame.wgsl `earth_curved`, src/render/earth.rs `curved_rel`: keep
+// in sync): the ground drops below the camera's level plane as the clouds do.
+fn earth_curved(rel: vec3<f32>) -> vec3<f32> {
+    let rc = terrain.fog_rgb.w;
+    let s = length(rel.xy);
+    if (rc <= 0.0 || s <= 0.0) {
+        return rel;
+    }
+    let theta = s / rc;
+    let sin_half = sin(0.5 * theta);
+    let drop = 2.0 * sin_half * sin_half;
+    let along = (rc + rel.z) * sin(theta) / s;
+    return vec3<f32>(rel.xy * along, rel.z * (1.0 - drop) - rc * drop);
+}
+
+// The altitude haze (shared/frame.wgsl `haze_mean`: keep in sync).
+fn haze_mean(per_m: f32, scale_m: f32, h0: f32, h1: f32) -> f32 {
+    let low = max(min(h0, h1), 0.0);
+    let x = abs(h1 - h0) / scale_m;
+    let spread = select((1.0 - exp(-x)) / max(x, 1.0e-3), 1.0 - 0.5 * x, x < 1.0e-3);
+    return per_m * exp(-low / scale_m) * spread;
+}
 
 @vertex
 fn vs_terrain(v: TerrainVertex) -> TerrainOut {
     var o: TerrainOut;
-    let rel = v.position_m + terrain.origin_rel.xyz;
+    let flat = v.position_m + terrain.origin_rel.xyz;
+    let rel = earth_curved(flat);
     o.position = terrain.view_proj * vec4<f32>(rel, 1.0);
     o.rel_m = rel;
+    o.dz_m = flat.z;
     o.height_m = v.height_m;
     o.normal = v.normal.xyz;
     o.ground_xy = v.position_m.xy;
@@ -116,7 +147,11 @@ fn fs_terrain(i: TerrainOut) -> @location(0) vec4<f32> {
     let fresnel = 0.02 + 0.98 * pow(1.0 - max(view.z, 0.0), 5.0);
     let glint = pow(max(dot(reflect(-terrain.sun_dir.xyz, n), view), 0.0), 200.0);
     lit += water * (terrain.fog_rgb.rgb * fresnel + terrain.sun_rgb.rgb * glint);
+    // The altitude haze along the ray from the camera (src/shading/fog.rs `AltitudeHaze`).
     let dist = length(i.rel_m);
-    let fog = 1.0 - exp(-dist * 3.0 / max(terrain.fog_rgb.w, 1.0));
+    let h0 = terrain.origin_rel.w;
+    let h1 = h0 + i.dz_m;
+    let k = terrain.haze;
+    let fog = 1.0 - exp(-dist * (haze_mean(k.x, k.y, h0, h1) + haze_mean(k.z, k.w, h0, h1)));
     return vec4<f32>(mix(lit, terrain.fog_rgb.rgb, fog), 1.0);
 }

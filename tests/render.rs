@@ -1592,3 +1592,262 @@ fn harris_lastra_darkens_a_cumulus_body_against_a_low_sun() {
     assert_eq!(lit_after(&mut rig, 272.5), 0, "a deck arrives: nothing lit");
     assert_eq!(lit_after(&mut rig, 275.0), 0, "the sun turns: nothing lit");
 }
+
+/// Issue 31, altitude haze: from FL350 over a reported visibility of 10 km or more (9999: clear
+/// air), cumulus 15 to 40 km ahead stand out from the ground right beneath them by at least 0.25
+/// in luminance, every one of them (each at the pixels of its body, against the same pixels with
+/// no clouds). The negative control: with the old haze (the surface visibility along the whole
+/// ray) the clouds and the ground both drown in it, and the same measure falls under 0.25. A
+/// visibility of exactly 10 km taken as it is (not as a capped report) is the hazy case: printed
+/// for the book, and the nearest cloud still stands out by 0.25.
+#[test]
+fn from_fl350_near_cumulus_stand_out_from_the_ground_below() {
+    use skycast::render::earth::curved_rel;
+    use skycast::shading::FogSettings;
+    let contrast = |altitude_haze: bool, literal_10_km: bool| -> Vec<f32> {
+        let ground = HeightField::from_fn(DVec2::ZERO, 120_000.0, 64, |_| 200.0);
+        let mut rig = Rig::new(ground);
+        // A report of 10 km is capped (9999): clear air; `literal_10_km` takes it as it is.
+        let shipped = FogSettings::default();
+        rig.host.sky.set_fog_settings(FogSettings {
+            altitude_haze,
+            capped_visibility_m: if literal_10_km {
+                20_000.0
+            } else {
+                shipped.capped_visibility_m
+            },
+            ..shipped
+        });
+        rig.host.sky.set_weather_overhead(&BlockWeather {
+            visibility_m: 10_000.0,
+            ground_elevation_m: 200.0,
+            ..BlockWeather::default()
+        });
+        let centres: Vec<DVec3> = (0..6)
+            .map(|k| {
+                let north = 15_000.0 + 5_000.0 * k as f64;
+                DVec3::new(if k % 2 == 0 { -2500.0 } else { 2500.0 }, north, 1700.0)
+            })
+            .collect();
+        let blocks: Vec<SkyBlock> = centres
+            .iter()
+            .enumerate()
+            .map(|(k, &c)| SkyBlock {
+                id: 40 + k as u64,
+                centre_m: c,
+                clouds: vec![big_cumulus(c, 2.0)],
+            })
+            .collect();
+        let cam_at = DVec3::new(0.0, 0.0, 10_668.0);
+        let name = match (altitude_haze, literal_10_km) {
+            (true, false) => "fl350-haze",
+            (true, true) => "fl350-haze-10km",
+            _ => "fl350-old-haze",
+        };
+        rig.set_clouds(blocks);
+        let cam = rig.camera(cam_at, 0.0, -25.0);
+        let (with, _) = rig.frame(name, &cam);
+        rig.set_clouds(Vec::new());
+        let (without, _) = rig.frame(&format!("{name}-ground"), &cam);
+        let vp = cam.view_proj_relative();
+        let rc = rig.host.sky.earth().camera_radius_m(cam_at.z);
+        centres
+            .iter()
+            .map(|&c| {
+                // The body of the cloud: 500 m up its middle, drawn on the round Earth.
+                let rel = (c + DVec3::new(0.0, 0.0, 500.0) - cam_at).as_vec3();
+                let clip = vp * curved_rel(rel, rc).extend(1.0);
+                let (x, y) = (clip.x / clip.w, clip.y / clip.w);
+                let px = ((x + 1.0) * 0.5 * W as f32) as i32;
+                let py = ((1.0 - y) * 0.5 * H as f32) as i32;
+                let mut diff = Vec::new();
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let (u, v) = (px + dx, py + dy);
+                        assert!(u >= 0 && v >= 0 && (u as u32) < W && (v as u32) < H);
+                        let i = (v as u32 * W + u as u32) as usize;
+                        diff.push(luminance(with.rgba[i]) - luminance(without.rgba[i]));
+                    }
+                }
+                median(diff)
+            })
+            .collect()
+    };
+    let now = contrast(true, false);
+    let before = contrast(false, false);
+    let hazy = contrast(true, true);
+    eprintln!(
+        "cloud minus ground luminance, 15 to 40 km: altitude haze {now:?}, old haze {before:?}, \
+         exactly 10 km {hazy:?}"
+    );
+    let least = now.iter().copied().fold(f32::MAX, f32::min);
+    let old_most = before.iter().copied().fold(f32::MIN, f32::max);
+    assert!(least >= 0.25, "a cloud stands out by only {least}");
+    assert!(old_most < 0.25, "the old haze: {old_most}");
+    assert!(hazy[0] >= 0.25, "exactly 10 km: {hazy:?}");
+}
+
+/// Issue 31, the far field: from FL350 over a heaped layer the weather has everywhere (half
+/// cover, 1,500 to 2,500 m), the rows of the frame whose rays meet the layer 150 to 400 km out
+/// (on the round Earth) show clouds: they differ from the same rows of a sky whose weather has
+/// none. The negative control is today's plate edge: with the far field off, nothing out there.
+#[test]
+fn from_fl350_the_clouds_reach_the_horizon() {
+    use skycast::clouds::far_map::FarMap;
+    let mut settings = RenderSettings::default();
+    // A narrow view (12 degrees) on the band below the horizon: 15 rows a degree.
+    settings.camera.fov_y_deg = 12.0;
+    let ground = HeightField::from_fn(DVec2::ZERO, 120_000.0, 16, |_| 0.0);
+    let mut rig = Rig::with_settings(ground, settings);
+    let map = |cover: f32| FarMap {
+        texels: 96,
+        texel_m: 10_000.0,
+        centre_m: DVec2::ZERO,
+        cells: vec![[cover, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
+    };
+    let cam_at = DVec3::new(0.0, 0.0, 10_668.0);
+    let cam = rig.camera(cam_at, 0.0, -3.5);
+    let mut frame = |name: &str, cover: f32, on: bool| {
+        rig.host.sky.set_far_map(&rig.host.gpu.queue, &map(cover));
+        rig.host.sky.set_far_field_enabled(on);
+        rig.frame(name, &cam).0
+    };
+    let cloudy = frame("far-field", 0.5, true);
+    let clear = frame("far-field-clear", 0.0, true);
+    let plate = frame("far-field-off", 0.5, false);
+    // Where a row's ray (the middle column) meets the layer's middle, 2 km up: the sphere's
+    // geometry in f64.
+    let r = 6_371_000.0f64;
+    let layer_km = |row: u32| -> Option<f64> {
+        let ndc = 1.0 - 2.0 * (row as f64 + 0.5) / H as f64;
+        let elevation = (-3.5f64).to_radians() + (ndc * 6.0f64.to_radians().tan()).atan();
+        let (rc, rl) = (r + cam_at.z, r + 2000.0);
+        let b = rc * elevation.sin();
+        let disc = b * b - (rc * rc - rl * rl);
+        (disc >= 0.0 && b < 0.0).then(|| (-b - disc.sqrt()) / 1000.0)
+    };
+    let rows: Vec<u32> = (0..H)
+        .filter(|&y| layer_km(y).is_some_and(|d| (150.0..=400.0).contains(&d)))
+        .collect();
+    let span = (
+        rows.first().and_then(|&y| layer_km(y)),
+        rows.last().and_then(|&y| layer_km(y)),
+    );
+    assert!(rows.len() >= 8, "rows {rows:?}");
+    let differ = |a: &Frame, b: &Frame| -> f32 {
+        let mut changed = 0;
+        for &y in &rows {
+            for x in 0..W {
+                let i = (y * W + x) as usize;
+                if (luminance(a.rgba[i]) - luminance(b.rgba[i])).abs() > 0.01 {
+                    changed += 1;
+                }
+            }
+        }
+        changed as f32 / (rows.len() as u32 * W) as f32
+    };
+    let far = differ(&cloudy, &clear);
+    let today = differ(&plate, &clear);
+    eprintln!("rows {span:?} km: clouds on {far} of the pixels, {today} with the far field off");
+    assert!(
+        far > 0.3,
+        "only {far} of the rows at 150-400 km show clouds"
+    );
+    assert!(today < 0.01, "the far field off still shows {today}");
+}
+
+/// Mean luminance change per pixel between successive frames of a flight north at 10 km, looking
+/// 8 degrees down, towards cumulus 58 to 62 km ahead (sprites: the ring off, drawn to 100 km)
+/// over a far field of heaped cloud: the clouds cross the end of the hand-over band at 60 km,
+/// where the sprites fade out and the far field fades in, over `band_m`. A frame's change is the
+/// sum over the pixels of their luminance's change; returned, each frame's change over the
+/// median change of the frames around it (three either side): above 1 where a frame changes
+/// more than the plain motion around it.
+fn hand_over_run(band_m: f32) -> Vec<f32> {
+    use skycast::clouds::far_map::FarMap;
+    let mut settings = RenderSettings::default();
+    settings.impostors.enabled = false;
+    settings.clouds.draw_distance_m = 100_000.0;
+    settings.far_field.fade_end_m = 60_000.0;
+    settings.far_field.fade_start_m = 60_000.0 - band_m;
+    settings.camera.fov_y_deg = 20.0;
+    let ground = HeightField::from_fn(DVec2::ZERO, 400_000.0, 16, |_| 0.0);
+    let mut rig = Rig::with_settings(ground, settings);
+    rig.host.sky.set_far_map(
+        &rig.host.gpu.queue,
+        &FarMap {
+            texels: 96,
+            texel_m: 10_000.0,
+            centre_m: DVec2::ZERO,
+            cells: vec![[0.15, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
+        },
+    );
+    let mut blocks = Vec::new();
+    // Sixteen along a diagonal 58 to 61.75 km ahead: as the camera flies 1 km, the end of the
+    // band passes four of them, each on a frame of its own.
+    for k in 0..16 {
+        let c = DVec3::new(
+            -30_000.0 + 4000.0 * k as f64,
+            58_000.0 + 250.0 * k as f64,
+            1500.0,
+        );
+        blocks.push(SkyBlock {
+            id: 60 + k as u64,
+            centre_m: c,
+            clouds: vec![big_cumulus(c, 3.0)],
+        });
+    }
+    rig.set_clouds(blocks);
+    let mut last: Option<Frame> = None;
+    let mut out = Vec::new();
+    for k in 0..41 {
+        // 25 m a frame (a tenth of a second at cruise).
+        let cam = rig.camera(DVec3::new(0.0, k as f64 * 25.0, 10_000.0), 0.0, -8.0);
+        let (frame, _) = rig.host.frame(&cam, &sun(), 0.05, 40_000.0).unwrap();
+        if let Some(prev) = &last {
+            let change = frame
+                .rgba
+                .iter()
+                .zip(&prev.rgba)
+                .map(|(a, b)| (luminance(*a) - luminance(*b)).abs())
+                .sum::<f32>();
+            out.push(change);
+        }
+        if k == 20 {
+            let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
+            std::fs::create_dir_all(&dir).unwrap();
+            frame
+                .write_png(&dir.join(format!("hand-over-{band_m}.png")))
+                .unwrap();
+        }
+        last = Some(frame);
+    }
+    (0..out.len())
+        .map(|k| {
+            let around: Vec<f32> = (k.saturating_sub(3)..(k + 4).min(out.len()))
+                .filter(|&j| j != k)
+                .map(|j| out[j])
+                .collect();
+            out[k] / median(around).max(1e-9)
+        })
+        .collect()
+}
+
+/// Issue 31, popping across the sprite / far-field hand-over: no frame of the flight changes
+/// more than 1.5x the plain motion of the frames around it. The negative control: a hand-over
+/// band of a metre (sprites out and far field in at once) makes the frames where a cloud crosses
+/// it pop.
+#[test]
+fn the_far_field_hand_over_does_not_pop() {
+    let blended = hand_over_run(18_000.0);
+    let worst = blended.iter().copied().fold(0.0, f32::max);
+    eprintln!("hand-over 18 km: worst {worst} x the frames around, {blended:?}");
+    let hard = hand_over_run(1.0);
+    let hard_worst = hard.iter().copied().fold(0.0, f32::max);
+    eprintln!("hand-over 1 m: worst {hard_worst} x the frames around, {hard:?}");
+    assert!(
+        worst <= 1.5,
+        "a frame pops: {worst} x the plain motion around it"
+    );
+    assert!(hard_worst > 1.5, "without a blend: {hard_worst}");
+}

@@ -4,14 +4,17 @@ struct Frame {
     inv_view_proj: mat4x4<f32>,
     sun_dir: vec4<f32>,
     sun_rgb: vec4<f32>,
+    // w: the camera's height above the haze's base (the ground under it), metres.
     sky_zenith_rgb: vec4<f32>,
+    // w: the camera's distance from the Earth's centre, metres (0: the flat frame).
     sky_horizon_rgb: vec4<f32>,
     in_cloud_rgba: vec4<f32>,
     // x: the host's background depth (1 standard Z, 0 reversed), y: 1 / soft_depth_fade_m (the
     // soft fades multiply by it: a division per fragment spared), z: soft_depth_fade_m,
     // w: in_cloud_visibility_m
     params: vec4<f32>,
-    // x: haze distance, metres
+    // The altitude haze (src/shading/fog.rs `AltitudeHaze::to_gpu`): x: the boundary layer's
+    // extinction at the ground, per metre; y: its scale height, metres; z, w: clear air's.
     haze: vec4<f32>,
     // The host projection's depth to metres: -(a d + b) / (c d + e) for (a, b, c, e).
     depth_to_view: vec4<f32>,
@@ -56,6 +59,40 @@ fn scene_m_at(frag_xy: vec2<f32>) -> f32 {
         return stored;
     }
     return linear_depth_m(stored);
+}
+
+// The round Earth: a camera-relative point of the flat frame placed on the sphere the camera
+// flies over (src/render/earth.rs `curved_rel`, keep in sync; also in terrain.wgsl).
+fn earth_curved(rel: vec3<f32>) -> vec3<f32> {
+    let rc = frame.sky_horizon_rgb.w;
+    let s = length(rel.xy);
+    if (rc <= 0.0 || s <= 0.0) {
+        return rel;
+    }
+    let theta = s / rc;
+    let sin_half = sin(0.5 * theta);
+    let drop = 2.0 * sin_half * sin_half;
+    let along = (rc + rel.z) * sin(theta) / s;
+    return vec3<f32>(rel.xy * along, rel.z * (1.0 - drop) - rc * drop);
+}
+
+// The mean of `per_m exp(-h / scale_m)` along a straight ray between heights `h0` and `h1`
+// above the haze's base (src/shading/fog.rs `mean_extinction`, keep in sync).
+fn haze_mean(per_m: f32, scale_m: f32, h0: f32, h1: f32) -> f32 {
+    let low = max(min(h0, h1), 0.0);
+    let x = abs(h1 - h0) / scale_m;
+    let spread = select((1.0 - exp(-x)) / max(x, 1.0e-3), 1.0 - 0.5 * x, x < 1.0e-3);
+    return per_m * exp(-low / scale_m) * spread;
+}
+
+// How much of what lies `dist_m` from the camera, `dz_m` above it (the flat frame's height
+// difference: the true one), shows through the altitude haze, 0..1
+// (`AltitudeHaze::transmittance`).
+fn haze_transmittance(dist_m: f32, dz_m: f32) -> f32 {
+    let h0 = frame.sky_zenith_rgb.w;
+    let h1 = h0 + dz_m;
+    let k = frame.haze;
+    return exp(-dist_m * (haze_mean(k.x, k.y, h0, h1) + haze_mean(k.z, k.w, h0, h1)));
 }
 
 // Full-screen triangle.

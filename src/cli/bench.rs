@@ -98,6 +98,13 @@ pub struct BenchArgs {
     /// three).
     #[arg(long = "scenario", value_parser = ["sparse", "scattered", "overcast"])]
     pub scenarios_only: Vec<String>,
+    /// Camera height above the scenario's station, feet (the cruise-altitude case: 35000).
+    #[arg(long, default_value_t = CRUISE_FT_AGL)]
+    pub alt_ft: f64,
+    /// Run only with the far field (`on`), only without it (`off`: its rows are the scenario
+    /// name with `-nofar`), or both, one after the other.
+    #[arg(long, default_value = "on", value_parser = ["on", "off", "both"])]
+    pub far_field: String,
     /// Run only with the impostor ring (`on`), only without it (`off`), or both.
     #[arg(long, default_value = "both", value_parser = ["on", "off", "both"])]
     pub impostors: String,
@@ -227,6 +234,8 @@ struct Setup {
     unix_s: f64,
     /// Time the sky's passes one by one (`--passes`).
     passes: bool,
+    /// Camera height above the station, feet.
+    alt_ft_agl: f64,
 }
 
 /// What a run came to.
@@ -251,6 +260,13 @@ fn fly(
     (impostors, scales): (bool, &[f32]),
 ) -> anyhow::Result<Vec<Flown>> {
     let ground = demo_ground(world.field(), &GroundSettings::default());
+    // The far field's map around the path (12 km: one map holds it), made once.
+    let far_map = setup.settings.far_field.enabled.then(|| {
+        let f = setup.settings.far_field;
+        let field = world.field();
+        skycast::clouds::far_map::FarMapFeed::new(f.texels, f.texel_m, f.move_texels, 1)
+            .update(DVec2::ZERO, |p| field.weather_at(p))
+    });
     let mut hosts = Vec::new();
     for &cloud_scale in scales {
         let mut settings = setup.settings;
@@ -268,6 +284,11 @@ fn fly(
             },
         )?);
     }
+    if let Some(Some(map)) = &far_map {
+        for host in &mut hosts {
+            host.sky.set_far_map(&host.gpu.queue, map);
+        }
+    }
     if setup.passes {
         for host in &mut hosts {
             if !host.sky.set_pass_timing(true) {
@@ -283,7 +304,7 @@ fn fly(
         first.gpu.adapter_info.name, first.gpu.adapter_info.backend
     );
     let max_sprites = first.max_sprites();
-    let alt_m = ground.height_at_m(DVec2::ZERO) + CRUISE_FT_AGL * METRES_PER_FOOT;
+    let alt_m = ground.height_at_m(DVec2::ZERO) + setup.alt_ft_agl * METRES_PER_FOOT;
     let sun = sun_position(setup.unix_s, at.0, at.1);
     let visibility_m = world.visibility_m();
     let step_m = PATH_LENGTH_M / (setup.frames - 1) as f64;
@@ -424,6 +445,15 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         frames: args.frames,
         unix_s,
         passes: args.passes,
+        alt_ft_agl: args.alt_ft,
+    };
+    if !(0.0..=60_000.0).contains(&args.alt_ft) {
+        anyhow::bail!("--alt-ft {} is outside 0..=60000", args.alt_ft);
+    }
+    let fars: &[bool] = match args.far_field.as_str() {
+        "on" => &[true],
+        "off" => &[false],
+        _ => &[true, false],
     };
     setup.settings.impostors.view_radius_m = view_radius_m;
     let clouds = &mut setup.settings.clouds;
@@ -449,9 +479,17 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         let (mut world, at) =
             scenario_world(&args.scenarios, scenario, &stations, &world_settings)?;
         let overdraw = mean_overdraw(&world, world_settings.seed);
-        for &impostors in rings {
+        for (&impostors, &far) in rings.iter().flat_map(|r| fars.iter().map(move |f| (r, f))) {
+            setup.settings.far_field.enabled = far;
+            // Rows without the far field go by a name of their own (a leak of a few bytes a
+            // run, for the life of the command).
+            let label: &'static str = if far {
+                scenario
+            } else {
+                Box::leak(format!("{scenario}-nofar").into_boxed_str())
+            };
             eprintln!(
-                "bench: {scenario}, impostors {}, cloud scales {}",
+                "bench: {label}, impostors {}, cloud scales {}",
                 if impostors { "on" } else { "off" },
                 scales
                     .iter()
@@ -484,7 +522,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
                     }
                 };
                 runs.push(Run {
-                    scenario,
+                    scenario: label,
                     overdraw,
                     impostors,
                     cloud_scale,
@@ -498,7 +536,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let scale_rank = |run: &Run| scales.iter().position(|&s| s == run.cloud_scale);
     runs.sort_by_key(|r| {
         (
-            SCENARIOS.iter().position(|&s| s == r.scenario),
+            SCENARIOS.iter().position(|&s| r.scenario.starts_with(s)),
+            r.scenario.len(),
             scale_rank(r),
             !r.impostors,
         )
@@ -635,7 +674,7 @@ fn print_table(adapter: &str, args: &BenchArgs, timing: &str, rows: &[Row]) {
         args.size.1,
         args.frames,
         PATH_LENGTH_M / 1000.0,
-        CRUISE_FT_AGL
+        args.alt_ft
     );
     println!(
         "{:<10} {:>9} {:>9} {:>5} {:>10} {:>8} {:>8} {:>10} {:>7} {:>10} {:>6} {:>7} {:>10} {:>9} {:>9}",

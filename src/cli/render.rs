@@ -249,6 +249,24 @@ pub fn load_look(
     Ok((settings, table))
 }
 
+/// Nearest-texel stretch of a `from`-sized image to `to`.
+fn stretch(values: &[f32], from: (u32, u32), to: (u32, u32)) -> Vec<f32> {
+    let mut out = Vec::with_capacity((to.0 * to.1) as usize);
+    for y in 0..to.1 {
+        let sy = (u64::from(y) * u64::from(from.1) / u64::from(to.1.max(1))) as u32;
+        for x in 0..to.0 {
+            let sx = (u64::from(x) * u64::from(from.0) / u64::from(to.0.max(1))) as u32;
+            out.push(
+                values
+                    .get((sy * from.0 + sx) as usize)
+                    .copied()
+                    .unwrap_or(0.0),
+            );
+        }
+    }
+    out
+}
+
 /// Runs `skycast render`.
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let (lat, lon) = args.at;
@@ -261,7 +279,21 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let field = loaded
         .input
         .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);
-    let ground = args.elevation.ground(&field)?;
+    let mut ground = args.elevation.ground(&field)?;
+    // From high up (above 18,000 ft) the demo ground reaches the horizon (sqrt(2 R h), 370 km
+    // from FL350), so its square edge does not cut the far clouds' ground; coarser, at the same
+    // vertex count.
+    let horizon_m = (2.0 * 6_371_000.0 * (args.alt_ft * METRES_PER_FOOT).max(0.0)).sqrt();
+    let shipped = GroundSettings::default();
+    if args.elevation.elevation.is_none() && args.alt_ft > 18_000.0 {
+        ground = demo_ground(
+            &field,
+            &GroundSettings {
+                size_m: 2.2 * horizon_m,
+                ..shipped
+            },
+        );
+    }
     let mut host = DemoHost::new(
         args.size.0,
         args.size.1,
@@ -277,8 +309,20 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let (frame, stats) = host.step_frame(&camera, unix_s, 0.0)?;
     let sun = sun_position(unix_s, lat, lon);
     frame.write_png(&args.out)?;
+    // The clouds' distance (the cloud target's, stretched to the frame): the EXR's
+    // `cloud_distance`, and its largest value printed.
+    let cloud_distance = host
+        .sky
+        .read_cloud_distance_m(&host.gpu.queue)
+        .map(|(w, h, d)| stretch(&d, (w, h), (frame.width, frame.height)));
     if let Some(exr) = &args.exr {
-        frame.write_exr(exr, camera.near_m, camera.far_m)?;
+        frame.write_exr_with(exr, camera.near_m, camera.far_m, cloud_distance.as_deref())?;
+    }
+    if let Some(d) = &cloud_distance {
+        println!(
+            "cloud_distance: largest {:.1} km",
+            d.iter().fold(0.0f32, |a, &b| a.max(b)) / 1000.0
+        );
     }
     let ground_m = ground.height_at_m(glam::DVec2::ZERO);
     println!(

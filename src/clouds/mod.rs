@@ -11,6 +11,8 @@
 //! - [`lifecycle`]: formation and dissipation as a per-sprite `alpha_morph` (§4).
 //! - [`field`]: [`CloudField`], the blocks around a point: background generation, weather changes
 //!   that dissipate old clouds while new ones form, and drift with the wind.
+//! - [`far_map`]: the far field's cloud map: the weather field on a coarse grid out to the
+//!   horizon of cruise altitude, cover, base and top of a low and a high layer per cell.
 //! - [`preview`]: a CPU orthographic splat of a block to an image, for eyes and tests.
 //!
 //! Units: world positions are f64 metres east, north and up (above mean sea level); everything
@@ -18,6 +20,7 @@
 
 pub mod block;
 pub mod config;
+pub mod far_map;
 pub mod field;
 pub mod generate;
 mod heap;

@@ -194,7 +194,8 @@ impl DemoHost {
                 sun_rgb: light.directional_rgb,
                 ambient: light.ambient_percent * 0.35,
                 fog_rgb: self.sky.fog().rgb,
-                visibility_m: visibility_m.min(self.sky.fog().distance_m),
+                haze: self.sky.ground_haze(visibility_m),
+                camera_radius_m: self.sky.earth().camera_radius_m(camera.position_m.z),
             },
         );
         let mut encoder = self

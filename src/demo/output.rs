@@ -59,16 +59,36 @@ impl Frame {
 
     /// Writes an EXR with linear R, G, B, A as half floats and `Z` (metres) as f32.
     pub fn write_exr(&self, path: &Path, near_m: f32, far_m: f32) -> Result<(), RenderError> {
+        self.write_exr_with(path, near_m, far_m, None)
+    }
+
+    /// [`Self::write_exr`] plus a `cloud_distance` channel (f32 metres from the camera plane of
+    /// the clouds each pixel shows, weighted by their alpha; 0 where there are none), one value a
+    /// pixel, when given.
+    pub fn write_exr_with(
+        &self,
+        path: &Path,
+        near_m: f32,
+        far_m: f32,
+        cloud_distance_m: Option<&[f32]>,
+    ) -> Result<(), RenderError> {
         use exr::prelude::*;
         let channel =
             |i: usize| -> Vec<f16> { self.rgba.iter().map(|p| f16::from_f32(p[i])).collect() };
-        let channels = SmallVec::from_vec(vec![
+        let mut list = vec![
             AnyChannel::new("R", FlatSamples::F16(channel(0))),
             AnyChannel::new("G", FlatSamples::F16(channel(1))),
             AnyChannel::new("B", FlatSamples::F16(channel(2))),
             AnyChannel::new("A", FlatSamples::F16(channel(3))),
             AnyChannel::new("Z", FlatSamples::F32(self.linear_depth_m(near_m, far_m))),
-        ]);
+        ];
+        if let Some(d) = cloud_distance_m.filter(|d| d.len() == self.rgba.len()) {
+            list.push(AnyChannel::new(
+                "cloud_distance",
+                FlatSamples::F32(d.to_vec()),
+            ));
+        }
+        let channels = SmallVec::from_vec(list);
         let image = Image::from_channels(
             (self.width as usize, self.height as usize),
             AnyChannels::sort(channels),

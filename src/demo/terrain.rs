@@ -189,8 +189,11 @@ pub struct TerrainLight {
     pub ambient: f32,
     /// Fog colour (the sky's horizon colour).
     pub fog_rgb: Vec3,
-    /// Visibility, metres.
-    pub visibility_m: f32,
+    /// The haze along view rays ([`crate::render::Sky::ground_haze`]).
+    pub haze: crate::shading::AltitudeHaze,
+    /// The camera's distance from the Earth's centre, metres (0: a flat ground;
+    /// [`crate::render::earth::EarthSettings::camera_radius_m`]).
+    pub camera_radius_m: f32,
 }
 
 impl Terrain {
@@ -297,10 +300,13 @@ impl Terrain {
             (DVec3::new(self.centre_m.x, self.centre_m.y, 0.0) - camera.position_m).as_vec3();
         let frame = GpuTerrainFrame {
             view_proj: camera.view_proj_relative().to_cols_array_2d(),
-            origin_rel: origin_rel.extend(0.0).to_array(),
+            origin_rel: origin_rel
+                .extend(camera.position_m.z as f32 - light.haze.base_msl_m)
+                .to_array(),
             sun_dir: light.sun_dir.extend(light.ambient).to_array(),
             sun_rgb: light.sun_rgb.extend(1.0).to_array(),
-            fog_rgb: light.fog_rgb.extend(light.visibility_m).to_array(),
+            fog_rgb: light.fog_rgb.extend(light.camera_radius_m).to_array(),
+            haze: light.haze.to_gpu(),
         };
         queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&frame));
     }

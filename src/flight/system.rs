@@ -222,6 +222,9 @@ pub struct SkySystem {
     /// The sun and time step of the last [`Self::update`], for the other views of its frame.
     sun: Option<crate::shading::SunPosition>,
     dt_s: f64,
+    /// The far field's cloud map around the camera, built from the weather field a few rows a
+    /// frame (docs/src/horizon.md).
+    far_map: crate::clouds::far_map::FarMapFeed,
 }
 
 impl SkySystem {
@@ -254,7 +257,14 @@ impl SkySystem {
             (field, input.skipped())
         });
         let clear = WeatherField::build(frame, &[], &config.field, &config.rule);
+        let far = config.sky.settings.far_field;
         Ok(Self {
+            far_map: crate::clouds::far_map::FarMapFeed::new(
+                far.texels,
+                far.texel_m,
+                far.move_texels,
+                far.rows_per_frame,
+            ),
             sky: Sky::new(device, queue, config.sky)?,
             world: World::new(clear, &config.world),
             frame,
@@ -309,6 +319,7 @@ impl SkySystem {
     pub fn set_weather_field(&mut self, field: WeatherField) {
         self.skipped = Skipped::default();
         self.world.set_field(field);
+        self.far_map.weather_changed();
         self.sky.ease_weather_overhead();
     }
 
@@ -378,6 +389,15 @@ impl SkySystem {
         self.sky.add_field_cpu_us(weather_us);
         let position_m = self.local_m(camera.position);
         self.world.update_sky(&mut self.sky, position_m, dt_s)?;
+        if self.sky.far_field_settings().enabled {
+            let field = self.world.field();
+            if let Some(map) = self
+                .far_map
+                .update(position_m.truncate(), |p| field.weather_at(p))
+            {
+                self.sky.set_far_map(queue, &map);
+            }
+        }
         self.sky
             .set_weather_overhead(&self.world.weather_over(position_m));
         let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());

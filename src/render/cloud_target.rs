@@ -140,6 +140,79 @@ impl CloudTarget {
             .unwrap_or(0)
     }
 
+    /// The clouds' distance of the last recorded frame, metres from the camera plane per texel
+    /// of the target (its colour's alpha weighs it; 0 where no cloud shows): width, height and
+    /// the texels row by row; `None` at scale 1 or before a frame. Waits for the GPU.
+    pub fn read_distance_m(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Option<(u32, u32, Vec<f32>)> {
+        let offscreen = self.offscreen.as_ref()?;
+        let textures = offscreen.textures.borrow();
+        let t = textures.as_ref()?;
+        let colour = t.colour.texture();
+        let distance = t.distance.texture();
+        let (w, h) = (colour.width(), colour.height());
+        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let rows = [
+            (w * 8).div_ceil(align) * align,
+            (w * 2).div_ceil(align) * align,
+        ];
+        let bufs: Vec<wgpu::Buffer> = rows
+            .iter()
+            .map(|row| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("clouds.distance_readback"),
+                    size: u64::from(row * h),
+                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                    mapped_at_creation: false,
+                })
+            })
+            .collect();
+        let mut enc = device.create_command_encoder(&Default::default());
+        for ((texture, buf), row) in [colour, distance].into_iter().zip(&bufs).zip(rows) {
+            enc.copy_texture_to_buffer(
+                wgpu::TexelCopyTextureInfo {
+                    texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::TexelCopyBufferInfo {
+                    buffer: buf,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(row),
+                        rows_per_image: Some(h),
+                    },
+                },
+                texture.size(),
+            );
+        }
+        queue.submit([enc.finish()]);
+        for b in &bufs {
+            b.map_async(wgpu::MapMode::Read, .., |_| {});
+        }
+        device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
+        let c = bufs[0].get_mapped_range(..).ok()?;
+        let d = bufs[1].get_mapped_range(..).ok()?;
+        let half = |p: &[u8], i: usize| half::f16::from_le_bytes([p[i], p[i + 1]]).to_f32();
+        let mut out = Vec::with_capacity((w * h) as usize);
+        for y in 0..h as usize {
+            for x in 0..w as usize {
+                let alpha = half(&c, y * rows[0] as usize + x * 8 + 6);
+                let km_alpha = half(&d, y * rows[1] as usize + x * 2);
+                out.push(if alpha > 0.01 {
+                    km_alpha / alpha * 1000.0
+                } else {
+                    0.0
+                });
+            }
+        }
+        Some((w, h, out))
+    }
+
     /// The target for a frame of the host's `depth_view`'s size (made or remade if the size
     /// changed); `None` at scale 1.
     pub fn frame(
@@ -316,8 +389,10 @@ impl Offscreen {
                     sample_count: 1,
                     dimension: wgpu::TextureDimension::D2,
                     format,
+                    // COPY_SRC: the clouds' distance read back for `--exr`'s `cloud_distance`.
                     usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                        | wgpu::TextureUsages::TEXTURE_BINDING,
+                        | wgpu::TextureUsages::TEXTURE_BINDING
+                        | wgpu::TextureUsages::COPY_SRC,
                     view_formats: &[],
                 })
                 .create_view(&Default::default())

@@ -17,9 +17,10 @@ pub struct GpuFrame {
     pub sun_dir: [f32; 4],
     /// rgb: sun colour; w: cosine of the glow radius.
     pub sun_rgb: [f32; 4],
-    /// rgb: sky colour straight up.
+    /// rgb: sky colour straight up; w: the camera's height above the haze's base, metres.
     pub sky_zenith_rgb: [f32; 4],
-    /// rgb: sky colour at the horizon.
+    /// rgb: sky colour at the horizon; w: the camera's distance from the Earth's centre, metres
+    /// (0: the flat frame; [`super::earth::EarthSettings::camera_radius_m`]).
     pub sky_horizon_rgb: [f32; 4],
     /// rgb: in-cloud fog colour; a: how far inside a cloud the camera is, 0..=1.
     pub in_cloud_rgba: [f32; 4],
@@ -27,7 +28,7 @@ pub struct GpuFrame {
     /// multiplication per fragment instead of a division), soft_depth_fade_m,
     /// in_cloud_visibility_m.
     pub params: [f32; 4],
-    /// x: distance at which sprites have faded 63% into the horizon haze, metres; yzw unused.
+    /// The altitude haze ([`crate::shading::AltitudeHaze::to_gpu`]).
     pub haze: [f32; 4],
     /// The host projection's depth to metres along the view axis ([`super::SkyView::depth_to_view`]).
     pub depth_to_view: [f32; 4],
@@ -223,16 +224,19 @@ const _: () = assert!(std::mem::size_of::<GpuSpriteView>() == 144 + 48 * MAX_LOC
 pub struct GpuTerrainFrame {
     /// Camera-relative world to clip space.
     pub view_proj: [[f32; 4]; 4],
-    /// xyz: mesh origin minus camera position, metres; w unused.
+    /// xyz: mesh origin minus camera position, metres; w: the camera's height above the haze's
+    /// base, metres.
     pub origin_rel: [f32; 4],
     /// xyz: unit vector towards the sun; w: ambient light factor.
     pub sun_dir: [f32; 4],
     /// rgb: sun colour.
     pub sun_rgb: [f32; 4],
-    /// rgb: fog colour; w: fog visibility, metres.
+    /// rgb: fog colour; w: the camera's distance from the Earth's centre, metres (0: flat).
     pub fog_rgb: [f32; 4],
+    /// The altitude haze ([`crate::shading::AltitudeHaze::to_gpu`]).
+    pub haze: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuTerrainFrame>() == 128);
+const _: () = assert!(std::mem::size_of::<GpuTerrainFrame>() == 144);
 
 /// One terrain vertex, relative to the mesh origin. Keep in sync with `shaders/terrain.wgsl`.
 #[repr(C)]

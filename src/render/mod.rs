@@ -21,6 +21,10 @@
 //!   matrices).
 //! - `cloud_target`: below full resolution, the clouds drawn off-screen against the farthest
 //!   depth of each block of pixels and composited with a full-resolution depth fix-up.
+//! - `earth`: the round Earth every far thing is drawn on (the flat frame's points dropped onto
+//!   the sphere; the shaders' `earth_curved`).
+//! - `far_field`: the clouds beyond the ring out to the horizon: two curved layers of the
+//!   weather's cloud map (`crate::clouds::far_map`), one full-screen pass.
 //! - `pass_timing`: GPU time of each of the sky's passes, a profiling aid (off by default).
 //!
 //! Positions are f64 on the CPU and camera-relative f32 on the GPU. Units: metres, degrees,
@@ -31,6 +35,8 @@ pub mod camera;
 mod cloud_light;
 pub mod cloud_target;
 pub mod draw_list;
+pub mod earth;
+pub mod far_field;
 pub mod gpu_types;
 pub mod impostor;
 mod overhead_ease;

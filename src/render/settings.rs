@@ -163,6 +163,12 @@ pub struct RenderSettings {
     /// The far-cloud impostor ring (Wang 6.2); built-in defaults when the table is absent.
     #[serde(default)]
     pub impostors: super::impostor::ImpostorSettings,
+    /// The round Earth (`[earth]`); curved with the mean radius when the table is absent.
+    #[serde(default)]
+    pub earth: super::earth::EarthSettings,
+    /// The far field (`[far_field]`); the built-in defaults when the table is absent.
+    #[serde(default)]
+    pub far_field: super::far_field::FarFieldSettings,
 }
 
 impl Default for RenderSettings {
@@ -220,6 +226,17 @@ impl RenderSettings {
                 "clouds.resolution_scale",
                 format!("must be 1, 0.5 or 0.25, is {}", s.clouds.resolution_scale),
             ));
+        }
+        if !(s.earth.radius_m >= 1000.0 && s.earth.radius_m.is_finite()) {
+            return Err(ConfigError::at_key(
+                path,
+                text,
+                "earth.radius_m",
+                format!("must be at least 1000 metres, is {}", s.earth.radius_m),
+            ));
+        }
+        if let Some((field, message)) = s.far_field.invalid_field() {
+            return Err(ConfigError::at_key(path, text, field, message));
         }
         if let Some((field, message)) = s.impostors.invalid_field() {
             return Err(ConfigError::at_key(path, text, field, message));

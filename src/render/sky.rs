@@ -125,6 +125,9 @@ pub struct Sky {
     /// Each camera's own state, [`ViewId::MAIN`] first: the blocks, weather and resident
     /// sprites above are shared by all.
     views: Vec<View>,
+    /// The clouds beyond the ring, out to the horizon (one for all views: its map and uniform
+    /// follow the camera of the last prepared view).
+    far_field: super::far_field::FarField,
     elapsed_s: f64,
     /// CPU time of block changes since the last prepare, and the host's field time.
     pending_us: u64,
@@ -307,6 +310,17 @@ impl Sky {
             },
         );
         let light = config.time_of_day.at(45.0);
+        let offscreen_targets = super::cloud_target::cloud_targets();
+        let far_field = super::far_field::FarField::new(
+            device,
+            config.settings.far_field,
+            &super::far_field::FarFieldShared {
+                host_frame_layout: &frame_layout,
+                offscreen_frame_layout: &ring_frame_layout,
+                targets: config.targets,
+                cloud_targets: Some(&offscreen_targets[..]),
+            },
+        );
         let main = View::new(
             device,
             queue,
@@ -339,6 +353,7 @@ impl Sky {
             build,
             view_layout,
             views: vec![main],
+            far_field,
             lifecycle: CloudsConfig::builtin().lifecycle,
             elapsed_s: 0.0,
             pending_us: 0,
@@ -627,6 +642,36 @@ impl Sky {
         self.settings.vertex_cache.enabled = enabled;
     }
 
+    /// Hands the far field a new cloud map ([`crate::clouds::far_map::FarMapFeed`] makes them
+    /// from the weather field as the camera moves); uploaded now.
+    pub fn set_far_map(&mut self, queue: &wgpu::Queue, map: &crate::clouds::far_map::FarMap) {
+        self.far_field.set_map(&self.device, queue, map);
+    }
+
+    /// Switches the far field on or off at run time (for comparisons; the sprites and the ring
+    /// fade out as before without it).
+    pub fn set_far_field_enabled(&mut self, enabled: bool) {
+        self.far_field.set_enabled(enabled);
+    }
+
+    /// The far field's settings (the map's size, the hand-over band).
+    pub fn far_field_settings(&self) -> super::far_field::FarFieldSettings {
+        *self.far_field.settings()
+    }
+
+    /// The clouds' distance in the main view's last recorded frame (metres from the camera
+    /// plane, weighted by what each cloud shows; 0 where none shows) at the cloud target's
+    /// resolution: width, height and the texels row by row. `None` with the clouds drawn at full
+    /// resolution (no cloud target). Waits for the GPU: for tools and tests.
+    pub fn read_cloud_distance_m(&self, queue: &wgpu::Queue) -> Option<(u32, u32, Vec<f32>)> {
+        self.views[0].clouds.read_distance_m(&self.device, queue)
+    }
+
+    /// Replaces the fog and haze settings (the shipped `config/fog.toml` until called).
+    pub fn set_fog_settings(&mut self, fog: crate::shading::FogSettings) {
+        self.fog.0 = fog;
+    }
+
     /// The weather over the camera (the layers and ground of its point of the weather field).
     /// Each frame works out how much of the sky the layers above the camera hide
     /// ([`crate::shading::hidden_above`]): below a thick deck the sky turns grey and dim and
@@ -653,6 +698,21 @@ impl Sky {
     /// found the camera in a rain or snow shaft.
     pub fn fog(&self) -> crate::shading::Fog {
         self.fog_for(self.views[0].in_rain)
+    }
+
+    /// The haze a host fogs its ground with along a view ray ([`crate::shading::AltitudeHaze`]:
+    /// thinning with height), for [`Self::fog`] with its visibility at most `visibility_m`; the
+    /// clouds fade into the same haze.
+    pub fn ground_haze(&self, visibility_m: f32) -> crate::shading::AltitudeHaze {
+        let mut fog = self.fog();
+        fog.distance_m = fog.distance_m.min(visibility_m);
+        self.fog.0.ground_haze(&fog, self.fog.1.ground_elevation_m)
+    }
+
+    /// The round Earth the sky draws on (`[earth]` of the renderer settings); a host draws its
+    /// far ground on the same ([`crate::render::earth::curved_rel`]).
+    pub fn earth(&self) -> crate::render::earth::EarthSettings {
+        self.settings.earth
     }
 
     /// [`Self::fog`] with a view's rain.
@@ -719,6 +779,7 @@ impl Sky {
             ring_bytes: self.views.iter().map(|v| v.ring.gpu_bytes()).sum(),
             cloud_target_bytes: self.views.iter().map(|v| v.clouds.gpu_bytes()).sum(),
             sheet_bytes: self.sheet_bytes,
+            far_field_bytes: self.far_field.gpu_bytes(),
             blocks,
             sprites,
             sprite_slots: sprite_slots.0,
@@ -842,6 +903,7 @@ impl Sky {
             lifecycle: &self.lifecycle,
             camera_z_m: camera.position_m.z as f32,
             farthest_m: self.settings.clouds.draw_distance_m,
+            hand_over_m: self.far_field.hand_over_m(),
         };
         let header = sprite_view::header(&light);
         let v = &mut self.views[i];
@@ -876,6 +938,11 @@ impl Sky {
         // In-cloud fog: the ambient of a mid-grey cloud at this time of day plus some sun.
         let fog_rgb = Vec3::splat(0.8) * self.clear_light.ambient_percent
             + self.clear_light.directional_rgb * 0.25;
+        let cloud_haze = self.fog.0.cloud_haze(
+            &self.fog_for(self.views[i].in_rain),
+            self.settings.clouds.haze_distance_m,
+            self.fog.1.ground_elevation_m,
+        );
         let frame = GpuFrame {
             view_proj: view_proj.to_cols_array_2d(),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
@@ -887,8 +954,18 @@ impl Sky {
                 .directional_rgb
                 .extend(sun_cfg.glow_radius_deg.to_radians().cos())
                 .to_array(),
-            sky_zenith_rgb: self.seen_light.sky_zenith_rgb.extend(1.0).to_array(),
-            sky_horizon_rgb: self.seen_light.sky_horizon_rgb.extend(1.0).to_array(),
+            // w: the camera's height above the haze's base; its distance from the Earth's
+            // centre (0: flat).
+            sky_zenith_rgb: self
+                .seen_light
+                .sky_zenith_rgb
+                .extend(camera.position_m.z as f32 - cloud_haze.base_msl_m)
+                .to_array(),
+            sky_horizon_rgb: self
+                .seen_light
+                .sky_horizon_rgb
+                .extend(self.settings.earth.camera_radius_m(camera.position_m.z))
+                .to_array(),
             in_cloud_rgba: fog_rgb.extend(in_cloud).to_array(),
             params: [
                 self.targets.background_depth(),
@@ -896,18 +973,12 @@ impl Sky {
                 self.settings.clouds.soft_depth_fade_m,
                 self.settings.in_cloud.visibility_m,
             ],
-            haze: [
-                self.fog.0.haze_distance_m(
-                    &self.fog_for(self.views[i].in_rain),
-                    self.settings.clouds.haze_distance_m,
-                ),
-                0.0,
-                0.0,
-                0.0,
-            ],
+            haze: cloud_haze.to_gpu(),
             depth_to_view: camera.depth_to_view(),
         };
         queue.write_buffer(&self.views[i].frame_buffer, 0, bytemuck::bytes_of(&frame));
+        self.far_field
+            .prepare(queue, camera.position_m, &self.clear_light);
         upload_bytes += std::mem::size_of::<GpuFrame>() as u64;
         let ring_frame = RingFrame {
             resident: &self.resident,
@@ -1078,6 +1149,8 @@ impl Sky {
             Some(target) => (target.sprite_pipeline(), target.in_cloud_pipeline()),
             None => (&self.sprite_pipeline, &self.in_cloud_pipeline),
         };
+        // The far field behind the ring and the sprites (blended over, back to front).
+        self.far_field.draw(&mut pass, offscreen.is_some());
         v.ring.draw(&mut pass, offscreen.is_some());
         if timer.is_some() {
             drop(pass);

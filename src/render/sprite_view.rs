@@ -49,6 +49,10 @@ pub(super) struct ViewLight<'a> {
     /// The farthest distance the view draws clouds at, metres: the sprites' draw distance for
     /// the camera, the view radius for an impostor.
     pub farthest_m: f32,
+    /// While the far field is drawn, the band (start, end metres) over which every cloud fades
+    /// out, below the horizon too, as the far field fades in (`far_fade` in
+    /// `shaders/sprite_build.wgsl`).
+    pub hand_over_m: Option<(f32, f32)>,
 }
 
 /// The uniform of a view (its lock table written apart).
@@ -59,7 +63,10 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
         lifecycle,
         camera_z_m,
         farthest_m,
+        hand_over_m,
     } = *light;
+    let (fade_start_m, fade_end_m) =
+        hand_over_m.unwrap_or((farthest_m * (1.0 - clouds.far_fade_fraction), farthest_m));
     let tod = &lighting.time_of_day;
     let m = &lighting.mapping;
     let hl = &lighting.harris_lastra;
@@ -90,10 +97,15 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
         hl_sky: (0.5 * (tod.sky_zenith_rgb + tod.sky_horizon_rgb) * hl.sky_strength)
             .extend(hl.ambient * tod.ambient_percent)
             .to_array(),
-        hl_deck: [1.0 - hl.forward_fraction(), 0.0, 0.0, 0.0],
+        hl_deck: [
+            1.0 - hl.forward_fraction(),
+            f32::from(u8::from(hand_over_m.is_some())),
+            0.0,
+            0.0,
+        ],
         far_fade_layer_turn: [
-            farthest_m * (1.0 - clouds.far_fade_fraction),
-            farthest_m,
+            fade_start_m,
+            fade_end_m,
             sin(clouds.layer_turn_start_deg),
             sin(clouds.layer_turn_end_deg),
         ],

@@ -121,6 +121,8 @@ pub struct SkyMemory {
     pub cloud_target_bytes: u64,
     /// The sprite sheet texture, every mip level.
     pub sheet_bytes: u64,
+    /// The far field's cloud map and uniform (0 with the far field off or no map yet).
+    pub far_field_bytes: u64,
     /// Blocks (cloud generations) the sky holds.
     pub blocks: u32,
     /// Sprites of those blocks.
@@ -143,5 +145,6 @@ impl SkyMemory {
             + self.ring_bytes
             + self.cloud_target_bytes
             + self.sheet_bytes
+            + self.far_field_bytes
     }
 }

@@ -37,7 +37,7 @@ pub mod time_of_day;
 pub use ambient::{ColourLevel, ColourLevels};
 pub use cover::{OvercastLight, hidden_above};
 pub use directional::{DirectionalMapping, directional_percent};
-pub use fog::{Fog, FogSettings};
+pub use fog::{AltitudeHaze, Fog, FogSettings};
 pub use harris_lastra::{
     HarrisLastra, LightScratch, Particle, ParticleLight, RelightTrigger, ShadingModel,
     ShadingSettings,

@@ -1,0 +1,247 @@
+// Pass `far_field.layers` (inside the sky pass, before the impostor ring): the clouds beyond the
+// ring and the sprites, out to the horizon, as two curved layers of the cloud map
+// (src/clouds/far_map.rs): each pixel's ray meets the sphere of a layer's height (the round
+// Earth of `earth_curved`), the map there gives the layer's cover, base, top and kind, and a
+// world-anchored noise thresholded by the cover cuts it into clouds (heaped: small lumps; sheets:
+// broad patches). Faded in over the band where the sprites and the ring fade out, faded into the
+// altitude haze, softly cut by the host's depth. Shared: shared/frame.wgsl.
+
+@group(1) @binding(0) var far_map: texture_2d_array<f32>;
+@group(1) @binding(1) var far_sampler: sampler;
+@group(1) @binding(2) var<uniform> ff: FarField;
+
+// Keep in sync with `GpuFarField` in src/render/far_field/mod.rs.
+struct FarField {
+    // xy: the map's centre relative to the camera, metres; z: the map's side, metres; w: cells
+    // per side.
+    centre_rel_size: vec4<f32>,
+    // xy: the map's centre in the noise's period, metres; z, w: the hand-over band (horizontal
+    // metres from the camera where the far field fades in).
+    noise_fade: vec4<f32>,
+    // rgb: a cloud top's colour in the sun; w: the camera's height above sea level, metres.
+    lit_rgb: vec4<f32>,
+    // rgb: a cloud base's colour; w: the heaped layers' noise scale, metres.
+    shade_rgb: vec4<f32>,
+    // x, y: the low and high layers' mean middle height above sea level, metres; z: the
+    // sheets' noise scale, metres; w: the noise's period, metres.
+    heights: vec4<f32>,
+};
+
+struct FarOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) ndc: vec2<f32>,
+};
+
+@vertex
+fn vs_far_field(@builtin(vertex_index) vi: u32) -> FarOut {
+    var o: FarOut;
+    o.position = fullscreen_position(vi);
+    o.ndc = o.position.xy;
+    return o;
+}
+
+// Where the ray `dir` (unit, from the camera) meets the layer `height_msl` metres above sea
+// level: the distance along it, or -1 where it does not (above the layer's horizon, or away
+// from a level layer). The sphere of radius `rc - camera + height` about the Earth's centre
+// (0, 0, -rc) when the Earth is round, the plane at that height when it is flat. From above a
+// ray that goes down through a round layer comes up through it again beyond its horizon (past
+// 330 km for a layer 8.7 km below: where a pilot sees far clouds' undersides through the gaps
+// of nearer ones, out to `sqrt(2 R h) + sqrt(2 R c)`); `far_side` asks for that crossing, unless
+// the ray meets the sea first.
+fn ray_to_layer(dir: vec3<f32>, height_msl: f32, far_side: bool) -> f32 {
+    let rc = frame.sky_horizon_rgb.w;
+    let above = ff.lit_rgb.w - height_msl;
+    if (rc <= 0.0) {
+        let t = -above / dir.z;
+        return select(-1.0, t, t > 0.0 && abs(dir.z) > 1e-6);
+    }
+    let b = rc * dir.z;
+    // rc^2 - r^2, with the difference of the radii exact.
+    let k = above * (2.0 * rc - above);
+    let disc = b * b - k;
+    if (disc < 0.0) {
+        return -1.0;
+    }
+    let root = sqrt(disc);
+    if (above > 0.0 && far_side) {
+        // The sea, if the ray meets it before it comes up through the layer again.
+        let camera = ff.lit_rgb.w;
+        let k_sea = camera * (2.0 * rc - camera);
+        let disc_sea = b * b - k_sea;
+        let t = -b + root;
+        let sea = select(1.0e12, k_sea / (-b + sqrt(max(disc_sea, 0.0))), disc_sea >= 0.0);
+        return select(-1.0, t, b < 0.0 && t < sea);
+    }
+    if (above > 0.0) {
+        // From above: the nearer crossing, where the ray goes down.
+        return select(-1.0, k / (-b + root), b < 0.0);
+    }
+    if (far_side) {
+        return -1.0;
+    }
+    // From below: the way out through the shell above.
+    return select(-b + root, -k / (b + root), b > 0.0);
+}
+
+// The flat frame's horizontal offset of a camera-relative point on the round Earth (the
+// inverse of `earth_curved`'s horizontal part: the arc along the Earth).
+fn flat_offset(p: vec3<f32>) -> vec2<f32> {
+    let rc = frame.sky_horizon_rgb.w;
+    let h = length(p.xy);
+    if (rc <= 0.0 || h <= 0.0) {
+        return p.xy;
+    }
+    return p.xy * (rc * atan2(h, rc + p.z) / h);
+}
+
+fn hash2(c: vec2<i32>) -> f32 {
+    var h = u32(c.x) * 747796405u ^ u32(c.y) * 2891336453u;
+    h = (h ^ (h >> 16u)) * 73244475u;
+    h = h ^ (h >> 16u);
+    return f32(h & 0xffffu) / 65535.0;
+}
+
+// Value noise with a period of `period` cells (so the world-anchored pattern wraps exactly).
+fn value_noise(p: vec2<f32>, period: i32) -> f32 {
+    let i = vec2<i32>(floor(p));
+    let f = fract(p);
+    let u = f * f * (3.0 - 2.0 * f);
+    let w = vec2<i32>(period);
+    let a = hash2((i % w + w) % w);
+    let b = hash2(((i + vec2<i32>(1, 0)) % w + w) % w);
+    let c = hash2(((i + vec2<i32>(0, 1)) % w + w) % w);
+    let d = hash2(((i + vec2<i32>(1, 1)) % w + w) % w);
+    return mix(mix(a, b, u.x), mix(c, d, u.x), u.y);
+}
+
+// Three octaves at `scale_m`, over the world point `world` (metres in the noise's period).
+fn cloud_noise(world: vec2<f32>, scale_m: f32) -> f32 {
+    let period = ff.heights.w;
+    let cells = i32(round(period / scale_m));
+    var n = 0.5 * value_noise(world / scale_m, cells);
+    n += 0.3 * value_noise(world / scale_m * 2.0 + vec2<f32>(17.3, 5.1), cells * 2);
+    n += 0.2 * value_noise(world / scale_m * 4.0 + vec2<f32>(3.7, 41.9), cells * 4);
+    return n;
+}
+
+// One layer along the ray: premultiplied colour and the distance of its clouds.
+struct FarHit {
+    colour: vec4<f32>,
+    distance_m: f32,
+};
+
+fn far_layer(dir: vec3<f32>, layer: i32, frag_xy: vec2<f32>, far_side: bool) -> FarHit {
+    var none: FarHit;
+    none.colour = vec4<f32>(0.0);
+    none.distance_m = 0.0;
+    var height = select(ff.heights.x, ff.heights.y, layer == 1);
+    var t = -1.0;
+    var cell = vec4<f32>(0.0);
+    var ground_xy = vec2<f32>(0.0);
+    // Meet the layer at its mean height, read the map there, meet it again at the height the
+    // map gives (twice: the layer's height varies slowly across the map).
+    for (var k = 0; k < 2; k++) {
+        t = ray_to_layer(dir, height, far_side);
+        if (t <= 0.0) {
+            return none;
+        }
+        ground_xy = flat_offset(dir * t);
+        let uv = (ground_xy - ff.centre_rel_size.xy) / ff.centre_rel_size.z + vec2<f32>(0.5);
+        if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0))) {
+            return none;
+        }
+        cell = textureSampleLevel(far_map, far_sampler, uv, layer, 0.0);
+        if (cell.x <= 0.01) {
+            return none;
+        }
+        height = 0.5 * (cell.y + cell.z);
+    }
+    // The hand-over: in over the band where the sprites and the ring fade out; out over the
+    // map's last two cells.
+    let s = length(ground_xy);
+    let band = smoothstep(ff.noise_fade.z, ff.noise_fade.w, s);
+    let uv = (ground_xy - ff.centre_rel_size.xy) / ff.centre_rel_size.z + vec2<f32>(0.5);
+    let edge = min(min(uv.x, uv.y), min(1.0 - uv.x, 1.0 - uv.y)) * ff.centre_rel_size.w;
+    let weight = band * smoothstep(0.5, 2.0, edge);
+    if (weight <= 0.0) {
+        return none;
+    }
+    // The clouds: the noise over the threshold the cover sets (cover 1: all of it).
+    let heaped = cell.w > 0.5;
+    let scale = select(ff.heights.z, ff.shade_rgb.w, heaped);
+    let world = ff.noise_fade.xy + (ground_xy - ff.centre_rel_size.xy);
+    let n = cloud_noise(world, scale);
+    // Seen at a slant, heaped clouds' sides fill the gaps between them (a cumulus field runs
+    // together towards the horizon): the cover of a slab `top - base` thick seen at the ray's
+    // elevation, as if the sides hid the gaps at random (`1 - (1 - c)^k`).
+    let sin_e = max(abs(dir.z), 0.01);
+    let sides = select(0.0, 0.5 * (cell.z - cell.y) / (ff.shade_rgb.w * sin_e), heaped);
+    let cover = 1.0 - pow(1.0 - clamp(cell.x, 0.0, 1.0), 1.0 + min(sides, 8.0));
+    let soft = select(0.12, 0.06, heaped);
+    let threshold = mix(0.78, 0.22, cover);
+    let density = select(smoothstep(threshold - soft, threshold + soft, n), 1.0, cover > 0.97);
+    var alpha = density * weight;
+    // Seen from above its top the sunlit side, from below its base the shade, in between mixed;
+    // the lumps of a heaped layer lit on their tops.
+    let camera = ff.lit_rgb.w;
+    // The far side of a layer below is seen from under it.
+    let from_above = select(smoothstep(cell.y, cell.z, camera), 0.0, far_side);
+    let relief = select(0.6 + 0.08 * n, 0.7 + 0.5 * (n - threshold), heaped);
+    var rgb = mix(ff.shade_rgb.rgb, ff.lit_rgb.rgb * clamp(relief, 0.6, 1.1), from_above);
+    // The altitude haze between the camera and the clouds (the flat frame's height: the true).
+    let haze = haze_transmittance(t, height - camera);
+    rgb = mix(frame.sky_horizon_rgb.rgb, rgb, haze);
+    // Behind the host's scene: softly cut, as the sprites are.
+    let p = dir * t;
+    let cloud_m = (frame.view_proj * vec4<f32>(p, 1.0)).w;
+    // Where the host drew nothing, nothing is in front, however far the clouds (its far plane
+    // may be nearer than the horizon: 160 km in the shipped settings).
+    var scene_m = scene_m_at(frag_xy);
+    if (!SCENE_IN_METRES && is_background(scene_depth_at(frag_xy))) {
+        scene_m = 1.0e9;
+    }
+    alpha *= clamp((scene_m - cloud_m) * frame.params.y, 0.0, 1.0);
+    var hit: FarHit;
+    hit.colour = vec4<f32>(rgb * alpha, alpha);
+    hit.distance_m = cloud_m;
+    return hit;
+}
+
+fn far_hit(i: FarOut) -> FarHit {
+    let far_pt = far_point(i.ndc);
+    let dir = normalize(far_pt.xyz / far_pt.w);
+    // The low layer's far side (beyond its horizon, seen through the gaps) behind its near side.
+    let near_low = far_layer(dir, 0, i.position.xy, false);
+    let beyond = far_layer(dir, 0, i.position.xy, true);
+    var low = near_low;
+    low.colour = near_low.colour + beyond.colour * (1.0 - near_low.colour.a);
+    let low_weighted = near_low.distance_m * near_low.colour.a
+        + beyond.distance_m * beyond.colour.a * (1.0 - near_low.colour.a);
+    low.distance_m = low_weighted / max(low.colour.a, 1e-6);
+    let high = far_layer(dir, 1, i.position.xy, false);
+    // The nearer layer over the farther one.
+    var front = low;
+    var back = high;
+    if (high.colour.a > 0.0 && (low.colour.a <= 0.0 || high.distance_m < low.distance_m)) {
+        front = high;
+        back = low;
+    }
+    var hit: FarHit;
+    hit.colour = front.colour + back.colour * (1.0 - front.colour.a);
+    let weighted = front.distance_m * front.colour.a
+        + back.distance_m * back.colour.a * (1.0 - front.colour.a);
+    hit.distance_m = weighted / max(hit.colour.a, 1e-6);
+    return hit;
+}
+
+@fragment
+fn fs_far_field(i: FarOut) -> @location(0) vec4<f32> {
+    return far_hit(i).colour;
+}
+
+// Into the cloud target (`cloud_target.rs`): the colour and the distance of its clouds.
+@fragment
+fn fs_far_field_offscreen(i: FarOut) -> CloudOut {
+    let hit = far_hit(i);
+    return cloud_out(hit.colour, hit.distance_m);
+}

@@ -1,0 +1,289 @@
+//! The far field's cloud map: the weather field out to the horizon of cruise altitude, as plain
+//! data the renderer draws far clouds from (`render/far_field`, docs/src/horizon.md).
+//!
+//! In: the weather at a point (the same field the blocks are made from: Sibson between the
+//! stations, the nearest station outside their hull). Out: a square grid of `texels` x `texels`
+//! cells of `texel_m`, centred on a point snapped to the grid (so a cell keeps its weather
+//! wherever the camera is, and a map moved by whole cells shows the same clouds), each holding
+//! two layers: the low and middle clouds (everything but the cirrus family) and the high ones
+//! (cirrus, cirrocumulus, cirrostratus). A layer is its cover (0..1, the layers of its kind
+//! overlapping at random, `1 - prod(1 - c)`), the base and top of its most covering member
+//! (metres above sea level) and whether that member is heaped (cumuliform: the far field's
+//! texture is then small and lumpy) or a sheet. Built a few rows a frame ([`FarMapFeed`]) and
+//! rebuilt after the camera moved `move_texels` cells or the weather changed.
+
+use glam::DVec2;
+
+use crate::weather::{BlockWeather, CloudType, METRES_PER_FOOT};
+
+/// One cell of the map: `[cover, base_msl_m, top_msl_m, heaped]` of the low / middle layer,
+/// then of the high layer.
+pub type FarCell = [f32; 8];
+
+/// The far field's cloud map (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FarMap {
+    /// Cells per side.
+    pub texels: u32,
+    /// Side of a cell, metres.
+    pub texel_m: f64,
+    /// The map's centre in the local frame, metres (a multiple of `texel_m`).
+    pub centre_m: DVec2,
+    /// `texels * texels` cells, row by row from the south-west corner eastwards, then north.
+    pub cells: Vec<FarCell>,
+}
+
+impl FarMap {
+    /// The centre of cell `(col, row)`, local metres.
+    pub fn cell_centre_m(&self, col: u32, row: u32) -> DVec2 {
+        cell_centre(self.centre_m, self.texels, self.texel_m, col, row)
+    }
+
+    /// The cell holding a local point, if the map covers it.
+    pub fn cell_at(&self, point_m: DVec2) -> Option<&FarCell> {
+        let half = f64::from(self.texels) * self.texel_m * 0.5;
+        let rel = point_m - self.centre_m + DVec2::splat(half);
+        let (col, row) = (rel.x / self.texel_m, rel.y / self.texel_m);
+        let n = f64::from(self.texels);
+        if !(0.0..n).contains(&col) || !(0.0..n).contains(&row) {
+            return None;
+        }
+        self.cells
+            .get(row as usize * self.texels as usize + col as usize)
+    }
+
+    /// Bytes of the map on the GPU (two RGBA half-float layers a cell).
+    pub fn gpu_bytes(&self) -> u64 {
+        u64::from(self.texels) * u64::from(self.texels) * 16
+    }
+}
+
+fn cell_centre(centre_m: DVec2, texels: u32, texel_m: f64, col: u32, row: u32) -> DVec2 {
+    let half = f64::from(texels) * 0.5;
+    centre_m
+        + DVec2::new(
+            (f64::from(col) + 0.5 - half) * texel_m,
+            (f64::from(row) + 0.5 - half) * texel_m,
+        )
+}
+
+/// Whether a type is drawn in the high layer.
+fn is_high(t: CloudType) -> bool {
+    matches!(
+        t,
+        CloudType::Cirrus | CloudType::Cirrocumulus | CloudType::Cirrostratus
+    )
+}
+
+/// Whether a type's far texture is heaped (cumuliform) rather than a sheet.
+fn is_heaped(t: CloudType) -> bool {
+    matches!(
+        t,
+        CloudType::CumulusHumilis
+            | CloudType::CumulusMediocris
+            | CloudType::CumulusCongestus
+            | CloudType::Cumulonimbus
+            | CloudType::Altocumulus
+            | CloudType::Cirrocumulus
+    )
+}
+
+/// The cell of a weather (module docs).
+pub fn far_cell(weather: &BlockWeather) -> FarCell {
+    let mut cell = [0.0f32; 8];
+    let ground = if weather.ground_elevation_m.is_finite() {
+        weather.ground_elevation_m
+    } else {
+        0.0
+    };
+    for high in [false, true] {
+        let mut clear = 1.0f32;
+        let mut best: Option<(f32, f32, f32, bool)> = None;
+        for l in weather
+            .layers
+            .iter()
+            .filter(|l| is_high(l.cloud_type) == high)
+        {
+            let cover = (l.coverage_oktas / 8.0).clamp(0.0, 1.0);
+            if cover <= 0.0 {
+                continue;
+            }
+            clear *= 1.0 - cover;
+            let base = ground + l.base_ft_agl * METRES_PER_FOOT as f32;
+            let top = base + l.thickness_ft.max(0.0) * METRES_PER_FOOT as f32;
+            if best.is_none_or(|b| cover > b.0) {
+                best = Some((cover, base, top, is_heaped(l.cloud_type)));
+            }
+        }
+        if let Some((_, base, top, heaped)) = best {
+            let at = if high { 4 } else { 0 };
+            cell[at] = 1.0 - clear;
+            cell[at + 1] = base;
+            cell[at + 2] = top.max(base + 1.0);
+            cell[at + 3] = f32::from(u8::from(heaped));
+        }
+    }
+    cell
+}
+
+/// A map being built, row by row.
+#[derive(Debug, Clone)]
+struct Building {
+    map: FarMap,
+    next_row: u32,
+}
+
+/// Keeps a far map around a moving camera: starts a new one when the camera has moved
+/// `move_texels` cells from the shown map's centre or the weather changed, and builds it
+/// `rows_per_frame` rows a frame (the first map at once), so no frame stalls on it.
+#[derive(Debug, Clone)]
+pub struct FarMapFeed {
+    texels: u32,
+    texel_m: f64,
+    move_texels: f64,
+    rows_per_frame: u32,
+    shown_centre: Option<DVec2>,
+    building: Option<Building>,
+    stale: bool,
+}
+
+impl FarMapFeed {
+    /// A feed of maps of `texels` x `texels` cells of `texel_m`.
+    pub fn new(texels: u32, texel_m: f64, move_texels: f64, rows_per_frame: u32) -> Self {
+        Self {
+            texels: texels.max(2),
+            texel_m: texel_m.max(1.0),
+            move_texels: move_texels.max(0.0),
+            rows_per_frame: rows_per_frame.max(1),
+            shown_centre: None,
+            building: None,
+            stale: true,
+        }
+    }
+
+    /// The weather changed: the next frames build a new map.
+    pub fn weather_changed(&mut self) {
+        self.stale = true;
+    }
+
+    /// One frame's share of the work around the camera at `camera_m` (local metres): a
+    /// finished map when there is one to show.
+    pub fn update(
+        &mut self,
+        camera_m: DVec2,
+        weather: impl Fn(DVec2) -> BlockWeather,
+    ) -> Option<FarMap> {
+        let snapped = (camera_m / self.texel_m).round() * self.texel_m;
+        let moved = self
+            .shown_centre
+            .is_none_or(|c| (c - camera_m).abs().max_element() > self.move_texels * self.texel_m);
+        if self.building.is_none() && (self.stale || moved) {
+            self.stale = false;
+            self.building = Some(Building {
+                map: FarMap {
+                    texels: self.texels,
+                    texel_m: self.texel_m,
+                    centre_m: snapped,
+                    cells: Vec::with_capacity((self.texels * self.texels) as usize),
+                },
+                next_row: 0,
+            });
+        }
+        let rows = if self.shown_centre.is_none() {
+            self.texels
+        } else {
+            self.rows_per_frame
+        };
+        let b = self.building.as_mut()?;
+        let end = (b.next_row + rows).min(b.map.texels);
+        for row in b.next_row..end {
+            for col in 0..b.map.texels {
+                let at = b.map.cell_centre_m(col, row);
+                b.map.cells.push(far_cell(&weather(at)));
+            }
+        }
+        b.next_row = end;
+        if end < b.map.texels {
+            return None;
+        }
+        let done = self.building.take()?;
+        self.shown_centre = Some(done.map.centre_m);
+        Some(done.map)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::weather::{BlockLayer, TypeSource};
+
+    fn layer(cloud_type: CloudType, oktas: f32, base_ft: f32, thick_ft: f32) -> BlockLayer {
+        BlockLayer {
+            cloud_type,
+            type_source: TypeSource::HeightRule,
+            coverage_oktas: oktas,
+            base_ft_agl: base_ft,
+            thickness_ft: thick_ft,
+        }
+    }
+
+    #[test]
+    fn a_cell_keeps_the_low_and_the_high_layers_apart() {
+        let w = BlockWeather {
+            layers: vec![
+                layer(CloudType::CumulusMediocris, 4.0, 3000.0, 3000.0),
+                layer(CloudType::Stratocumulus, 2.0, 8000.0, 1000.0),
+                layer(CloudType::Cirrus, 6.0, 25000.0, 1500.0),
+            ],
+            ground_elevation_m: 200.0,
+            ..BlockWeather::default()
+        };
+        let c = far_cell(&w);
+        // Half and a quarter, overlapping at random: 1 - 0.5 x 0.75.
+        assert!((c[0] - 0.625).abs() < 1e-6, "{c:?}");
+        // The most covering low layer's base and top, above sea level; heaped.
+        assert!((c[1] - (200.0 + 914.4)).abs() < 0.1, "{c:?}");
+        assert!((c[2] - (200.0 + 1828.8)).abs() < 0.1, "{c:?}");
+        assert_eq!(c[3], 1.0);
+        assert!((c[4] - 0.75).abs() < 1e-6 && c[7] == 0.0, "{c:?}");
+        assert_eq!(far_cell(&BlockWeather::default())[0], 0.0);
+    }
+
+    #[test]
+    fn the_feed_builds_the_first_map_at_once_and_later_ones_over_frames() {
+        // Cloud only north of y = 70 km.
+        let weather = |p: DVec2| BlockWeather {
+            layers: if p.y > 70_000.0 {
+                vec![layer(CloudType::Stratus, 8.0, 1000.0, 1000.0)]
+            } else {
+                Vec::new()
+            },
+            ..BlockWeather::default()
+        };
+        let mut feed = FarMapFeed::new(16, 10_000.0, 2.0, 4);
+        let map = feed.update(DVec2::new(3_000.0, -4_000.0), weather).unwrap();
+        assert_eq!(map.centre_m, DVec2::ZERO);
+        assert_eq!(map.cells.len(), 256);
+        assert_eq!(map.cell_at(DVec2::new(0.0, 75_000.0)).unwrap()[0], 1.0);
+        assert_eq!(map.cell_at(DVec2::new(0.0, 65_000.0)).unwrap()[0], 0.0);
+        assert!(map.cell_at(DVec2::new(0.0, 81_000.0)).is_none());
+        assert_eq!(map.gpu_bytes(), 16 * 16 * 16);
+        // Within two cells nothing is built; past them, four frames of four rows.
+        assert!(feed.update(DVec2::new(15_000.0, 0.0), weather).is_none());
+        let mut frames = 0;
+        let next = loop {
+            frames += 1;
+            if let Some(m) = feed.update(DVec2::new(25_000.0, 0.0), weather) {
+                break m;
+            }
+        };
+        assert_eq!(frames, 4);
+        assert_eq!(next.centre_m, DVec2::new(30_000.0, 0.0));
+        // A cell keeps its weather when the map moves.
+        let p = DVec2::new(45_000.0, 75_000.0);
+        assert_eq!(map.cell_at(p), next.cell_at(p));
+        // A weather change rebuilds where the camera is.
+        feed.weather_changed();
+        assert!(feed.update(DVec2::new(25_000.0, 0.0), weather).is_none());
+    }
+}

@@ -1,0 +1,422 @@
+//! The far field: the clouds beyond the sprites and the impostor ring, out to the horizon of
+//! the camera's altitude (docs/src/horizon.md). In: a [`FarMap`] (the weather field on a coarse
+//! grid, `src/clouds/far_map.rs`, built on the CPU a few rows a frame) and the frame's camera and
+//! light. Out: one full-screen pass (`shaders/far_field.wgsl`) drawn before the ring into the
+//! same target, which meets two curved layers (the low and middle clouds, the high ones) on the
+//! round Earth ([`super::earth`]), cuts them into clouds with a world-anchored noise thresholded
+//! by the map's cover, and fades them in over the band where the sprites and the ring fade out.
+//! The map lives in one small texture (two RGBA half-float layers a cell: 96 x 96 cells of 10 km
+//! are 147 KB). Settings: `[far_field]` of `config/render.toml`.
+
+use glam::{DVec2, DVec3, Vec3};
+use serde::{Deserialize, Serialize};
+
+use crate::clouds::far_map::FarMap;
+use crate::shading::TimeOfDay;
+
+use super::pipeline::{PassDesc, SceneDepth, premultiplied_over};
+
+/// The far field's shader.
+const WGSL: &str = include_str!("../../../shaders/far_field.wgsl");
+
+/// Settings of the far field (`[far_field]` of `config/render.toml`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FarFieldSettings {
+    /// Draw the far field (false: the clouds end where the sprites and the ring do).
+    pub enabled: bool,
+    /// Cells per side of the cloud map.
+    pub texels: u32,
+    /// Side of a cell, metres.
+    pub texel_m: f64,
+    /// A new map is built after the camera moved this many cells from the shown one's centre.
+    pub move_texels: f64,
+    /// Rows of a new map built a frame (the first map is built at once).
+    pub rows_per_frame: u32,
+    /// The hand-over: the far field fades in, the sprites and the ring fade out, between these
+    /// horizontal distances from the camera, metres.
+    pub fade_start_m: f32,
+    /// See `fade_start_m`.
+    pub fade_end_m: f32,
+    /// Size of the lumps of heaped (cumuliform) layers, metres; sheets' patches are 4 times it.
+    pub heaped_scale_m: f32,
+}
+
+impl Default for FarFieldSettings {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            texels: 96,
+            texel_m: 10_000.0,
+            move_texels: 2.0,
+            rows_per_frame: 2,
+            fade_start_m: 42_000.0,
+            fade_end_m: 60_000.0,
+            heaped_scale_m: 4_000.0,
+        }
+    }
+}
+
+impl FarFieldSettings {
+    /// The first field that is out of range and why, if any.
+    pub fn invalid_field(&self) -> Option<(&'static str, String)> {
+        if !(2..=1024).contains(&self.texels) {
+            return Some(("far_field.texels", "must be 2..=1024".into()));
+        }
+        if !(self.texel_m >= 100.0 && self.texel_m.is_finite()) {
+            return Some(("far_field.texel_m", "must be at least 100 metres".into()));
+        }
+        if !(self.move_texels >= 0.0 && self.move_texels.is_finite()) {
+            return Some(("far_field.move_texels", "must be 0 or more".into()));
+        }
+        if self.rows_per_frame == 0 {
+            return Some(("far_field.rows_per_frame", "must be at least 1".into()));
+        }
+        if !(self.fade_start_m >= 0.0 && self.fade_end_m > self.fade_start_m) {
+            return Some((
+                "far_field.fade_end_m",
+                "must be above fade_start_m, which must be 0 or more".into(),
+            ));
+        }
+        if !(self.heaped_scale_m >= 10.0 && self.heaped_scale_m.is_finite()) {
+            return Some((
+                "far_field.heaped_scale_m",
+                "must be at least 10 metres".into(),
+            ));
+        }
+        None
+    }
+
+    /// The noise's period, metres: a whole number of the heaped and the sheet cells.
+    fn noise_period_m(&self) -> f64 {
+        1024.0 * f64::from(self.heaped_scale_m)
+    }
+}
+
+/// The far field's uniform. Keep in sync with `FarField` in `shaders/far_field.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuFarField {
+    /// xy: the map's centre relative to the camera, metres; z: the map's side, metres; w: cells
+    /// per side.
+    pub centre_rel_size: [f32; 4],
+    /// xy: the map's centre in the noise's period, metres; z, w: the hand-over band, metres.
+    pub noise_fade: [f32; 4],
+    /// rgb: a cloud top's colour in the sun; w: the camera's height above sea level, metres.
+    pub lit_rgb: [f32; 4],
+    /// rgb: a cloud base's colour; w: the heaped layers' noise scale, metres.
+    pub shade_rgb: [f32; 4],
+    /// x, y: the low and high layers' mean middle height above sea level, metres; z: the
+    /// sheets' noise scale, metres; w: the noise's period, metres.
+    pub heights: [f32; 4],
+}
+const _: () = assert!(std::mem::size_of::<GpuFarField>() == 80);
+
+/// What the far field needs of the sky's layouts and targets.
+pub(super) struct FarFieldShared<'a> {
+    /// Group 0 of the passes into the host's targets.
+    pub host_frame_layout: &'a wgpu::BindGroupLayout,
+    /// Group 0 of the passes into the off-screen cloud target.
+    pub offscreen_frame_layout: &'a wgpu::BindGroupLayout,
+    /// The host's colour format and samples.
+    pub targets: super::targets::HostTargets,
+    /// The off-screen cloud target's colour targets, where the clouds are drawn below full
+    /// resolution.
+    pub cloud_targets: Option<&'a [(wgpu::TextureFormat, Option<wgpu::BlendState>)]>,
+}
+
+/// The map on the GPU.
+struct MapOnGpu {
+    texture: wgpu::Texture,
+    group: wgpu::BindGroup,
+    centre_m: DVec2,
+    side_m: f64,
+    texels: u32,
+    /// Mean middle heights of the low and high layers, metres above sea level.
+    heights: [f32; 2],
+}
+
+/// The far field's pipelines, map and uniform (module docs).
+pub struct FarField {
+    settings: FarFieldSettings,
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+    offscreen_pipeline: Option<wgpu::RenderPipeline>,
+    sampler: wgpu::Sampler,
+    uniform: wgpu::Buffer,
+    map: Option<MapOnGpu>,
+}
+
+impl FarField {
+    /// Builds the pipelines and the uniform (the map comes with [`Self::set_map`]).
+    pub(super) fn new(
+        device: &wgpu::Device,
+        settings: FarFieldSettings,
+        shared: &FarFieldShared,
+    ) -> Self {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("far_field.layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let over = Some(premultiplied_over());
+        let direct = super::pipeline::pipeline(
+            device,
+            &PassDesc {
+                label: "far_field.layers",
+                wgsl: WGSL,
+                vs: "vs_far_field",
+                fs: "fs_far_field",
+                bind_groups: &[Some(shared.host_frame_layout), Some(&layout)],
+                buffers: &[],
+                targets: &[(shared.targets.colour_format, over)],
+                samples: shared.targets.sample_count,
+                scene: SceneDepth::host(shared.targets.sample_count),
+            },
+        );
+        let offscreen_pipeline = shared.cloud_targets.map(|targets| {
+            super::pipeline::pipeline(
+                device,
+                &PassDesc {
+                    label: "far_field.layers_offscreen",
+                    wgsl: WGSL,
+                    vs: "vs_far_field",
+                    fs: "fs_far_field_offscreen",
+                    bind_groups: &[Some(shared.offscreen_frame_layout), Some(&layout)],
+                    buffers: &[],
+                    targets,
+                    samples: 1,
+                    scene: SceneDepth::FarthestMetres,
+                },
+            )
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("far_field.sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("far_field.uniform"),
+            size: std::mem::size_of::<GpuFarField>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self {
+            settings,
+            layout,
+            pipeline: direct,
+            offscreen_pipeline,
+            sampler,
+            uniform,
+            map: None,
+        }
+    }
+
+    /// The settings it was made with.
+    pub fn settings(&self) -> &FarFieldSettings {
+        &self.settings
+    }
+
+    /// Whether it draws (enabled, with a map).
+    pub fn is_drawn(&self) -> bool {
+        self.settings.enabled && self.map.is_some()
+    }
+
+    /// Switches it on or off at run time (the sprites and the ring then fade as before).
+    pub fn set_enabled(&mut self, enabled: bool) {
+        self.settings.enabled = enabled;
+    }
+
+    /// The hand-over band (start, end metres) the sprites and the ring fade out over, while the
+    /// far field is drawn.
+    pub fn hand_over_m(&self) -> Option<(f32, f32)> {
+        self.is_drawn()
+            .then_some((self.settings.fade_start_m, self.settings.fade_end_m))
+    }
+
+    /// Uploads a new map (a texture of its size; the old one is dropped).
+    pub(super) fn set_map(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, map: &FarMap) {
+        let n = map.texels;
+        if map.cells.len() != (n * n) as usize {
+            log::warn!(
+                "far field: a map of {} cells for {n} x {n}",
+                map.cells.len()
+            );
+            return;
+        }
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("far_field.map"),
+            size: wgpu::Extent3d {
+                width: n,
+                height: n,
+                depth_or_array_layers: 2,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let mut sums = [(0.0f64, 0.0f64); 2];
+        for layer in 0..2u32 {
+            let data: Vec<u16> = map
+                .cells
+                .iter()
+                .flat_map(|c| {
+                    let at = layer as usize * 4;
+                    let (s, w) = &mut sums[layer as usize];
+                    *s += f64::from(c[at] * 0.5 * (c[at + 1] + c[at + 2]));
+                    *w += f64::from(c[at]);
+                    c[at..at + 4]
+                        .iter()
+                        .map(|&v| half::f16::from_f32(v).to_bits())
+                })
+                .collect();
+            queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: layer,
+                    },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                bytemuck::cast_slice(&data),
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(n * 8),
+                    rows_per_image: Some(n),
+                },
+                wgpu::Extent3d {
+                    width: n,
+                    height: n,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        // Layers of no cloud anywhere keep a height the ray can meet (1.5 km and 9 km).
+        let mean = |(s, w): (f64, f64), none: f64| (if w > 0.0 { s / w } else { none }) as f32;
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("far_field.group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.uniform.as_entire_binding(),
+                },
+            ],
+        });
+        self.map = Some(MapOnGpu {
+            texture,
+            group,
+            centre_m: map.centre_m,
+            side_m: f64::from(n) * map.texel_m,
+            texels: n,
+            heights: [mean(sums[0], 1500.0), mean(sums[1], 9000.0)],
+        });
+    }
+
+    /// Writes this frame's uniform for a camera at `camera_m` under the light `light`.
+    pub(super) fn prepare(&self, queue: &wgpu::Queue, camera_m: DVec3, light: &TimeOfDay) {
+        let Some(map) = &self.map else {
+            return;
+        };
+        let s = &self.settings;
+        let period = s.noise_period_m();
+        let centre_rel = (map.centre_m - camera_m.truncate()).as_vec2();
+        let noise = DVec2::new(
+            map.centre_m.x.rem_euclid(period),
+            map.centre_m.y.rem_euclid(period),
+        )
+        .as_vec2();
+        // A far cloud's colours: Wang's mid-grey-to-white levels in the ambient light, with the
+        // sun's share of its median directional shading on the top.
+        let ambient = light.ambient_percent;
+        let lit: Vec3 = Vec3::splat(0.9) * ambient + light.directional_rgb * 0.6;
+        let shade: Vec3 = Vec3::splat(0.62) * ambient + light.directional_rgb * 0.12;
+        let gpu = GpuFarField {
+            centre_rel_size: [
+                centre_rel.x,
+                centre_rel.y,
+                map.side_m as f32,
+                map.texels as f32,
+            ],
+            noise_fade: [noise.x, noise.y, s.fade_start_m, s.fade_end_m],
+            lit_rgb: lit.extend(camera_m.z as f32).to_array(),
+            shade_rgb: shade.extend(s.heaped_scale_m).to_array(),
+            heights: [
+                map.heights[0],
+                map.heights[1],
+                s.heaped_scale_m * 4.0,
+                period as f32,
+            ],
+        };
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&gpu));
+    }
+
+    /// Draws the far field into `pass` (the sky pass, or the off-screen cloud pass when
+    /// `offscreen`), if it is drawn.
+    pub(super) fn draw(&self, pass: &mut wgpu::RenderPass, offscreen: bool) {
+        let Some(map) = self.map.as_ref().filter(|_| self.settings.enabled) else {
+            return;
+        };
+        let p = match (offscreen, &self.offscreen_pipeline) {
+            (true, Some(p)) => p,
+            _ => &self.pipeline,
+        };
+        pass.set_pipeline(p);
+        pass.set_bind_group(1, &map.group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// Bytes of GPU memory it holds (the map texture and the uniform).
+    pub fn gpu_bytes(&self) -> u64 {
+        self.uniform.size()
+            + self.map.as_ref().map_or(0, |m| {
+                let e = m.texture.size();
+                u64::from(e.width) * u64::from(e.height) * u64::from(e.depth_or_array_layers) * 8
+            })
+    }
+}
