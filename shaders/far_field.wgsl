@@ -139,13 +139,18 @@ fn far_layer(dir: vec3<f32>, layer: i32, frag_xy: vec2<f32>, far_side: bool) -> 
     var cell = vec4<f32>(0.0);
     var ground_xy = vec2<f32>(0.0);
     // Meet the layer at its mean height, read the map there, meet it again at the height the
-    // map gives (twice: the layer's height varies slowly across the map).
+    // map gives (twice: the layer's height varies slowly across the map). Rays that meet it
+    // short of the hand-over band (the sprites' clouds), off the map, or where the map has no
+    // cloud stop at once: the pass's cost is the band beyond.
     for (var k = 0; k < 2; k++) {
         t = ray_to_layer(dir, height, far_side);
         if (t <= 0.0) {
             return none;
         }
         ground_xy = flat_offset(dir * t);
+        if (dot(ground_xy, ground_xy) < 0.8 * ff.noise_fade.z * ff.noise_fade.z) {
+            return none;
+        }
         let uv = (ground_xy - ff.centre_rel_size.xy) / ff.centre_rel_size.z + vec2<f32>(0.5);
         if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0))) {
             return none;
@@ -154,7 +159,11 @@ fn far_layer(dir: vec3<f32>, layer: i32, frag_xy: vec2<f32>, far_side: bool) -> 
         if (cell.x <= 0.01) {
             return none;
         }
-        height = 0.5 * (cell.y + cell.z);
+        let mid = 0.5 * (cell.y + cell.z);
+        if (abs(mid - height) < 30.0) {
+            break;
+        }
+        height = mid;
     }
     // The hand-over: in over the band where the sprites and the ring fade out; out over the
     // map's last two cells.
@@ -212,7 +221,12 @@ fn far_hit(i: FarOut) -> FarHit {
     let dir = normalize(far_pt.xyz / far_pt.w);
     // The low layer's far side (beyond its horizon, seen through the gaps) behind its near side.
     let near_low = far_layer(dir, 0, i.position.xy, false);
-    let beyond = far_layer(dir, 0, i.position.xy, true);
+    var beyond: FarHit;
+    beyond.colour = vec4<f32>(0.0);
+    beyond.distance_m = 0.0;
+    if (near_low.colour.a < 0.99) {
+        beyond = far_layer(dir, 0, i.position.xy, true);
+    }
     var low = near_low;
     low.colour = near_low.colour + beyond.colour * (1.0 - near_low.colour.a);
     let low_weighted = near_low.distance_m * near_low.colour.a

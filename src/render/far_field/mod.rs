@@ -324,8 +324,9 @@ impl FarField {
                 },
             );
         }
-        // Layers of no cloud anywhere keep a height the ray can meet (1.5 km and 9 km).
-        let mean = |(s, w): (f64, f64), none: f64| (if w > 0.0 { s / w } else { none }) as f32;
+        // A layer with no cloud anywhere goes 10,000 km up: every ray leaves the map before it
+        // meets it, and the pass spends nothing on it.
+        let mean = |(s, w): (f64, f64), _: f64| (if w > 0.0 { s / w } else { 1.0e7 }) as f32;
         let view = texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
