@@ -25,6 +25,8 @@ struct FarField {
     // x, y: the low and high layers' mean middle height above sea level, metres; z: the
     // sheets' noise scale, metres; w: the noise's period, metres.
     heights: vec4<f32>,
+    // x: how far the map has faded in, 0..1 (a first map, new weather).
+    fade: vec4<f32>,
 };
 
 struct FarOut {
@@ -171,7 +173,7 @@ fn far_layer(dir: vec3<f32>, layer: i32, frag_xy: vec2<f32>, far_side: bool) -> 
     let band = smoothstep(ff.noise_fade.z, ff.noise_fade.w, s);
     let uv = (ground_xy - ff.centre_rel_size.xy) / ff.centre_rel_size.z + vec2<f32>(0.5);
     let edge = min(min(uv.x, uv.y), min(1.0 - uv.x, 1.0 - uv.y)) * ff.centre_rel_size.w;
-    let weight = band * smoothstep(0.5, 2.0, edge);
+    let weight = band * smoothstep(0.5, 2.0, edge) * ff.fade.x;
     if (weight <= 0.0) {
         return none;
     }

@@ -1708,7 +1708,9 @@ fn from_fl350_the_clouds_reach_the_horizon() {
     let cam_at = DVec3::new(0.0, 0.0, 10_668.0);
     let cam = rig.camera(cam_at, 0.0, -3.5);
     let mut frame = |name: &str, cover: f32, on: bool| {
-        rig.host.sky.set_far_map(&rig.host.gpu.queue, &map(cover));
+        rig.host
+            .sky
+            .set_far_map(&rig.host.gpu.queue, &map(cover), None);
         rig.host.sky.set_far_field_enabled(on);
         rig.frame(name, &cam).0
     };
@@ -1781,6 +1783,7 @@ fn hand_over_run(band_m: f32) -> Vec<f32> {
             centre_m: DVec2::ZERO,
             cells: vec![[0.15, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
         },
+        None,
     );
     let mut blocks = Vec::new();
     // Sixteen along a diagonal 58 to 61.75 km ahead: as the camera flies 1 km, the end of the

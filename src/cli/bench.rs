@@ -286,7 +286,7 @@ fn fly(
     }
     if let Some(Some(map)) = &far_map {
         for host in &mut hosts {
-            host.sky.set_far_map(&host.gpu.queue, map);
+            host.sky.set_far_map(&host.gpu.queue, map, None);
         }
     }
     if setup.passes {

@@ -395,7 +395,8 @@ impl SkySystem {
                 .far_map
                 .update(position_m.truncate(), |p| field.weather_at(p))
             {
-                self.sky.set_far_map(queue, &map);
+                let fade_s = self.world.arrival_fade_s();
+                self.sky.set_far_map(queue, &map, fade_s);
             }
         }
         self.sky

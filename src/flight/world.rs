@@ -167,6 +167,13 @@ impl World {
         self.synchronous_clouds = on;
     }
 
+    /// How long clouds that arrive in a sky that had none take to fade in, seconds; `None`
+    /// while clouds are synchronous (they are there whole in the first frame) or it is 0.
+    pub fn arrival_fade_s(&self) -> Option<f64> {
+        let s = self.settings.arrival_fade_s;
+        (s > 0.0 && !self.synchronous_clouds).then_some(s)
+    }
+
     /// Takes a new weather field (built off the frame thread, e.g. by a
     /// [`LiveWeather`](crate::weather::live::LiveWeather)'s prepare) without stopping: the living
     /// clouds of every block whose weather changed dissipate while the new ones form; unchanged

@@ -643,9 +643,18 @@ impl Sky {
     }
 
     /// Hands the far field a new cloud map ([`crate::clouds::far_map::FarMapFeed`] makes them
-    /// from the weather field as the camera moves); uploaded now.
-    pub fn set_far_map(&mut self, queue: &wgpu::Queue, map: &crate::clouds::far_map::FarMap) {
-        self.far_field.set_map(&self.device, queue, map);
+    /// from the weather field as the camera moves); uploaded now. The first map, and a new
+    /// map of the same place (the weather changed), fade in over `fade_in_s` when given (as
+    /// arriving clouds do); a map moved with the camera shows at once (its cells keep their
+    /// weather).
+    pub fn set_far_map(
+        &mut self,
+        queue: &wgpu::Queue,
+        map: &crate::clouds::far_map::FarMap,
+        fade_in_s: Option<f64>,
+    ) {
+        self.far_field
+            .set_map(&self.device, queue, map, (self.elapsed_s, fade_in_s));
     }
 
     /// Switches the far field on or off at run time (for comparisons; the sprites and the ring
@@ -978,7 +987,7 @@ impl Sky {
         };
         queue.write_buffer(&self.views[i].frame_buffer, 0, bytemuck::bytes_of(&frame));
         self.far_field
-            .prepare(queue, camera.position_m, &self.clear_light);
+            .prepare(queue, camera.position_m, &self.clear_light, self.elapsed_s);
         upload_bytes += std::mem::size_of::<GpuFrame>() as u64;
         let ring_frame = RingFrame {
             resident: &self.resident,

@@ -109,8 +109,10 @@ pub struct GpuFarField {
     /// x, y: the low and high layers' mean middle height above sea level, metres; z: the
     /// sheets' noise scale, metres; w: the noise's period, metres.
     pub heights: [f32; 4],
+    /// x: how far the map has faded in, 0..=1; yzw unused.
+    pub fade: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuFarField>() == 80);
+const _: () = assert!(std::mem::size_of::<GpuFarField>() == 96);
 
 /// What the far field needs of the sky's layouts and targets.
 pub(super) struct FarFieldShared<'a> {
@@ -145,6 +147,8 @@ pub struct FarField {
     sampler: wgpu::Sampler,
     uniform: wgpu::Buffer,
     map: Option<MapOnGpu>,
+    /// When the shown map began to fade in (the sky's clock, seconds) and over how long.
+    fade: Option<(f64, f64)>,
 }
 
 impl FarField {
@@ -236,6 +240,7 @@ impl FarField {
             sampler,
             uniform,
             map: None,
+            fade: None,
         }
     }
 
@@ -261,8 +266,20 @@ impl FarField {
             .then_some((self.settings.fade_start_m, self.settings.fade_end_m))
     }
 
-    /// Uploads a new map (a texture of its size; the old one is dropped).
-    pub(super) fn set_map(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, map: &FarMap) {
+    /// Uploads a new map (a texture of its size; the old one is dropped). `(now_s, fade_in_s)`:
+    /// the sky's clock, and how long a first map or a new map of the same place (new weather)
+    /// takes to fade in (`None`: at once).
+    pub(super) fn set_map(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        map: &FarMap,
+        (now_s, fade_in_s): (f64, Option<f64>),
+    ) {
+        let new_weather = self.map.as_ref().is_none_or(|m| m.centre_m == map.centre_m);
+        if new_weather {
+            self.fade = fade_in_s.map(|s| (now_s, s));
+        }
         let n = map.texels;
         if map.cells.len() != (n * n) as usize {
             log::warn!(
@@ -359,8 +376,15 @@ impl FarField {
         });
     }
 
-    /// Writes this frame's uniform for a camera at `camera_m` under the light `light`.
-    pub(super) fn prepare(&self, queue: &wgpu::Queue, camera_m: DVec3, light: &TimeOfDay) {
+    /// Writes this frame's uniform for a camera at `camera_m` under the light `light`, at
+    /// `now_s` of the sky's clock.
+    pub(super) fn prepare(
+        &self,
+        queue: &wgpu::Queue,
+        camera_m: DVec3,
+        light: &TimeOfDay,
+        now_s: f64,
+    ) {
         let Some(map) = &self.map else {
             return;
         };
@@ -392,6 +416,14 @@ impl FarField {
                 map.heights[1],
                 s.heaped_scale_m * 4.0,
                 period as f32,
+            ],
+            fade: [
+                self.fade.map_or(1.0, |(start, over)| {
+                    ((now_s - start) / over.max(1e-3)).clamp(0.0, 1.0) as f32
+                }),
+                0.0,
+                0.0,
+                0.0,
             ],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&gpu));
