@@ -602,7 +602,8 @@ fn render_command_writes_png_and_exr() {
         .iter()
         .map(|c| c.name.to_string())
         .collect();
-    assert_eq!(names, ["A", "B", "G", "R", "Z"]);
+    // `cloud_distance`: the clouds' distance (issue 31).
+    assert_eq!(names, ["A", "B", "G", "R", "Z", "cloud_distance"]);
     // The EXR holds the PNG's picture in linear light (within the 8-bit rounding: measured
     // 0.5 of a level) and the depth in metres: the ground 217 m below fills the bottom row
     // (measured at most 1,166 m), the clouds write no depth (the top row is the far plane).
@@ -1234,6 +1235,9 @@ fn ring_rebuilds_do_not_pop() {
 /// scale (off-screen at 1/2), against full resolution, every pixel. The deck from below was kept
 /// again when decks stopped taking the sun on their undersides (`sunlit_depth_m`): the sunlit
 /// heaps it showed are gone, an even grey ceiling is left (about 0.1 a channel from before).
+/// The cumulus field from above and the Cb line were kept again for issue 31 (the round Earth,
+/// the altitude haze and the far field at their horizons: 0.0100 and 0.0112 a channel from the
+/// frames kept before, just over the bound).
 #[test]
 fn gpu_sprites_draw_the_frames_of_the_cpu_path() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("reference");

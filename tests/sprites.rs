@@ -628,7 +628,9 @@ fn a_layer_seen_above_the_horizon_fades_out_where_the_clouds_end() {
 /// clear air (visibility past the fog's cap: the clear-air haze, 13.3 km), against the same cloud
 /// wholly hazed (a 1 m haze distance: the horizon's colour), the cloud at a 2 km haze distance
 /// differs by under a tenth of what it does with the clouds' own haze distance out of the way
-/// (then 13.3 km). Without the haze term (`o.haze = 0.0;`) nothing is hazed and this fails.
+/// (then 13.3 km). Without the haze term (`o.haze = 0.0;`) nothing is hazed and this fails. The
+/// clouds' haze distance is the uniform haze's (`altitude_haze = false` in `config/fog.toml`);
+/// the altitude haze has its own test in `tests/render.rs`.
 #[test]
 fn a_far_cloud_fades_into_the_horizon_haze() {
     let contrast = |haze_distance_m: f32| {
@@ -651,6 +653,10 @@ fn a_far_cloud_fades_into_the_horizon_haze() {
             },
         )
         .unwrap_or_else(|e| panic!("sprite tests need an adapter: {e}"));
+        host.sky.set_fog_settings(skycast::shading::FogSettings {
+            altitude_haze: false,
+            ..Default::default()
+        });
         host.sky.set_weather_overhead(&BlockWeather {
             visibility_m: 1e9,
             ..BlockWeather::default()

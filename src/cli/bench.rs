@@ -264,8 +264,11 @@ fn fly(
     let far_map = setup.settings.far_field.enabled.then(|| {
         let f = setup.settings.far_field;
         let field = world.field();
-        skycast::clouds::far_map::FarMapFeed::new(f.texels, f.texel_m, f.move_texels, 1)
-            .update(DVec2::ZERO, |p| field.weather_at(p))
+        skycast::clouds::far_map::FarMapFeed::new(f.texels, f.texel_m, f.move_texels, 1).update(
+            DVec2::ZERO,
+            true,
+            |p| field.weather_at(p),
+        )
     });
     let mut hosts = Vec::new();
     for &cloud_scale in scales {

@@ -10,7 +10,8 @@
 //! overlapping at random, `1 - prod(1 - c)`), the base and top of its most covering member
 //! (metres above sea level) and whether that member is heaped (cumuliform: the far field's
 //! texture is then small and lumpy) or a sheet. Built a few rows a frame ([`FarMapFeed`]) and
-//! rebuilt after the camera moved `move_texels` cells or the weather changed.
+//! rebuilt after the camera moved `move_texels` cells or the weather changed (at once for offline
+//! frames).
 
 use glam::DVec2;
 
@@ -135,7 +136,7 @@ struct Building {
 
 /// Keeps a far map around a moving camera: starts a new one when the camera has moved
 /// `move_texels` cells from the shown map's centre or the weather changed, and builds it
-/// `rows_per_frame` rows a frame (the first map at once), so no frame stalls on it.
+/// `rows_per_frame` rows a frame (at once when asked: offline frames), so no frame stalls on it.
 #[derive(Debug, Clone)]
 pub struct FarMapFeed {
     texels: u32,
@@ -167,10 +168,12 @@ impl FarMapFeed {
     }
 
     /// One frame's share of the work around the camera at `camera_m` (local metres): a
-    /// finished map when there is one to show.
+    /// finished map when there is one to show. `whole`: build the first map at once (offline
+    /// frames, the warm-up); otherwise, and for every later map, `rows_per_frame` rows a frame.
     pub fn update(
         &mut self,
         camera_m: DVec2,
+        whole: bool,
         weather: impl Fn(DVec2) -> BlockWeather,
     ) -> Option<FarMap> {
         let snapped = (camera_m / self.texel_m).round() * self.texel_m;
@@ -189,7 +192,7 @@ impl FarMapFeed {
                 next_row: 0,
             });
         }
-        let rows = if self.shown_centre.is_none() {
+        let rows = if whole && self.shown_centre.is_none() {
             self.texels
         } else {
             self.rows_per_frame
@@ -250,7 +253,7 @@ mod tests {
     }
 
     #[test]
-    fn the_feed_builds_the_first_map_at_once_and_later_ones_over_frames() {
+    fn the_feed_builds_a_whole_map_at_once_or_a_few_rows_a_frame() {
         // Cloud only north of y = 70 km.
         let weather = |p: DVec2| BlockWeather {
             layers: if p.y > 70_000.0 {
@@ -261,7 +264,9 @@ mod tests {
             ..BlockWeather::default()
         };
         let mut feed = FarMapFeed::new(16, 10_000.0, 2.0, 4);
-        let map = feed.update(DVec2::new(3_000.0, -4_000.0), weather).unwrap();
+        let map = feed
+            .update(DVec2::new(3_000.0, -4_000.0), true, weather)
+            .unwrap();
         assert_eq!(map.centre_m, DVec2::ZERO);
         assert_eq!(map.cells.len(), 256);
         assert_eq!(map.cell_at(DVec2::new(0.0, 75_000.0)).unwrap()[0], 1.0);
@@ -269,11 +274,14 @@ mod tests {
         assert!(map.cell_at(DVec2::new(0.0, 81_000.0)).is_none());
         assert_eq!(map.gpu_bytes(), 16 * 16 * 16);
         // Within two cells nothing is built; past them, four frames of four rows.
-        assert!(feed.update(DVec2::new(15_000.0, 0.0), weather).is_none());
+        assert!(
+            feed.update(DVec2::new(15_000.0, 0.0), false, weather)
+                .is_none()
+        );
         let mut frames = 0;
         let next = loop {
             frames += 1;
-            if let Some(m) = feed.update(DVec2::new(25_000.0, 0.0), weather) {
+            if let Some(m) = feed.update(DVec2::new(25_000.0, 0.0), false, weather) {
                 break m;
             }
         };
@@ -284,6 +292,9 @@ mod tests {
         assert_eq!(map.cell_at(p), next.cell_at(p));
         // A weather change rebuilds where the camera is.
         feed.weather_changed();
-        assert!(feed.update(DVec2::new(25_000.0, 0.0), weather).is_none());
+        assert!(
+            feed.update(DVec2::new(25_000.0, 0.0), false, weather)
+                .is_none()
+        );
     }
 }

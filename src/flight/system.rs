@@ -391,10 +391,11 @@ impl SkySystem {
         self.world.update_sky(&mut self.sky, position_m, dt_s)?;
         if self.sky.far_field_settings().enabled {
             let field = self.world.field();
-            if let Some(map) = self
-                .far_map
-                .update(position_m.truncate(), |p| field.weather_at(p))
-            {
+            if let Some(map) = self.far_map.update(
+                position_m.truncate(),
+                self.world.synchronous_clouds(),
+                |p| field.weather_at(p),
+            ) {
                 let fade_s = self.world.arrival_fade_s();
                 self.sky.set_far_map(queue, &map, fade_s);
             }

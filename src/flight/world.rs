@@ -167,6 +167,11 @@ impl World {
         self.synchronous_clouds = on;
     }
 
+    /// Whether every frame waits for its clouds ([`Self::set_synchronous_clouds`]).
+    pub fn synchronous_clouds(&self) -> bool {
+        self.synchronous_clouds
+    }
+
     /// How long clouds that arrive in a sky that had none take to fade in, seconds; `None`
     /// while clouds are synchronous (they are there whole in the first frame) or it is 0.
     pub fn arrival_fade_s(&self) -> Option<f64> {

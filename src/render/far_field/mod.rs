@@ -31,7 +31,7 @@ pub struct FarFieldSettings {
     pub texel_m: f64,
     /// A new map is built after the camera moved this many cells from the shown one's centre.
     pub move_texels: f64,
-    /// Rows of a new map built a frame (the first map is built at once).
+    /// Rows of a new map built a frame (at once for an offline frame, clouds synchronous).
     pub rows_per_frame: u32,
     /// The hand-over: the far field fades in, the sprites and the ring fade out, between these
     /// horizontal distances from the camera, metres.
@@ -49,7 +49,7 @@ impl Default for FarFieldSettings {
             texels: 96,
             texel_m: 10_000.0,
             move_texels: 2.0,
-            rows_per_frame: 2,
+            rows_per_frame: 1,
             fade_start_m: 42_000.0,
             fade_end_m: 60_000.0,
             heaped_scale_m: 4_000.0,
