@@ -350,7 +350,10 @@ fn build_sprite(k: u32, at: u32) {
     let b = draws.blocks[block_of(k)];
     let in_block = k - b.first;
     let entry = lists[cloud_of(b, in_block)];
-    let slot = orders[entry.order_base + (in_block - entry.first)];
+    // In the cloud's order, or (the shadow map, `hl_deck.y`) in its slots' own: sums that do not
+    // change with the camera's sort. A `select`, not an `if` on the uniform (see below).
+    let in_order = entry.order_base + (in_block - entry.first);
+    let slot = select(orders[in_order], in_order, view.hl_deck.y > 0.5);
     let s = sprites[slot];
     let cloud = clouds[entry.cloud];
     let flat_radius = cloud.level4_radius_flat;

@@ -107,6 +107,10 @@ pub struct BenchArgs {
     /// timestamps between passes.
     #[arg(long)]
     pub passes: bool,
+    /// The clouds' shadows on the ground: `on` or `off` (default: the renderer settings'
+    /// `[cloud_shadows] enabled`).
+    #[arg(long, value_name = "on|off", value_parser = super::render::parse_on_off)]
+    pub cloud_shadows: Option<bool>,
 }
 
 /// One frame of one run.
@@ -397,11 +401,14 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     if args.frames < 2 {
         anyhow::bail!("--frames {} is less than 2", args.frames);
     }
-    let (settings, table) = load_look(
+    let (mut settings, table) = load_look(
         args.render_settings.as_ref(),
         args.time_of_day.as_ref(),
         args.cloud_scale,
     )?;
+    if let Some(on) = args.cloud_shadows {
+        settings.cloud_shadows.enabled = on;
+    }
     // The chosen scale first, then full resolution to compare with.
     let mut scales = vec![settings.clouds.resolution_scale];
     if scales[0] != 1.0 {

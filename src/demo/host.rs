@@ -185,8 +185,9 @@ impl DemoHost {
         mut stats: FrameStats,
     ) -> FrameStats {
         let light = self.sky.light();
+        let shadows = self.sky.cloud_shadows();
         self.terrain.prepare(
-            &self.gpu.queue,
+            (&self.gpu.device, &self.gpu.queue),
             camera,
             &TerrainLight {
                 sun_dir,
@@ -195,6 +196,7 @@ impl DemoHost {
                 fog_rgb: self.sky.fog().rgb,
                 visibility_m: visibility_m.min(self.sky.fog().distance_m),
             },
+            &shadows,
         );
         let mut encoder = self
             .gpu

@@ -208,7 +208,7 @@ fn fade_opacity(fade: Fade) -> f32 {
     }
 }
 
-fn fade_code(fade: Fade) -> (u32, f32) {
+pub(super) fn fade_code(fade: Fade) -> (u32, f32) {
     match fade {
         Fade::Steady => (0, 1.0),
         Fade::Forming(p) => (1, p.clamp(0.0, 1.0)),

@@ -206,7 +206,9 @@ pub struct GpuSpriteView {
     /// ambient grey.
     pub hl_sky: [f32; 4],
     /// Harris and Lastra: x the part of a deck's optical depth that takes the sun's total
-    /// light (direct and scattered forward) away: `1 - forward_fraction`; yzw unused.
+    /// light (direct and scattered forward) away: `1 - forward_fraction`; y: 1 to take each
+    /// cloud's sprites in their slots' order instead of the bound order (the shadow map); zw
+    /// unused.
     pub hl_deck: [f32; 4],
     /// x, y: the distance from the view's camera over which sprites seen above the horizon fade
     /// out (start, end), metres; z, w: sines of the angles over which layer sprites take their
@@ -231,8 +233,11 @@ pub struct GpuTerrainFrame {
     pub sun_rgb: [f32; 4],
     /// rgb: fog colour; w: fog visibility, metres.
     pub fog_rgb: [f32; 4],
+    /// Camera-relative position to the cloud shadow map's texture coordinates
+    /// ([`crate::render::CloudShadowMap`]).
+    pub shadow_uv: [[f32; 4]; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuTerrainFrame>() == 128);
+const _: () = assert!(std::mem::size_of::<GpuTerrainFrame>() == 192);
 
 /// One terrain vertex, relative to the mesh origin. Keep in sync with `shaders/terrain.wgsl`.
 #[repr(C)]

@@ -21,6 +21,8 @@
 //!   matrices).
 //! - `cloud_target`: below full resolution, the clouds drawn off-screen against the farthest
 //!   depth of each block of pixels and composited with a full-resolution depth fix-up.
+//! - `shadow`: the clouds drawn from the sun into a shadow map a host multiplies into its
+//!   ground's sunlight.
 //! - `pass_timing`: GPU time of each of the sky's passes, a profiling aid (off by default).
 //!
 //! Positions are f64 on the CPU and camera-relative f32 on the GPU. Units: metres, degrees,
@@ -41,6 +43,7 @@ mod resident;
 mod scatter;
 pub mod scene;
 pub mod settings;
+pub mod shadow;
 mod sheet_crop;
 pub mod sky;
 mod slots;
@@ -54,6 +57,7 @@ pub use readback::SpriteCorner;
 pub use resident::BYTES_PER_SPRITE;
 pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};
 pub use settings::RenderSettings;
+pub use shadow::{CloudShadowMap, ShadowImage, ShadowSettings};
 pub use sky::{Sky, SkyConfig, SpriteSheet};
 pub use stats::{FrameStats, Lighting};
 pub use targets::{HostTargets, SkyView};

@@ -146,6 +146,8 @@ pub struct Sky {
     ring: ImpostorRing,
     /// Where the clouds are drawn: the host's colour (scale 1) or the off-screen cloud target.
     clouds: CloudTarget,
+    /// The clouds' shadow map for the host's ground (`shadow`).
+    shadows: super::shadow::CloudShadows,
 }
 
 const SKY_WGSL: &str = include_str!("../../shaders/sky.wgsl");
@@ -342,6 +344,13 @@ impl Sky {
                 cloud_targets: (divisor > 1).then_some(&offscreen_targets[..]),
             },
         );
+        let shadows = super::shadow::CloudShadows::new(
+            device,
+            queue,
+            config.settings.cloud_shadows,
+            &sheet_layout,
+            &view_layout,
+        );
         Ok(Self {
             device: device.clone(),
             settings: config.settings,
@@ -386,6 +395,7 @@ impl Sky {
             overhead_ease: OverheadEase::default(),
             ring,
             clouds,
+            shadows,
         })
     }
 
@@ -461,6 +471,7 @@ impl Sky {
         for r in self.resident.blocks.values_mut() {
             r.motion.offset_m = offset_m;
         }
+        self.shadows.set_drift(offset_m);
     }
 
     /// Sets where a block is in its life, keeping its drift; false if the sky does not hold it.
@@ -565,13 +576,41 @@ impl Sky {
         } else {
             None
         };
+        self.shadows
+            .set_timing(&self.queue, self.pass_timer.is_some());
         self.pass_timer.is_some()
     }
 
     /// GPU time of each group of passes of the last recorded frame, once it was submitted:
     /// waits for the device. `None` while pass timing is off or if the times cannot be read.
     pub fn pass_times(&self) -> Option<super::PassTimes> {
-        super::pass_timing::pass_times(&self.pass_timer.as_ref()?.read_ms(&self.device)?)
+        let times =
+            super::pass_timing::pass_times(&self.pass_timer.as_ref()?.read_ms(&self.device)?);
+        let shadow_ms = self.shadows.last_ms().unwrap_or(0.0);
+        times.map(|t| super::PassTimes { shadow_ms, ..t })
+    }
+
+    /// The clouds' shadow map of the last prepared frame and the matrix a host looks it up with
+    /// ([`super::CloudShadowMap`]): the host multiplies its ground's direct sunlight by
+    /// `exp(-tau)`. Take it every frame (after [`Self::prepare`]): the lookup follows the camera
+    /// and the clouds' drift, and the texture is replaced when the shadows are switched.
+    pub fn cloud_shadows(&self) -> super::CloudShadowMap<'_> {
+        self.shadows.map()
+    }
+
+    /// Switches the cloud shadows on (drawn from the next [`Self::prepare`]) or off (the map a
+    /// single texel of open sun).
+    pub fn set_cloud_shadows(&mut self, on: bool) {
+        self.shadows.set_enabled(&self.queue, on);
+        self.settings.cloud_shadows.enabled = on;
+    }
+
+    /// The shadow map's optical depth read back (tests and tools); waits for the device.
+    pub fn read_back_cloud_shadows(
+        &self,
+        queue: &wgpu::Queue,
+    ) -> Result<super::ShadowImage, RenderError> {
+        self.shadows.read_back(queue)
     }
 
     /// CPU time of the last [`Self::record`], microseconds.
@@ -649,7 +688,9 @@ impl Sky {
     }
 
     /// The light of the last prepared frame under the cloud cover (see [`Self::set_weather_overhead`]):
-    /// what a host lights its own scene with.
+    /// what a host lights its own scene with. With the cloud shadows on, its sun is the clear
+    /// sun, for the host to dim by the shadow map ([`Self::cloud_shadows`]) where clouds stop it;
+    /// off, the sun is dimmed by the share of the sky the cover hides, everywhere alike.
     pub fn light(&self) -> TimeOfDay {
         self.seen_light
     }
@@ -669,6 +710,7 @@ impl Sky {
             + self.scatter.gpu_bytes()
             + self.view.gpu_bytes()
             + self.ring.gpu_bytes()
+            + self.shadows.gpu_bytes()
     }
 
     /// CPU work of a frame: advances time by `dt_s`, uploads blocks that arrived, sorts blocks
@@ -699,6 +741,10 @@ impl Sky {
         self.seen_light = self
             .clear_light
             .under_cover(hidden, &self.time_of_day.overcast);
+        if self.settings.cloud_shadows.enabled {
+            // The shadow map dims the sun where the clouds stop it: in open sun it is whole.
+            self.seen_light.directional_rgb = self.clear_light.directional_rgb;
+        }
         let sun_dir = sun.direction_enu().as_vec3();
         let lighting = Lighting {
             sun_dir,
@@ -834,11 +880,14 @@ impl Sky {
             camera_m: camera.position_m,
         };
         upload_bytes += self.ring.prepare_builds(queue, &ring_frame, &mut stats);
+        let at = (camera.position_m, sun_dir, self.elapsed_s);
+        upload_bytes += (self.shadows).prepare(queue, &self.resident, &light, at, &mut stats);
         // Quad indices and built corners for the largest draw of the frame (the sprites, an
-        // impostor's sector).
+        // impostor's sector, the shadow map's chunk).
         let most = stats
             .sprites_drawn
             .max(self.ring.most_sprites_pending())
+            .max(self.shadows.pending_sprites())
             .min(CHUNK);
         if most > self.quads.1 {
             let sprites = most.next_power_of_two();
@@ -849,7 +898,7 @@ impl Sky {
         // Impostor renders (8 frames of a rebuild) need no host target: they go in a submission
         // of the sky's own, ahead of the host's frame, with the patch of changed orders they
         // read.
-        if self.ring.has_pending() {
+        if self.ring.has_pending() || self.shadows.has_pending() {
             let mut encoder = self
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -861,6 +910,14 @@ impl Sky {
                 &self.sheet_group,
                 &self.build,
                 &self.resident.group,
+                &self.quads.0,
+            );
+            let resident = &self.resident.group;
+            (self.shadows).record(
+                &mut encoder,
+                &self.sheet_group,
+                &self.build,
+                resident,
                 &self.quads.0,
             );
             queue.submit([encoder.finish()]);

@@ -64,6 +64,14 @@ pub struct FrameStats {
     pub sprites_lit: u32,
     /// CPU time of that light, microseconds (part of `cpu_update_us`).
     pub light_us: u64,
+    /// Bytes of the cloud shadow map's texture and buffers (`[cloud_shadows]`; a texel while
+    /// switched off).
+    pub shadow_gpu_bytes: u64,
+    /// Whether the cloud shadow map was drawn this frame (else its last drawing, moved with the
+    /// clouds' drift, is looked up).
+    pub shadow_redrawn: bool,
+    /// Sprites drawn into the shadow map this frame (0 when it was not drawn).
+    pub shadow_sprites: u32,
 }
 
 impl FrameStats {
