@@ -21,14 +21,16 @@ struct VertexIn {
     @location(0) position_visible: vec4<f32>,
     @location(1) uv: vec2<f32>,
     @location(2) colour: vec4<f32>,
+    // x: how many sprites of its cloud this one stands for (far clouds are built sparser).
+    @location(3) stands_for: vec2<f32>,
 };
 
 struct VertexOut {
     @builtin(position) position: vec4<f32>,
     // xy: sheet texture coordinates; z: the corner's opacity (its fades included).
     @location(0) uv_alpha: vec3<f32>,
-    // xy: the corner in clip space (the edge fade).
-    @location(1) clip: vec2<f32>,
+    // xy: the corner in clip space (the edge fade); z: how many sprites it stands for.
+    @location(1) clip_stands_for: vec3<f32>,
 };
 
 @vertex
@@ -41,7 +43,7 @@ fn vs_shadow(v: VertexIn) -> VertexOut {
     }
     o.position = shadow.clip_from_eye * vec4<f32>(v.position_visible.xyz, 1.0);
     o.uv_alpha = vec3<f32>(v.uv, v.colour.a);
-    o.clip = o.position.xy;
+    o.clip_stands_for = vec3<f32>(o.position.xy, max(v.stands_for.x, 1.0));
     return o;
 }
 
@@ -52,7 +54,8 @@ fn fs_shadow(i: VertexOut) -> @location(0) vec4<f32> {
     let alpha = clamp(texel.a * i.uv_alpha.z, 0.0, 0.98);
     // The map's last texels fade out: a shadow ends softly at its edge, and the edge texels a
     // host's clamped lookup repeats beyond it hold nothing.
-    let edge = max(abs(i.clip.x), abs(i.clip.y));
+    let edge = max(abs(i.clip_stands_for.x), abs(i.clip_stands_for.y));
     let keep = 1.0 - smoothstep(1.0 - shadow.params.y, 1.0 - 0.25 * shadow.params.y, edge);
-    return vec4<f32>(-log(1.0 - alpha) * shadow.params.x * keep, 0.0, 0.0, 0.0);
+    let tau = -log(1.0 - alpha) * i.clip_stands_for.z;
+    return vec4<f32>(tau * shadow.params.x * keep, 0.0, 0.0, 0.0);
 }

@@ -428,7 +428,7 @@ fn recheck(
             cloud: state.cloud_slot,
             first,
             order_base: state.sprite_base,
-            _pad: 0,
+            stride: 0,
         });
         first += state.sprites;
     }
@@ -532,7 +532,7 @@ pub(super) fn fresh_view(
                 cloud: state.cloud_slot,
                 first,
                 order_base: orders.len() as u32,
-                _pad: 0,
+                stride: 0,
             });
             let at = orders.len();
             orders.resize(at + cloud.sprites.len(), 0);

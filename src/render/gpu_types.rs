@@ -69,8 +69,9 @@ pub struct GpuSpriteVertex {
     pub position_visible: [f32; 4],
     /// Texture coordinate on the sheet.
     pub uv: [f32; 2],
-    /// Padding to 16 bytes.
-    pub _pad: [f32; 2],
+    /// x: how many sprites of its cloud it stands for (1 but in the shadow map's far clouds,
+    /// built every few sprites); y: padding.
+    pub stands_for: [f32; 2],
     /// Wang 5.3 vertex colour `(C_amb + C_dir)` and alpha (ambient alpha times the fades).
     pub colour: [f32; 4],
 }
@@ -158,8 +159,8 @@ pub struct GpuListCloud {
     pub first: u32,
     /// Where its back-to-front sprite order starts in the bound order buffer.
     pub order_base: u32,
-    /// Unused.
-    pub _pad: u32,
+    /// Every how many of its sprites are built (0 or 1: all; the shadow map's far clouds).
+    pub stride: u32,
 }
 const _: () = assert!(std::mem::size_of::<GpuListCloud>() == 16);
 

@@ -51,6 +51,23 @@ pub struct ShadowSettings {
     /// Optical depth of a sprite fragment along the sun's ray per the optical depth its opacity
     /// shows the eye (`-ln(1 - alpha)`): 1 casts the shadow the clouds look like they would.
     pub opacity_scale: f32,
+    /// Blocks within this distance of the camera across the sun's rays cast the shadows of all
+    /// their sprites, metres.
+    #[serde(default = "default_full_detail_m")]
+    pub full_detail_m: f64,
+    /// Beyond it, every this many sprites of a cloud one is drawn, standing for them all (its
+    /// optical depth times this): the far field holds most of the sprites and lies under the
+    /// haze. 1: every sprite everywhere.
+    #[serde(default = "default_far_sprite_stride")]
+    pub far_sprite_stride: u32,
+}
+
+fn default_full_detail_m() -> f64 {
+    15_000.0
+}
+
+fn default_far_sprite_stride() -> u32 {
+    8
 }
 
 impl Default for ShadowSettings {
@@ -63,6 +80,8 @@ impl Default for ShadowSettings {
             recentre_fraction: 0.1,
             rebuild_sun_deg: 0.5,
             opacity_scale: 1.0,
+            full_detail_m: default_full_detail_m(),
+            far_sprite_stride: default_far_sprite_stride(),
         }
     }
 }
@@ -102,6 +121,16 @@ impl ShadowSettings {
         }
         if self.opacity_scale.is_nan() || self.opacity_scale < 0.0 {
             return Some(("cloud_shadows.opacity_scale", "must be 0 or more".into()));
+        }
+        if self.full_detail_m.is_nan() || self.full_detail_m < 0.0 {
+            return Some(("cloud_shadows.full_detail_m", "must be 0 or more".into()));
+        }
+        if !(1..=64).contains(&self.far_sprite_stride) {
+            let v = self.far_sprite_stride;
+            return Some((
+                "cloud_shadows.far_sprite_stride",
+                format!("must be 1..=64, is {v}"),
+            ));
         }
         None
     }

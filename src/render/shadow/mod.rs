@@ -138,6 +138,35 @@ pub struct CloudShadows {
     timed: Cell<bool>,
 }
 
+/// The built corners as the shadow pass reads them: `GpuSpriteVertex`'s position, uv, how many
+/// sprites it stands for, and colour (its alpha).
+fn shadow_vertex_layout() -> wgpu::VertexBufferLayout<'static> {
+    const ATTRS: [wgpu::VertexAttribute; 4] = wgpu::vertex_attr_array![
+        0 => Float32x4, 1 => Float32x2, 2 => Float32x4, 3 => Float32x2
+    ];
+    // Offsets: position 0, uv 16, stands_for 24, colour 32 (`GpuSpriteVertex`).
+    const PLACED: [wgpu::VertexAttribute; 4] = [
+        ATTRS[0],
+        wgpu::VertexAttribute {
+            offset: 16,
+            ..ATTRS[1]
+        },
+        wgpu::VertexAttribute {
+            offset: 32,
+            ..ATTRS[2]
+        },
+        wgpu::VertexAttribute {
+            offset: 24,
+            ..ATTRS[3]
+        },
+    ];
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<GpuSpriteVertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &PLACED,
+    }
+}
+
 /// A texture of `side` x `side` texels of optical depth.
 fn shadow_texture(device: &wgpu::Device, side: u32) -> (wgpu::Texture, wgpu::TextureView) {
     let texture = device.create_texture(&wgpu::TextureDescriptor {
@@ -219,7 +248,7 @@ impl CloudShadows {
                 module: &module,
                 entry_point: Some("vs_shadow"),
                 compilation_options: Default::default(),
-                buffers: &[Some(GpuSpriteVertex::layout())],
+                buffers: &[Some(shadow_vertex_layout())],
             },
             primitive: wgpu::PrimitiveState {
                 cull_mode: None,
@@ -462,14 +491,24 @@ impl CloudShadows {
         for r in order {
             let list_base = self.lists.len() as u32;
             let mut first = 0u32;
+            // Beyond `full_detail_m` across the rays, every `far_sprite_stride`th sprite of a
+            // cloud stands for that many (its optical depth times the stride): far shadows lie
+            // under the haze, and the far field holds most of the sprites.
+            let (x, y) = frame.across(r.centre_m());
+            let near = x.abs().max(y.abs()) - r.radius_m <= self.settings.full_detail_m;
+            let stride = if near {
+                1
+            } else {
+                self.settings.far_sprite_stride
+            };
             for state in r.clouds.iter().filter(|c| c.sprites > 0) {
                 self.lists.push(GpuListCloud {
                     cloud: state.cloud_slot,
                     first,
                     order_base: state.sprite_base,
-                    _pad: 0,
+                    stride,
                 });
-                first += state.sprites;
+                first += state.sprites.div_ceil(stride);
             }
             let (fade_kind, fade_progress) = fade_code(r.motion.fade);
             self.draws.push(GpuDrawBlock {
