@@ -605,6 +605,13 @@ impl Sky {
         self.settings.cloud_shadows.enabled = on;
     }
 
+    /// Draws the cloud shadow map at the next [`Self::prepare`] whatever changed (it is drawn
+    /// again by itself when the camera has gone far, the sun turned, blocks came or went, or,
+    /// while clouds form or dissipate, after `update_interval_s`).
+    pub fn redraw_cloud_shadows(&mut self) {
+        self.shadows.redraw();
+    }
+
     /// The shadow map's optical depth read back (tests and tools); waits for the device.
     pub fn read_back_cloud_shadows(
         &self,

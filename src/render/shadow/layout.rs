@@ -40,8 +40,9 @@ pub struct ShadowSettings {
     /// Half the side of the square the map covers across the sun's rays, metres (at least the
     /// sprites' draw distance, so every cloud drawn casts its shadow).
     pub half_extent_m: f64,
-    /// Draw the map again after this much sky time, seconds (clouds forming and dissipating;
-    /// between draws the map moves with the clouds' drift).
+    /// While a cloud it covers forms or dissipates, draw the map again after this much sky
+    /// time, seconds (between draws the map moves with the clouds' drift; steady clouds need no
+    /// new drawing).
     pub update_interval_s: f64,
     /// Draw it again, centred anew, after the camera moved this fraction of the half extent
     /// across the sun's rays.
@@ -235,13 +236,15 @@ impl ShadowFrame {
 }
 
 /// Whether the map drawn at `drawn` (with the sky time then, `drawn_s`) must be drawn again for
-/// the camera at `camera_m`, the sun along `sun` and sky time `now_s`.
+/// the camera at `camera_m`, the sun along `sun` and sky time `now_s`; `changing`: some cloud it
+/// covers forms or dissipates (only then does time alone make it stale: the drift is the
+/// lookup's).
 pub fn needs_redraw(
     drawn: &ShadowFrame,
-    drawn_s: f64,
+    (drawn_s, now_s): (f64, f64),
     camera_m: DVec3,
     sun: DVec3,
-    now_s: f64,
+    changing: bool,
     settings: &ShadowSettings,
 ) -> bool {
     let (x, y) = drawn.across(camera_m);
@@ -251,7 +254,7 @@ pub fn needs_redraw(
         .angle_between(sun.normalize_or(DVec3::Z))
         .to_degrees()
         > settings.rebuild_sun_deg;
-    let aged = now_s - drawn_s >= settings.update_interval_s || now_s < drawn_s;
+    let aged = changing && (now_s - drawn_s >= settings.update_interval_s || now_s < drawn_s);
     moved || turned || aged
 }
 
@@ -340,32 +343,37 @@ mod tests {
         let sun0 = sun(40.0, 180.0);
         let frame = ShadowFrame::new(DVec3::ZERO, sun0, &s);
         let step = s.recentre_fraction * s.half_extent_m;
-        assert!(!needs_redraw(&frame, 0.0, DVec3::ZERO, sun0, 0.5, &s));
-        assert!(needs_redraw(&frame, 0.0, DVec3::ZERO, sun0, 1.0, &s));
+        let at = |t: f64| (0.0, t);
+        assert!(!needs_redraw(&frame, at(0.5), DVec3::ZERO, sun0, true, &s));
+        assert!(needs_redraw(&frame, at(1.0), DVec3::ZERO, sun0, true, &s));
+        // Steady clouds: time alone changes nothing (the lookup follows the drift).
         assert!(!needs_redraw(
             &frame,
-            0.0,
-            frame.right * step * 0.9,
-            sun0,
-            0.1,
-            &s
-        ));
-        assert!(needs_redraw(
-            &frame,
-            0.0,
-            frame.right * step * 1.1,
-            sun0,
-            0.1,
-            &s
-        ));
-        // Along the rays (a climb towards the sun) changes nothing.
-        assert!(!needs_redraw(&frame, 0.0, sun0 * 5_000.0, sun0, 0.1, &s));
-        assert!(needs_redraw(
-            &frame,
-            0.0,
+            at(100.0),
             DVec3::ZERO,
-            sun(41.0, 180.0),
-            0.1,
+            sun0,
+            false,
+            &s
+        ));
+        let moved = |f: f64| frame.right * step * f;
+        assert!(!needs_redraw(&frame, at(0.1), moved(0.9), sun0, false, &s));
+        assert!(needs_redraw(&frame, at(0.1), moved(1.1), sun0, false, &s));
+        // Along the rays (a climb towards the sun) changes nothing.
+        assert!(!needs_redraw(
+            &frame,
+            at(0.1),
+            sun0 * 5_000.0,
+            sun0,
+            false,
+            &s
+        ));
+        let turned = sun(41.0, 180.0);
+        assert!(needs_redraw(
+            &frame,
+            at(0.1),
+            DVec3::ZERO,
+            turned,
+            false,
             &s
         ));
     }

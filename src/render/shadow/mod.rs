@@ -16,7 +16,7 @@
 //! The map covers a square across the sun's rays around the camera (`half_extent_m`, at least
 //! the sprites' draw distance), centred on a texel of a grid fixed to the world, so a camera
 //! moving within a texel leaves every shadow as it was (no shimmer). It is drawn again after
-//! `update_interval_s` of sky time (clouds forming and dissipating), when the camera has gone
+//! `update_interval_s` of sky time while a cloud it covers forms or dissipates, when the camera has gone
 //! `recentre_fraction` of the half extent, the sun has turned `rebuild_sun_deg`, or the blocks
 //! it covers changed; between draws the lookup matrix moves the map with the clouds' drift
 //! (SilverLining reuses its map across frames the same way). Its last texels are faded out, so
@@ -127,6 +127,8 @@ pub struct CloudShadows {
     drawn: Option<(ShadowFrame, f64, DVec3)>,
     /// The blocks the last drawing covered: how many and their ids summed.
     covered: (usize, u64),
+    /// Draw the map at the next prepare whatever changed ([`Self::redraw`]).
+    force: bool,
     /// The clouds' drift now ([`super::Sky::set_drift`]).
     drift_m: DVec3,
     /// This frame's draw: its sprites, if the map is drawn this frame.
@@ -289,6 +291,7 @@ impl CloudShadows {
             list_buffers_made: 0,
             drawn: None,
             covered: (0, 0),
+            force: false,
             drift_m: DVec3::ZERO,
             pending: None,
             lookup: Mat4::ZERO,
@@ -323,6 +326,12 @@ impl CloudShadows {
                 },
             );
         }
+    }
+
+    /// Draws the map at the next prepare whatever changed (a host that moved its clouds by
+    /// other means than the drift, tests).
+    pub fn redraw(&mut self) {
+        self.force = true;
     }
 
     /// The settings in use.
@@ -383,8 +392,11 @@ impl CloudShadows {
         let stale = match &self.drawn {
             None => true,
             Some((frame, at_s, _)) => {
-                needs_redraw(frame, *at_s, camera_m, sun, now_s, &s)
-                    || covered(blocks, frame) != self.covered
+                let (count, ids, changing) = covered(blocks, frame);
+                let times = (*at_s, now_s);
+                std::mem::take(&mut self.force)
+                    || needs_redraw(frame, times, camera_m, sun, changing, &s)
+                    || (count, ids) != self.covered
             }
         };
         let mut bytes = 0;
@@ -401,7 +413,8 @@ impl CloudShadows {
             };
             let frame = ShadowFrame::new(camera_m, sun, &s);
             let sprites = self.shadow_view(blocks, &frame);
-            self.covered = covered(blocks, &frame);
+            let (count, ids, _) = covered(blocks, &frame);
+            self.covered = (count, ids);
             let mut header = sprite_view::header(&ViewLight {
                 camera_z_m: frame.eye_m.z as f32,
                 farthest_m: NO_FAR_FADE_M,
@@ -659,15 +672,16 @@ fn is_covered(r: &super::resident::Resident, frame: &ShadowFrame) -> bool {
     x.abs() <= reach && y.abs() <= reach
 }
 
-/// The blocks a drawing at `frame` covers: how many, and their ids summed (a block arriving or
-/// going changes it).
-fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (usize, u64) {
-    blocks
-        .values()
-        .filter(|r| is_covered(r, frame))
-        .fold((0, 0u64), |(n, ids), r| {
-            (n + 1, ids.wrapping_add(r.block.id))
-        })
+/// The blocks a drawing at `frame` covers: how many, their ids summed (a block arriving or
+/// going changes it), and whether any of them forms or dissipates.
+fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (usize, u64, bool) {
+    blocks.values().filter(|r| is_covered(r, frame)).fold(
+        (0, 0u64, false),
+        |(n, ids, changing), r| {
+            let fading = r.motion.fade != super::Fade::Steady;
+            (n + 1, ids.wrapping_add(r.block.id), changing || fading)
+        },
+    )
 }
 
 fn smoothstep(a: f64, b: f64, x: f64) -> f64 {
