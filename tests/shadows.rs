@@ -34,6 +34,9 @@ fn cruise_host(configure: impl FnOnce(&mut SkySystemConfig)) -> DemoHost {
     let flat = HeightField::from_fn(DVec2::ZERO, 1_000.0, 2, |_| 0.0);
     let mut host = DemoHost::new(W, H, &flat, config)
         .unwrap_or_else(|e| panic!("shadow tests need an adapter: {e}"));
+    // Every cloud around in the first frame, as `skycast render` has it (a simulator's first
+    // frames wait for none and fade them in as they arrive).
+    host.sky.world_mut().set_synchronous_clouds(true);
     let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
     host.sky
         .set_weather(Weather::File(&manifest.join(METARS)))
