@@ -188,8 +188,16 @@ impl From<&Camera> for HostCamera {
 pub struct HostLighting {
     /// Unit vector towards the sun, east-north-up.
     pub sun_direction: Vec3,
-    /// Direct sunlight colour, dimmed under cloud cover.
+    /// Direct sunlight colour: the clear sun, with the cloud shadows on or off. The host
+    /// multiplies it by the shadow map's `exp(-tau)` ([`Sky::cloud_shadows`]) where clouds stop
+    /// it; with the shadows off the clouds cast none and the ground has this sun everywhere.
     pub sun_rgb: Vec3,
+    /// The mean share (0..=1) of the direct sun the cloud cover over the camera lets through
+    /// ([`Sky::sun_cover_transmittance`]). Not applied to `sun_rgb`: for a host that draws
+    /// without the shadow map and wants its ground dimmed evenly under a cover instead
+    /// (`sun_rgb * sun_cover_transmittance`). skycast's own ground and `examples/host.rs` use the
+    /// map and do not apply it.
+    pub sun_cover_transmittance: f32,
     /// Ambient light as a fraction of full daylight.
     pub ambient: f32,
     /// Sky colour straight up and at the horizon.
@@ -471,6 +479,7 @@ impl SkySystem {
         HostLighting {
             sun_direction: self.sun_direction,
             sun_rgb: light.directional_rgb,
+            sun_cover_transmittance: self.sky.sun_cover_transmittance(),
             ambient: light.ambient_percent,
             zenith_rgb: light.sky_zenith_rgb,
             horizon_rgb: light.sky_horizon_rgb,

@@ -135,8 +135,12 @@ pub struct Sky {
     queue: wgpu::Queue,
     /// The time-of-day light of the last frame, clear sky: what the clouds are lit with.
     clear_light: TimeOfDay,
-    /// `clear_light` under the cloud cover over the camera: the sky colours and the host's light.
+    /// The host's light: the clear sun (the shadow map dims it where clouds stop it, or
+    /// nothing does with the shadows off) and the sky colours under the cover over the camera.
     seen_light: TimeOfDay,
+    /// The mean share of the direct sun the cover over the camera lets through (1 - the share
+    /// of the sky it hides): the sky's own sun glow, and for a host without the map.
+    cover_transmittance: f32,
     /// The weather over the camera: its cloud layers and ground elevation, metres.
     overhead: (Vec<BlockLayer>, f32),
     /// The fog settings and the weather over the camera they read (visibility, obscuration).
@@ -357,6 +361,7 @@ impl Sky {
             queue: queue.clone(),
             clear_light: light,
             seen_light: light,
+            cover_transmittance: 1.0,
             overhead: (Vec::new(), 0.0),
             fog: (
                 Default::default(),
@@ -727,12 +732,25 @@ impl Sky {
         self.seen_light.sky_horizon_rgb
     }
 
-    /// The light of the last prepared frame under the cloud cover (see [`Self::set_weather_overhead`]):
-    /// what a host lights its own scene with. With the cloud shadows on, its sun is the clear
-    /// sun, for the host to dim by the shadow map ([`Self::cloud_shadows`]) where clouds stop it;
-    /// off, the sun is dimmed by the share of the sky the cover hides, everywhere alike.
+    /// The light of the last prepared frame (see [`Self::set_weather_overhead`]): what a host
+    /// lights its own scene with. Its sun (`directional_rgb`) is the clear direct sun, with the
+    /// cloud shadows on or off: the host dims it by the shadow map ([`Self::cloud_shadows`])
+    /// where the clouds stop it. With the shadows off the clouds cast none (the map lets all
+    /// the sun through), so the ground is in the clear sun everywhere, as open ground is with
+    /// them on. The sky colours are those under the cover over the camera. A host that draws
+    /// without the map and wants the cover to dim its ground evenly multiplies the sun by
+    /// [`Self::sun_cover_transmittance`]; skycast's own ground does not.
     pub fn light(&self) -> TimeOfDay {
         self.seen_light
+    }
+
+    /// The mean share (0..=1) of the direct sun the cloud cover over the camera lets through,
+    /// of the last prepared frame: 1 minus the share of the sky it hides, eased through a
+    /// change of the weather. Not applied to [`Self::light`]'s sun: it is for a host that does
+    /// not look up the shadow map and wants its ground dimmed evenly under a cover instead
+    /// (skycast's ground before the shadow map). The sky's own sun glow is dimmed by it.
+    pub fn sun_cover_transmittance(&self) -> f32 {
+        self.cover_transmittance
     }
 
     /// The time-of-day light for a sun position (for hosts lighting their own scene).
@@ -828,10 +846,12 @@ impl Sky {
         self.seen_light = self
             .clear_light
             .under_cover(hidden, &self.time_of_day.overcast);
-        if self.settings.cloud_shadows.enabled {
-            // The shadow map dims the sun where the clouds stop it: in open sun it is whole.
-            self.seen_light.directional_rgb = self.clear_light.directional_rgb;
-        }
+        // The host's sun is the clear sun, on or off: the shadow map dims it where the clouds
+        // stop it, and with the shadows off nothing does (off casts no shadows; it does not
+        // dim the ground evenly). The cover's mean dimming is kept apart for a host without
+        // the map.
+        self.cover_transmittance = 1.0 - hidden.clamp(0.0, 1.0);
+        self.seen_light.directional_rgb = self.clear_light.directional_rgb;
         let sun_dir = sun.direction_enu().as_vec3();
         let lighting = Lighting {
             sun_dir,
@@ -937,9 +957,9 @@ impl Sky {
             sun_dir: sun_dir
                 .extend(sun_cfg.disc_radius_deg.to_radians().cos())
                 .to_array(),
-            sun_rgb: self
-                .seen_light
-                .directional_rgb
+            // The sky's own sun glow and disc behind the clouds: dimmed by the cover as a
+            // whole, the same with the shadows on or off.
+            sun_rgb: (self.seen_light.directional_rgb * self.cover_transmittance)
                 .extend(sun_cfg.glow_radius_deg.to_radians().cos())
                 .to_array(),
             sky_zenith_rgb: self.seen_light.sky_zenith_rgb.extend(1.0).to_array(),
