@@ -217,6 +217,7 @@ fn shadows_darken_the_ground_under_clouds_and_only_there() {
         let map = (&map, lookup);
         let d = darkening_in_view(&on, &off, &camera, map);
         let itself = darkening_in_view(&off, &off, &camera, map);
+        eprintln!("{name}: shadow GPU memory {} bytes", stats.shadow_gpu_bytes);
         for (what, d) in [("on/off", &d), ("off/off", &itself)] {
             eprintln!(
                 "{name} {what}: shaded ground (tau >= 1) {} px, median luminance ratio {:.3}; open sun {} px, worst change {:.4}",
