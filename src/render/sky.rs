@@ -1020,7 +1020,11 @@ impl Sky {
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some("sky.impostors"),
                 });
-            self.scatter.record(&mut encoder);
+            if self.views[i].ring.has_pending() {
+                self.scatter.record(&mut encoder);
+            } else {
+                self.scatter.record_kept(&mut encoder);
+            }
             self.views[i].ring.record_builds(
                 &mut encoder,
                 &self.sheet_group,

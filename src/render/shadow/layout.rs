@@ -32,8 +32,10 @@ const DEPTH_RANGE_M: f64 = 200_000.0;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShadowSettings {
-    /// Draw the shadow map (false: a host's lookups find open sun everywhere, and the map takes
-    /// no memory).
+    /// Draw the shadow map. False means the clouds cast no shadows: a host's lookups find open
+    /// sun everywhere, so its ground has the clear sun everywhere (`Sky::light` gives the clear
+    /// sun either way; the cover's mean dimming is `Sky::sun_cover_transmittance`, applied by
+    /// no skycast ground), and the map takes no memory.
     pub enabled: bool,
     /// Side of the map, texels (R16Float: 1024 is 2 MiB; at most [`MAX_SIZE_PX`], 4 MiB).
     pub size_px: u32,

@@ -64,7 +64,8 @@ const _: () = assert!(std::mem::size_of::<GpuCloudShadow>() == 80);
 /// frame): `uv = (uv_from_camera_relative * vec4(q, 1)).xy`, `tau` the texture sampled there
 /// (linear filtering, clamped to its edge: its border texels hold 0), and the direct sun
 /// multiplied by `exp(-tau)`; the ambient light stays. Switched off, the texture is a single
-/// texel of 0: the same lookup finds open sun everywhere.
+/// texel of 0: the same lookup finds open sun everywhere, and the ground has the clear sun
+/// ([`super::Sky::light`]) everywhere, as open ground does with the map on.
 #[derive(Debug, Clone, Copy)]
 pub struct CloudShadowMap<'a> {
     /// The optical depth of the clouds along the sun's ray ([`SHADOW_FORMAT`], filterable).
