@@ -116,6 +116,8 @@ pub struct InCloudAirSettings {
     pub visibility_m: f32,
     /// How far the nearest cloud is looked for, metres.
     pub search_radius_m: f64,
+    /// Cell size of the grid a line of sight walks through a generation's cloud boxes, metres.
+    pub grid_cell_m: f64,
 }
 
 /// Precipitation rate and type (`[precipitation]`).
@@ -245,6 +247,9 @@ impl AirSettings {
         }
         if !positive(c.search_radius_m) {
             return Err(bad("in_cloud.search_radius_m", "must be above 0"));
+        }
+        if !(c.grid_cell_m >= 50.0 && c.grid_cell_m <= 10_000.0) {
+            return Err(bad("in_cloud.grid_cell_m", "must be within 50..=10000"));
         }
         let p = &s.precipitation;
         if !(0.0 <= p.light_mm_h
