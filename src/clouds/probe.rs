@@ -182,18 +182,30 @@ impl GenerationBoxes {
             return;
         };
         let mut best = best_t;
-        // A box is counted in the cell whose stretch of the segment holds its entry (its
-        // footprint covers that point, so that cell lists it); once the nearest entry is
-        // before the cell is left, no later cell can hold a nearer one.
-        self.grid.walk(a, b, from, to, |list, cell_in, cell_out| {
+        // A box is tested the first time a cell lists it (a big box is listed in many cells),
+        // and counted once; once the nearest entry is before the cell is left, no box not yet
+        // met can be entered earlier (its entry point lies in a later cell, which lists it).
+        // On the stack for up to 2,048 boxes (a block holds a few hundred clouds).
+        let mut stack = [0u64; 32];
+        let mut heap = Vec::new();
+        let words = self.boxes.len().div_ceil(64);
+        let met: &mut [u64] = if words <= stack.len() {
+            &mut stack[..words]
+        } else {
+            heap.resize(words, 0u64);
+            &mut heap
+        };
+        self.grid.walk(a, b, from, to, |list, _, cell_out| {
             for &index in list {
+                let (word, bit) = (index as usize / 64, 1u64 << (index % 64));
+                if met[word] & bit != 0 {
+                    continue;
+                }
+                met[word] |= bit;
                 let bx = &self.boxes[index as usize];
                 let Some((t0, t1)) = bx.segment(a, b) else {
                     continue;
                 };
-                if t0 < cell_in || t0 >= cell_out {
-                    continue;
-                }
                 if hit(bx, t0, t1) {
                     best = best.min(t0);
                 }
@@ -494,16 +506,17 @@ impl<'a> CloudProbe<'a> {
 
     /// Every generation of the blocks whose square reaches within `reach_m` of the air-frame
     /// box `lo..hi` (horizontally) and passes `wanted` (its square padded by a block, for the
-    /// clouds that overhang it) and whose clouds' bounds pass `near`, with its boxes. The cache
-    /// is locked once for the query.
-    fn generations(
+    /// clouds that overhang it) and whose clouds' bounds pass `near`, as `keep` makes of it
+    /// and its boxes (`None`: left out). The cache is locked once for the query.
+    fn generations<T>(
         &self,
         lo: DVec2,
         hi: DVec2,
         reach_m: f64,
         wanted: impl Fn(DVec2, DVec2) -> bool,
         near: impl Fn(DVec3, DVec3) -> bool,
-    ) -> Vec<(&'a FieldBlock, Arc<GenerationBoxes>)> {
+        mut keep: impl FnMut(&'a FieldBlock, &Arc<GenerationBoxes>) -> Option<T>,
+    ) -> Vec<T> {
         // Clouds overhang their block by up to a block.
         let pad = reach_m + BLOCK_SIZE_M;
         let a = BlockIndex::containing(lo - DVec2::splat(pad));
@@ -556,8 +569,10 @@ impl<'a> CloudProbe<'a> {
                 }
                 let live = field.generations(index);
                 for (serial, boxes) in &entry.generations {
-                    if let Some(g) = live.iter().find(|g| g.serial == *serial) {
-                        out.push((g, Arc::clone(boxes)));
+                    if let Some(g) = live.iter().find(|g| g.serial == *serial)
+                        && let Some(kept) = keep(g, boxes)
+                    {
+                        out.push(kept);
                     }
                 }
             }
@@ -592,7 +607,8 @@ impl<'a> CloudProbe<'a> {
             let (c, h) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
             ((q - c).abs() - h).max(DVec3::ZERO).length() <= reach
         };
-        for (g, boxes) in self.generations(q.truncate(), q.truncate(), reach, all, near) {
+        let keep = |g, b: &Arc<GenerationBoxes>| Some((g, Arc::clone(b)));
+        for (g, boxes) in self.generations(q.truncate(), q.truncate(), reach, all, near, keep) {
             if boxes.distance_m(q) > reach.min(nearest.max(nearest_cb)) {
                 continue;
             }
@@ -662,15 +678,16 @@ impl<'a> CloudProbe<'a> {
             )
             .is_some()
         };
-        let mut near: Vec<(f64, &FieldBlock, Arc<GenerationBoxes>)> = self
-            .generations(lo.truncate(), hi.truncate(), 0.0, crosses, |lo, hi| {
-                slab(qa, qb, lo, hi).is_some()
-            })
-            .into_iter()
-            .filter_map(|(g, boxes)| {
-                slab(qa, qb, boxes.lo_m, boxes.hi_m).map(|(t0, _)| (t0, g, boxes))
-            })
-            .collect();
+        let mut near: Vec<(f64, &FieldBlock, Arc<GenerationBoxes>)> = self.generations(
+            lo.truncate(),
+            hi.truncate(),
+            0.0,
+            crosses,
+            |lo, hi| slab(qa, qb, lo, hi).is_some(),
+            |g, boxes| {
+                slab(qa, qb, boxes.lo_m, boxes.hi_m).map(|(t0, _)| (t0, g, Arc::clone(boxes)))
+            },
+        );
         near.sort_by(|x, y| x.0.total_cmp(&y.0));
         for (enter, g, boxes) in near {
             if !whole && first.is_some_and(|f| enter > f.0) {
