@@ -278,6 +278,9 @@ pub struct AloftColumn {
     pub levels: Vec<AloftLevel>,
 }
 
+/// One level of a placed site: (velocity east/north kt, temperature C).
+type SiteLevel = (DVec2, Option<f64>);
+
 #[derive(Debug, Clone, Copy)]
 struct Vertex {
     position: Point2<f64>,
@@ -295,8 +298,8 @@ impl HasPosition for Vertex {
 #[derive(Debug)]
 pub struct WindsAloftField {
     levels_ft: Vec<f64>,
-    /// Per placed site, per level: (velocity east/north kt, temperature C).
-    values: Vec<Vec<Option<(DVec2, Option<f64>)>>>,
+    /// Per placed site, per level.
+    values: Vec<Vec<Option<SiteLevel>>>,
     tri: DelaunayTriangulation<Vertex>,
     /// Sites the table placed, of all.
     pub placed: usize,
@@ -512,11 +515,8 @@ mod tests {
                 let v = blended.velocity_kt.unwrap();
                 let want = velocity_kt(level.from_deg, level.speed_kt);
                 assert!((v - want).length() < 1e-6, "{} {v} {want}", site.id);
-                if level.temperature_c.is_some() {
-                    assert!(
-                        (blended.temperature_c.unwrap() - level.temperature_c.unwrap()).abs()
-                            < 1e-9
-                    );
+                if let Some(t) = level.temperature_c {
+                    assert!((blended.temperature_c.unwrap() - t).abs() < 1e-9);
                 }
                 checked += 1;
             }
