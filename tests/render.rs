@@ -769,9 +769,10 @@ fn fly_command_writes_frames_and_csv() {
 
 /// The air data agrees with the pictures (issue 33, Done means 1): along the approach through
 /// the San Antonio deck (`skycast fly`, every frame drawn, 96 x 54), the frames whose air data
-/// says wholly in cloud (0.99 and more) are one flat grey (luminance standard deviation under
-/// 0.01), those above 0.9 nearly (under 0.02: the issue's 0.01 is missed at 0.93, 0.0104, by
-/// the renderer's own fog, whose measure this is), and the frames under 0.1 are not; and at the camera it is the renderer's own `in_cloud`.
+/// says above 0.9 in cloud are one flat grey (luminance standard deviation under 0.01; 0.0104
+/// at 0.93 while the fog's opacity was capped at the measure, none since its extinction is the
+/// air data's visibility: shaders/in_cloud.wgsl), and the frames under 0.1 are not; and at the
+/// camera it is the renderer's own `in_cloud`.
 #[test]
 fn fly_air_in_cloud_agrees_with_the_pictures() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("fly-air");
@@ -813,17 +814,10 @@ fn fly_air_in_cloud_agrees_with_the_pictures() {
             .collect();
         let mean = lum.iter().sum::<f32>() / lum.len() as f32;
         let std = (lum.iter().map(|l| (l - mean).powi(2)).sum::<f32>() / lum.len() as f32).sqrt();
-        if air >= 0.99 {
+        if air > 0.9 {
             inside += 1;
             assert!(
                 std < 0.01,
-                "{}: in cloud {air}, luminance std {std}",
-                png.display()
-            );
-        } else if air > 0.9 {
-            // Not quite whole: a trace of the scene shows (0.0104 measured at 0.93).
-            assert!(
-                std < 0.02,
                 "{}: in cloud {air}, luminance std {std}",
                 png.display()
             );
@@ -837,7 +831,7 @@ fn fly_air_in_cloud_agrees_with_the_pictures() {
         }
     }
     assert!(
-        inside >= 2 && outside >= 10,
+        inside >= 3 && outside >= 10,
         "inside {inside}, outside {outside}"
     );
 }

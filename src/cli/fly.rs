@@ -34,6 +34,10 @@ pub struct FlyArgs {
     /// Station table placing reports the file does not place.
     #[arg(long, default_value = DEFAULT_STATIONS)]
     pub stations: PathBuf,
+    /// NOAA's winds and temperatures aloft (FB, e.g. FD1US1) for the air data above the
+    /// boundary layer, its sites placed through `--stations`.
+    #[arg(long, value_name = "FILE")]
+    pub winds_aloft: Option<PathBuf>,
     /// The flight path (TOML, see config/flights/).
     #[arg(long)]
     pub path: PathBuf,
@@ -101,6 +105,16 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     }
     let mut host = DemoHost::new(args.size.0, args.size.1, &ground, config)?;
     host.sky.set_weather_field(field);
+    if let Some(path) = &args.winds_aloft {
+        let fb = skycast::weather::winds_aloft::WindsAloft::load(path)?;
+        let table = StationTable::load(&args.stations)?;
+        let (placed, _) = host.sky.world_mut().set_winds_aloft(Some(&fb), &table);
+        eprintln!(
+            "winds aloft: {}: {placed} of {} sites placed",
+            path.display(),
+            fb.sites.len()
+        );
+    }
     if let Some(path) = &args.clouds {
         host.sky
             .world_mut()

@@ -18,6 +18,7 @@ use skycast::weather::field::{CloudTypeRule, FieldSettings};
 use skycast::weather::files::WeatherFile;
 use skycast::weather::metar::{ConvectiveKind, Cover, SkyCode};
 use skycast::weather::theme::{self, Theme};
+use skycast::weather::winds_aloft::WindsAloft;
 use skycast::weather::{
     BlockIndex, BlockWeather, LineWarning, LocalFrame, StationTable, WeatherInput,
 };
@@ -43,6 +44,10 @@ pub struct WeatherArgs {
     /// Air-data settings (default: the shipped config/air.toml).
     #[arg(long)]
     pub air_settings: Option<PathBuf>,
+    /// With `--alt-ft`: NOAA's winds and temperatures aloft (FB, e.g. FD1US1) for the air above
+    /// the boundary layer, its sites placed through `--stations`.
+    #[arg(long, value_name = "FILE", requires = "alt_ft")]
+    pub winds_aloft: Option<PathBuf>,
     /// Cloud-type rule (default: the shipped config/cloud_type_rule.toml).
     #[arg(long)]
     pub rule: Option<PathBuf>,
@@ -236,7 +241,11 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
                 Some(path) => AirSettings::load(path)?,
                 None => AirSettings::default(),
             };
-            Some(air_at(&loaded, lat, lon, alt_ft, settings)?)
+            let aloft = match &args.winds_aloft {
+                Some(path) => Some((WindsAloft::load(path)?, StationTable::load(&args.stations)?)),
+                None => None,
+            };
+            Some(air_at(&loaded, lat, lon, alt_ft, settings, aloft.as_ref())?)
         }
         _ => None,
     };
@@ -299,6 +308,7 @@ pub fn air_at(
     lon_deg: f64,
     alt_ft: f64,
     settings: AirSettings,
+    aloft: Option<&(WindsAloft, StationTable)>,
 ) -> anyhow::Result<AirData> {
     let frame = LocalFrame::new(lat_deg, lon_deg);
     let field = loaded.input.field(frame, &loaded.settings, &loaded.rule);
@@ -309,6 +319,15 @@ pub fn air_at(
     };
     let mut world = World::new(field, &world_settings);
     world.set_air_settings(settings, FogSettings::default());
+    if let Some((fb, table)) = aloft {
+        let (placed, unplaced) = world.set_winds_aloft(Some(fb), table);
+        eprintln!(
+            "winds aloft: {}: {placed} of {} sites placed (not in the station table: {})",
+            fb.path.display(),
+            fb.sites.len(),
+            unplaced.join(" ")
+        );
+    }
     let point = DVec3::new(0.0, 0.0, alt_ft * skycast::weather::METRES_PER_FOOT);
     world
         .settle_clouds_around(point)

@@ -19,6 +19,7 @@ pub mod remarks;
 pub mod stations;
 pub mod theme;
 pub mod watch;
+pub mod winds_aloft;
 
 pub use block::{
     BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, METRES_PER_FOOT, TypeSource, Wind,
