@@ -13,7 +13,7 @@ use serde::Serialize;
 use skycast::flight::{AirData, World, WorldSettings};
 use skycast::shading::{FogSettings, sun_position};
 use skycast::weather::air::AirSettings;
-use skycast::weather::block::{BlockLayer, TypeSource, ceiling_ft, cover_seen_from_below_oktas};
+use skycast::weather::block::{BlockLayer, ceiling_ft, cover_seen_from_below_oktas};
 use skycast::weather::field::{CloudTypeRule, FieldSettings};
 use skycast::weather::files::WeatherFile;
 use skycast::weather::metar::{ConvectiveKind, Cover, SkyCode};
@@ -453,11 +453,10 @@ pub fn describe_block(at: &AtBlock) -> String {
     }
     // The layers a report's covers sum over: CB and TCU are reported with their own amount
     // (ICAO Annex 3), outside the summation principle.
-    let convective = |l: &BlockLayer| l.type_source == TypeSource::Reported;
     let summed: Vec<BlockLayer> = w
         .layers
         .iter()
-        .filter(|l| !convective(l))
+        .filter(|l| !l.has_own_amount())
         .copied()
         .collect();
     for l in &w.layers {
@@ -465,7 +464,7 @@ pub fn describe_block(at: &AtBlock) -> String {
             .ok()
             .and_then(|v| v.as_str().map(str::to_string))
             .unwrap_or_default();
-        let cover = if convective(l) {
+        let cover = if l.has_own_amount() {
             "its own amount, not summed".to_string()
         } else {
             format!(
