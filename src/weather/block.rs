@@ -169,6 +169,9 @@ pub struct BlockWeather {
     pub dewpoint_c: f32,
     /// Precipitation intensity 0 (none) ..= 1 (heavy), from the reports' present weather.
     pub precipitation: f32,
+    /// Thunder, 0 (none) ..= 3 (`+TS`): 1 `-TS`, 2 `TS`, interpolated between the reports.
+    #[serde(default)]
+    pub thunder: f32,
     /// Ground elevation under the block, metres above mean sea level (from station elevations).
     pub ground_elevation_m: f32,
 }
