@@ -271,8 +271,14 @@ impl World {
             true => 0,
             false => std::thread::available_parallelism().map_or(1, |n| n.get().max(2) - 1),
         };
-        let field = CloudField::new(config, Arc::new(self.types.clone()), threads)
+        let mut field = CloudField::new(config, Arc::new(self.types.clone()), threads)
             .map_err(|e| RenderError::Clouds(e.to_string()))?;
+        // Storm anvils spread along the wind aloft of the air data's own profile.
+        field.set_storms(crate::weather::storms::StormContext {
+            wind: self.air_settings().wind,
+            lat_deg: self.field.frame().to_lat_lon_deg(DVec2::ZERO).0,
+            ..Default::default()
+        });
         self.clouds_config = config;
         self.living = Some(LivingClouds {
             field,
