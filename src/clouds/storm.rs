@@ -302,10 +302,10 @@ fn cell_raws(
     // the budget allows; the rim thinner and fibrous.
     let a = 0.5 * cell.anvil_width_m;
     let centre = cell.anvil_offset();
-    let s_anvil = (a * (std::f64::consts::PI / anvil_budget.max(1) as f64).sqrt() / 0.8)
+    let s_anvil = (a * (std::f64::consts::PI / anvil_budget.max(1) as f64).sqrt() / 0.65)
         .max(0.8 * anvil_t)
         .max(smin);
-    let step = 0.8 * s_anvil;
+    let step = 0.65 * s_anvil;
     let rim = (a - 0.3 * s_anvil).max(0.5 * a);
     let m = ((2.0 * rim / step).ceil() as i64).clamp(1, 24);
     let cell_step = 2.0 * rim / m as f64;
@@ -337,7 +337,12 @@ fn cell_raws(
                 group: group - 1,
                 rotation_deg: None,
                 base: None,
-                category: edge.then_some(TextureCategory::Wispy),
+                // A smooth slab (foggy sprites), not a field of puffs; fibres at the rim.
+                category: Some(if edge {
+                    TextureCategory::Wispy
+                } else {
+                    TextureCategory::Foggy
+                }),
             });
         }
     }
