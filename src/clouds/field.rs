@@ -238,6 +238,8 @@ pub struct CloudField {
     unsettled: usize,
     /// What the weather field's storm cells are decided with.
     storms: StormContext,
+    /// The storm cells over the field, as last decided (in the moving air's frame).
+    cells: Vec<StormCell>,
 }
 
 impl CloudField {
@@ -266,7 +268,24 @@ impl CloudField {
             membership: 0,
             unsettled: 0,
             storms: StormContext::default(),
+            cells: Vec::new(),
         }
+    }
+
+    /// What the storm cells are decided with.
+    pub fn storms(&self) -> &StormContext {
+        &self.storms
+    }
+
+    /// The storm cells over the field as last decided, in the moving air's frame (add
+    /// [`Self::drift_m`] for the ground's).
+    pub fn cells(&self) -> &[StormCell] {
+        &self.cells
+    }
+
+    /// The field's seed (the cells' and the flashes').
+    pub fn seed(&self) -> u64 {
+        self.config.field.seed
     }
 
     /// Decides the storm cells with `storms` (the settings, the air data's wind profile and
@@ -360,6 +379,11 @@ impl CloudField {
                 }
                 Some(_) => {}
             }
+        }
+        if !cb_seen {
+            self.cells.clear();
+        } else if let Some(decided) = cells {
+            self.cells = decided;
         }
         // Blocks a block beyond the rim leave the field.
         let keep = radius + BLOCK_SIZE_M;

@@ -396,6 +396,14 @@ impl SkySystem {
         Ok((stats, changes))
     }
 
+    /// The lightning flashes since the last call (each an in-cloud flash or a stroke to the
+    /// ground, with its time and place in the local frame), oldest first: drain it each frame,
+    /// for thunder and for lighting the host's own scene. Only cells under a report with TS
+    /// (or a theme's `thunder`) flash.
+    pub fn drain_flashes(&mut self) -> Vec<crate::weather::storms::Flash> {
+        self.world.drain_flashes()
+    }
+
     /// Records the sky's passes into the host's encoder after the host drew its scene: the sky
     /// behind everything, the clouds faded softly into the host's depth (read, never written),
     /// the fog inside a cloud. The host's textures are checked first ([`Sky::record`]): colour

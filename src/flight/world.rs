@@ -21,6 +21,7 @@ use crate::render::scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite};
 use crate::render::{RenderError, Sky, SpriteSheet};
 use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
+use crate::weather::storms::{Flash, flashes_between};
 use crate::weather::{BlockIndex, BlockWeather};
 use std::sync::Arc;
 
@@ -128,7 +129,12 @@ pub struct World {
     field_version: u64,
     /// Settings and caches of the air data ([`super::air`]).
     pub(super) air: super::air::AirState,
+    /// Lightning flashes not yet drained by the host, oldest first.
+    flashes: std::collections::VecDeque<Flash>,
 }
+
+/// Flashes kept for a host that does not drain them, at most (the oldest go first).
+const FLASHES_KEPT: usize = 1024;
 
 impl World {
     /// The world of `field` (whose frame origin is the world's centre).
@@ -143,6 +149,33 @@ impl World {
             synchronous_clouds: false,
             field_version: 0,
             air: Default::default(),
+            flashes: std::collections::VecDeque::new(),
+        }
+    }
+
+    /// The lightning flashes since the last call, oldest first, positions in the local frame
+    /// (metres east, north, up MSL): for thunder and for lighting the host's own scene. At most
+    /// the last 1,024 are kept between calls.
+    pub fn drain_flashes(&mut self) -> Vec<Flash> {
+        self.flashes.drain(..).collect()
+    }
+
+    /// The flashes that started in the last `dt_s` seconds of the living field, queued.
+    fn queue_flashes(&mut self, dt_s: f64) {
+        let Some(living) = self.living.as_ref() else {
+            return;
+        };
+        let field = &living.field;
+        let now = field.time_s();
+        let drift = field.drift_m();
+        let lightning = field.storms().settings.lightning;
+        for mut f in flashes_between(field.cells(), now - dt_s, now, &lightning, field.seed()) {
+            f.position_m[0] += drift.x;
+            f.position_m[1] += drift.y;
+            if self.flashes.len() >= FLASHES_KEPT {
+                self.flashes.pop_front();
+            }
+            self.flashes.push_back(f);
         }
     }
 
@@ -358,6 +391,10 @@ impl World {
             living.field.wait_for_pending();
         }
         living.field.advance(dt_s);
+        self.queue_flashes(dt_s);
+        let Some(living) = self.living.as_mut() else {
+            return Ok(());
+        };
         let drift = living.field.drift_m();
         let offset_m = DVec3::new(drift.x, drift.y, 0.0);
         let now = living.field.time_s();
