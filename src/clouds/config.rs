@@ -161,6 +161,14 @@ pub struct StormCellConfig {
     pub sprite_over_base: [f32; 2],
     /// Share of the sprites that go to the anvil, 0..1.
     pub anvil_share: f32,
+    /// The cell's five ambient colour levels, lowest first, heights as fractions of the cell's
+    /// height (the type's own levels where absent).
+    #[serde(default)]
+    pub colour_levels: Option<[ColourLevelConfig; 5]>,
+    /// The share of the cell's height, from its base up, in the shadow of the body above (the
+    /// type's `shaded_base_m` is for a chimney: a cell's sprites are taller than it), 0..=1.
+    #[serde(default)]
+    pub shaded_share: f32,
 }
 
 /// Precipitation falling from a cloud's base where the weather reports it (rain or snow
@@ -543,9 +551,10 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
                 && cell.sprite_over_base[0] <= cell.sprite_over_base[1]
                 && cell.sprite_over_base[1] <= 1.0
                 && cell.anvil_share > 0.0
-                && cell.anvil_share < 1.0,
+                && cell.anvil_share < 1.0
+                && (0.0..=1.0).contains(&cell.shaded_share),
             "cell",
-            "needs sprites 50..=4000, 0 < sprite_over_base low <= high <= 1, 0 < anvil_share < 1",
+            "needs sprites 50..=4000, 0 < sprite_over_base low <= high <= 1, 0 < anvil_share < 1, 0 <= shaded_share <= 1",
         )?;
     }
     if let Some(p) = c.precipitation {

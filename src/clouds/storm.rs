@@ -35,7 +35,9 @@ const DRAW_KEY: u64 = 0x6472_6177;
 const FALLBACK: StormCellConfig = StormCellConfig {
     sprites: 700,
     sprite_over_base: [0.13, 0.19],
-    anvil_share: 0.3,
+    anvil_share: 0.25,
+    colour_levels: None,
+    shaded_share: 0.0,
 };
 
 /// The whole cell as one cloud. `weather` is the weather the rain falls through (its
@@ -66,7 +68,16 @@ pub fn cell_cloud(cell: &StormCell, config: &CloudTypeConfig, weather: &BlockWea
         wind_axis_deg: 0.0,
     };
     let mut cloud = finish_cloud(&ctx, cell.centre(), kept, &mut rng);
-    cloud.shaded_base_m = config.shaded_base_m.unwrap_or(0.0);
+    cloud.shaded_base_m = config
+        .shaded_base_m
+        .unwrap_or(0.0)
+        .max(draw.shaded_share * height as f32);
+    if let Some(levels) = draw.colour_levels {
+        cloud.colour_levels = levels.map(|l| super::block::ColourLevel {
+            height_m: ((l.height as f64 - 0.5) * height) as f32,
+            rgba: l.rgba,
+        });
+    }
     if let Some(precipitation) = &config.precipitation
         && cell.precipitation > 0.0
     {
@@ -170,10 +181,11 @@ fn cell_raws(
         (s, s)
     };
 
-    // The base: a jittered grid of flat-bottomed sprites over the base disc.
-    let step = 0.85 * s_mean;
-    let rim = (r_base - 0.3 * s_mean).max(0.3 * r_base);
-    let m = ((2.0 * rim / step).ceil() as i64).clamp(1, 16);
+    // The base: a close jittered grid of flat-bottomed sprites over the base disc (close, so
+    // the base is one opaque, flat underside).
+    let step = 0.6 * s_mean;
+    let rim = (r_base - 0.15 * s_mean).max(0.3 * r_base);
+    let m = ((2.0 * rim / step).ceil() as i64).clamp(1, 20);
     let cell_step = 2.0 * rim / m as f64;
     for gy in 0..m {
         for gx in 0..m {
@@ -219,13 +231,13 @@ fn cell_raws(
     let mut boxes: Vec<Box3> = Vec::new();
     for k in 0..cell.turrets.max(1) {
         let (r, top, at) = if k == 0 {
-            let r = 0.55 * r_base;
+            let r = 0.7 * r_base;
             let off = DVec2::new(rng.range_f64(-1.0, 1.0), rng.range_f64(-1.0, 1.0))
                 * 0.25
                 * (r_base - r);
             (r, anvil_floor + 0.5 * anvil_t, off)
         } else {
-            let r = r_base * rng.range_f64(0.3, 0.45);
+            let r = r_base * rng.range_f64(0.4, 0.55);
             let room = (r_base - r) * 0.95;
             let off = loop {
                 let p = DVec2::new(rng.range_f64(-1.0, 1.0), rng.range_f64(-1.0, 1.0));
@@ -233,13 +245,13 @@ fn cell_raws(
                     break p * room;
                 }
             };
-            (r, anvil_floor * rng.range_f64(0.3, 0.85), off)
+            (r, anvil_floor * rng.range_f64(0.4, 0.9), off)
         };
         let n = ((top / (1.8 * r)).ceil() as usize).clamp(1, 8);
         let mut drift = at;
         for b in 0..n {
             let t = b as f64 / (n.max(2) - 1) as f64;
-            let half_w = r * (1.0 - 0.3 * t);
+            let half_w = r * (1.0 - 0.15 * t);
             if b > 0 {
                 drift += DVec2::new(rng.range_f64(-1.0, 1.0), rng.range_f64(-1.0, 1.0)) * 0.1 * r;
                 let room = (r_base - half_w).max(0.0);

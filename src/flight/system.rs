@@ -378,6 +378,7 @@ impl SkySystem {
         self.sky.add_field_cpu_us(weather_us);
         let position_m = self.local_m(camera.position);
         self.world.update_sky(&mut self.sky, position_m, dt_s)?;
+        self.sky.set_flash(self.world.flash_now());
         self.sky
             .set_weather_overhead(&self.world.weather_over(position_m));
         let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());

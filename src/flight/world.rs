@@ -21,7 +21,7 @@ use crate::render::scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite};
 use crate::render::{RenderError, Sky, SpriteSheet};
 use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
-use crate::weather::storms::{Flash, flashes_between};
+use crate::weather::storms::{Flash, FlashKind, flashes_between};
 use crate::weather::{BlockIndex, BlockWeather};
 use std::sync::Arc;
 
@@ -131,6 +131,8 @@ pub struct World {
     pub(super) air: super::air::AirState,
     /// Lightning flashes not yet drained by the host, oldest first.
     flashes: std::collections::VecDeque<Flash>,
+    /// The latest in-cloud flash, lighting its cell while it lasts.
+    lit: Option<Flash>,
 }
 
 /// Flashes kept for a host that does not drain them, at most (the oldest go first).
@@ -150,7 +152,24 @@ impl World {
             field_version: 0,
             air: Default::default(),
             flashes: std::collections::VecDeque::new(),
+            lit: None,
         }
+    }
+
+    /// The in-cloud flash lighting its cell now, as the sky draws it: its light fades from the
+    /// settings' `brightness` to none over `duration_s` (`config/storms.toml`).
+    pub fn flash_now(&self) -> Option<crate::render::SkyFlash> {
+        let field = &self.living.as_ref()?.field;
+        let f = self.lit?;
+        let l = field.storms().settings.lightning;
+        let age = field.time_s() - f.time_s;
+        (0.0..l.duration_s)
+            .contains(&age)
+            .then(|| crate::render::SkyFlash {
+                position_m: DVec3::from_array(f.position_m),
+                reach_m: l.reach_m as f32,
+                light: (l.brightness * (1.0 - age / l.duration_s)) as f32,
+            })
     }
 
     /// The lightning flashes since the last call, oldest first, positions in the local frame
@@ -172,6 +191,9 @@ impl World {
         for mut f in flashes_between(field.cells(), now - dt_s, now, &lightning, field.seed()) {
             f.position_m[0] += drift.x;
             f.position_m[1] += drift.y;
+            if f.kind == FlashKind::InCloud {
+                self.lit = Some(f);
+            }
             if self.flashes.len() >= FLASHES_KEPT {
                 self.flashes.pop_front();
             }

@@ -76,6 +76,8 @@ pub struct LightningSettings {
     pub duration_s: f64,
     /// Light an in-cloud flash adds to its cell at its peak, fraction of white, 0..=4.
     pub brightness: f64,
+    /// How far an in-cloud flash's light reaches (its 1/e distance), metres.
+    pub reach_m: f64,
 }
 
 impl Default for StormSettings {
@@ -161,6 +163,9 @@ impl StormSettings {
         }
         if !(0.0..=4.0).contains(&l.brightness) {
             return Err(bad("lightning.brightness", "must be within 0..=4"));
+        }
+        if !(l.reach_m >= 10.0 && l.reach_m <= 50_000.0) {
+            return Err(bad("lightning.reach_m", "must be within 10..=50000"));
         }
         Ok(s)
     }
