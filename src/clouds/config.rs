@@ -169,6 +169,13 @@ pub struct StormCellConfig {
     /// type's `shaded_base_m` is for a chimney: a cell's sprites are taller than it), 0..=1.
     #[serde(default)]
     pub shaded_share: f32,
+    /// Opacity factor of the anvil's sprites, in its middle and at its rim, 0..=1.
+    #[serde(default = "opaque")]
+    pub anvil_alpha: [f32; 2],
+}
+
+fn opaque() -> [f32; 2] {
+    [1.0, 1.0]
 }
 
 /// Precipitation falling from a cloud's base where the weather reports it (rain or snow
@@ -552,9 +559,10 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
                 && cell.sprite_over_base[1] <= 1.0
                 && cell.anvil_share > 0.0
                 && cell.anvil_share < 1.0
-                && (0.0..=1.0).contains(&cell.shaded_share),
+                && (0.0..=1.0).contains(&cell.shaded_share)
+                && cell.anvil_alpha.iter().all(|a| (0.0..=1.0).contains(a)),
             "cell",
-            "needs sprites 50..=4000, 0 < sprite_over_base low <= high <= 1, 0 < anvil_share < 1, 0 <= shaded_share <= 1",
+            "needs sprites 50..=4000, 0 < sprite_over_base low <= high <= 1, 0 < anvil_share < 1, 0 <= shaded_share <= 1, anvil_alpha within 0..=1",
         )?;
     }
     if let Some(p) = c.precipitation {
