@@ -137,31 +137,18 @@ fn a_10_km_cell_from_20_km_spans_25_degrees_on_a_dark_base_and_a_flash_lights_it
     // same rows (left of the cell, where the anvil downwind to the east does not reach).
     let (lo, hi) = (body_cols[0], *body_cols.last().unwrap());
     let middle = lo + (hi - lo) / 4..=hi - (hi - lo) / 4;
-    for y in bottom.saturating_sub(12)..=bottom {
-        let row: Vec<f32> = middle
-            .clone()
-            .map(|x| luminance(storm.rgba[at(x, y)]))
-            .collect();
-        let sky = luminance(storm.rgba[at(2, y)]);
-        eprintln!(
-            "row {y}: cell {:.3} sky {sky:.3}",
-            row.iter().sum::<f32>() / row.len() as f32
-        );
-    }
     // The flat base seen nearly edge-on from under it and the lowest body: the cell's lowest
     // rows but the last two (its soft lower edge, blended with the sky below).
     let base_rows = bottom.saturating_sub(6)..=bottom.saturating_sub(2);
     let mean = |px: Vec<[f32; 4]>| px.iter().map(|&p| luminance(p)).sum::<f32>() / px.len() as f32;
-    let base: Vec<[f32; 4]> = base_rows
+    let base: Vec<usize> = base_rows
         .clone()
-        .flat_map(|y| middle.clone().map(move |x| (x, y)))
-        .filter(|&(x, y)| mask[at(x, y)])
-        .map(|(x, y)| storm.rgba[at(x, y)])
+        .flat_map(|y| middle.clone().map(move |x| at(x, y)))
+        .filter(|&i| mask[i])
         .collect();
-    let beside: Vec<[f32; 4]> = base_rows
-        .flat_map(|y| (0..lo.saturating_sub(4)).map(move |x| (x, y)))
-        .filter(|&(x, y)| !mask[at(x, y)] && storm.depth[at(x, y)] >= 1.0)
-        .map(|(x, y)| storm.rgba[at(x, y)])
+    let beside: Vec<usize> = base_rows
+        .flat_map(|y| (0..lo.saturating_sub(4)).map(move |x| at(x, y)))
+        .filter(|&i| !mask[i] && storm.depth[i] >= 1.0)
         .collect();
     assert!(
         base.len() > 20 && beside.len() > 20,
@@ -169,7 +156,11 @@ fn a_10_km_cell_from_20_km_spans_25_degrees_on_a_dark_base_and_a_flash_lights_it
         base.len(),
         beside.len()
     );
-    let ratio = mean(base) / mean(beside);
+    let ratio_in = |f: &Frame| {
+        mean(base.iter().map(|&i| f.rgba[i]).collect())
+            / mean(beside.iter().map(|&i| f.rgba[i]).collect())
+    };
+    let ratio = ratio_in(&storm);
     eprintln!("base / sky beside: {ratio:.2}");
     // The cell spans 25 degrees and more; its body, 10 km across, near the 28 degrees 10 km
     // make at 20 km (its flanks fade into the sky).
@@ -178,6 +169,18 @@ fn a_10_km_cell_from_20_km_spans_25_degrees_on_a_dark_base_and_a_flash_lights_it
         "a 10 km cell from 20 km: {tall_deg:.1} deg tall, body {wide_deg:.1} deg wide"
     );
     assert!(ratio <= 0.65, "the base is {ratio:.2} of the sky beside it");
+
+    // The same view in the shipped clear air (40 km): printed, for the book.
+    host.sky.set_fog_settings(shipped);
+    let hazed = frame(&mut host, "cell_from_20_km_shipped_fog", &camera);
+    eprintln!(
+        "base / sky beside in the shipped 40 km clear air: {:.2}",
+        ratio_in(&hazed)
+    );
+    host.sky.set_fog_settings(FogSettings {
+        clear_visibility_m: 100_000.0,
+        ..shipped
+    });
 
     // An in-cloud flash in the middle of the tower: the cell brighter from inside, the sky
     // around the same.
