@@ -159,16 +159,43 @@ pub fn part_in_block(whole: &Cloud, block: BlockIndex, layer: u8) -> Option<Clou
     if sprites.is_empty() {
         return None;
     }
+    // Centred on its own sprites (at the cell's mid-height, where the colour levels are
+    // measured from): the renderer bounds, culls, orders and rings a cloud by a sphere around
+    // its centre, and one around the cell's would hold the whole cell for every part.
+    let n = sprites.len() as f32;
+    let shift = glam::Vec3::new(
+        sprites.iter().map(|s| s.offset_m[0]).sum::<f32>() / n,
+        sprites.iter().map(|s| s.offset_m[1]).sum::<f32>() / n,
+        0.0,
+    );
+    let moved = |o: [f32; 3]| (glam::Vec3::from_array(o) - shift).to_array();
+    let sprites: Vec<_> = sprites
+        .into_iter()
+        .map(|mut s| {
+            s.offset_m = moved(s.offset_m);
+            s
+        })
+        .collect();
+    let radius = sprites
+        .iter()
+        .map(|s| glam::Vec3::from_array(s.offset_m).length())
+        .fold(1.0f32, f32::max);
     Some(Cloud {
-        centre_m: whole.centre_m,
+        centre_m: whole.centre_m + shift.as_dvec3(),
         cloud_type: whole.cloud_type,
         layer,
-        radius_m: whole.radius_m,
+        radius_m: radius,
         flat: whole.flat,
         sunlit_depth_m: whole.sunlit_depth_m,
         shaded_base_m: whole.shaded_base_m,
         colour_levels: whole.colour_levels,
-        shading_groups: whole.shading_groups.clone(),
+        shading_groups: whole
+            .shading_groups
+            .iter()
+            .map(|g| super::block::ShadingGroup {
+                centre_m: moved(g.centre_m),
+            })
+            .collect(),
         sprites,
     })
 }
@@ -468,18 +495,27 @@ mod tests {
         let config = types.get(CloudType::Cumulonimbus);
         let c = cell();
         let whole = cell_cloud(&c, config, &weather());
-        let mut count = 0;
         let mut blocks = 0;
+        let mut placed = Vec::new();
         for j in -8..8 {
             for i in -6..10 {
                 if let Some(part) = part_in_block(&whole, BlockIndex::new(i, j), 0) {
-                    count += part.sprites.len();
                     blocks += 1;
-                    assert_eq!(part.centre_m, whole.centre_m);
+                    // Centred on its own sprites, its sphere holds them and not the cell.
+                    assert!(part.radius_m < 0.4 * whole.radius_m, "{}", part.radius_m);
+                    placed.extend(world(&part).into_iter().map(|p| p.to_array()));
                 }
             }
         }
-        assert_eq!(count, whole.sprites.len());
+        // Every sprite where the whole cell has it, once.
+        let mut all: Vec<[f64; 3]> = world(&whole).into_iter().map(|p| p.to_array()).collect();
+        let key = |p: &[f64; 3]| p.map(|v| (v * 10.0).round() as i64);
+        all.sort_by_key(key);
+        placed.sort_by_key(key);
+        assert_eq!(all.len(), placed.len());
+        for (a, b) in all.iter().zip(&placed) {
+            assert!((0..3).all(|k| (a[k] - b[k]).abs() < 0.05), "{a:?} {b:?}");
+        }
         assert!(blocks >= 9, "a cell spans {blocks} blocks");
         // Drawn again (another block asks), the same cell.
         assert_eq!(cell_cloud(&c, config, &weather()), whole);
