@@ -588,3 +588,46 @@ fn two_views_recorded_into_one_encoder_each_show_their_own_clouds() {
     eprintln!("a view adds {bytes} bytes of GPU memory; the sky's buffers grew by {grown}");
     assert!(bytes > 0 && grown <= bytes, "{grown} > {bytes}");
 }
+
+#[test]
+fn the_host_drains_flashes_of_a_ts_theme_and_none_without_ts() {
+    use skycast::Weather;
+    use skycast::weather::storms::FlashKind;
+    let theme = Path::new("weather/themes/thunderstorm_cells.toml");
+    let mut h = host::Host::new("standard", Some(theme)).expect("host");
+    let mut flashes = Vec::new();
+    // Two minutes in 10 s frames, drained each frame as a host does.
+    for _ in 0..12 {
+        h.sky
+            .update(&h.queue, &h.camera, host::UNIX_S, 10.0)
+            .expect("update");
+        flashes.extend(h.sky.drain_flashes());
+    }
+    let cells = h
+        .sky
+        .world()
+        .living_field()
+        .map_or(0, |f| f.cells().iter().filter(|c| c.thunder > 0).count());
+    assert!(cells > 0, "the theme's TS cells");
+    // At least one flash a minute per cell (the theme's TS: 4 a minute on average).
+    assert!(
+        flashes.len() >= 2 * cells,
+        "{} flashes of {cells} cells in 2 minutes",
+        flashes.len()
+    );
+    assert!(flashes.windows(2).all(|w| w[0].time_s <= w[1].time_s));
+    assert!(flashes.iter().any(|f| f.kind == FlashKind::InCloud));
+    assert!(h.sky.drain_flashes().is_empty(), "drained");
+    // Weather without TS: the cells and their flashes go.
+    h.sky
+        .set_weather(Weather::File(Path::new(
+            "weather/themes/fair_weather_cumulus.toml",
+        )))
+        .expect("weather");
+    for _ in 0..12 {
+        h.sky
+            .update(&h.queue, &h.camera, host::UNIX_S, 10.0)
+            .expect("update");
+    }
+    assert!(h.sky.drain_flashes().is_empty(), "no TS, no flash");
+}

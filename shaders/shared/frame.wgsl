@@ -11,10 +11,13 @@ struct Frame {
     // soft fades multiply by it: a division per fragment spared), z: soft_depth_fade_m,
     // w: in_cloud_visibility_m
     params: vec4<f32>,
-    // x: haze distance, metres
+    // x: haze distance, metres; y: the reach of `flash`, metres
     haze: vec4<f32>,
     // The host projection's depth to metres: -(a d + b) / (c d + e) for (a, b, c, e).
     depth_to_view: vec4<f32>,
+    // A lightning flash lighting its cell from inside: xyz its centre, camera-relative metres;
+    // w the light it adds at the centre (0: none).
+    flash: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> frame: Frame;

@@ -49,8 +49,11 @@ use super::weather::DEFAULT_STATIONS;
 mod passes;
 mod plot;
 
-/// The scenarios, in the order of the table.
-const SCENARIOS: [&str; 3] = ["sparse", "scattered", "overcast"];
+/// The scenarios, in the order of the table: the first three run by default, `storm` (a
+/// thunderstorm report: the weather field's storm cells) when asked for with `--scenario`.
+const SCENARIOS: [&str; 4] = ["sparse", "scattered", "overcast", "storm"];
+/// The scenario run only when asked for.
+const ON_REQUEST: &str = "storm";
 /// The path: due east, centred on the station, this long, at this height above its ground.
 const PATH_LENGTH_M: f64 = 12_000.0;
 const CRUISE_FT_AGL: f64 = 5_000.0;
@@ -70,7 +73,7 @@ pub struct BenchArgs {
     /// Directory for bench.csv, frames.csv and frame_time.png (created).
     #[arg(long, default_value = "out/bench")]
     pub out: PathBuf,
-    /// Directory holding sparse.metar, scattered.metar and overcast.metar.
+    /// Directory holding sparse.metar, scattered.metar, overcast.metar and storm.metar.
     #[arg(long, default_value = "weather/scenarios")]
     pub scenarios: PathBuf,
     /// Station table placing the scenario reports.
@@ -94,9 +97,9 @@ pub struct BenchArgs {
     /// UTC time, RFC 3339 (default: the shipped weather file's time).
     #[arg(long, value_parser = parse_time)]
     pub time: Option<f64>,
-    /// Run only this scenario (sparse, scattered or overcast); repeat for more (default: all
-    /// three).
-    #[arg(long = "scenario", value_parser = ["sparse", "scattered", "overcast"])]
+    /// Run only this scenario (sparse, scattered, overcast, or storm: SBBH's TSRA BKN045CB);
+    /// repeat for more (default: sparse, scattered and overcast).
+    #[arg(long = "scenario", value_parser = ["sparse", "scattered", "overcast", "storm"])]
     pub scenarios_only: Vec<String>,
     /// Run only with the impostor ring (`on`), only without it (`off`), or both.
     #[arg(long, default_value = "both", value_parser = ["on", "off", "both"])]
@@ -450,7 +453,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         _ => &[true, false],
     };
     for scenario in SCENARIOS {
-        if !args.scenarios_only.is_empty() && !args.scenarios_only.iter().any(|s| s == scenario) {
+        let asked = args.scenarios_only.iter().any(|s| s == scenario);
+        if (!args.scenarios_only.is_empty() || scenario == ON_REQUEST) && !asked {
             continue;
         }
         let (mut world, at) =

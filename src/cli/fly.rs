@@ -181,6 +181,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "turbulence",
         "icing",
         "sight_hits",
+        "flashes",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
@@ -283,6 +284,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             format!("{:.2}", air.turbulence),
             (air.icing as u8).to_string(),
             sight_hits.to_string(),
+            // The lightning flashes this frame, drained as a host drains them.
+            host.sky.drain_flashes().len().to_string(),
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);

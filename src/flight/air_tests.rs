@@ -201,7 +201,11 @@ fn still_clear_air_has_no_turbulence_and_no_icing() {
 #[test]
 fn icing_only_in_cloud_or_precipitation_at_0_to_minus_20() {
     let w = world(REAL, 42.239, -8.624, true);
-    let cb = boxes_of(&w, CloudType::Cumulonimbus)[0];
+    // A storm cell is drawn in parts, one a block: the part holding most of the tower's height.
+    let cb = boxes_of(&w, CloudType::Cumulonimbus)
+        .into_iter()
+        .max_by(|a, b| a.half_m.z.total_cmp(&b.half_m.z))
+        .unwrap();
     let ground = f64::from(w.field().weather_at(DVec2::ZERO).ground_elevation_m);
     // Up the middle of the Cb: icing exactly where it is 0 to -20 C.
     let (lo, hi) = (

@@ -386,6 +386,7 @@ impl SkySystem {
         self.sky.add_field_cpu_us(weather_us);
         let position_m = self.local_m(camera.position);
         self.world.update_sky(&mut self.sky, position_m, dt_s)?;
+        self.sky.set_flash(self.world.flash_now());
         self.sky
             .set_weather_overhead(&self.world.weather_over(position_m));
         let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
@@ -402,6 +403,14 @@ impl SkySystem {
         // This frame is not recorded yet: the last recording is the previous frame's.
         stats.record_us = self.sky.last_record_us();
         Ok((stats, changes))
+    }
+
+    /// The lightning flashes since the last call (each an in-cloud flash or a stroke to the
+    /// ground, with its time and place in the local frame), oldest first: drain it each frame,
+    /// for thunder and for lighting the host's own scene. Only cells under a report with TS
+    /// (or a theme's `thunder`) flash.
+    pub fn drain_flashes(&mut self) -> Vec<crate::weather::storms::Flash> {
+        self.world.drain_flashes()
     }
 
     /// Records the sky's passes into the host's encoder after the host drew its scene: the sky

@@ -27,12 +27,16 @@ pub struct GpuFrame {
     /// multiplication per fragment instead of a division), soft_depth_fade_m,
     /// in_cloud_visibility_m.
     pub params: [f32; 4],
-    /// x: distance at which sprites have faded 63% into the horizon haze, metres; yzw unused.
+    /// x: distance at which sprites have faded 63% into the horizon haze, metres; y: the
+    /// reach of `flash`, metres; zw unused.
     pub haze: [f32; 4],
     /// The host projection's depth to metres along the view axis ([`super::SkyView::depth_to_view`]).
     pub depth_to_view: [f32; 4],
+    /// A lightning flash lighting its cell from inside: xyz its centre, camera-relative
+    /// metres; w the light it adds at the centre (0: none). Its reach is `haze.y` metres.
+    pub flash: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuFrame>() == 256);
+const _: () = assert!(std::mem::size_of::<GpuFrame>() == 272);
 
 /// One sprite as it lives on the GPU from the moment its block arrives until the block goes
 /// (written once, never per frame), packed into 32 bytes: at a million sprites within 100 km

@@ -59,7 +59,7 @@ pub use resident::{BYTES_PER_SPRITE, resident_slots_bound};
 pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};
 pub use settings::RenderSettings;
 pub use shadow::{CloudShadowMap, ShadowImage, ShadowSettings};
-pub use sky::{Sky, SkyConfig, SpriteSheet};
+pub use sky::{Sky, SkyConfig, SkyFlash, SpriteSheet};
 pub use stats::{FrameStats, Lighting, SkyMemory};
 pub use targets::{HostTargets, SkyView};
 pub use view::ViewId;

@@ -150,6 +150,19 @@ pub struct Sky {
     /// The clouds' shadow map for the host's ground (`shadow`): one for every view, as the
     /// sun is; the main view's prepare draws it.
     shadows: super::shadow::CloudShadows,
+    /// The lightning flash lighting a cell now, if any.
+    flash: Option<SkyFlash>,
+}
+
+/// A lightning flash lighting its cell from inside, as the sprites draw it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkyFlash {
+    /// Its centre, metres east/north/up in the local frame.
+    pub position_m: glam::DVec3,
+    /// How far its light reaches (the Gaussian's 1/e distance), metres.
+    pub reach_m: f32,
+    /// The light it adds at its centre now, 0..=4 (fraction of white).
+    pub light: f32,
 }
 
 const SKY_WGSL: &str = include_str!("../../shaders/sky.wgsl");
@@ -372,6 +385,7 @@ impl Sky {
             ),
             overhead_ease: OverheadEase::default(),
             shadows,
+            flash: None,
         })
     }
 
@@ -707,6 +721,17 @@ impl Sky {
         self.fog_for(self.views[0].in_rain)
     }
 
+    /// Lights the sprites near a lightning flash from inside this frame on (`None`: no flash).
+    pub fn set_flash(&mut self, flash: Option<SkyFlash>) {
+        self.flash = flash;
+    }
+
+    /// Reads the fog (and the clouds' aerial perspective) with `settings` from now on instead
+    /// of the shipped `config/fog.toml`.
+    pub fn set_fog_settings(&mut self, settings: crate::shading::FogSettings) {
+        self.fog.0 = settings;
+    }
+
     /// [`Self::fog`] with a view's rain.
     fn fog_for(&self, in_rain: f32) -> crate::shading::Fog {
         let mut air = self.fog.0.fog(&self.fog.1, self.seen_light.sky_horizon_rgb);
@@ -976,11 +1001,17 @@ impl Sky {
                     &self.fog_for(self.views[i].in_rain),
                     self.settings.clouds.haze_distance_m,
                 ),
-                0.0,
+                self.flash.map_or(0.0, |f| f.reach_m),
                 0.0,
                 0.0,
             ],
             depth_to_view: camera.depth_to_view(),
+            flash: self.flash.map_or([0.0; 4], |f| {
+                (f.position_m - camera.position_m)
+                    .as_vec3()
+                    .extend(f.light)
+                    .to_array()
+            }),
         };
         queue.write_buffer(&self.views[i].frame_buffer, 0, bytemuck::bytes_of(&frame));
         upload_bytes += std::mem::size_of::<GpuFrame>() as u64;

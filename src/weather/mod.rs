@@ -17,6 +17,7 @@ pub mod live;
 pub mod metar;
 pub mod remarks;
 pub mod stations;
+pub mod storms;
 pub mod theme;
 pub mod watch;
 pub mod winds_aloft;
