@@ -673,9 +673,11 @@ impl Sky {
 
     /// CPU work of a frame: advances time by `dt_s`, uploads blocks that arrived, sorts blocks
     /// and clouds, recomputes the sprite orders Wang's cache says are stale, and writes the draw
-    /// list and this frame's uniforms (only what changed goes to the GPU); impostor renders go in
-    /// a submission of their own. A frame prepared and never recorded is flushed by the next
-    /// prepare, so nothing piles up however the host drives it.
+    /// list and this frame's uniforms (only what changed goes to the GPU). It submits nothing of
+    /// its own to the device (the impostor renders of a ring rebuild go into the next
+    /// [`Self::record`]), except that a frame prepared and never recorded is flushed by the next
+    /// prepare, so nothing piles up however the host drives it; the time that flush holds the
+    /// frame thread is `gpu_wait_us`, not in `cpu_update_us`.
     pub fn prepare(
         &mut self,
         queue: &wgpu::Queue,
@@ -685,9 +687,14 @@ impl Sky {
     ) -> FrameStats {
         let start = Instant::now();
         let camera: SkyView = view.into();
+        let mut gpu_wait_us = 0;
         if !self.recorded.replace(false) {
-            // The last frame's writes never reached a submit: send them, so they are freed.
+            // The last frame's writes never reached a submit: send them, so they are freed. A
+            // device still busy with earlier work can hold the submit (lavapipe waits in it for
+            // the submission before): timed apart, as a wait.
+            let wait = Instant::now();
             queue.submit([]);
+            gpu_wait_us = wait.elapsed().as_micros() as u64;
         }
         self.elapsed_s += dt_s.max(0.0);
         self.clear_light = self.time_of_day.at(sun.elevation_deg as f32);
@@ -730,6 +737,9 @@ impl Sky {
         (stats.sprites_lit, stats.light_us) = (self.resident.lit_sprites, self.resident.light_us);
         self.ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
+        // The frame's sorting budget, shared with a ring that is being rebuilt.
+        let sort_budget = self.settings.vertex_cache.max_sorted_sprites_per_frame;
+        let sort_budget = sort_budget - self.ring.sort_reserve(sort_budget);
         let resident = &mut self.resident;
         let inside = main_view(
             &mut resident.blocks,
@@ -741,7 +751,7 @@ impl Sky {
             },
             (camera.position_m, &camera.frustum()),
             self.elapsed_s,
-            &self.settings,
+            (&self.settings, sort_budget),
             &mut self.locks,
             &mut self.draws,
             &mut stats,
@@ -832,6 +842,7 @@ impl Sky {
             template: &frame,
             view: &light,
             camera_m: camera.position_m,
+            cache: &self.settings.vertex_cache,
         };
         upload_bytes += self.ring.prepare_builds(queue, &ring_frame, &mut stats);
         // Quad indices and built corners for the largest draw of the frame (the sprites, an
@@ -846,25 +857,6 @@ impl Sky {
         }
         self.build.reserve(&self.device, most);
         stats.upload_bytes = upload_bytes;
-        // Impostor renders (8 frames of a rebuild) need no host target: they go in a submission
-        // of the sky's own, ahead of the host's frame, with the patch of changed orders they
-        // read.
-        if self.ring.has_pending() {
-            let mut encoder = self
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("sky.impostors"),
-                });
-            self.scatter.record(&mut encoder);
-            self.ring.record_builds(
-                &mut encoder,
-                &self.sheet_group,
-                &self.build,
-                &self.resident.group,
-                &self.quads.0,
-            );
-            queue.submit([encoder.finish()]);
-        }
         stats.cloud_scale = self.clouds.scale();
         stats.cloud_target_bytes = self.clouds.gpu_bytes();
         stats.sprite_gpu_bytes = self.resident.gpu_bytes()
@@ -872,8 +864,9 @@ impl Sky {
             + self.build.gpu_bytes()
             + self.view.gpu_bytes();
         stats.field_us = std::mem::take(&mut self.field_us);
-        stats.cpu_update_us =
-            start.elapsed().as_micros() as u64 + std::mem::take(&mut self.pending_us);
+        stats.gpu_wait_us = gpu_wait_us;
+        stats.cpu_update_us = (start.elapsed().as_micros() as u64).saturating_sub(gpu_wait_us)
+            + std::mem::take(&mut self.pending_us);
         stats
     }
 
@@ -913,6 +906,16 @@ impl Sky {
         };
         stamp(encoder, Stamp::Start);
         self.scatter.record(encoder);
+        // The impostors this frame (and any frames prepared since the last recorded one)
+        // rebuilt: in the host's submission, never in one of the sky's own, which could hold
+        // the host's frame thread while the device is busy.
+        self.ring.record_builds(
+            encoder,
+            &self.sheet_group,
+            &self.build,
+            &self.resident.group,
+            &self.quads.0,
+        );
         let view_group = self.view.group().filter(|_| self.sprites_to_draw > 0);
         let parts: Vec<(u32, u32, u32)> = view_group
             .map(|_| chunks(self.sprites_to_draw).collect())
