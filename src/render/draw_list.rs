@@ -505,6 +505,10 @@ pub(super) struct RingOrders {
     /// By block id and cloud index.
     kept: HashMap<(u64, usize), RingOrder>,
     keys: SortKeys,
+    /// The gather under way ([`RingSort::gather`]) and its clouds still to sort (block id,
+    /// cloud index): found once, when it starts, so that its later frames look at nothing else.
+    gather: Option<u64>,
+    todo: Vec<(u64, usize)>,
 }
 
 /// One cloud's order seen from a ring centre.
@@ -520,6 +524,8 @@ struct RingOrder {
 /// When a ring build started and what it may sort this frame.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct RingSort<'a> {
+    /// Which impostor of which build is being gathered (a new value starts a new gather).
+    pub gather: u64,
     /// Sky time when the build started: orders computed since are good for it, older ones as
     /// long as Wang's thresholds (judged then) hold.
     pub since_s: f64,
@@ -538,8 +544,9 @@ impl RingOrders {
     }
 
     /// Sorts, from `from_m`, the clouds of blocks `ids` within `draw_m` whose order is missing
-    /// or stale, while `budget` (sprites) lasts, taking what it sorts from it. Returns whether
-    /// every such cloud now has a good order, and the sprites sorted.
+    /// or stale, while `budget` (sprites) lasts, taking what it sorts from it. Which clouds
+    /// those are is found on the first call of a gather; later calls of it sort what is left.
+    /// Returns whether every such cloud now has a good order, and the sprites sorted.
     pub fn sort(
         &mut self,
         blocks: &Blocks,
@@ -548,53 +555,69 @@ impl RingOrders {
         when: &RingSort,
         budget: &mut u32,
     ) -> (bool, u32) {
-        let (mut done, mut sorted) = (true, 0u32);
-        for id in ids {
-            let Some(r) = blocks.get(id).filter(|r| r.place.is_some()) else {
-                continue;
-            };
-            let fading = r.motion.fade != Fade::Steady;
-            for (ci, (state, cloud)) in r.clouds.iter().zip(&r.block.clouds).enumerate() {
-                let rel = from_m - (state.centre_m + r.motion.offset_m);
-                let near_edge = (rel.length() - state.radius_m as f64).max(0.0);
-                if near_edge > draw_m || state.sprites == 0 || state.sprites > when.largest {
+        if self.gather != Some(when.gather) {
+            self.gather = Some(when.gather);
+            self.todo.clear();
+            for id in ids {
+                let Some(r) = blocks.get(id).filter(|r| r.place.is_some()) else {
                     continue;
+                };
+                let fading = r.motion.fade != Fade::Steady;
+                for (ci, (state, cloud)) in r.clouds.iter().zip(&r.block.clouds).enumerate() {
+                    let rel = from_m - (state.centre_m + r.motion.offset_m);
+                    let near_edge = (rel.length() - state.radius_m as f64).max(0.0);
+                    if near_edge > draw_m || state.sprites == 0 || state.sprites > when.largest {
+                        continue;
+                    }
+                    let good = self.kept.get(&(*id, ci)).is_some_and(|o| {
+                        o.order.len() == cloud.sprites.len()
+                            && (o.at_s >= when.since_s
+                                || (when.cache.enabled
+                                    && !used_up(
+                                        ((o.from_rel_m, o.at_s), fading),
+                                        rel,
+                                        when.since_s,
+                                        near_edge,
+                                        when.cache,
+                                        1.0,
+                                    )))
+                    });
+                    if !good {
+                        self.todo.push((*id, ci));
+                    }
                 }
-                let good = self.kept.get(&(*id, ci)).is_some_and(|o| {
-                    o.order.len() == cloud.sprites.len()
-                        && (o.at_s >= when.since_s
-                            || (when.cache.enabled
-                                && !used_up(
-                                    ((o.from_rel_m, o.at_s), fading),
-                                    rel,
-                                    when.since_s,
-                                    near_edge,
-                                    when.cache,
-                                    1.0,
-                                )))
-                });
-                if good {
-                    continue;
-                }
-                if state.sprites > *budget {
-                    done = false;
-                    continue;
-                }
-                *budget -= state.sprites;
-                sorted += state.sprites;
-                let mut order = vec![0u32; cloud.sprites.len()];
-                order_into(cloud, rel.as_vec3(), 0, &mut order, &mut self.keys);
-                self.kept.insert(
-                    (*id, ci),
-                    RingOrder {
-                        from_rel_m: rel,
-                        at_s: when.time_s,
-                        order,
-                    },
-                );
             }
         }
-        (done, sorted)
+        let mut sorted = 0u32;
+        let mut left = Vec::new();
+        for (id, ci) in std::mem::take(&mut self.todo) {
+            // A block gone since (or off the GPU) is not in the view either.
+            let Some(r) = blocks.get(&id).filter(|r| r.place.is_some()) else {
+                continue;
+            };
+            let (Some(state), Some(cloud)) = (r.clouds.get(ci), r.block.clouds.get(ci)) else {
+                continue;
+            };
+            if state.sprites > *budget {
+                left.push((id, ci));
+                continue;
+            }
+            *budget -= state.sprites;
+            sorted += state.sprites;
+            let rel = from_m - (state.centre_m + r.motion.offset_m);
+            let mut order = vec![0u32; cloud.sprites.len()];
+            order_into(cloud, rel.as_vec3(), 0, &mut order, &mut self.keys);
+            self.kept.insert(
+                (id, ci),
+                RingOrder {
+                    from_rel_m: rel,
+                    at_s: when.time_s,
+                    order,
+                },
+            );
+        }
+        self.todo = left;
+        (self.todo.is_empty(), sorted)
     }
 
     /// An impostor's view from `from_m` (no locks), once [`Self::sort`] is done for it: the

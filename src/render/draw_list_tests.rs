@@ -211,6 +211,7 @@ fn ring_orders_are_sorted_within_the_frames_budget_and_kept_between_builds() {
     let reach = (centre, 100_000.0);
     let mut ring = RingOrders::default();
     let when = |since_s: f64, time_s: f64| RingSort {
+        gather: since_s as u64,
         since_s,
         time_s,
         cache: &cache,

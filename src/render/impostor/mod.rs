@@ -112,6 +112,8 @@ pub struct ImpostorRing {
     sorts: RingOrders,
     /// Time the ring has seen pass (the sum of the frames' steps), seconds.
     clock_s: f64,
+    /// Builds started.
+    builds: u64,
 }
 
 const SPRITES_WGSL: &str = include_str!("../../../shaders/sprites.wgsl");
@@ -411,6 +413,7 @@ impl ImpostorRing {
             bytes,
             sorts: RingOrders::default(),
             clock_s: 0.0,
+            builds: 0,
         }
     }
 
@@ -547,6 +550,7 @@ impl ImpostorRing {
             }
         }
         self.sorts.retain(blocks);
+        self.builds += 1;
         self.build = Some(Build {
             ring,
             next: 0,
@@ -595,7 +599,8 @@ impl ImpostorRing {
                 let whole = cache.max_sorted_sprites_per_frame;
                 (1, whole.saturating_sub(stats.sprites_recomputed), whole)
             };
-            let when = RingSort {
+            let mut when = RingSort {
+                gather: 0,
                 since_s: build.since_s,
                 time_s: self.clock_s,
                 cache,
@@ -612,6 +617,7 @@ impl ImpostorRing {
                     .filter(|r| in_sector(i, centre, r.centre_m()))
                     .map(|r| r.block.id)
                     .collect();
+                when.gather = self.builds * IMPOSTORS as u64 + i as u64;
                 let (sorted_all, sorted) =
                     self.sorts.sort(blocks, &sector, reach, &when, &mut budget);
                 stats.ring_sprites_sorted += sorted;
