@@ -10,7 +10,7 @@ XVFB_PACKAGES := xvfb xauth libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcomm
 # Mesa's Vulkan loader complains on every start when this is unset; /tmp silences it.
 export XDG_RUNTIME_DIR ?= /tmp
 
-.PHONY: demo test vulkan xvfb fuzz soak pictures mutants
+.PHONY: demo test vulkan xvfb fuzz soak pictures mutants docs
 
 demo: vulkan
 	cargo run --release --quiet -- demo
@@ -25,48 +25,62 @@ test: vulkan xvfb
 	cargo clippy --lib --no-default-features -- -D warnings
 	! cargo tree -e normal --no-default-features | grep -E '^[^a-z]*(clap|indicatif|env_logger|anyhow|exr|winit|noto-sans-mono-bitmap) '
 
-# The live-weather soak test (ignored by default): one simulated hour, a weather change every
-# five minutes; fails if memory (RSS) or the renderer's GPU buffers grow after the first changes.
+# Hours of flight (tests/soak.rs; `make test` flies one): SOAK_HOURS simulated hours, a watched
+# weather file rewritten every five minutes through six weathers (clear to thunderstorm cells),
+# the figures of each hour printed; fails if a cycle of the weathers holds more GPU memory than
+# the one before, or RSS grows by 2% from the first hour to the last. Release: about 5 s an hour.
+SOAK_HOURS ?= 6
 soak: vulkan
-	cargo test --test live -- --ignored --nocapture
+	SOAK_HOURS=$(SOAK_HOURS) cargo test --release --test soak -- --ignored --nocapture
 
-# Regenerates the README's pictures: one block of each type (CPU), each theme over Orlando at
-# 2 pm local, and frames along the three shipped flights (lavapipe is enough; ~1 minute).
+# Regenerates the pictures of the README and the book (docs/src/pictures/): one block of each
+# type (CPU), each theme over Orlando at 2 pm local, and frames along the three shipped flights
+# (lavapipe is enough; ~1 minute).
 SKYCAST := cargo run --quiet --
+# The book shows the pictures and mdBook publishes only docs/src, so they live there.
+PICTURES := docs/src/pictures
 METARS := weather/awc-metars-2025-01-27T22Z.cache.csv
 THEME = $(SKYCAST) render --at 28.5,-81.45 --time 2025-01-27T19:00:00Z --size 480x270
 FRAME = $(SKYCAST) render --size 640x360
-# The two shading models side by side (README, "Two shading models").
+# The two shading models side by side (the book's Rendering, "Two shading models").
 SHADING = $(SKYCAST) render --weather weather/themes/fair_weather_cumulus.toml --at 28.5,-81.45 --size 480x270
 pictures: vulkan
-	$(SKYCAST) sheet --out /tmp/skycast-sheet.png --over-sky tests/pictures/sheet_over_sky.png
-	$(SKYCAST) preview --type cumulus_mediocris --lifecycle --out tests/pictures/lifecycle.png
-	$(SKYCAST) preview --all --out tests/pictures/types/
-	$(THEME) --weather weather/themes/fair_weather_cumulus.toml --alt-ft 2500 --heading 90 --pitch 6 --out tests/pictures/themes/fair_weather_cumulus.png
-	$(THEME) --weather weather/themes/building_cumulus_cb_line.toml --alt-ft 3000 --heading 90 --pitch 8 --out tests/pictures/themes/building_cumulus_cb_line.png
-	$(THEME) --weather weather/themes/low_stratus_and_fog.toml --alt-ft 2600 --heading 90 --pitch -8 --out tests/pictures/themes/low_stratus_and_fog.png
-	$(THEME) --weather weather/themes/frontal_nimbostratus.toml --alt-ft 900 --heading 90 --pitch 8 --out tests/pictures/themes/frontal_nimbostratus.png
-	$(THEME) --weather weather/themes/thunderstorm_cells.toml --alt-ft 1500 --heading 90 --pitch 3 --out tests/pictures/themes/thunderstorm_cells.png
-	$(THEME) --weather weather/themes/high_cirrus.toml --alt-ft 5000 --heading 205 --pitch 20 --out tests/pictures/themes/high_cirrus.png
-	$(FRAME) --weather $(METARS) --at 33.90,-118.36 --alt-ft 3000 --heading 135 --pitch 8 --out tests/pictures/frames/cruise_under_cumulus.png
-	$(FRAME) --weather $(METARS) --at 33.90,-118.36 --alt-ft 5500 --heading 135 --pitch -8 --out tests/pictures/frames/cruise_over_cumulus.png
-	$(FRAME) --weather weather/themes/building_cumulus_cb_line.toml --at 28.5,-81.62 --alt-ft 3000 --heading 90 --pitch 10 --out tests/pictures/frames/cumulonimbus_line.png
-	$(FRAME) --weather $(METARS) --at 29.4270,-98.6080 --alt-ft 5000 --heading 40 --pitch -3 --out tests/pictures/frames/approach_above_deck.png
-	$(FRAME) --weather $(METARS) --at 29.4800,-98.5480 --alt-ft 3300 --heading 40 --pitch -3 --out tests/pictures/frames/approach_in_deck.png
-	$(FRAME) --weather $(METARS) --at 29.5230,-98.5000 --alt-ft 1500 --heading 40 --pitch 10 --out tests/pictures/frames/approach_below_deck.png
-	$(FRAME) --weather $(METARS) --at 53.43,-6.10 --time 2025-01-27T14:00:00Z --alt-ft 700 --heading 280 --pitch 12 --out tests/pictures/airports/dublin_approach.png
-	$(FRAME) --weather $(METARS) --at -4.80,136.887 --alt-ft 900 --heading 0 --pitch 14 --out tests/pictures/airports/timika_cb.png
-	$(FRAME) --weather weather/themes/low_stratus_and_fog.toml --at 28.5,-81.45 --time 2025-01-27T13:30:00Z --alt-ft 450 --heading 90 --pitch -4 --out tests/pictures/airports/fog_morning.png
-	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 283 --heading 315 --pitch 10 --out tests/pictures/pilot/deck_below.png
-	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 3083 --heading 135 --pitch -10 --out tests/pictures/pilot/deck_above.png
-	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 4000 --heading 10 --pitch -89 --out tests/pictures/pilot/deck_nadir.png
-	$(FRAME) --weather weather/views/high_broken_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 1000 --heading 0 --pitch 45 --out tests/pictures/pilot/cirrocumulus_below.png
-	cargo test --quiet --test pilot rain_falls_out_of_a_storm && cp target/tmp/pilot/storm/rain.png tests/pictures/pilot/storm_20km.png
+	$(SKYCAST) sheet --out /tmp/skycast-sheet.png --over-sky $(PICTURES)/sheet_over_sky.png
+	$(SKYCAST) preview --type cumulus_mediocris --lifecycle --out $(PICTURES)/lifecycle.png
+	$(SKYCAST) preview --all --out $(PICTURES)/types/
+	$(THEME) --weather weather/themes/fair_weather_cumulus.toml --alt-ft 2500 --heading 90 --pitch 6 --out $(PICTURES)/themes/fair_weather_cumulus.png
+	$(THEME) --weather weather/themes/building_cumulus_cb_line.toml --alt-ft 3000 --heading 90 --pitch 8 --out $(PICTURES)/themes/building_cumulus_cb_line.png
+	$(THEME) --weather weather/themes/low_stratus_and_fog.toml --alt-ft 2600 --heading 90 --pitch -8 --out $(PICTURES)/themes/low_stratus_and_fog.png
+	$(THEME) --weather weather/themes/frontal_nimbostratus.toml --alt-ft 900 --heading 90 --pitch 8 --out $(PICTURES)/themes/frontal_nimbostratus.png
+	$(THEME) --weather weather/themes/thunderstorm_cells.toml --alt-ft 1500 --heading 90 --pitch 3 --out $(PICTURES)/themes/thunderstorm_cells.png
+	$(THEME) --weather weather/themes/high_cirrus.toml --alt-ft 5000 --heading 205 --pitch 20 --out $(PICTURES)/themes/high_cirrus.png
+	$(FRAME) --weather $(METARS) --at 33.90,-118.36 --alt-ft 3000 --heading 135 --pitch 8 --out $(PICTURES)/frames/cruise_under_cumulus.png
+	$(FRAME) --weather $(METARS) --at 33.90,-118.36 --alt-ft 5500 --heading 135 --pitch -8 --out $(PICTURES)/frames/cruise_over_cumulus.png
+	$(FRAME) --weather weather/themes/building_cumulus_cb_line.toml --at 28.5,-81.62 --alt-ft 3000 --heading 90 --pitch 10 --out $(PICTURES)/frames/cumulonimbus_line.png
+	$(FRAME) --weather $(METARS) --at 29.4270,-98.6080 --alt-ft 5000 --heading 40 --pitch -3 --out $(PICTURES)/frames/approach_above_deck.png
+	$(FRAME) --weather $(METARS) --at 29.4800,-98.5480 --alt-ft 3300 --heading 40 --pitch -3 --out $(PICTURES)/frames/approach_in_deck.png
+	$(FRAME) --weather $(METARS) --at 29.5230,-98.5000 --alt-ft 1500 --heading 40 --pitch 10 --out $(PICTURES)/frames/approach_below_deck.png
+	$(FRAME) --weather $(METARS) --at 53.43,-6.10 --time 2025-01-27T14:00:00Z --alt-ft 700 --heading 280 --pitch 12 --out $(PICTURES)/airports/dublin_approach.png
+	$(FRAME) --weather $(METARS) --at -4.80,136.887 --alt-ft 900 --heading 0 --pitch 14 --out $(PICTURES)/airports/timika_cb.png
+	$(FRAME) --weather weather/themes/low_stratus_and_fog.toml --at 28.5,-81.45 --time 2025-01-27T13:30:00Z --alt-ft 450 --heading 90 --pitch -4 --out $(PICTURES)/airports/fog_morning.png
+	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 283 --heading 315 --pitch 10 --out $(PICTURES)/pilot/deck_below.png
+	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 3083 --heading 135 --pitch -10 --out $(PICTURES)/pilot/deck_above.png
+	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 4000 --heading 10 --pitch -89 --out $(PICTURES)/pilot/deck_nadir.png
+	$(FRAME) --weather weather/views/high_broken_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 1000 --heading 0 --pitch 45 --out $(PICTURES)/pilot/cirrocumulus_below.png
+	cargo test --quiet --test pilot rain_falls_out_of_a_storm && cp target/tmp/pilot/storm/rain.png $(PICTURES)/pilot/storm_20km.png
 	for m in wang harris_lastra; do \
-		$(SHADING) --shading $$m --time 2025-01-27T19:00:00Z --alt-ft 2500 --heading 90 --pitch 6 --out tests/pictures/shading/noon_$$m.png && \
-		$(SHADING) --shading $$m --time 2025-01-27T22:30:00Z --alt-ft 4500 --heading 246 --pitch 3 --out tests/pictures/shading/low_sun_$$m.png && \
-		$(SHADING) --shading $$m --time 2025-01-27T22:52:00Z --alt-ft 3000 --heading 150 --pitch 5 --out tests/pictures/shading/dusk_$$m.png || exit 1; \
+		$(SHADING) --shading $$m --time 2025-01-27T19:00:00Z --alt-ft 2500 --heading 90 --pitch 6 --out $(PICTURES)/shading/noon_$$m.png && \
+		$(SHADING) --shading $$m --time 2025-01-27T22:30:00Z --alt-ft 4500 --heading 246 --pitch 3 --out $(PICTURES)/shading/low_sun_$$m.png && \
+		$(SHADING) --shading $$m --time 2025-01-27T22:52:00Z --alt-ft 3000 --heading 150 --pitch 5 --out $(PICTURES)/shading/dusk_$$m.png || exit 1; \
 	done
+
+# Builds the book (docs/book.toml, docs/src/) into docs/book/ with mdBook, installed when missing
+# (`cargo install` compiles it: half an hour on the shared 2-core VM under load; the build itself
+# takes under a second). `make test` does not need it: the
+# book's links, pictures and quoted commands are checked by tests/docs.rs.
+docs:
+	@command -v mdbook >/dev/null || { echo "installing mdbook: cargo install --locked mdbook"; cargo install --locked mdbook; }
+	mdbook build docs
 
 # Runs every cargo-fuzz target for FUZZ_SECONDS each (see fuzz/README.md); needs cargo-fuzz.
 FUZZ_SECONDS ?= 120
@@ -86,17 +100,17 @@ fuzz:
 # reuses target/ (a copy would rebuild every dependency); each file is put back after its mutants,
 # so do not edit the tree while it runs. About 9 s a mutant on 2 cores (the default set: 184
 # mutants, 27 minutes). MUTANTS_FILES picks the files (the default is the set scored in the
-# README), MUTANTS_ARGS adds options (--shard 1/4, --list, --iterate to try again only what was
+# book, docs/src/testing.md), MUTANTS_ARGS adds options (--shard 1/4, --list, --iterate to try again only what was
 # not caught). Results in mutants.out/ (caught.txt, missed.txt, unviable.txt, timeout.txt); missed
-# mutants (cargo-mutants' status 2) are listed, not failed on: the README says which are accepted
-# and why.
+# mutants (cargo-mutants' status 2) are listed, not failed on: docs/src/testing.md says which are
+# accepted and why.
 MUTANTS_FILES ?= src/clouds/lifecycle.rs src/render/slots.rs src/weather/metar/sky.rs \
 	src/shading/directional.rs
 mutants:
 	@command -v cargo-mutants >/dev/null || { echo "installing cargo-mutants"; cargo install --locked cargo-mutants; }
 	cargo mutants --in-place --cargo-arg=--lib --timeout 30 --build-timeout 600 \
 		$(addprefix --file ,$(MUTANTS_FILES)) $(MUTANTS_ARGS) || [ $$? = 2 ]
-	@echo "missed (the README lists the accepted ones, with why):"; cat mutants.out/missed.txt
+	@echo "missed (docs/src/testing.md lists the accepted ones, with why):"; cat mutants.out/missed.txt
 
 # Installs lavapipe where missing: as root directly, else with sudo, else says the one line to run.
 vulkan:

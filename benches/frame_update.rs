@@ -103,11 +103,15 @@ fn run(c: &mut Cruise, cache: bool) -> (u64, u64, u64) {
             .gpu
             .device
             .create_command_encoder(&Default::default());
-        c.host.sky.record(
-            &mut encoder,
-            &c.host.target.colour_view,
-            &c.host.target.depth_view,
-        );
+        // The demo host's own targets: they match the sky's.
+        c.host
+            .sky
+            .record(
+                &mut encoder,
+                &c.host.target.colour_view,
+                &c.host.target.depth_view,
+            )
+            .expect("the demo host's targets");
         recomputed += stats.sprites_recomputed as u64;
         drawn += stats.sprites_drawn as u64;
         uploaded += stats.upload_bytes;

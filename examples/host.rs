@@ -2,7 +2,7 @@
 //! object. `cargo run --example host -- [standard|reversed|msaa] [out.png]`
 use glam::camera::rh::{proj::directx as proj, view::look_at_mat4};
 use glam::{Mat4, Vec3};
-use skycast::{HostCamera, HostPosition, HostTargets, SkySystem, Weather};
+use skycast::{HostCamera, HostPosition, HostTargets, SkySystem, ViewId, Weather};
 use wgpu::{TextureFormat, TextureUsages as Usage, util::DeviceExt};
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 
@@ -34,7 +34,10 @@ pub struct Host {
     /// The single-sample copy of `colour` (itself when not multisampled).
     pub resolved: wgpu::Texture,
     ground: (wgpu::RenderPipeline, wgpu::BindGroup),
-    camera: HostCamera,
+    pub camera: HostCamera,
+    /// The air where the camera is, read every frame after the sky's update (what a flight
+    /// model and its systems take: wind, temperature, pressure, in-cloud, turbulence, icing).
+    pub air: Option<skycast::flight::AirData>,
 }
 
 impl Host {
@@ -58,25 +61,7 @@ impl Host {
             sample_count: samples,
             ..Default::default()
         };
-        let texture = |format: TextureFormat, sample_count, usage| {
-            let size = wgpu::Extent3d {
-                width: W,
-                height: H,
-                depth_or_array_layers: 1,
-            };
-            let (dimension, mip_level_count, view_formats) =
-                (wgpu::TextureDimension::D2, 1, &[][..]);
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: None,
-                size,
-                mip_level_count,
-                sample_count,
-                dimension,
-                format,
-                usage,
-                view_formats,
-            })
-        };
+        let texture = |format, sample_count, usage| texture(&device, format, sample_count, usage);
         let colour = texture(
             targets.colour_format,
             samples,
@@ -96,15 +81,12 @@ impl Host {
 
         // The sky: one object on the host's device, for the host's targets.
         let mut sky = SkySystem::new(&device, &queue, targets, AT)?;
-        sky.world_mut().set_synchronous_clouds(true); // the same frame every run, for the test
+        // The warm-up, for the tests: the first frame waits for every cloud around, the same
+        // frame every run. A simulator leaves it off (`main` does): no frame waits.
+        sky.world_mut().set_synchronous_clouds(true);
         if let Some(path) = weather {
             sky.set_weather(Weather::File(path))?;
         }
-        let (h, p) = (
-            HEADING_DEG.to_radians() as f32,
-            PITCH_DEG.to_radians() as f32,
-        );
-        let forward = Vec3::new(h.sin() * p.cos(), h.cos() * p.cos(), p.sin());
         let (fov, aspect) = (50f32.to_radians(), W as f32 / H as f32);
         let projection = match reversed {
             true => proj::perspective_infinite_reverse(fov, aspect, 1.0),
@@ -117,7 +99,7 @@ impl Host {
         };
         let camera = HostCamera {
             position,
-            view: look_at_mat4(Vec3::ZERO, forward, Vec3::Z),
+            view: look(HEADING_DEG, PITCH_DEG),
             projection,
         };
         let ground = ground(&device, &targets, camera.projection * camera.view);
@@ -131,6 +113,7 @@ impl Host {
             resolved,
             ground,
             camera,
+            air: None,
         })
     }
 
@@ -169,27 +152,14 @@ impl Host {
     /// The sky's frame step, then its passes over the host's colour, reading its depth.
     pub fn draw_sky(&mut self, encoder: &mut wgpu::CommandEncoder) -> Result<skycast::FrameStats> {
         let (stats, _) = self.sky.update(&self.queue, &self.camera, UNIX_S, 0.0)?;
+        self.air = Some(self.sky.air_at(self.camera.position));
         let (colour, depth) = (
             self.colour.create_view(&Default::default()),
             self.depth.create_view(&Default::default()),
         );
-        self.sky.record(encoder, &colour, &depth);
+        self.sky.record(encoder, &colour, &depth)?;
         if self.targets.sample_count > 1 {
-            let resolve_target = Some(self.resolved.create_view(&Default::default()));
-            let ops = wgpu::Operations {
-                load: wgpu::LoadOp::Load,
-                store: wgpu::StoreOp::Store,
-            };
-            let attachment = wgpu::RenderPassColorAttachment {
-                view: &colour,
-                depth_slice: None,
-                resolve_target: resolve_target.as_ref(),
-                ops,
-            };
-            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                color_attachments: &[Some(attachment)],
-                ..Default::default()
-            });
+            resolve(encoder, &colour, &self.resolved);
         }
         Ok(stats)
     }
@@ -211,6 +181,138 @@ impl Host {
         };
         read_back(&self.device, &self.queue, encoder, single)
     }
+}
+
+/// A second view of the same sky (a monitor looking back over the tail, a mirror): its own
+/// camera and targets, no ground of its own (its depth cleared to the far value).
+pub struct SecondView {
+    pub id: ViewId,
+    pub camera: HostCamera,
+    pub colour: wgpu::Texture,
+    pub depth: wgpu::Texture,
+    /// The single-sample copy of `colour` (unused when not multisampled).
+    pub resolved: wgpu::Texture,
+}
+
+impl Host {
+    /// Adds a view from the same place looking `heading_deg`, `pitch_deg`, with targets of its
+    /// own (the sky's formats and samples).
+    pub fn add_view(&mut self, heading_deg: f64, pitch_deg: f64) -> SecondView {
+        let (d, t) = (&self.device, &self.targets);
+        let attachment = Usage::RENDER_ATTACHMENT | Usage::COPY_SRC;
+        SecondView {
+            id: self.sky.add_view(),
+            camera: HostCamera {
+                view: look(heading_deg, pitch_deg),
+                ..self.camera
+            },
+            colour: texture(d, t.colour_format, t.sample_count, attachment),
+            depth: texture(
+                d,
+                t.depth_format,
+                t.sample_count,
+                attachment | Usage::TEXTURE_BINDING,
+            ),
+            resolved: texture(d, t.colour_format, 1, attachment),
+        }
+    }
+
+    /// The view's share of the frame step, then its passes into `encoder` (after
+    /// [`Self::draw_sky`]'s, in the same encoder or another).
+    pub fn draw_view(
+        &mut self,
+        view: &SecondView,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> Result<skycast::FrameStats> {
+        let stats = self.sky.update_view(view.id, &self.queue, &view.camera)?;
+        let colour = view.colour.create_view(&Default::default());
+        let depth = view.depth.create_view(&Default::default());
+        let store = wgpu::StoreOp::Store;
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &colour,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(self.targets.background_depth()),
+                    store,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        self.sky.record_view(view.id, encoder, &colour, &depth)?;
+        if self.targets.sample_count > 1 {
+            resolve(encoder, &colour, &view.resolved);
+        }
+        Ok(stats)
+    }
+}
+
+/// The view matrix for east-north-up axes looking `heading_deg` (clockwise from north) and
+/// `pitch_deg` up.
+fn look(heading_deg: f64, pitch_deg: f64) -> Mat4 {
+    let (h, p) = (
+        heading_deg.to_radians() as f32,
+        pitch_deg.to_radians() as f32,
+    );
+    let forward = Vec3::new(h.sin() * p.cos(), h.cos() * p.cos(), p.sin());
+    look_at_mat4(Vec3::ZERO, forward, Vec3::Z)
+}
+
+/// A texture of the frame's size.
+fn texture(
+    device: &wgpu::Device,
+    format: TextureFormat,
+    sample_count: u32,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    let size = wgpu::Extent3d {
+        width: W,
+        height: H,
+        depth_or_array_layers: 1,
+    };
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: None,
+        size,
+        mip_level_count: 1,
+        sample_count,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// The host resolves its multisampled colour itself, after the sky recorded: an empty pass
+/// with a resolve target.
+fn resolve(
+    encoder: &mut wgpu::CommandEncoder,
+    colour: &wgpu::TextureView,
+    resolved: &wgpu::Texture,
+) {
+    let resolve_target = Some(resolved.create_view(&Default::default()));
+    let ops = wgpu::Operations {
+        load: wgpu::LoadOp::Load,
+        store: wgpu::StoreOp::Store,
+    };
+    let attachment = wgpu::RenderPassColorAttachment {
+        view: colour,
+        depth_slice: None,
+        resolve_target: resolve_target.as_ref(),
+        ops,
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        color_attachments: &[Some(attachment)],
+        ..Default::default()
+    });
 }
 
 /// The ground pipeline (depth tested the host's way) and its uniform.
@@ -330,11 +432,70 @@ fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let mode = args.get(1).map_or("standard", String::as_str);
     let mut host = Host::new(mode, Some(std::path::Path::new(THEME)))?;
+    // As a simulator runs it: the first update queues the clouds around and returns, and they
+    // arrive over the next frames, fading in.
+    host.sky.world_mut().set_synchronous_clouds(false);
+    let dt_s = 1.0 / 60.0;
+    let start = std::time::Instant::now();
+    let (first, _) = host.sky.update(&host.queue, &host.camera, UNIX_S, dt_s)?;
+    let first_ms = start.elapsed().as_secs_f64() * 1e3;
+    // Four seconds of 60 Hz frame steps (drawn or not, it is the same step), by which the
+    // clouds have arrived and faded in: the blocks the sky holds after some of them.
+    let mut arrived = vec![(1, host.sky.block_ids().count())];
+    for frame in 2..=240 {
+        std::thread::sleep(std::time::Duration::from_secs_f64(dt_s));
+        host.sky.update(&host.queue, &host.camera, UNIX_S, dt_s)?;
+        if [2, 5, 10, 30, 60, 240].contains(&frame) {
+            arrived.push((frame, host.sky.block_ids().count()));
+        }
+    }
+    println!(
+        "first update {first_ms:.1} ms (cloud field {} us, sky {} us); blocks held after (frames, blocks): {arrived:?}",
+        first.field_us, first.cpu_update_us
+    );
     let out = args.get(2).map_or("host.png", String::as_str);
     image::save_buffer(out, &host.frame()?, W, H, image::ExtendedColorType::Rgba8)?;
+    // A second view of the same sky, looking back over the tail, recorded into the same
+    // encoder as the main one: its own draw list, ring and cloud target.
+    let back = host.add_view(HEADING_DEG + 180.0, 8.0);
+    let mut encoder = host.device.create_command_encoder(&Default::default());
+    host.draw_ground(&mut encoder);
+    host.draw_sky(&mut encoder)?;
+    host.draw_view(&back, &mut encoder)?;
+    let single = |v: &SecondView| {
+        if host.targets.sample_count > 1 {
+            v.resolved.clone()
+        } else {
+            v.colour.clone()
+        }
+    };
+    let back_pixels = read_back(&host.device, &host.queue, encoder, &single(&back))?;
+    let back_out = out.replace(".png", "_back.png");
+    image::save_buffer(
+        &back_out,
+        &back_pixels,
+        W,
+        H,
+        image::ExtendedColorType::Rgba8,
+    )?;
+    println!(
+        "second view: {back_out}; it adds {:.1} MB of GPU memory",
+        host.sky.view_gpu_bytes(back.id) as f64 / 1e6
+    );
     println!(
         "{mode}: {out}; light for the host's own scene: {:?}",
         host.sky.lighting()
     );
+    if let Some(air) = &host.air {
+        println!(
+            "air: wind {:03.0}/{:.0} kt, {:.1} C, {:.1} hPa, in cloud {:.2}, turbulence {:?}",
+            air.wind_from_deg,
+            air.wind_kt,
+            air.temperature_c,
+            air.pressure_hpa,
+            air.in_cloud,
+            air.turbulence_category
+        );
+    }
     Ok(())
 }

@@ -24,7 +24,7 @@
 //!     projection, // the host's projection, as its depth convention has it
 //! };
 //! let (stats, _applied) = sky.update(queue, &camera, 1_738_015_200.0, 1.0 / 60.0)?;
-//! sky.record(encoder, colour, depth); // reads the host's depth, never writes it
+//! sky.record(encoder, colour, depth)?; // checks the targets; reads the host's depth, never writes it
 //! let light = sky.lighting();         // sun, ambient, horizon and fog for the host's scene
 //! # let _ = (stats, light); Ok(()) }
 //! ```
@@ -32,6 +32,13 @@
 //! `examples/host.rs` is a complete host (its own device, targets and ground) that the tests run
 //! with standard Z, reversed Z and 4x MSAA. A host that writes `default-features = false`
 //! compiles none of the command line's crates.
+//!
+//! The types a host touches: [`SkySystem`] (the sky), [`HostTargets`] (its colour and depth
+//! targets), [`Weather`] (what the sky is given), [`HostCamera`] and [`HostPosition`] (its camera
+//! each frame), [`FrameStats`] (what a frame cost), [`HostLighting`] (the light to draw its own
+//! scene with) and [`SkyError`]. [`SkySystemConfig`] holds settings of the host's own; [`Sky`]
+//! and [`SkyView`] are the renderer underneath, for a host with its own weather and cloud
+//! handling. The book (`docs/src/embedding.md` in the repository) has the host's terms in full.
 //!
 //! # Stages
 //!
@@ -56,4 +63,10 @@ pub mod weather;
 pub use flight::{
     HostCamera, HostLighting, HostPosition, SkyError, SkySystem, SkySystemConfig, Weather,
 };
-pub use render::{FrameStats, HostTargets, Sky, SkyView};
+pub use render::{FrameStats, HostTargets, Sky, SkyView, ViewId};
+
+/// The README's embedding snippet, compiled by `cargo test --doc` so that it cannot drift from
+/// the API (the README's only Rust block; its shell blocks are checked by `tests/docs.rs`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

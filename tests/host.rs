@@ -185,6 +185,16 @@ fn host_frame(mode: &str) -> (Vec<u8>, bool) {
     };
     let mut sky = encoder(&h);
     h.draw_sky(&mut sky).expect("sky");
+    // The host read the air where it is (250/8 kt at the surface, 24 C): above the boundary
+    // layer, veered 30 degrees and cooler.
+    let air = h
+        .air
+        .as_ref()
+        .expect("the host reads the air data each frame");
+    assert!(
+        (air.wind_from_deg - 280.0).abs() < 1.0 && air.temperature_c < 24.0,
+        "{mode}: {air:?}"
+    );
     let after = if copyable {
         host::read_back(&h.device, &h.queue, sky, &h.depth).expect("depth")
     } else {
@@ -225,4 +235,352 @@ fn the_example_host_draws_the_clouds_render_draws_in_every_depth_convention() {
         // sample of a multisampled one.
         assert!(depth_unchanged, "{mode}: the sky changed the host's depth");
     }
+}
+
+/// Real reports of 2025-01-27 around 22Z, one a line, as a host would have them: Los Angeles
+/// stations (in NOAA's table) and three that are not in it (placed only by a file that gives
+/// positions).
+const LOS_ANGELES: &str =
+    "KLAX 272153Z 26008KT 10SM FEW025 FEW060 SCT160 SCT250 14/07 A3008 RMK AO2 SLP187 T01390067
+KBUR 272153Z 17004KT 10SM BKN085 13/03 A3006 RMK AO2 SLP174 T01330028
+KVNY 272151Z VRB05KT 10SM SCT055 BKN085 15/01 A3005 RMK AO2 SLP174 T01500006
+KLGB 272153Z VRB03KT 10SM SCT040 14/05 A3007 RMK AO2 SLP180 T01440050
+KSMO 272151Z 24006KT 10SM FEW025 14/05 A3008 RMK AO2 SLP186 T01440050
+";
+const THREE_OF_FIVE_UNPLACED: &str =
+    "KLAX 272153Z 26008KT 10SM FEW025 FEW060 SCT160 SCT250 14/07 A3008 RMK AO2 SLP187 T01390067
+KIKT 272225Z AUTO VRB04KT 10SM SCT028 BKN033 OVC050 22/12 A3011 RMK A01
+KBUR 272153Z 17004KT 10SM BKN085 13/03 A3006 RMK AO2 SLP174 T01330028
+PFNO 272223Z AUTO 21005KT 1SM -SN BR SCT017 BKN023 OVC046 M18/M20 A2955 RMK AO2 P0000 FZRANO
+PAMK 272222Z AUTO 27010KT 9SM FEW010 BKN038 OVC049 M18/M20 A2972 RMK AO2 SNE17 P00
+";
+
+/// The example's frame after `setup` gave its sky weather.
+fn frame_with(setup: impl FnOnce(&mut skycast::SkySystem)) -> Vec<u8> {
+    let mut h = host::Host::new("standard", None).expect("host");
+    setup(&mut h.sky);
+    h.frame().expect("frame")
+}
+
+#[test]
+fn plain_metar_text_needs_no_station_file_and_says_what_it_skipped() {
+    use skycast::Weather;
+    use skycast::weather::WarningKind;
+    let name = Path::new("metars.txt");
+    let clear = frame_with(|_| {});
+    let clouds = frame_with(|sky| {
+        let skipped = sky
+            .set_weather(Weather::Bytes {
+                name,
+                bytes: LOS_ANGELES.as_bytes(),
+            })
+            .expect("plain METAR text");
+        assert_eq!((skipped.reports_found, skipped.reports_used), (5, 5));
+        assert!(skipped.is_empty(), "{skipped}");
+    });
+    // The reports placed by the built-in table give clouds: a good part of the sky above the
+    // horizon differs from the same frame without weather.
+    let cloud = cloud_mask(&clouds, &clear);
+    let cover = cloud.iter().filter(|&&c| c).count() as f64 / cloud.len() as f64;
+    assert!(cover > 0.05, "clouds on {cover:.3} of the sky");
+
+    // Three reports the table cannot place: three warnings, by line and station, counted.
+    let mut h = host::Host::new("standard", None).expect("host");
+    let skipped = h
+        .sky
+        .set_weather(Weather::Bytes {
+            name,
+            bytes: THREE_OF_FIVE_UNPLACED.as_bytes(),
+        })
+        .expect("two usable reports");
+    assert_eq!(skipped.reports_used, 2);
+    assert_eq!(skipped.count(WarningKind::NoPosition), 3, "{skipped}");
+    let lines: Vec<usize> = skipped.warnings.iter().map(|w| w.line).collect();
+    assert_eq!(lines, [2, 4, 5]);
+    for (w, station) in skipped.warnings.iter().zip(["KIKT", "PFNO", "PAMK"]) {
+        assert!(w.message.starts_with(station), "{w}");
+    }
+    assert_eq!(
+        skipped.to_string(),
+        "3 reports without a position, lines 2, 4 and 5"
+    );
+    assert_eq!(h.sky.weather_skipped(), &skipped);
+
+    // No usable report is an error, not an empty sky; garbage bytes too.
+    let unplaced: String = THREE_OF_FIVE_UNPLACED
+        .lines()
+        .filter(|l| !l.starts_with("KLAX") && !l.starts_with("KBUR"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let err = h
+        .sky
+        .set_weather(Weather::Bytes {
+            name,
+            bytes: unplaced.as_bytes(),
+        })
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("no usable report") && err.contains("3 reports without a position"),
+        "{err}"
+    );
+    let garbage: Vec<u8> = (0..600u32).map(|k| (k * 7919 % 251) as u8 + 1).collect();
+    let err = h
+        .sky
+        .set_weather(Weather::Bytes {
+            name,
+            bytes: &garbage,
+        })
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("not a weather file"), "{err}");
+    // The last good weather stays.
+    assert_eq!(h.sky.weather_skipped(), &skipped);
+}
+
+/// A texture of the example's size on its device.
+fn texture(
+    h: &host::Host,
+    format: wgpu::TextureFormat,
+    samples: u32,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    h.device.create_texture(&wgpu::TextureDescriptor {
+        label: None,
+        size: wgpu::Extent3d {
+            width: host::W,
+            height: host::H,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+const COLOUR: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT;
+const DEPTH: wgpu::TextureUsages =
+    wgpu::TextureUsages::RENDER_ATTACHMENT.union(wgpu::TextureUsages::TEXTURE_BINDING);
+
+/// The example host in `mode` updated, then recording into `colour` and `depth`, which do not
+/// match its targets: the sky's error, after the encoder was finished and submitted (nothing
+/// in it for wgpu's validation to panic on).
+fn refused(h: &mut host::Host, colour: &wgpu::Texture, depth: &wgpu::Texture) -> String {
+    h.sky
+        .update(&h.queue, &h.camera, host::UNIX_S, 0.0)
+        .expect("the example's own camera");
+    let mut encoder = h.device.create_command_encoder(&Default::default());
+    let (colour, depth) = (
+        colour.create_view(&Default::default()),
+        depth.create_view(&Default::default()),
+    );
+    let err = h.sky.record(&mut encoder, &colour, &depth).unwrap_err();
+    h.queue.submit([encoder.finish()]);
+    h.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .expect("poll");
+    err.to_string()
+}
+
+#[test]
+fn a_projection_against_the_reversed_flag_is_refused_naming_both() {
+    let fov = 50f32.to_radians();
+    let aspect = host::W as f32 / host::H as f32;
+    let standard = glam::camera::rh::proj::directx::perspective(fov, aspect, 1.0, 300_000.0);
+    let reversed = glam::camera::rh::proj::directx::perspective_infinite_reverse(fov, aspect, 1.0);
+    for (mode, wrong) in [("standard", reversed), ("reversed", standard)] {
+        let mut h = host::Host::new(mode, None).expect(mode);
+        let camera = skycast::HostCamera {
+            projection: wrong,
+            ..h.camera
+        };
+        let err = h
+            .sky
+            .update(&h.queue, &camera, host::UNIX_S, 0.0)
+            .unwrap_err()
+            .to_string();
+        let flag = format!("reversed_z is {}", mode == "reversed");
+        assert!(
+            err.contains(&flag) && err.contains("but the projection is"),
+            "{mode}: {err}"
+        );
+        // The host's own projection still draws.
+        h.frame().expect("the right projection");
+    }
+}
+
+#[test]
+fn a_depth_without_texture_binding_is_refused() {
+    let mut h = host::Host::new("standard", None).expect("host");
+    let depth = texture(
+        &h,
+        h.targets.depth_format,
+        1,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
+    let colour = texture(&h, h.targets.colour_format, 1, COLOUR);
+    let err = refused(&mut h, &colour, &depth);
+    assert!(err.contains("without TEXTURE_BINDING"), "{err}");
+}
+
+#[test]
+fn textures_of_another_sample_count_are_refused() {
+    // Targets of 4 samples, textures of 1.
+    let mut h = host::Host::new("msaa", None).expect("host");
+    let colour = texture(&h, h.targets.colour_format, 1, COLOUR);
+    let depth = texture(&h, h.targets.depth_format, 1, DEPTH);
+    let err = refused(&mut h, &colour, &depth);
+    assert!(
+        err.contains("1 sample(s) a pixel but HostTargets::sample_count is 4"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_colour_target_of_another_format_is_refused() {
+    let mut h = host::Host::new("standard", None).expect("host");
+    let colour = texture(&h, wgpu::TextureFormat::Bgra8UnormSrgb, 1, COLOUR);
+    let depth = texture(&h, h.targets.depth_format, 1, DEPTH);
+    let err = refused(&mut h, &colour, &depth);
+    assert!(
+        err.contains("Bgra8UnormSrgb") && err.contains("Rgba8UnormSrgb"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_sky_system_counts_its_recording_in_the_frame_cpu() {
+    let mut h = host::Host::new("standard", Some(Path::new(host::THEME))).expect("host");
+    let mut records = Vec::new();
+    let mut stats = Vec::new();
+    for _ in 0..2 {
+        let mut encoder = h.device.create_command_encoder(&Default::default());
+        h.draw_ground(&mut encoder);
+        stats.push(h.draw_sky(&mut encoder).expect("sky"));
+        records.push(h.sky.last_record_us());
+        h.queue.submit([encoder.finish()]);
+    }
+    // Through `update` the recording counted is the previous frame's.
+    assert!(records[0] > 0);
+    assert_eq!(stats[1].record_us, records[0]);
+    let s = &stats[1];
+    assert_eq!(s.sky_cpu_us(), s.field_us + s.cpu_update_us + s.record_us);
+}
+
+/// Cloud pixels above the horizon, as a fraction.
+fn cover(frame: &[u8], clear: &[u8]) -> f64 {
+    let mask = cloud_mask(frame, clear);
+    mask.iter().filter(|&&c| c).count() as f64 / mask.len() as f64
+}
+
+#[test]
+fn the_first_frames_do_not_wait_and_clouds_fade_in_as_they_arrive() {
+    // Every block drawn as sprites (no ring), so each one's own fade shows.
+    let host_without_ring = |theme: bool| {
+        let weather = theme.then(|| Path::new(host::THEME));
+        let mut h = host::Host::new("standard", weather).expect("host");
+        h.sky.set_impostors(false);
+        h
+    };
+    let clear = host_without_ring(false).frame().expect("clear");
+    // The warm-up (synchronous clouds): every block there in the first frame, whole.
+    let mut warm = host_without_ring(true);
+    let whole = warm.frame().expect("warm frame");
+    let blocks = warm.sky.block_ids().count();
+    assert!(cover(&whole, &clear) > 0.2);
+
+    // The default: the first update queues the blocks and returns; they come in over the next
+    // updates (the frames' time standing still while they do, so none has faded in yet).
+    let mut h = host_without_ring(true);
+    h.sky.world_mut().set_synchronous_clouds(false);
+    let mut updates = 0;
+    while h.sky.block_ids().count() < blocks {
+        h.sky
+            .update(&h.queue, &h.camera, host::UNIX_S, 0.0)
+            .expect("update");
+        updates += 1;
+        assert!(
+            updates < 3_000,
+            "{} of {blocks} blocks came",
+            h.sky.block_ids().count()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    assert!(updates > 1, "the first update waited for the clouds");
+    let step = |h: &mut host::Host, dt_s: f64| {
+        h.sky
+            .update(&h.queue, &h.camera, host::UNIX_S, dt_s)
+            .expect("update");
+    };
+    let arrived = h.frame().expect("frame");
+    // A third of the way through their fade in, then past it.
+    step(&mut h, 1.0);
+    let fading = h.frame().expect("frame");
+    step(&mut h, 3.0);
+    let settled = h.frame().expect("frame");
+    let covers = [&arrived, &fading, &settled].map(|f| cover(f, &clear));
+    assert!(
+        covers[0] < 0.02 && covers[1] > covers[0] + 0.05 && covers[2] > covers[1] + 0.05,
+        "cloud cover as they arrive, fading in, settled: {covers:?}"
+    );
+    // Settled, the sky is the warm-up's.
+    let agree = agreement(&cloud_mask(&settled, &clear), &cloud_mask(&whole, &clear));
+    assert!(
+        agree >= 0.97,
+        "settled clouds agree with the warm-up's on {agree:.3}"
+    );
+}
+
+/// Mean absolute difference of two RGBA8 frames' colour, 0..1.
+fn mean_difference(a: &[u8], b: &[u8]) -> f64 {
+    let sum: u64 = a
+        .chunks(4)
+        .zip(b.chunks(4))
+        .map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c]) as u64).sum::<u64>())
+        .sum();
+    sum as f64 / (a.len() / 4 * 3) as f64 / 255.0
+}
+
+#[test]
+fn two_views_recorded_into_one_encoder_each_show_their_own_clouds() {
+    let mut h = host::Host::new("standard", Some(Path::new(host::THEME))).expect("host");
+    let front_alone = h.frame().expect("front");
+    let sky_bytes = h.sky.gpu_buffer_bytes();
+    // A second monitor from the same seat, looking back over the tail.
+    let back = h.add_view(host::HEADING_DEG + 180.0, 8.0);
+    let read = |h: &host::Host, encoder, texture: &wgpu::Texture| {
+        host::read_back(&h.device, &h.queue, encoder, texture).expect("read back")
+    };
+    let encoder = |h: &host::Host| h.device.create_command_encoder(&Default::default());
+    // Each view drawn alone, in a submission of its own.
+    let mut e = encoder(&h);
+    h.draw_view(&back, &mut e).expect("back");
+    let back_alone = read(&h, e, &back.colour);
+    // Both updated, then both recorded into one encoder, one submit.
+    let mut e = encoder(&h);
+    h.draw_ground(&mut e);
+    h.draw_sky(&mut e).expect("front");
+    h.draw_view(&back, &mut e).expect("back");
+    let front_both = read(&h, e, &h.colour);
+    let back_both = read(&h, encoder(&h), &back.colour);
+    // The two views show different skies: the comparison can tell them apart.
+    let apart = mean_difference(&front_alone, &back_alone);
+    assert!(apart > 0.05, "the views look alike: {apart:.4}");
+    for (name, both, alone) in [
+        ("front", &front_both, &front_alone),
+        ("back", &back_both, &back_alone),
+    ] {
+        let d = mean_difference(both, alone);
+        eprintln!("{name}: one encoder against alone, mean absolute difference {d:.5}");
+        assert!(d < 0.01, "{name}: {d:.4}");
+    }
+    // What a view adds: its frame uniform, draw list, ring and cloud target, no more (the
+    // resident sprites are the sky's: its buffers grew by the view's own at most).
+    let bytes = h.sky.view_gpu_bytes(back.id);
+    let grown = h.sky.gpu_buffer_bytes() - sky_bytes;
+    eprintln!("a view adds {bytes} bytes of GPU memory; the sky's buffers grew by {grown}");
+    assert!(bytes > 0 && grown <= bytes, "{grown} > {bytes}");
 }

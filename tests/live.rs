@@ -1,12 +1,7 @@
 //! Live weather on real headless renders (lavapipe where there is no GPU), tiny frames: the
 //! weather file is rewritten during a flight and the sky follows without a pop, broken files keep
-//! the old sky, a 5,000-station file loads while frames go on. The soak test (`make soak`,
-//! ignored by default) flies one simulated hour with a change every five minutes.
-
-#[path = "support/rss.rs"]
-mod rss;
-
-use rss::rss_bytes;
+//! the old sky, a 5,000-station file loads while frames go on. Hours of changes are flown in
+//! `tests/soak.rs`.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -433,8 +428,8 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
     assert!(frames_during_load >= 2, "the frames waited for the load");
     // A frame of this tiny flight measured 16-29 ms of CPU (synchronous clouds); one that waited
     // for the load (decoding 5,000 reports and triangulating them, 450 ms here) would take the
-    // load's time.
-    assert!(max_cpu < Duration::from_millis(60), "{max_cpu:?}");
+    // load's time. Compared as a ratio, not against a wall time: on a loaded machine a frame
+    // measured 80-146 ms while the load took longer still.
     assert!(
         max_cpu * 2 < load,
         "a frame took {max_cpu:?} of the load's {load:?}"
@@ -468,65 +463,6 @@ fn the_same_change_without_a_fade_pops() {
     let plain = motion.max(motion_after);
     eprintln!("without a fade: plain motion {plain:.5}, worst frame during the change {worst:.5}");
     assert!(worst > 1.5 * plain, "{worst} <= 1.5 x {plain}");
-}
-
-/// One simulated hour at a tiny size, a weather change every five minutes (through the timed
-/// events' path), one frame a second, every tenth drawn: memory and GPU buffers stop growing
-/// after the first changes. `make soak`.
-#[test]
-#[ignore = "soak test: one simulated hour; run with make soak"]
-fn soak_one_hour_of_weather_changes_does_not_grow() {
-    let dir = temp_dir("soak");
-    let files: Vec<PathBuf> = ["FEW045", "BKN035", "SCT040", "OVC030"]
-        .iter()
-        .enumerate()
-        .map(|(k, sky)| {
-            let p = dir.join(format!("{k}.txt"));
-            std::fs::write(&p, reports(sky)).unwrap();
-            p
-        })
-        .collect();
-    let mut flight = Flight::new(field_of(&files[0]), 8_000.0, None, 60.0);
-    flight.circle = true;
-    for k in 1..12 {
-        flight
-            .host
-            .sky
-            .schedule_weather(&files[k % files.len()], k as f64 * 300.0)
-            .unwrap();
-    }
-    let mut applied = 0;
-    let mut settled: Option<(u64, u64)> = None;
-    let (mut rss_max, mut gpu_max) = (0u64, 0u64);
-    for s in 0..3600 {
-        let (_, changes, _) = flight.step(1.0, s % 10 == 0);
-        applied += changes.iter().filter(|c| c.is_ok()).count();
-        if s == 900 {
-            settled = Some((rss_bytes(), flight.host.sky.gpu_buffer_bytes()));
-        }
-        if s > 900 {
-            rss_max = rss_max.max(rss_bytes());
-            gpu_max = gpu_max.max(flight.host.sky.gpu_buffer_bytes());
-        }
-    }
-    let (rss_settled, gpu_settled) = settled.unwrap();
-    eprintln!(
-        "soak: {applied} changes; RSS {:.1} MB at 15 min, max {:.1} MB after; GPU buffers {} \
-         bytes at 15 min, max {} after",
-        rss_settled as f64 / 1e6,
-        rss_max as f64 / 1e6,
-        gpu_settled,
-        gpu_max
-    );
-    assert_eq!(applied, 11);
-    assert!(
-        rss_max <= rss_settled + rss_settled / 10 + (16 << 20),
-        "RSS grew from {rss_settled} to {rss_max}"
-    );
-    assert!(
-        gpu_max <= gpu_settled,
-        "GPU buffers grew from {gpu_settled} to {gpu_max}"
-    );
 }
 
 /// A new report's fog and cloud cover come in with its clouds, not in the frame it arrives: the

@@ -359,7 +359,7 @@ fn draw_to_steady(
     let mut timestamps = true;
     for _ in 0..512 {
         let start = Instant::now();
-        let stats = host.draw(&camera, sun, dt_s, visibility_m);
+        let stats = host.draw(&camera, sun, dt_s, visibility_m)?;
         let (frame_ms, sky_ms) = match host.last_gpu_split_ms() {
             Some([ground, sky]) => (ground + sky, sky),
             None => {

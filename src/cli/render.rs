@@ -269,6 +269,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         sky_config((lat, lon), (settings, table), &loaded),
     )?;
     host.sky.set_weather_field(field);
+    // One offline frame: the warm-up, so it has every cloud around.
+    host.sky.world_mut().set_synchronous_clouds(true);
     let position = glam::DVec3::new(0.0, 0.0, args.alt_ft * METRES_PER_FOOT);
     let camera = host.camera(position, args.heading, args.pitch);
     // The same frame step a simulator's frame runs (the clouds around generated before it).

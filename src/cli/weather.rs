@@ -1,12 +1,19 @@
-//! `skycast weather FILE [--stations FILE] [--at LAT,LON] [--json]`: what a weather file holds
-//! and, with `--at`, the interpolated weather of the 4 km block there.
+//! `skycast weather FILE [--stations FILE] [--at LAT,LON [--alt-ft FT]] [--json]`: what a
+//! weather file holds and, with `--at`, the interpolated weather of the 4 km block there; with
+//! `--alt-ft` too, the air data at that altitude (wind, temperature, pressure, visibility, cloud,
+//! turbulence, icing: `skycast::flight::air`), the clouds around generated as a flight would.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
+use glam::DVec3;
 use serde::Serialize;
+use skycast::flight::{AirData, World, WorldSettings};
+use skycast::shading::{FogSettings, sun_position};
+use skycast::weather::air::AirSettings;
+use skycast::weather::block::{BlockLayer, TypeSource, ceiling_ft, cover_seen_from_below_oktas};
 use skycast::weather::field::{CloudTypeRule, FieldSettings};
 use skycast::weather::files::WeatherFile;
 use skycast::weather::metar::{ConvectiveKind, Cover, SkyCode};
@@ -30,6 +37,12 @@ pub struct WeatherArgs {
     /// Also print the interpolated weather of the block at this latitude,longitude (degrees).
     #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
     pub at: Option<(f64, f64)>,
+    /// With `--at`: the air data at this altitude, feet above mean sea level.
+    #[arg(long, value_name = "FT", requires = "at", allow_hyphen_values = true)]
+    pub alt_ft: Option<f64>,
+    /// Air-data settings (default: the shipped config/air.toml).
+    #[arg(long)]
+    pub air_settings: Option<PathBuf>,
     /// Cloud-type rule (default: the shipped config/cloud_type_rule.toml).
     #[arg(long)]
     pub rule: Option<PathBuf>,
@@ -70,6 +83,8 @@ struct ThemeJsonOut<'a> {
     description: &'a str,
     points: usize,
     at: Option<&'a AtBlock>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    air: Option<&'a AirData>,
 }
 
 /// Counts over the located reports of a file.
@@ -149,6 +164,8 @@ struct JsonOut<'a> {
     #[serde(flatten)]
     summary: &'a Summary,
     at: Option<&'a AtBlock>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    air: Option<&'a AirData>,
 }
 
 /// Everything `skycast weather` needs, loaded: the weather, the rule and the settings.
@@ -213,6 +230,16 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
         args.field_settings.as_deref(),
     )?;
     let at = args.at.map(|(lat, lon)| at_block(&loaded, lat, lon));
+    let air = match (args.at, args.alt_ft) {
+        (Some((lat, lon)), Some(alt_ft)) => {
+            let settings = match &args.air_settings {
+                Some(path) => AirSettings::load(path)?,
+                None => AirSettings::default(),
+            };
+            Some(air_at(&loaded, lat, lon, alt_ft, settings)?)
+        }
+        _ => None,
+    };
     let file = match &loaded.input {
         WeatherInput::Reports(file) => file,
         WeatherInput::Theme(theme) => {
@@ -224,12 +251,16 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
                     description: &theme.description,
                     points: theme.points.len(),
                     at: at.as_ref(),
+                    air: air.as_ref(),
                 };
                 println!("{}", serde_json::to_string(&out)?);
             } else {
                 print!("{}", describe_theme(&args.file, theme));
                 if let Some(at) = &at {
                     print!("{}", describe_block(at));
+                }
+                if let Some(air) = &air {
+                    print!("{}", describe_air(air));
                 }
             }
             return Ok(());
@@ -245,6 +276,7 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
             warnings: &file.warnings,
             summary: &summary,
             at: at.as_ref(),
+            air: air.as_ref(),
         };
         println!("{}", serde_json::to_string(&out)?);
         return Ok(());
@@ -253,7 +285,88 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
     if let Some(at) = &at {
         print!("{}", describe_block(at));
     }
+    if let Some(air) = &air {
+        print!("{}", describe_air(air));
+    }
     Ok(())
+}
+
+/// The air data at a point and altitude: a world whose frame has its origin there, its clouds
+/// generated around it (as far as the air data looks), the sun where it is now.
+pub fn air_at(
+    loaded: &Loaded,
+    lat_deg: f64,
+    lon_deg: f64,
+    alt_ft: f64,
+    settings: AirSettings,
+) -> anyhow::Result<AirData> {
+    let frame = LocalFrame::new(lat_deg, lon_deg);
+    let field = loaded.input.field(frame, &loaded.settings, &loaded.rule);
+    let world_settings = WorldSettings {
+        // The search radius, plus a block for the clouds overhanging their blocks.
+        cloud_radius_m: settings.in_cloud.search_radius_m + 4_000.0,
+        ..WorldSettings::default()
+    };
+    let mut world = World::new(field, &world_settings);
+    world.set_air_settings(settings, FogSettings::default());
+    let point = DVec3::new(0.0, 0.0, alt_ft * skycast::weather::METRES_PER_FOOT);
+    world
+        .settle_clouds_around(point)
+        .context("generating the clouds around the point")?;
+    let now_s = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64());
+    let sun = sun_position(now_s, lat_deg, lon_deg).direction_enu();
+    Ok(world.air_at(point, sun))
+}
+
+/// The text description of the air data.
+pub fn describe_air(a: &AirData) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "air at {:.0} ft AGL: wind {:03.0}/{:.0} kt gusting {:.0}, temperature {:.1} C, \
+         dewpoint {:.1} C, pressure {:.1} hPa (QNH {:.1}), pressure altitude {:.0} ft, \
+         density altitude {:.0} ft",
+        a.height_agl_ft,
+        a.wind_from_deg,
+        a.wind_kt,
+        a.gust_kt,
+        a.temperature_c,
+        a.dewpoint_c,
+        a.pressure_hpa,
+        a.qnh_hpa,
+        a.pressure_altitude_ft,
+        a.density_altitude_ft
+    );
+    let nearest = a
+        .nearest_cloud_m
+        .map_or("none within reach".to_string(), |d| format!("{d:.0} m"));
+    let _ = writeln!(
+        out,
+        "  visibility {:.0} m, in cloud {:.2} (nearest cloud {nearest}), precipitation {:?} \
+         {:.1} mm/h, turbulence {:.2} ({:?}), icing {}",
+        a.visibility_m,
+        a.in_cloud,
+        a.precipitation,
+        a.precipitation_mm_h,
+        a.turbulence,
+        a.turbulence_category,
+        if a.icing { "yes" } else { "no" }
+    );
+    let ceiling = a
+        .ceiling_ft_agl
+        .map_or("none".to_string(), |c| format!("{c:.0} ft AGL"));
+    let _ = writeln!(
+        out,
+        "  layers above {}, below {}, ceiling {ceiling}, sky covered overhead {:.0}%, sun hidden {:.0}%",
+        a.layers_above.len(),
+        a.layers_below.len(),
+        a.sky_coverage * 100.0,
+        a.sun_occlusion * 100.0
+    );
+    out
 }
 
 /// The text summary of a theme.
@@ -334,22 +447,38 @@ pub fn describe_block(at: &AtBlock) -> String {
     if w.layers.is_empty() {
         let _ = writeln!(out, "  no cloud");
     } else {
-        let ceiling = skycast::weather::block::ceiling_ft(&w.layers, 5.0)
-            .map_or("none".to_string(), |c| format!("{c:.0} ft AGL"));
+        let ceiling =
+            ceiling_ft(&w.layers, 5.0).map_or("none".to_string(), |c| format!("{c:.0} ft AGL"));
         let _ = writeln!(out, "  ceiling {ceiling}");
     }
+    // The layers a report's covers sum over: CB and TCU are reported with their own amount
+    // (ICAO Annex 3), outside the summation principle.
+    let convective = |l: &BlockLayer| l.type_source == TypeSource::Reported;
+    let summed: Vec<BlockLayer> = w
+        .layers
+        .iter()
+        .filter(|l| !convective(l))
+        .copied()
+        .collect();
     for l in &w.layers {
         let source = serde_json::to_value(l.type_source)
             .ok()
             .and_then(|v| v.as_str().map(str::to_string))
             .unwrap_or_default();
+        let cover = if convective(l) {
+            "its own amount, not summed".to_string()
+        } else {
+            format!(
+                "{:.1} seen from below",
+                cover_seen_from_below_oktas(&summed, l.base_ft_agl)
+            )
+        };
         let _ = writeln!(
             out,
-            "  {:<18} {:<11} {:.1} oktas ({:.1} seen from below), base {:.0} ft AGL, {:.0} ft thick",
+            "  {:<18} {:<11} {:.1} oktas ({cover}), base {:.0} ft AGL, {:.0} ft thick",
             l.cloud_type.name(),
             source,
             l.coverage_oktas,
-            skycast::weather::block::cover_seen_from_below_oktas(&w.layers, l.base_ft_agl),
             l.base_ft_agl,
             l.thickness_ft
         );

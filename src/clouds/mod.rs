@@ -24,6 +24,7 @@ mod heap;
 pub mod lifecycle;
 pub mod noise;
 pub mod preview;
+pub mod probe;
 pub mod rain;
 pub mod rng;
 pub mod sheet;

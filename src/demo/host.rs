@@ -13,7 +13,7 @@ use super::headless::{self, Frame, HeadlessGpu, OffscreenTarget};
 use super::terrain::{HeightField, Terrain, TerrainLight, procedural_relief_m};
 use crate::flight::{HostCamera, SkyError, SkySystem, SkySystemConfig};
 use crate::render::gpu_types::GpuSprite;
-use crate::render::{Camera, FrameStats, RenderError, Timestamps};
+use crate::render::{Camera, FrameStats, RenderError, Sky, Timestamps};
 use crate::shading::SunPosition;
 use crate::weather::field::WeatherField;
 
@@ -141,7 +141,7 @@ impl DemoHost {
         // The ground's visibility is the sky's fog alone: the weather over the camera, eased
         // through a change of the report as its clouds form (`Sky::ease_weather_overhead`).
         Ok((
-            self.draw_prepared(camera, sun_dir, f32::INFINITY, stats),
+            self.draw_prepared(camera, sun_dir, f32::INFINITY, stats)?,
             changes,
         ))
     }
@@ -158,14 +158,15 @@ impl DemoHost {
     }
 
     /// Draws one frame (ground, then sky) without reading it back, the sky prepared by hand
-    /// (the clouds given to the renderer directly, no frame step); returns the sky's stats.
+    /// (the clouds given to the renderer directly, no frame step); returns the sky's stats, or
+    /// why the sky refused the frame ([`Sky::record`]'s checks).
     pub fn draw(
         &mut self,
         camera: &Camera,
         sun: &SunPosition,
         dt_s: f64,
         visibility_m: f32,
-    ) -> FrameStats {
+    ) -> Result<FrameStats, RenderError> {
         if let Some(t) = &self.timer {
             t.stamp(&self.gpu, 0);
         }
@@ -183,7 +184,7 @@ impl DemoHost {
         sun_dir: glam::Vec3,
         visibility_m: f32,
         mut stats: FrameStats,
-    ) -> FrameStats {
+    ) -> Result<FrameStats, RenderError> {
         let light = self.sky.light();
         self.terrain.prepare(
             &self.gpu.queue,
@@ -213,18 +214,20 @@ impl DemoHost {
         if let Some(t) = &self.timer {
             t.stamps.write(&mut encoder, 3);
         }
-        self.sky.record(
+        // The renderer's own record: `draw` prepares it by hand, without the frame step.
+        Sky::record(
+            &self.sky,
             &mut encoder,
             &self.target.colour_view,
             &self.target.depth_view,
-        );
+        )?;
         stats.record_us = self.sky.last_record_us();
         if let Some(t) = &self.timer {
             t.stamps.write(&mut encoder, 4);
             t.stamps.resolve(&mut encoder);
         }
         self.gpu.queue.submit([encoder.finish()]);
-        stats
+        Ok(stats)
     }
 
     /// GPU time of the last drawn frame (ground and sky passes), milliseconds, where the device
@@ -269,7 +272,7 @@ impl DemoHost {
         dt_s: f64,
         visibility_m: f32,
     ) -> Result<(Frame, FrameStats), RenderError> {
-        let stats = self.draw(camera, sun, dt_s, visibility_m);
+        let stats = self.draw(camera, sun, dt_s, visibility_m)?;
         Ok((self.target.read_back(&self.gpu)?, stats))
     }
 }

@@ -10,11 +10,14 @@
 //! waypoints), so position and velocity are continuous, and views blended with a smoothstep
 //! between waypoints.
 
+pub mod air;
 mod path;
+pub mod radar;
 mod spline;
 pub mod system;
 pub mod world;
 
+pub use air::{AirData, AirLayer, PrecipitationType, TurbulenceCategory};
 pub use path::{CameraPose, FlightPath, FlightPlan, View, Waypoint, WeatherEvent};
 pub use system::{
     HostCamera, HostLighting, HostPosition, SkyError, SkySystem, SkySystemConfig, Weather,

@@ -17,11 +17,13 @@ use std::time::{Duration, Instant};
 use glam::{DVec3, Mat4, Vec3};
 
 use super::world::{World, WorldSettings};
-use crate::render::{Camera, FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView};
+use crate::render::{
+    Camera, FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView, ViewId,
+};
 use crate::shading::sun_position;
 use crate::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
 use crate::weather::live::{LiveChange, LiveWeather, Prepare};
-use crate::weather::{LocalFrame, StationTable, WeatherError, WeatherInput};
+use crate::weather::{LocalFrame, Skipped, StationTable, WeatherError, WeatherInput};
 
 /// Why the sky could not be built or given its weather.
 #[derive(Debug, thiserror::Error)]
@@ -34,7 +36,9 @@ pub enum SkyError {
     Weather(#[from] WeatherError),
 }
 
-/// How a [`SkySystem`] is set up. [`SkySystemConfig::new`] needs no files.
+/// How a [`SkySystem`] is set up. [`SkySystemConfig::new`] needs no files; a host that keeps
+/// settings of its own (loaded from its files, a wider cloud radius) changes the fields and hands
+/// the result to [`SkySystem::with_config`].
 #[derive(Debug, Clone)]
 pub struct SkySystemConfig {
     /// The sky's look and the host's targets (formats, reversed Z, samples).
@@ -48,7 +52,9 @@ pub struct SkySystemConfig {
     pub field: FieldSettings,
     /// Which cloud type a reported layer is, where the report does not say.
     pub rule: CloudTypeRule,
-    /// Places the reports of files that give no positions (NOAA's station table).
+    /// Places the reports of files that give no positions (plain METAR lines, NOAA cycle
+    /// files). `None`: NOAA's table shipped inside the library ([`StationTable::builtin`]); a
+    /// host with a newer table passes its own.
     pub stations: Option<Arc<StationTable>>,
 }
 
@@ -76,7 +82,25 @@ impl SkySystemConfig {
     }
 }
 
-/// Weather for the sky.
+/// Weather for the sky, given to [`SkySystem::set_weather`]: a file read once (a simulator's
+/// scenario), the same already in memory (downloaded by the host), or a file the sky keeps
+/// watching (one the host replaces every few minutes with fresh reports).
+///
+/// ```
+/// use skycast::Weather;
+/// use std::{path::Path, time::Duration};
+///
+/// let once = Weather::File(Path::new("weather/themes/fair_weather_cumulus.toml"));
+/// let downloaded = Weather::Bytes {
+///     name: Path::new("metars.txt"), // tells a theme (.toml) from reports, and names errors
+///     bytes: b"KLAX 272153Z 25010KT 10SM FEW025 SCT040 18/09 A2992\n",
+/// };
+/// let live = Weather::Watch {
+///     path: Path::new("metars.cache.csv"),
+///     settle: Duration::from_millis(500),
+/// };
+/// # let _ = (once, downloaded, live);
+/// ```
 #[derive(Debug, Clone, Copy)]
 pub enum Weather<'a> {
     /// A report file (the aviation weather service's `metars.cache.csv`, a NOAA cycle file,
@@ -100,7 +124,8 @@ pub enum Weather<'a> {
     },
 }
 
-/// Where the host's camera is.
+/// Where the host's camera is: latitude, longitude and altitude for a host that flies the globe,
+/// or metres from the origin given to [`SkySystem::new`] for one that works in a local frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum HostPosition {
     /// Latitude and longitude in degrees, altitude in metres above mean sea level.
@@ -116,7 +141,26 @@ pub enum HostPosition {
     Local(DVec3),
 }
 
-/// The host's camera this frame, as the host has it.
+/// The host's camera this frame, as the host has it, given to [`SkySystem::update`] every
+/// frame. The sky reads the host's depth through `projection`, so it must be the projection the
+/// host drew its scene with.
+///
+/// ```
+/// use glam::camera::rh::{proj::directx as proj, view::look_to_mat4};
+/// use glam::{DVec3, Vec3};
+/// use skycast::{HostCamera, HostPosition};
+///
+/// // Looking north, level, from 1,500 m above the origin; east-north-up axes (z up); clip
+/// // depth 0 to 1, reversed Z with an infinite far plane (the host's targets say reversed).
+/// let view = look_to_mat4(Vec3::ZERO, Vec3::Y, Vec3::Z);
+/// let projection = proj::perspective_infinite_reverse(60f32.to_radians(), 16.0 / 9.0, 1.0);
+/// let camera = HostCamera {
+///     position: HostPosition::Local(DVec3::new(0.0, 0.0, 1500.0)),
+///     view,
+///     projection,
+/// };
+/// # let _ = camera;
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HostCamera {
     /// Where it is.
@@ -158,17 +202,26 @@ pub struct HostLighting {
     pub fog_rgb: Vec3,
 }
 
-/// The sky a simulator embeds. See the module docs.
+/// The sky a simulator embeds: one per view, built once on the host's device with
+/// [`SkySystem::new`] (or [`SkySystem::with_config`] for settings of the host's own), given
+/// weather with [`SkySystem::set_weather`], then every frame [`SkySystem::update`] and
+/// [`SkySystem::record`] after the host drew its scene. The crate's front page shows the frame in
+/// code; `examples/host.rs` is a complete host.
 pub struct SkySystem {
     sky: Sky,
     world: World,
     frame: LocalFrame,
-    live: LiveWeather<WeatherField>,
-    prepare_field: Prepare<WeatherField>,
+    live: LiveWeather<(WeatherField, Skipped)>,
+    prepare_field: Prepare<(WeatherField, Skipped)>,
+    /// What the weather in use left out, counted.
+    skipped: Skipped,
     stations: Option<Arc<StationTable>>,
     /// Seconds of frames so far (the clock of weather changes).
     clock_s: f64,
     sun_direction: Vec3,
+    /// The sun and time step of the last [`Self::update`], for the other views of its frame.
+    sun: Option<crate::shading::SunPosition>,
+    dt_s: f64,
 }
 
 impl SkySystem {
@@ -196,8 +249,10 @@ impl SkySystem {
         let (lat, lon) = config.origin_lat_lon_deg;
         let frame = LocalFrame::new(lat, lon);
         let (settings, rule) = (config.field.clone(), config.rule.clone());
-        let prepare_field: Prepare<WeatherField> =
-            Arc::new(move |input| input.field(LocalFrame::new(lat, lon), &settings, &rule));
+        let prepare_field: Prepare<(WeatherField, Skipped)> = Arc::new(move |input| {
+            let field = input.field(LocalFrame::new(lat, lon), &settings, &rule);
+            (field, input.skipped())
+        });
         let clear = WeatherField::build(frame, &[], &config.field, &config.rule);
         Ok(Self {
             sky: Sky::new(device, queue, config.sky)?,
@@ -205,9 +260,12 @@ impl SkySystem {
             frame,
             live: LiveWeather::new(),
             prepare_field,
+            skipped: Skipped::default(),
             stations: config.stations,
             clock_s: 0.0,
             sun_direction: Vec3::Z,
+            sun: None,
+            dt_s: 0.0,
         })
     }
 
@@ -216,31 +274,48 @@ impl SkySystem {
     /// applied by the frames that follow. The clouds of every block whose weather changed
     /// dissipate while the new ones form, and the light and fog under them go over with them
     /// ([`Sky::ease_weather_overhead`]).
-    pub fn set_weather(&mut self, weather: Weather) -> Result<(), SkyError> {
-        let stations = self.stations.as_deref();
+    ///
+    /// Returns what the input left out and why, counted ("31 reports without a position,
+    /// lines ..."; also [`Self::weather_skipped`]). An input none of whose reports can be used
+    /// is [`WeatherError::NoUsableReport`], not an empty sky.
+    pub fn set_weather(&mut self, weather: Weather) -> Result<Skipped, SkyError> {
+        let table = self.stations();
+        let stations = Some(&*table);
         let input = match weather {
             Weather::File(path) => WeatherInput::load(path, stations)?,
             Weather::Bytes { name, bytes } => WeatherInput::parse(name, bytes, stations)?,
-            Weather::Watch { path, settle } => {
-                // Read now, so the sky has this weather from the next frame; then watched.
-                let input = WeatherInput::load(path, stations)?;
-                self.live.watch(
-                    path,
-                    self.stations.clone(),
-                    settle,
-                    Arc::clone(&self.prepare_field),
-                )?;
-                input
-            }
+            // Read now, so the sky has this weather from the next frame; then watched.
+            Weather::Watch { path, .. } => WeatherInput::load(path, stations)?,
         };
-        self.set_weather_field((self.prepare_field)(input));
-        Ok(())
+        // Checked before the watch starts, so a file with nothing usable is not watched either.
+        let input = input.usable()?;
+        if let Weather::Watch { path, settle } = weather {
+            self.live
+                .watch(path, Some(table), settle, Arc::clone(&self.prepare_field))?;
+        }
+        let (field, skipped) = (self.prepare_field)(input);
+        self.set_weather_field(field);
+        self.skipped = skipped.clone();
+        Ok(skipped)
+    }
+
+    /// What the weather in use left out and why, counted: of the last [`Self::set_weather`],
+    /// or of the last file a watch or schedule applied (an update's applied files).
+    pub fn weather_skipped(&self) -> &Skipped {
+        &self.skipped
     }
 
     /// Takes a weather field the host built itself (same as [`Self::set_weather`] otherwise).
     pub fn set_weather_field(&mut self, field: WeatherField) {
+        self.skipped = Skipped::default();
         self.world.set_field(field);
         self.sky.ease_weather_overhead();
+    }
+
+    /// Timed weather events ([`Self::schedule_weather`]) not applied yet: a queue a long flight
+    /// watches (it empties as their times come).
+    pub fn weather_events_pending(&self) -> usize {
+        self.live.scheduled()
     }
 
     /// Schedules a weather file for `at_s` seconds of frames from now (a front passing in a
@@ -250,16 +325,23 @@ impl SkySystem {
         self.live.schedule(
             self.clock_s + at_s,
             path,
-            self.stations.clone(),
+            Some(self.stations()),
             Arc::clone(&self.prepare_field),
         )?;
         Ok(())
     }
 
+    /// The station table reports without a position are placed with: the host's, or the one
+    /// shipped inside the library.
+    fn stations(&self) -> Arc<StationTable> {
+        self.stations.clone().unwrap_or_else(StationTable::builtin)
+    }
+
     /// The frame step, CPU side: applies weather that is ready, advances the living clouds by
     /// `dt_s` around the camera and hands the sky what changed, places the sun for `utc_unix_s`,
     /// and prepares the sky's frame. Returns the frame's stats (its CPU cost included, the
-    /// weather's in `weather_us`) and the weather files that arrived this frame: applied, or
+    /// weather's in `weather_us`, the previous frame's [`Self::record`] in `record_us`, all of
+    /// it in [`FrameStats::sky_cpu_us`]) and the weather files that arrived this frame: applied, or
     /// rejected with the one line that says why (the last good sky stays). Call
     /// [`Self::record`] after it, in the frame's encoder.
     pub fn update(
@@ -269,14 +351,24 @@ impl SkySystem {
         utc_unix_s: f64,
         dt_s: f64,
     ) -> Result<(FrameStats, Vec<Result<PathBuf, String>>), SkyError> {
+        // A wrong depth convention is refused before the frame does any work.
+        self.sky.targets().check_projection(camera.projection)?;
         let start = Instant::now();
         let dt_s = dt_s.max(0.0);
+        self.dt_s = dt_s;
         self.clock_s += dt_s;
         let mut changes = Vec::new();
         for change in self.live.poll(self.clock_s) {
             changes.push(match change {
-                LiveChange::Loaded { source, weather } => {
-                    self.set_weather_field(weather);
+                LiveChange::Loaded {
+                    source,
+                    weather: (field, skipped),
+                } => {
+                    self.set_weather_field(field);
+                    if !skipped.is_empty() {
+                        log::info!("{}: {skipped}", source.display());
+                    }
+                    self.skipped = skipped;
                     Ok(source)
                 }
                 LiveChange::Rejected(why) => Err(why),
@@ -284,20 +376,14 @@ impl SkySystem {
         }
         let weather_us = start.elapsed().as_micros() as u64;
         self.sky.add_field_cpu_us(weather_us);
-        let position_m = match camera.position {
-            HostPosition::Local(p) => p,
-            HostPosition::LatLonAlt {
-                lat_deg,
-                lon_deg,
-                alt_m,
-            } => self.frame.to_local_m(lat_deg, lon_deg).extend(alt_m),
-        };
+        let position_m = self.local_m(camera.position);
         self.world.update_sky(&mut self.sky, position_m, dt_s)?;
         self.sky
             .set_weather_overhead(&self.world.weather_over(position_m));
         let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
         let sun = sun_position(utc_unix_s, lat, lon);
         self.sun_direction = sun.direction_enu().as_vec3();
+        self.sun = Some(sun);
         let view = SkyView {
             position_m,
             view: camera.view,
@@ -305,19 +391,77 @@ impl SkySystem {
         };
         let mut stats = self.sky.prepare(queue, view, &sun, dt_s);
         stats.weather_us = weather_us;
+        // This frame is not recorded yet: the last recording is the previous frame's.
+        stats.record_us = self.sky.last_record_us();
         Ok((stats, changes))
     }
 
     /// Records the sky's passes into the host's encoder after the host drew its scene: the sky
     /// behind everything, the clouds faded softly into the host's depth (read, never written),
-    /// the fog inside a cloud.
+    /// the fog inside a cloud. The host's textures are checked first ([`Sky::record`]): colour
+    /// and depth formats, samples, the depth's `TEXTURE_BINDING`, the depth convention against
+    /// the projection; a mismatch is an error naming both sides, and nothing is recorded.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         colour: &wgpu::TextureView,
         depth: &wgpu::TextureView,
-    ) {
-        self.sky.record(encoder, colour, depth);
+    ) -> Result<(), SkyError> {
+        Ok(self.sky.record(encoder, colour, depth)?)
+    }
+
+    /// Adds a view of the same sky: another camera with its own targets (of the same formats
+    /// and samples as the [`HostTargets`] the sky was made for; any size), e.g. a second
+    /// monitor, a mirror, an outside camera near the aircraft. It has its own draw list,
+    /// impostor ring and off-screen cloud target; the clouds, the weather and the resident
+    /// sprites are shared (the clouds live around the camera of [`Self::update`]). Each frame:
+    /// [`Self::update`] for the main camera, then [`Self::update_view`] for each other view,
+    /// then [`Self::record`] and [`Self::record_view`], into one encoder or several. A view
+    /// costs [`Sky::view_gpu_bytes`] of GPU memory.
+    pub fn add_view(&mut self) -> ViewId {
+        self.sky.add_view()
+    }
+
+    /// A view's share of the frame step, after [`Self::update`] (whose time, sun and clouds
+    /// it uses): its draw list, ring and uniforms from `camera`. The projection is checked
+    /// against the targets as in `update`. Returns the view's stats (`record_us`: its previous
+    /// recording). [`Self::lighting`] is then this view's.
+    pub fn update_view(
+        &mut self,
+        id: ViewId,
+        queue: &wgpu::Queue,
+        camera: &HostCamera,
+    ) -> Result<FrameStats, SkyError> {
+        self.sky.targets().check_projection(camera.projection)?;
+        if !self.sky.has_view(id) {
+            return Err(RenderError::Targets(format!(
+                "{id:?} does not exist (the sky has {} views)",
+                self.sky.view_count()
+            ))
+            .into());
+        }
+        let position_m = self.local_m(camera.position);
+        let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
+        let sun = self.sun.unwrap_or_else(|| sun_position(0.0, lat, lon));
+        let view = SkyView {
+            position_m,
+            view: camera.view,
+            projection: camera.projection,
+        };
+        let mut stats = self.sky.prepare_view(id, queue, view, &sun, self.dt_s);
+        stats.record_us = self.sky.view_record_us(id);
+        Ok(stats)
+    }
+
+    /// [`Self::record`] for a view of [`Self::add_view`], into its own targets.
+    pub fn record_view(
+        &self,
+        id: ViewId,
+        encoder: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) -> Result<(), SkyError> {
+        Ok(self.sky.record_view(id, encoder, colour, depth)?)
     }
 
     /// The light and fog of the last [`Self::update`], for the host's own scene.
@@ -365,5 +509,27 @@ impl std::ops::Deref for SkySystem {
 impl std::ops::DerefMut for SkySystem {
     fn deref_mut(&mut self) -> &mut Sky {
         &mut self.sky
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::camera::rh::view::look_at_mat4;
+    use glam::{Mat4, Vec3, Vec4};
+
+    /// What the embedding chapter (docs/src/host-errors.md) tells a y-up host: its view times
+    /// the axis swap is the view for east-north-up axes.
+    #[test]
+    fn a_y_up_hosts_view_times_the_axis_swap_is_the_east_north_up_view() {
+        // East, north, up to a y-up right-handed world's (x east, y up, z south).
+        let enu_to_host = Mat4::from_cols(Vec4::X, Vec4::NEG_Z, Vec4::Y, Vec4::W);
+        // Looking north-east and a little up, in each world's own axes.
+        let forward_enu = Vec3::new(0.6, 0.7, 0.2).normalize();
+        let forward_host = Vec3::new(forward_enu.x, forward_enu.z, -forward_enu.y);
+        let enu = look_at_mat4(Vec3::ZERO, forward_enu, Vec3::Z);
+        let host = look_at_mat4(Vec3::ZERO, forward_host, Vec3::Y);
+        assert!((host * enu_to_host).abs_diff_eq(enu, 1e-6));
+        // Without the swap it is another view.
+        assert!(!host.abs_diff_eq(enu, 1e-3));
     }
 }

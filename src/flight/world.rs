@@ -33,6 +33,16 @@ pub struct WorldSettings {
     pub cloud_radius_m: f64,
     /// Seed of the cloud generation.
     pub seed: u64,
+    /// A block generated for a sky that had none around it (the first frames, a jump to
+    /// another place) fades in over this time as it arrives, seconds of the frames' time,
+    /// instead of appearing at once; beyond the impostor ring it comes in with the ring's
+    /// crossfade instead. Not while clouds are synchronous ([`World::set_synchronous_clouds`]).
+    #[serde(default = "default_arrival_fade_s")]
+    pub arrival_fade_s: f64,
+}
+
+fn default_arrival_fade_s() -> f64 {
+    WorldSettings::default().arrival_fade_s
 }
 
 impl Default for WorldSettings {
@@ -42,6 +52,7 @@ impl Default for WorldSettings {
             // at 24 km showed its edge; beyond the 20 km ring radius they are impostors.
             cloud_radius_m: 60_000.0,
             seed: 2003,
+            arrival_fade_s: 3.0,
         }
     }
 }
@@ -96,6 +107,9 @@ pub struct LivingClouds {
     /// The newest generation handed to the sky, and the field's membership count then.
     newest_serial: u64,
     membership: Option<u64>,
+    /// Generations fading in as they arrive (see [`WorldSettings::arrival_fade_s`]), with the
+    /// field time they arrived at.
+    arriving: HashMap<u64, f64>,
     /// Generations forming or dissipating this frame and the last.
     fading: Vec<u64>,
     was_fading: Vec<u64>,
@@ -112,6 +126,8 @@ pub struct World {
     synchronous_clouds: bool,
     /// Counts weather fields taken ([`World::set_field`]).
     field_version: u64,
+    /// Settings and caches of the air data ([`super::air`]).
+    pub(super) air: super::air::AirState,
 }
 
 impl World {
@@ -126,6 +142,7 @@ impl World {
             clouds_config: CloudsConfig::builtin(),
             synchronous_clouds: false,
             field_version: 0,
+            air: Default::default(),
         }
     }
 
@@ -142,8 +159,10 @@ impl World {
     }
 
     /// When `on`, every frame of [`Self::update_sky`] waits for the blocks it queued, so what
-    /// a frame shows does not depend on thread timing: for tests and reproducible renders, never
-    /// for a simulator's frame loop (off by default: blocks arrive when generated).
+    /// a frame shows does not depend on thread timing, and they show whole at once: the warm-up
+    /// for tests and offline rendering (turned on for the first frame, it gives that frame
+    /// every cloud), never for a simulator's frame loop. Off by default: no frame waits, not
+    /// even the first; blocks arrive as they are generated and fade in.
     pub fn set_synchronous_clouds(&mut self, on: bool) {
         self.synchronous_clouds = on;
     }
@@ -237,8 +256,57 @@ impl World {
 }
 
 impl World {
+    /// Makes the living clouds if there are none yet; true when it did.
+    fn start_living(&mut self) -> Result<bool, RenderError> {
+        if self.living.is_some() {
+            return Ok(false);
+        }
+        let mut config = self.clouds_config;
+        config.field.radius_m = self.settings.cloud_radius_m;
+        config.field.seed = self.settings.seed;
+        // Generating while frames go on: one thread per core but one, so the frame thread
+        // keeps a core of its own (on 2 busy cores the first update's median went from 11
+        // to 3 ms). Synchronous (the warm-up, tests, offline): every core (0).
+        let threads = match self.synchronous_clouds {
+            true => 0,
+            false => std::thread::available_parallelism().map_or(1, |n| n.get().max(2) - 1),
+        };
+        let field = CloudField::new(config, Arc::new(self.types.clone()), threads)
+            .map_err(|e| RenderError::Clouds(e.to_string()))?;
+        self.clouds_config = config;
+        self.living = Some(LivingClouds {
+            field,
+            weather: HashMap::new(),
+            asked: None,
+            in_sky: HashSet::new(),
+            seen: HashSet::new(),
+            newest_serial: 0,
+            membership: None,
+            arriving: HashMap::new(),
+            fading: Vec::new(),
+            was_fading: Vec::new(),
+        });
+        Ok(true)
+    }
+
+    /// Generates the living clouds around `point_m` and waits for them, without a sky: for
+    /// asking about the air ([`Self::air_at`]) where nothing is drawn (the command line, tests).
+    pub fn settle_clouds_around(&mut self, point_m: DVec3) -> Result<(), RenderError> {
+        self.start_living()?;
+        let weather_field = &self.field;
+        if let Some(living) = self.living.as_mut() {
+            living
+                .field
+                .update(point_m.truncate(), &|i| weather_field.block_weather(i));
+            living.field.wait_for_pending();
+            living.field.advance(0.0);
+        }
+        Ok(())
+    }
+
     /// Advances the clouds stage's [`CloudField`] around `camera_m` by `dt_s` seconds (blocks
-    /// generated in the background, the first call waits for them; drifting with the wind;
+    /// generated in the background, no call waits for them unless clouds are synchronous;
+    /// arriving into an empty sky, they fade in; drifting with the wind;
     /// forming and dissipating when the weather changes) and hands `sky` what changed: new
     /// generations are inserted (uploaded once), gone ones removed, and every block's drift and
     /// fade set. Its own CPU time goes into the sky's next [`crate::render::FrameStats::field_us`].
@@ -250,30 +318,13 @@ impl World {
         dt_s: f64,
     ) -> Result<(), RenderError> {
         let start = Instant::now();
-        if self.living.is_none() {
-            let mut config = self.clouds_config;
-            config.field.radius_m = self.settings.cloud_radius_m;
-            config.field.seed = self.settings.seed;
-            let field = CloudField::new(config, Arc::new(self.types.clone()), 0)
-                .map_err(|e| RenderError::Clouds(e.to_string()))?;
-            sky.set_lifecycle(config.lifecycle);
-            self.living = Some(LivingClouds {
-                field,
-                weather: HashMap::new(),
-                asked: None,
-                in_sky: HashSet::new(),
-                seen: HashSet::new(),
-                newest_serial: 0,
-                membership: None,
-                fading: Vec::new(),
-                was_fading: Vec::new(),
-            });
+        if self.start_living()? {
+            sky.set_lifecycle(self.clouds_config.lifecycle);
         }
         let weather_field = &self.field;
         let Some(living) = self.living.as_mut() else {
             return Ok(());
         };
-        let first = living.field.time_s() == 0.0 && living.field.block_count() == 0;
         // The blocks around are asked for again only when the camera entered another block of
         // the moving air, the air drifted past a block, or the weather changed.
         let drift = living.field.drift_m();
@@ -297,7 +348,7 @@ impl World {
         } else {
             living.field.poll();
         }
-        if first || self.synchronous_clouds {
+        if self.synchronous_clouds {
             living.field.wait_for_pending();
         }
         living.field.advance(dt_s);
@@ -306,8 +357,11 @@ impl World {
         let now = living.field.time_s();
         let lifecycle = *living.field.lifecycle();
         let sky_before_us = sky.pending_cpu_us();
-        // Nothing came, went, forms or dissipates: only the drift changed.
-        if living.membership == Some(living.field.membership()) && living.was_fading.is_empty() {
+        // Nothing came, went, forms, dissipates or arrives: only the drift changed.
+        if living.membership == Some(living.field.membership())
+            && living.was_fading.is_empty()
+            && living.arriving.is_empty()
+        {
             sky.set_drift(offset_m);
             sky.add_field_cpu_us(start.elapsed().as_micros() as u64);
             return Ok(());
@@ -319,10 +373,34 @@ impl World {
         let mut count = 0;
         let newest = living.newest_serial;
         living.fading.clear();
+        // Which new generations fade in as they arrive: steady ones (a weather change's form
+        // instead) within the impostor ring (beyond it the ring's crossfade brings them in).
+        // Flying on, blocks join at the field's rim, beyond the ring: only a sky that had no
+        // clouds around (the first frames, a jump) has arrivals to fade.
+        let fade_in_s = self.settings.arrival_fade_s;
+        let fade_in = fade_in_s > 0.0 && !self.synchronous_clouds;
+        let impostors = &sky.settings().impostors;
+        let ring_m = impostors.enabled.then_some(impostors.ring_radius_m);
         for (index, fb) in living.field.blocks() {
             count += 1;
+            let arrives = fb.serial > newest
+                && fade_in
+                && fb.phase == Phase::Steady
+                && ring_m
+                    .is_none_or(|r| (index.centre_m() + drift).distance(camera_m.truncate()) <= r);
+            if arrives {
+                living.arriving.insert(fb.serial, now);
+            }
+            let arrival = living
+                .arriving
+                .get(&fb.serial)
+                .map(|&since| ((now - since) / fade_in_s) as f32)
+                .filter(|&p| p < 1.0);
+            if arrival.is_none() {
+                living.arriving.remove(&fb.serial);
+            }
             let fade = match fb.phase {
-                Phase::Steady => Fade::Steady,
+                Phase::Steady => arrival.map_or(Fade::Steady, Fade::Forming),
                 Phase::Forming { .. } | Phase::Unforming { .. } => {
                     Fade::Forming(progress(fb.phase, now, &lifecycle))
                 }
@@ -358,6 +436,7 @@ impl World {
             let gone: Vec<u64> = living.in_sky.difference(&living.seen).copied().collect();
             for id in gone {
                 living.in_sky.remove(&id);
+                living.arriving.remove(&id);
                 sky.remove_block(id);
             }
         }

@@ -47,16 +47,18 @@ mod slots;
 mod sprite_view;
 pub mod stats;
 pub mod targets;
+mod view;
 
 pub use camera::{Camera, Frustum};
 pub use pass_timing::{PassTimes, Timestamps};
 pub use readback::SpriteCorner;
-pub use resident::BYTES_PER_SPRITE;
+pub use resident::{BYTES_PER_SPRITE, resident_slots_bound};
 pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};
 pub use settings::RenderSettings;
 pub use sky::{Sky, SkyConfig, SpriteSheet};
-pub use stats::{FrameStats, Lighting};
+pub use stats::{FrameStats, Lighting, SkyMemory};
 pub use targets::{HostTargets, SkyView};
+pub use view::ViewId;
 
 /// How to install a software Vulkan driver where there is no GPU (Debian, Ubuntu).
 pub const INSTALL_HINT: &str = "sudo apt-get install -y mesa-vulkan-drivers libvulkan1";

@@ -1,9 +1,12 @@
 //! The clouds on the GPU. A block's sprites and clouds are written into storage buffers once,
 //! when it arrives, into a range of slots it keeps until it goes ([`SlotRanges`]); after that a
 //! frame writes only what changed: a cloud's back-to-front order when Wang's cache says so, and
-//! the small draw list. The buffers grow in powers of two up to the device's limits (or the
-//! host's budget); past that the farthest blocks are left out and counted, never a validation
-//! error.
+//! the small draw list. The buffers grow only when the blocks held at once need more slots
+//! than they have (to a sixteenth more, in steps of their first size), up to the device's limits
+//! (or the host's budget); past that the farthest blocks are left out and counted, never a
+//! validation error. So their size follows the most sprites and clouds ever held at once: during
+//! a weather change, the old generation dissipating while the new one forms
+//! (`docs/src/long-flights.md` gives the bound).
 //!
 //! Units: metres; sprite and cloud data relative to the cloud centre, cloud centres f64.
 
@@ -235,6 +238,21 @@ pub(super) struct ResidentSet {
 const FIRST_SPRITES: u32 = 4096;
 const FIRST_CLOUDS: u32 = 256;
 
+/// The most sprite and cloud slots the resident buffers grow to while at most `sprites` sprites
+/// and `clouds` clouds are held at once (the blocks of every generation alive, forming,
+/// dissipating or steady): a sixteenth more, rounded up to steps of 4,096 sprites and 256
+/// clouds, and never less than those. Each sprite slot costs [`BYTES_PER_SPRITE`], each cloud
+/// slot 144 bytes. How many a weather holds is in `docs/src/long-flights.md`.
+pub fn resident_slots_bound(sprites: u32, clouds: u32) -> (u32, u32) {
+    let up = |n: u32, step: u32| {
+        let step = step as u64;
+        ((n as u64 * 17 / 16).div_ceil(step) * step)
+            .max(step)
+            .min(u32::MAX as u64) as u32
+    };
+    (up(sprites, FIRST_SPRITES), up(clouds, FIRST_CLOUDS))
+}
+
 impl ResidentSet {
     /// Empty buffers on `device`; `budget_bytes` caps the sprite memory (0: the device's
     /// limits alone).
@@ -303,6 +321,17 @@ impl ResidentSet {
             + self.light_buffer.size()
             + self.order_buffer.size()
             + self.list_buffer.size()
+    }
+
+    /// Blocks held, their sprites, and the sprite and cloud slots (in all, in use).
+    pub fn occupancy(&self) -> (u32, u32, (u32, u32), (u32, u32)) {
+        let sprites = self.blocks.values().map(Resident::sprite_count).sum();
+        (
+            self.blocks.len() as u32,
+            sprites,
+            (self.sprite_slots.capacity(), self.sprite_slots.used()),
+            (self.cloud_slots.capacity(), self.cloud_slots.used()),
+        )
     }
 
     /// Adds or replaces a block (uploaded by the next [`Self::place_and_upload`]).
@@ -426,7 +455,9 @@ impl ResidentSet {
 
     /// Grows (or only packs) the buffers so that block `id` fits, if the limits allow: every
     /// block is placed and written again (rare: a buffer that grows gets a sixteenth more than it
-    /// needs).
+    /// needs). A buffer with slots enough in pieces keeps its size ([`SlotRanges::capacity_for`]):
+    /// growing it then (the cloud buffer went from 256 slots to 4,096 when a block's clouds found
+    /// no range) made the size depend on how a long flight's changes had cut up the slots.
     fn grow_for(&mut self, id: u64) -> bool {
         let Some(r) = self.blocks.get(&id) else {
             return false;
@@ -437,25 +468,17 @@ impl ResidentSet {
         if need_sprites > self.limit_sprites {
             return false;
         }
-        // What does not fit grows to a sixteenth more than is needed, in steps of 4,096; a
-        // buffer with room enough but in pieces keeps its size and is only packed again.
-        let grown = |fits: bool, need: u32, cap: u32| {
-            if fits {
-                return cap;
-            }
-            let want = (need as u64 * 17 / 16).div_ceil(4096) * 4096;
-            want.min(u32::MAX as u64).max(cap as u64) as u32
-        };
-        let cap = self.sprite_slots.capacity();
-        let sprite_fits = self.sprite_slots.fits(n_sprites);
-        let cloud_fits = self.cloud_slots.fits(n_clouds);
-        if sprite_fits && cloud_fits {
+        if self.sprite_slots.fits(n_sprites) && self.cloud_slots.fits(n_clouds) {
             return false;
         }
-        let sprites = grown(sprite_fits, need_sprites, cap)
+        // In steps of the first sizes: 4,096 sprites (160 KB), 256 clouds (36 KB).
+        let sprites = self
+            .sprite_slots
+            .capacity_for(n_sprites, FIRST_SPRITES)
             .min(self.limit_sprites)
             .max(need_sprites);
-        let clouds = grown(cloud_fits, need_clouds, self.cloud_slots.capacity());
+        let clouds = self.cloud_slots.capacity_for(n_clouds, FIRST_CLOUDS);
+        debug_assert!(clouds >= need_clouds);
         let b = buffers(&self.device, &self.layout, sprites, clouds);
         self.sprite_buffer = b.sprites;
         self.cloud_buffer = b.clouds;

@@ -15,7 +15,6 @@
 //! read-only attachment: a software rasteriser then shades only those pixels, while a shader's
 //! own test runs the whole shader on every pixel.
 
-use std::cell::Cell;
 use std::collections::HashSet;
 use std::time::Instant;
 
@@ -24,10 +23,10 @@ use wgpu::util::DeviceExt;
 
 use super::RenderError;
 use super::build::{CHUNK, SpriteBuild, chunks};
-use super::cloud_target::{CloudShared, CloudTarget, can_test_against, cloud_targets, divisor_of};
+use super::cloud_target::can_test_against;
 use super::draw_list::{Copies, Locks, main_view};
-use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuSpriteVertex};
-use super::impostor::{ImpostorRing, RingFrame, RingShared};
+use super::gpu_types::{GpuFrame, GpuSpriteVertex};
+use super::impostor::RingFrame;
 use super::overhead_ease::OverheadEase;
 use super::pass_timing::{STAMPS, Stamp};
 use super::pipeline::{
@@ -37,9 +36,10 @@ use super::resident::{ResidentSet, quad_index_buffer};
 use super::scatter::Scatter;
 use super::scene::{BlockMotion, SkyBlock};
 use super::settings::RenderSettings;
-use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
-use super::stats::{FrameStats, Lighting};
+use super::sprite_view::{self, ViewData, ViewLight};
+use super::stats::{FrameStats, Lighting, SkyMemory};
 use super::targets::{self, HostTargets, SkyView};
+use super::view::{View, ViewId, ViewShared};
 use crate::clouds::{CloudsConfig, LifecycleConfig};
 use crate::shading::{SunPosition, TimeOfDay, TimeOfDayTable, hidden_above};
 use crate::weather::{BlockLayer, BlockWeather};
@@ -93,15 +93,22 @@ impl SpriteSheet {
 }
 
 /// The sky subsystem: pipelines, the GPU-resident clouds, their sprite orders and the ring.
+/// A host drives it directly only when it has its own weather and cloud handling (it hands the
+/// sky blocks of clouds, the sun and its view); otherwise [`crate::SkySystem`] does all of that
+/// around it.
 pub struct Sky {
     device: wgpu::Device,
     settings: RenderSettings,
     time_of_day: TimeOfDayTable,
     lifecycle: LifecycleConfig,
-    frame_buffer: wgpu::Buffer,
     frame_layout: wgpu::BindGroupLayout,
+    /// The layouts a view is made with (the impostor renders' group 0, the sheet's group).
+    ring_frame_layout: wgpu::BindGroupLayout,
+    sheet_layout: wgpu::BindGroupLayout,
     targets: HostTargets,
     sheet_group: wgpu::BindGroup,
+    /// Bytes of the sheet texture (every mip level), for [`Self::memory`].
+    sheet_bytes: u64,
     sky_pipeline: wgpu::RenderPipeline,
     /// The sky background kept by a depth test against the host's depth as a read-only
     /// attachment (in a pass of its own); `None` where the host's depth format has a stencil
@@ -115,20 +122,13 @@ pub struct Sky {
     scatter: Scatter,
     build: SpriteBuild,
     view_layout: wgpu::BindGroupLayout,
-    view: ViewBuffers,
-    draws: Vec<GpuDrawBlock>,
-    locks: Locks,
+    /// Each camera's own state, [`ViewId::MAIN`] first: the blocks, weather and resident
+    /// sprites above are shared by all.
+    views: Vec<View>,
     elapsed_s: f64,
-    sprites_to_draw: u32,
-    in_cloud: f32,
-    /// How opaque the rain or snow shaft the camera is in is there (0: none): the fog thickens.
-    in_rain: f32,
     /// CPU time of block changes since the last prepare, and the host's field time.
     pending_us: u64,
     field_us: u64,
-    record_us: Cell<u64>,
-    /// Whether the last prepared frame was recorded (if not, its writes are flushed).
-    recorded: Cell<bool>,
     /// Timestamps between the passes, while pass timing is on.
     pass_timer: Option<super::Timestamps>,
     /// Kept to make the pass timer.
@@ -143,9 +143,6 @@ pub struct Sky {
     fog: (crate::shading::FogSettings, BlockWeather),
     /// The cover and visibility frames show, eased through a change of the weather in time.
     overhead_ease: OverheadEase,
-    ring: ImpostorRing,
-    /// Where the clouds are drawn: the host's colour (scale 1) or the off-screen cloud target.
-    clouds: CloudTarget,
 }
 
 const SKY_WGSL: &str = include_str!("../../shaders/sky.wgsl");
@@ -207,12 +204,6 @@ impl Sky {
             // fill-bound frame it saved an eighth of the sprites' time (lavapipe, overcast).
             mipmap_filter: wgpu::MipmapFilterMode::Nearest,
             ..Default::default()
-        });
-        let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sky.frame"),
-            size: std::mem::size_of::<GpuFrame>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
         });
         let samples = config.targets.sample_count;
         let frame_layout = targets::frame_layout(device, samples > 1);
@@ -316,40 +307,28 @@ impl Sky {
             },
         );
         let light = config.time_of_day.at(45.0);
-        // Validated settings hold one of the three scales; a hand-built one falls back to 1.
-        let divisor = divisor_of(config.settings.clouds.resolution_scale).unwrap_or(1);
-        let clouds = CloudTarget::new(
-            device,
-            &CloudShared {
-                host_frame_layout: &frame_layout,
-                frame_layout: &ring_frame_layout,
-                sheet_layout: &sheet_layout,
-                targets: config.targets,
-            },
-            divisor,
-        );
-        let offscreen_targets = cloud_targets();
-        let ring = ImpostorRing::new(
+        let main = View::new(
             device,
             queue,
-            config.settings.impostors,
-            &RingShared {
+            &ViewShared {
                 targets: config.targets,
-                frame_layout: &ring_frame_layout,
+                settings: &config.settings,
                 host_frame_layout: &frame_layout,
+                ring_frame_layout: &ring_frame_layout,
                 sheet_layout: &sheet_layout,
                 view_layout: &view_layout,
-                cloud_targets: (divisor > 1).then_some(&offscreen_targets[..]),
             },
         );
         Ok(Self {
             device: device.clone(),
             settings: config.settings,
             time_of_day: config.time_of_day,
-            frame_buffer,
             frame_layout,
+            ring_frame_layout,
+            sheet_layout,
             targets: config.targets,
             sheet_group,
+            sheet_bytes: sheet.mips.iter().map(|m| m.len() as u64).sum(),
             sky_pipeline,
             sky_tested_pipeline,
             sprite_pipeline,
@@ -358,19 +337,12 @@ impl Sky {
             quads: (quad_index_buffer(device, 4096), 4096),
             scatter: Scatter::new(device),
             build,
-            view: ViewBuffers::new(device, false),
             view_layout,
-            draws: Vec::new(),
-            locks: Locks::default(),
+            views: vec![main],
             lifecycle: CloudsConfig::builtin().lifecycle,
             elapsed_s: 0.0,
-            sprites_to_draw: 0,
-            in_cloud: 0.0,
-            in_rain: 0.0,
             pending_us: 0,
             field_us: 0,
-            record_us: Cell::new(0),
-            recorded: Cell::new(true),
             pass_timer: None,
             queue: queue.clone(),
             clear_light: light,
@@ -384,9 +356,46 @@ impl Sky {
                 },
             ),
             overhead_ease: OverheadEase::default(),
-            ring,
-            clouds,
         })
+    }
+
+    /// Adds a view: another camera with its own targets (of the same formats and samples), its
+    /// own draw list, impostor ring and off-screen cloud target; the blocks, the weather and
+    /// the resident sprites stay shared. Prepare it with [`Self::prepare_view`] and record it
+    /// with [`Self::record_view`]; several views record into one encoder. It costs
+    /// [`Self::view_gpu_bytes`] of GPU memory.
+    pub fn add_view(&mut self) -> ViewId {
+        let view = View::new(
+            &self.device,
+            &self.queue,
+            &ViewShared {
+                targets: self.targets,
+                settings: &self.settings,
+                host_frame_layout: &self.frame_layout,
+                ring_frame_layout: &self.ring_frame_layout,
+                sheet_layout: &self.sheet_layout,
+                view_layout: &self.view_layout,
+            },
+        );
+        self.views.push(view);
+        ViewId(self.views.len() - 1)
+    }
+
+    /// Whether the sky has this view.
+    pub fn has_view(&self, id: ViewId) -> bool {
+        id.0 < self.views.len()
+    }
+
+    /// The views the sky has, [`ViewId::MAIN`] included.
+    pub fn view_count(&self) -> usize {
+        self.views.len()
+    }
+
+    /// Bytes of one view's own GPU buffers and textures (frame uniform, draw list and locks,
+    /// impostor ring, off-screen cloud target as last sized): what a view adds. 0 for an
+    /// unknown view.
+    pub fn view_gpu_bytes(&self, id: ViewId) -> u64 {
+        self.views.get(id.0).map_or(0, View::gpu_bytes)
     }
 
     /// Replaces the clouds with `blocks` (none drifting, all steady). A block the sky already
@@ -436,7 +445,9 @@ impl Sky {
     fn retire(&mut self, id: u64) -> bool {
         match self.resident.remove(id) {
             Some(slots) => {
-                self.locks.release(slots);
+                for view in &mut self.views {
+                    view.locks.release(slots.clone());
+                }
                 true
             }
             None => false,
@@ -511,7 +522,9 @@ impl Sky {
         for (_, r) in old.blocks {
             self.resident.insert(r.block, r.motion);
         }
-        self.locks = Locks::default();
+        for view in &mut self.views {
+            view.locks = Locks::default();
+        }
     }
 
     /// Counts `us` microseconds of the host's cloud field work for this frame into the next
@@ -534,12 +547,13 @@ impl Sky {
         &self,
         queue: &wgpu::Queue,
     ) -> Result<Vec<super::SpriteCorner>, RenderError> {
+        let main = &self.views[0];
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.scatter.record(&mut encoder);
-        let read = super::readback::read_buffer(&self.device, self.sprites_to_draw);
+        let read = super::readback::read_buffer(&self.device, main.sprites_to_draw);
         let corner_bytes = 4 * std::mem::size_of::<GpuSpriteVertex>() as u64;
-        if let Some(view_group) = self.view.group() {
-            for (chunk, first, sprites) in chunks(self.sprites_to_draw) {
+        if let Some(view_group) = main.view.group() {
+            for (chunk, first, sprites) in chunks(main.sprites_to_draw) {
                 let group = &self.resident.group;
                 self.build
                     .record(&mut encoder, view_group, group, (chunk, sprites));
@@ -552,7 +566,7 @@ impl Sky {
                 );
             }
         }
-        super::readback::read_corners(&self.device, queue, encoder, &read, self.sprites_to_draw)
+        super::readback::read_corners(&self.device, queue, encoder, &read, main.sprites_to_draw)
     }
 
     /// Times each group of the sky's passes on the GPU from the next [`Self::record`] on (a
@@ -576,7 +590,17 @@ impl Sky {
 
     /// CPU time of the last [`Self::record`], microseconds.
     pub fn last_record_us(&self) -> u64 {
-        self.record_us.get()
+        self.views[0].record_us.get()
+    }
+
+    /// CPU time of the last [`Self::record_view`] of `id`, microseconds (0 for an unknown view).
+    pub fn view_record_us(&self, id: ViewId) -> u64 {
+        self.views.get(id.0).map_or(0, |v| v.record_us.get())
+    }
+
+    /// The host's targets the sky was made for.
+    pub fn targets(&self) -> &HostTargets {
+        &self.targets
     }
 
     /// The settings the sky was made with.
@@ -588,7 +612,10 @@ impl Sky {
     /// afresh). Returns false and changes nothing when turning it on in a sky made with
     /// `impostors.enabled = false`: the ring's textures are made at start-up only.
     pub fn set_impostors(&mut self, enabled: bool) -> bool {
-        let switched = self.ring.set_enabled(enabled);
+        let mut switched = true;
+        for view in &mut self.views {
+            switched &= view.ring.set_enabled(enabled);
+        }
         if switched {
             self.settings.impostors.enabled = enabled;
         }
@@ -625,11 +652,16 @@ impl Sky {
     /// the last frame showed ([`Self::ease_weather_overhead`]), thicker where the last frame
     /// found the camera in a rain or snow shaft.
     pub fn fog(&self) -> crate::shading::Fog {
+        self.fog_for(self.views[0].in_rain)
+    }
+
+    /// [`Self::fog`] with a view's rain.
+    fn fog_for(&self, in_rain: f32) -> crate::shading::Fog {
         let mut air = self.fog.0.fog(&self.fog.1, self.seen_light.sky_horizon_rgb);
         if let Some(shown) = self.overhead_ease.visibility_m() {
             air.distance_m = shown;
         }
-        self.fog.0.in_rain(air, self.in_rain)
+        self.fog.0.in_rain(air, in_rain)
     }
 
     /// The fraction of the sky hidden above `altitude_m` by the weather overhead, 0..=1.
@@ -660,15 +692,40 @@ impl Sky {
     }
 
     /// Bytes of the GPU buffers the sky holds now (frame uniforms, the resident sprites, the
-    /// draw list, the ring): what a long flight watches for growth.
+    /// draw list, the ring); [`Self::memory`] counts the textures too.
     pub fn gpu_buffer_bytes(&self) -> u64 {
-        self.frame_buffer.size()
+        self.views.iter().map(View::gpu_buffer_bytes).sum::<u64>()
             + self.resident.gpu_bytes()
             + self.quads.0.size()
             + self.build.gpu_bytes()
             + self.scatter.gpu_bytes()
-            + self.view.gpu_bytes()
-            + self.ring.gpu_bytes()
+    }
+
+    /// Every buffer and texture the sky holds now (the ring and the off-screen cloud target
+    /// included), and the blocks and slots behind the resident buffers: what a long flight
+    /// watches for growth.
+    pub fn memory(&self) -> SkyMemory {
+        let (blocks, sprites, sprite_slots, cloud_slots) = self.resident.occupancy();
+        SkyMemory {
+            resident_bytes: self.resident.gpu_bytes(),
+            draw_bytes: self
+                .views
+                .iter()
+                .map(|v| v.frame_buffer.size() + v.view.gpu_bytes())
+                .sum::<u64>()
+                + self.quads.0.size()
+                + self.build.gpu_bytes()
+                + self.scatter.gpu_bytes(),
+            ring_bytes: self.views.iter().map(|v| v.ring.gpu_bytes()).sum(),
+            cloud_target_bytes: self.views.iter().map(|v| v.clouds.gpu_bytes()).sum(),
+            sheet_bytes: self.sheet_bytes,
+            blocks,
+            sprites,
+            sprite_slots: sprite_slots.0,
+            sprite_slots_used: sprite_slots.1,
+            cloud_slots: cloud_slots.0,
+            cloud_slots_used: cloud_slots.1,
+        }
     }
 
     /// CPU work of a frame: advances time by `dt_s`, uploads blocks that arrived, sorts blocks
@@ -685,10 +742,27 @@ impl Sky {
         sun: &SunPosition,
         dt_s: f64,
     ) -> FrameStats {
+        self.prepare_view(ViewId::MAIN, queue, view, sun, dt_s)
+    }
+
+    /// [`Self::prepare`] for one view (see [`Self::add_view`]): its draw list, ring and
+    /// uniforms from its camera. Every view of a frame is given the frame's `dt_s`: the main
+    /// view's advances the sky's clock, the others' only their ring's crossfade. An unknown
+    /// view prepares the main one (see [`Self::has_view`]).
+    pub fn prepare_view(
+        &mut self,
+        id: ViewId,
+        queue: &wgpu::Queue,
+        view: impl Into<SkyView>,
+        sun: &SunPosition,
+        dt_s: f64,
+    ) -> FrameStats {
         let start = Instant::now();
+        let i = if id.0 < self.views.len() { id.0 } else { 0 };
         let camera: SkyView = view.into();
+        self.views[i].projection = Some(camera.projection);
         let mut gpu_wait_us = 0;
-        if !self.recorded.replace(false) {
+        if !self.views[i].recorded.replace(false) {
             // The last frame's writes never reached a submit: send them, so they are freed. A
             // device still busy with earlier work can hold the submit (lavapipe waits in it for
             // the submission before): timed apart, as a wait.
@@ -696,7 +770,11 @@ impl Sky {
             queue.submit([]);
             gpu_wait_us = wait.elapsed().as_micros() as u64;
         }
-        self.elapsed_s += dt_s.max(0.0);
+        // The frame's clock is the main view's; the others use `dt_s` for their ring's
+        // crossfade only.
+        if i == ViewId::MAIN.0 {
+            self.elapsed_s += dt_s.max(0.0);
+        }
         self.clear_light = self.time_of_day.at(sun.elevation_deg as f32);
         let (hidden, _) = self.overhead_ease.show(
             self.sky_hidden_at(camera.position_m.z),
@@ -735,12 +813,14 @@ impl Sky {
         upload_bytes += placed_bytes;
         upload_bytes += self.resident.relight(queue, camera.position_m);
         (stats.sprites_lit, stats.light_us) = (self.resident.lit_sprites, self.resident.light_us);
-        self.ring
+        self.views[i]
+            .ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
         // The frame's sorting budget, shared with a ring that is being rebuilt.
         let sort_budget = self.settings.vertex_cache.max_sorted_sprites_per_frame;
-        let sort_budget = sort_budget - self.ring.sort_reserve(sort_budget);
+        let sort_budget = sort_budget - self.views[i].ring.sort_reserve(sort_budget);
         let resident = &mut self.resident;
+        let v = &mut self.views[i];
         let inside = main_view(
             &mut resident.blocks,
             Copies {
@@ -752,8 +832,8 @@ impl Sky {
             (camera.position_m, &camera.frustum()),
             self.elapsed_s,
             (&self.settings, sort_budget),
-            &mut self.locks,
-            &mut self.draws,
+            &mut v.locks,
+            &mut v.draws,
             &mut stats,
         );
         let resident = &mut self.resident;
@@ -765,7 +845,7 @@ impl Sky {
             (&resident.lists_cpu, &resident.list_buffer),
             &mut resident.dirty_lists,
         );
-        let locks = self.locks.gpu();
+        let locks = self.views[i].locks.gpu();
         let light = ViewLight {
             lighting: &lighting,
             clouds: &self.settings.clouds,
@@ -774,8 +854,9 @@ impl Sky {
             farthest_m: self.settings.clouds.draw_distance_m,
         };
         let header = sprite_view::header(&light);
-        let changed_locks = self.locks.take_changed().then_some(&locks[..]);
-        upload_bytes += self.view.write(
+        let v = &mut self.views[i];
+        let changed_locks = v.locks.take_changed().then_some(&locks[..]);
+        upload_bytes += v.view.write(
             &self.device,
             queue,
             &self.view_layout,
@@ -783,21 +864,21 @@ impl Sky {
             changed_locks,
             ViewData::Resident {
                 counts: [
-                    self.draws.len() as u32,
+                    v.draws.len() as u32,
                     locks.len() as u32,
                     stats.sprites_drawn,
                     0,
                 ],
-                draws: &self.draws,
+                draws: &v.draws,
                 lists: &self.resident.list_buffer,
                 orders: &self.resident.order_buffer,
                 generation: self.resident.generation,
             },
         );
-        self.sprites_to_draw = stats.sprites_drawn;
+        self.views[i].sprites_to_draw = stats.sprites_drawn;
         let in_cloud = inside.cloud;
-        self.in_cloud = in_cloud;
-        self.in_rain = inside.rain;
+        self.views[i].in_cloud = in_cloud;
+        self.views[i].in_rain = inside.rain;
         stats.in_cloud = in_cloud;
 
         let view_proj = camera.view_proj();
@@ -826,16 +907,17 @@ impl Sky {
                 self.settings.in_cloud.visibility_m,
             ],
             haze: [
-                self.fog
-                    .0
-                    .haze_distance_m(&self.fog(), self.settings.clouds.haze_distance_m),
+                self.fog.0.haze_distance_m(
+                    &self.fog_for(self.views[i].in_rain),
+                    self.settings.clouds.haze_distance_m,
+                ),
                 0.0,
                 0.0,
                 0.0,
             ],
             depth_to_view: camera.depth_to_view(),
         };
-        queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&frame));
+        queue.write_buffer(&self.views[i].frame_buffer, 0, bytemuck::bytes_of(&frame));
         upload_bytes += std::mem::size_of::<GpuFrame>() as u64;
         let ring_frame = RingFrame {
             resident: &self.resident,
@@ -844,12 +926,14 @@ impl Sky {
             camera_m: camera.position_m,
             cache: &self.settings.vertex_cache,
         };
-        upload_bytes += self.ring.prepare_builds(queue, &ring_frame, &mut stats);
+        upload_bytes += self.views[i]
+            .ring
+            .prepare_builds(queue, &ring_frame, &mut stats);
         // Quad indices and built corners for the largest draw of the frame (the sprites, an
         // impostor's sector).
         let most = stats
             .sprites_drawn
-            .max(self.ring.most_sprites_pending())
+            .max(self.views[i].ring.most_sprites_pending())
             .min(CHUNK);
         if most > self.quads.1 {
             let sprites = most.next_power_of_two();
@@ -857,12 +941,12 @@ impl Sky {
         }
         self.build.reserve(&self.device, most);
         stats.upload_bytes = upload_bytes;
-        stats.cloud_scale = self.clouds.scale();
-        stats.cloud_target_bytes = self.clouds.gpu_bytes();
+        stats.cloud_scale = self.views[i].clouds.scale();
+        stats.cloud_target_bytes = self.views[i].clouds.gpu_bytes();
         stats.sprite_gpu_bytes = self.resident.gpu_bytes()
             + self.quads.0.size()
             + self.build.gpu_bytes()
-            + self.view.gpu_bytes();
+            + self.views[i].view.gpu_bytes();
         stats.field_us = std::mem::take(&mut self.field_us);
         stats.gpu_wait_us = gpu_wait_us;
         stats.cpu_update_us = (start.elapsed().as_micros() as u64).saturating_sub(gpu_wait_us)
@@ -873,21 +957,52 @@ impl Sky {
     /// Records the sky's passes into the host's encoder: sky background, then the ring, sprites
     /// and in-cloud fog, straight into the host's colour or, below full resolution, into the
     /// sky's cloud target composited over it (`cloud_target`; it follows the host's frame size).
-    /// `depth_view` is the host's depth (Depth32Float with `TEXTURE_BINDING`), only read.
+    /// `depth_view` is the host's depth (the format of [`HostTargets::depth_format`], with
+    /// `TEXTURE_BINDING`), only read.
+    ///
+    /// Before anything is recorded the host's textures are checked against the targets the sky
+    /// was made for, and the last prepared projection against their depth convention
+    /// ([`HostTargets::check_textures`], [`HostTargets::check_projection`]): a mismatch is
+    /// [`RenderError::Targets`] naming both sides, and nothing is recorded.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         colour_view: &wgpu::TextureView,
         depth_view: &wgpu::TextureView,
-    ) {
+    ) -> Result<(), RenderError> {
+        self.record_view(ViewId::MAIN, encoder, colour_view, depth_view)
+    }
+
+    /// [`Self::record`] for one view, with that view's targets (the same formats and samples;
+    /// any size). Several views record into one encoder, each drawing its own prepared frame.
+    /// An unknown view is an error.
+    pub fn record_view(
+        &self,
+        id: ViewId,
+        encoder: &mut wgpu::CommandEncoder,
+        colour_view: &wgpu::TextureView,
+        depth_view: &wgpu::TextureView,
+    ) -> Result<(), RenderError> {
+        let v = self.views.get(id.0).ok_or_else(|| {
+            RenderError::Targets(format!(
+                "view {} does not exist (the sky has {})",
+                id.0,
+                self.views.len()
+            ))
+        })?;
         let start = Instant::now();
+        self.targets
+            .check_textures(colour_view.texture(), depth_view.texture())?;
+        if let Some(projection) = v.projection {
+            self.targets.check_projection(projection)?;
+        }
         let frame_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sky.frame_group"),
             layout: &self.frame_layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
-                    resource: self.frame_buffer.as_entire_binding(),
+                    resource: v.frame_buffer.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
@@ -906,19 +1021,19 @@ impl Sky {
         };
         stamp(encoder, Stamp::Start);
         self.scatter.record(encoder);
-        // The impostors this frame (and any frames prepared since the last recorded one)
-        // rebuilt: in the host's submission, never in one of the sky's own, which could hold
-        // the host's frame thread while the device is busy.
-        self.ring.record_builds(
+        // The impostors this view's frame (and any frames prepared since its last recorded
+        // one) rebuilt: in the host's submission, never in one of the sky's own, which could
+        // hold the host's frame thread while the device is busy.
+        v.ring.record_builds(
             encoder,
             &self.sheet_group,
             &self.build,
             &self.resident.group,
             &self.quads.0,
         );
-        let view_group = self.view.group().filter(|_| self.sprites_to_draw > 0);
+        let view_group = v.view.group().filter(|_| v.sprites_to_draw > 0);
         let parts: Vec<(u32, u32, u32)> = view_group
-            .map(|_| chunks(self.sprites_to_draw).collect())
+            .map(|_| chunks(v.sprites_to_draw).collect())
             .unwrap_or_default();
         if parts.len() == 1
             && let Some(group) = view_group
@@ -930,9 +1045,7 @@ impl Sky {
         // Below full resolution the clouds go to the cloud target, composited at the end with
         // the sky background; at full resolution they are drawn over the sky in the host's colour.
         stamp(encoder, Stamp::Build);
-        let offscreen = self
-            .clouds
-            .frame(&self.device, &self.frame_buffer, depth_view);
+        let offscreen = v.clouds.frame(&self.device, &v.frame_buffer, depth_view);
         let mut pass = match &offscreen {
             Some(target) => {
                 target.downsample(encoder, &frame_group);
@@ -968,7 +1081,7 @@ impl Sky {
             Some(target) => (target.sprite_pipeline(), target.in_cloud_pipeline()),
             None => (&self.sprite_pipeline, &self.in_cloud_pipeline),
         };
-        self.ring.draw(&mut pass, offscreen.is_some());
+        v.ring.draw(&mut pass, offscreen.is_some());
         if timer.is_some() {
             drop(pass);
             stamp(encoder, Stamp::Ring);
@@ -995,7 +1108,7 @@ impl Sky {
             pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..n * 6, 0, 0..1);
         }
-        if self.in_cloud > 0.0 {
+        if v.in_cloud > 0.0 {
             pass.set_pipeline(in_cloud_pipeline);
             pass.draw(0..3, 0..1);
         }
@@ -1008,8 +1121,9 @@ impl Sky {
         if let Some(timer) = timer {
             timer.resolve(encoder);
         }
-        self.recorded.set(true);
-        self.record_us.set(start.elapsed().as_micros() as u64);
+        v.recorded.set(true);
+        v.record_us.set(start.elapsed().as_micros() as u64);
+        Ok(())
     }
 
     /// A pass over the host's colour (kept), with the frame's group 0 bound, and the host's

@@ -1,8 +1,11 @@
 //! Ranges of slots in a GPU buffer: blocks of sprites (and of clouds) take a contiguous range
 //! when they arrive and give it back when they go, so a block is written once and never moved.
 //! First fit over a sorted free list, with neighbours merged on release: the field brings and
-//! retires a few blocks at a time, so the list stays short. A full buffer is replaced by one
-//! twice the size and every block placed again (see `resident`).
+//! retires a few blocks at a time, so the list stays short. When a block finds no range long
+//! enough, every block is placed again (see `resident`): packed at the same capacity when the
+//! slots free are enough in all, in a larger buffer only when they are not
+//! ([`SlotRanges::capacity_for`]), so the capacity follows the most slots ever held at once and
+//! never how the free ones happen to be cut up.
 
 use std::ops::Range;
 
@@ -36,6 +39,20 @@ impl SlotRanges {
     /// Whether a range of `len` slots is free.
     pub fn fits(&self, len: u32) -> bool {
         len == 0 || self.free.iter().any(|r| r.end - r.start >= len)
+    }
+
+    /// The capacity to place every block again in when `len` more slots find no free range:
+    /// the same one when the free slots are enough in all (packing them makes one range), else
+    /// the slots held and a sixteenth more (room for the next few blocks without another
+    /// move), rounded up to a multiple of `step`.
+    pub fn capacity_for(&self, len: u32, step: u32) -> u32 {
+        let need = self.used() as u64 + len as u64;
+        if need <= self.capacity as u64 {
+            return self.capacity;
+        }
+        let step = step.max(1) as u64;
+        let want = (need * 17 / 16).div_ceil(step) * step;
+        want.min(u32::MAX as u64) as u32
     }
 
     /// A range of `len` slots, if one is free (`len` 0 gives an empty range).
@@ -107,5 +124,25 @@ mod tests {
         // Growing keeps at least the old size (`resident`): the capacity is the slots in all,
         // used or not.
         assert_eq!((s.capacity(), SlotRanges::new(0).capacity()), (100, 0));
+    }
+
+    #[test]
+    fn slots_free_in_pieces_are_packed_at_the_same_capacity() {
+        // 256 cloud slots cut into pieces of 16: 128 free in all, no range of 20.
+        let mut s = SlotRanges::new(256);
+        let held: Vec<_> = (0..16).map(|_| s.allocate(16).unwrap()).collect();
+        for r in held.into_iter().step_by(2) {
+            s.release(r);
+        }
+        assert_eq!((s.used(), s.fits(20)), (128, false));
+        // Packed, 20 more fit in the same 256 (the cloud buffers jumped to 4,096 slots here,
+        // 553 KB, two hours into the soak).
+        assert_eq!(s.capacity_for(20, 256), 256);
+        assert_eq!(s.capacity_for(128, 256), 256);
+        // One more than the capacity: what is held and a sixteenth, rounded up to the step.
+        assert_eq!(s.capacity_for(129, 256), 512);
+        assert_eq!(s.capacity_for(129, 1), 273);
+        assert_eq!(SlotRanges::new(12_288).capacity_for(12_522, 4096), 16_384);
+        assert_eq!(SlotRanges::new(0).capacity_for(0, 4096), 0);
     }
 }

@@ -7,7 +7,16 @@ use crate::shading::{
     DirectionalMapping, ForwardScattering, HarrisLastra, ShadingModel, TimeOfDay,
 };
 
-/// What one frame's update did and cost.
+/// What one frame's update did and cost, returned by [`crate::SkySystem::update`] and
+/// [`crate::Sky::prepare`]: a host logs it or shows it in an overlay (`skycast fly` writes it to
+/// `frames.csv`, one row a frame).
+///
+/// ```
+/// use skycast::FrameStats;
+///
+/// let stats = FrameStats { field_us: 23, cpu_update_us: 338, record_us: 31, ..FrameStats::default() };
+/// assert_eq!(stats.sky_cpu_us(), 392); // what the sky cost the frame thread
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct FrameStats {
     /// Sprites drawn as sprites this frame (the impostors' not counted).
@@ -40,8 +49,10 @@ pub struct FrameStats {
     /// The host's weather step this frame (polling a watched file, switching in a new field;
     /// never reading one), microseconds; part of `field_us`.
     pub weather_us: u64,
-    /// CPU time of the last [`crate::render::Sky::record`], microseconds (filled in by hosts that
-    /// record after they prepare, like the demo host).
+    /// CPU time of the last [`crate::render::Sky::record`], microseconds. Through
+    /// [`crate::SkySystem::update`] it is the previous frame's recording (this frame's has not
+    /// happened when `update` returns); a host driving [`crate::render::Sky`] itself that
+    /// records after it prepares fills in this frame's, as the demo host does.
     pub record_us: u64,
     /// Bytes written to the GPU by this frame's update (new blocks, changed sprite orders, the
     /// draw list, uniforms, impostor builds).
@@ -74,13 +85,17 @@ pub struct FrameStats {
     pub sprites_lit: u32,
     /// CPU time of that light, microseconds (part of `cpu_update_us`).
     pub light_us: u64,
+    /// CPU time of the host's air-data queries this frame (`SkySystem::air_at`, lines of
+    /// sight), microseconds: set by the host that asks (`skycast fly` does), 0 otherwise.
+    pub air_us: u64,
 }
 
 impl FrameStats {
-    /// All the CPU time the sky cost the frame thread: the cloud field, the update and the
-    /// recording, microseconds; waits for the device (`gpu_wait_us`) are not in it.
+    /// All the CPU time the sky cost the frame thread: the cloud field, the update, the
+    /// recording and the host's air-data queries, microseconds; waits for the device
+    /// (`gpu_wait_us`) are not in it.
     pub fn sky_cpu_us(&self) -> u64 {
-        self.field_us + self.cpu_update_us + self.record_us
+        self.field_us + self.cpu_update_us + self.record_us + self.air_us
     }
 }
 
@@ -99,4 +114,45 @@ pub struct Lighting {
     pub model: ShadingModel,
     /// The Harris and Lastra model's constants.
     pub harris_lastra: HarrisLastra,
+}
+
+/// Everything the sky holds on the GPU, and the blocks and slots behind it: what a long flight
+/// watches for growth (`tests/soak.rs`). Bytes are the sizes the buffers and textures were
+/// created with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SkyMemory {
+    /// The resident sprite, cloud, light, order and cloud-list buffers.
+    pub resident_bytes: u64,
+    /// What a frame draws with: the frame uniform, the camera view's uniform and draw list, the
+    /// build pass's corners and chunk uniforms, the quad indices and the order patch.
+    pub draw_bytes: u64,
+    /// The impostor ring's textures and buffers (0 with the ring off).
+    pub ring_bytes: u64,
+    /// The off-screen cloud target's textures at the last recorded frame size (0 at scale 1).
+    pub cloud_target_bytes: u64,
+    /// The sprite sheet texture, every mip level.
+    pub sheet_bytes: u64,
+    /// Blocks (cloud generations) the sky holds.
+    pub blocks: u32,
+    /// Sprites of those blocks.
+    pub sprites: u32,
+    /// Sprite slots of the resident buffers, in all.
+    pub sprite_slots: u32,
+    /// Sprite slots in use (by blocks placed on the GPU).
+    pub sprite_slots_used: u32,
+    /// Cloud slots of the resident buffers, in all.
+    pub cloud_slots: u32,
+    /// Cloud slots in use.
+    pub cloud_slots_used: u32,
+}
+
+impl SkyMemory {
+    /// Bytes of every buffer and texture the sky holds.
+    pub fn gpu_bytes(&self) -> u64 {
+        self.resident_bytes
+            + self.draw_bytes
+            + self.ring_bytes
+            + self.cloud_target_bytes
+            + self.sheet_bytes
+    }
 }

@@ -11,7 +11,23 @@ use super::RenderError;
 use super::camera::{Camera, Frustum};
 
 /// What the host's colour and depth targets are. The defaults are a single-sample
-/// `Rgba8UnormSrgb` colour target over a standard-Z `Depth32Float` depth.
+/// `Rgba8UnormSrgb` colour target over a standard-Z `Depth32Float` depth. Give the sky the
+/// host's own; [`HostTargets::validate`] says what it cannot use.
+///
+/// ```
+/// use skycast::HostTargets;
+///
+/// // A simulator with reversed Z and 4x MSAA on a depth-stencil buffer:
+/// let targets = HostTargets {
+///     depth_format: wgpu::TextureFormat::Depth24PlusStencil8,
+///     reversed_z: true,
+///     sample_count: 4,
+///     ..HostTargets::default()
+/// };
+/// assert!(targets.validate().is_ok());
+/// assert_eq!(targets.background_depth(), 0.0); // what the host clears its depth to
+/// assert!(HostTargets { sample_count: 2, ..targets }.validate().is_err());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct HostTargets {
     /// Format of the colour target the sky draws into.
@@ -66,6 +82,98 @@ impl HostTargets {
         Ok(())
     }
 
+    /// Checks the projection a frame is drawn with against [`Self::reversed_z`]: a reversed
+    /// projection maps the near plane to depth 1, a standard one to 0. A mismatch would draw a
+    /// wrong sky without a word (the background where the host's ground is, clouds faded into
+    /// the wrong depth), so it is an error naming both sides.
+    pub fn check_projection(&self, projection: Mat4) -> Result<(), RenderError> {
+        let reversed = maps_near_to_one(projection).ok_or_else(|| {
+            RenderError::Targets(
+                "the projection is not a perspective one: depth does not change along the view"
+                    .to_string(),
+            )
+        })?;
+        if reversed == self.reversed_z {
+            return Ok(());
+        }
+        let says = |r: bool| {
+            if r {
+                "reversed (near at depth 1)"
+            } else {
+                "standard (near at depth 0)"
+            }
+        };
+        Err(RenderError::Targets(format!(
+            "HostTargets::reversed_z is {}: the sky expects depth {}, but the projection is {}",
+            self.reversed_z,
+            says(self.reversed_z),
+            says(reversed)
+        )))
+    }
+
+    /// Checks the host's colour and depth textures against these targets and against what the
+    /// sky's pipelines were made for, before anything is recorded: the colour format, the depth
+    /// format, the samples of each, the depth's `TEXTURE_BINDING` (the sky reads it), the two
+    /// being the same size. Each mismatch names both sides; without the check wgpu's
+    /// validation panics inside `record` or `encoder.finish()`.
+    ///
+    /// The textures' own formats are compared: a view in the other sRGB-ness of its texture
+    /// (through `view_formats`) is taken on trust.
+    pub fn check_textures(
+        &self,
+        colour: &wgpu::Texture,
+        depth: &wgpu::Texture,
+    ) -> Result<(), RenderError> {
+        let err = |message: String| Err(RenderError::Targets(message));
+        let (c, d) = (colour.format(), depth.format());
+        if c != self.colour_format
+            && c.remove_srgb_suffix() != self.colour_format.remove_srgb_suffix()
+        {
+            return err(format!(
+                "the colour texture is {c:?} but HostTargets::colour_format (the sky's pipelines) is {:?}",
+                self.colour_format
+            ));
+        }
+        if d != self.depth_format {
+            return err(format!(
+                "the depth texture is {d:?} but HostTargets::depth_format (the sky's pipelines) is {:?}",
+                self.depth_format
+            ));
+        }
+        for (what, texture) in [("colour", colour), ("depth", depth)] {
+            if texture.sample_count() != self.sample_count {
+                return err(format!(
+                    "the {what} texture has {} sample(s) a pixel but HostTargets::sample_count is {}",
+                    texture.sample_count(),
+                    self.sample_count
+                ));
+            }
+        }
+        if !depth.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
+            return err(format!(
+                "the depth texture's usage is {:?}, without TEXTURE_BINDING: the sky reads the host's depth as a texture (it never writes it)",
+                depth.usage()
+            ));
+        }
+        if !colour
+            .usage()
+            .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+        {
+            return err(format!(
+                "the colour texture's usage is {:?}, without RENDER_ATTACHMENT: the sky draws into it",
+                colour.usage()
+            ));
+        }
+        let (cs, ds) = (colour.size(), depth.size());
+        if (cs.width, cs.height) != (ds.width, ds.height) {
+            return err(format!(
+                "the colour texture is {} x {} but the depth texture {} x {}",
+                cs.width, cs.height, ds.width, ds.height
+            ));
+        }
+        Ok(())
+    }
+
     /// The depth value the host clears to: where nothing was drawn.
     pub fn background_depth(&self) -> f32 {
         if self.reversed_z { 0.0 } else { 1.0 }
@@ -73,7 +181,9 @@ impl HostTargets {
 }
 
 /// Where the sky is seen from this frame: the camera's position in the sky's east-north-up frame
-/// (f64 metres, z above mean sea level) and the host's own matrices.
+/// (f64 metres, z above mean sea level) and the host's own matrices. A host that drives the
+/// [`super::Sky`] itself gives one to [`super::Sky::prepare`] every frame; [`crate::SkySystem`]
+/// makes it from the host's [`crate::HostCamera`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SkyView {
     /// Camera position, metres east, north and above mean sea level.
@@ -84,6 +194,23 @@ pub struct SkyView {
     pub view: Mat4,
     /// The host's projection matrix, clip depth in WebGPU's `[0, 1]`, standard or reversed.
     pub projection: Mat4,
+}
+
+/// Whether `projection` maps nearer points to larger depths (reversed Z: the near plane at 1),
+/// from two points in front of the camera; `None` when depth does not change with distance.
+pub fn maps_near_to_one(projection: Mat4) -> Option<bool> {
+    // In front is where clip w is positive: -z for a right-handed view space, +z left-handed.
+    let forward = if projection.z_axis.w <= 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let depth = |metres: f32| {
+        let clip = projection * glam::Vec4::new(0.0, 0.0, forward * metres, 1.0);
+        clip.z / clip.w
+    };
+    let (near, far) = (depth(10.0), depth(10_000.0));
+    (near.is_finite() && far.is_finite() && near != far).then_some(near > far)
 }
 
 impl SkyView {
@@ -207,6 +334,27 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn the_depth_convention_is_read_from_the_projection() {
+        let fov = 60f32.to_radians();
+        let rh = glam::camera::rh::proj::directx::perspective(fov, 1.5, 1.0, 100_000.0);
+        let reversed = glam::camera::rh::proj::directx::perspective(fov, 1.5, 100_000.0, 1.0);
+        let infinite = glam::camera::rh::proj::directx::perspective_infinite_reverse(fov, 1.5, 0.5);
+        let lh = glam::camera::lh::proj::directx::perspective(fov, 1.5, 1.0, 100_000.0);
+        assert_eq!(maps_near_to_one(rh), Some(false));
+        assert_eq!(maps_near_to_one(lh), Some(false));
+        assert_eq!(maps_near_to_one(reversed), Some(true));
+        assert_eq!(maps_near_to_one(infinite), Some(true));
+        // Depth the same at every distance: no convention to read.
+        let flat = Mat4::from_cols(
+            glam::Vec4::X,
+            glam::Vec4::Y,
+            glam::Vec4::new(0.0, 0.0, 0.0, -1.0),
+            glam::Vec4::ZERO,
+        );
+        assert_eq!(maps_near_to_one(flat), None);
     }
 
     #[test]

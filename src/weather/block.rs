@@ -190,14 +190,22 @@ pub fn own_coverage_oktas(below_oktas: f64, total_oktas: f64) -> Option<f64> {
     Some(8.0 * (1.0 - (1.0 - total_oktas.min(8.0) / 8.0) / clear_below))
 }
 
-/// The ceiling, feet AGL: the lowest base where the sky seen from below is broken or overcast
-/// (at least `broken_oktas`, 5 for the 5/8 that BKN starts at); `None` when it never is.
+/// The ceiling, feet AGL, as a report gives it: the lowest base where the sky seen from below is
+/// broken or overcast (at least `broken_oktas`, 5 for the 5/8 that BKN starts at), counting the
+/// layers of the summation principle; a reported CB or TCU layer ([`TypeSource::Reported`]) has
+/// its own amount (ICAO Annex 3) and makes a ceiling only when that amount is broken itself.
+/// `None` when there is none.
 pub fn ceiling_ft(layers: &[BlockLayer], broken_oktas: f32) -> Option<f32> {
+    let convective = |l: &BlockLayer| l.type_source == TypeSource::Reported;
+    let summed: Vec<BlockLayer> = layers.iter().filter(|l| !convective(l)).copied().collect();
     let mut bases: Vec<f32> = layers.iter().map(|l| l.base_ft_agl).collect();
     bases.sort_by(f32::total_cmp);
-    bases
-        .into_iter()
-        .find(|&b| cover_seen_from_below_oktas(layers, b) >= broken_oktas - 1e-4)
+    bases.into_iter().find(|&b| {
+        cover_seen_from_below_oktas(&summed, b) >= broken_oktas - 1e-4
+            || layers.iter().any(|l| {
+                convective(l) && l.base_ft_agl <= b && l.coverage_oktas >= broken_oktas - 1e-4
+            })
+    })
 }
 
 #[cfg(test)]
@@ -233,6 +241,17 @@ mod tests {
         assert_eq!(cover_seen_from_below_oktas(&layers, 700.0), 0.0);
         assert_eq!(ceiling_ft(&layers, 5.0), Some(4500.0));
         assert_eq!(ceiling_ft(&layers[..2], 5.0), None);
+        // FEW011 SCT017CB BKN023 (LEVX): the Cb's 4 oktas are its own, so the ceiling is the
+        // BKN023, not the 5 oktas the Cb and the FEW011 would make together at 1,700 ft; a
+        // broken Cb alone (BKN045CB) is a ceiling.
+        let cb = |coverage_oktas: f32, base_ft_agl: f32| BlockLayer {
+            cloud_type: CloudType::Cumulonimbus,
+            type_source: TypeSource::Reported,
+            ..layer(coverage_oktas, base_ft_agl)
+        };
+        let levx = [layer(2.0, 1100.0), cb(4.0, 1700.0), layer(4.0, 2300.0)];
+        assert_eq!(ceiling_ft(&levx, 5.0), Some(2300.0));
+        assert_eq!(ceiling_ft(&[cb(6.0, 4500.0)], 5.0), Some(4500.0));
         // Nothing more is seen above an overcast, and a cover that does not grow adds nothing.
         assert_eq!(own_coverage_oktas(8.0, 8.0), None);
         assert_eq!(own_coverage_oktas(6.0, 6.0), None);

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::error::{LineWarning, WeatherError};
+use super::error::{LineWarning, WarningKind, WeatherError};
 use super::metar::Report;
 use super::stations::StationTable;
 
@@ -191,6 +191,7 @@ pub fn place<E: Display>(
             Err(err) => {
                 warnings.push(LineWarning {
                     line: r.line,
+                    kind: WarningKind::Undecodable,
                     message: format!("cannot decode `{}`: {err}", shorten(&r.text)),
                 });
                 continue;
@@ -199,6 +200,7 @@ pub fn place<E: Display>(
         for w in &report.warnings {
             warnings.push(LineWarning {
                 line: r.line,
+                kind: WarningKind::GroupIgnored,
                 message: format!("{}: {w}", report.station),
             });
         }
@@ -219,6 +221,7 @@ pub fn place<E: Display>(
             }),
             None => warnings.push(LineWarning {
                 line: r.line,
+                kind: WarningKind::NoPosition,
                 message: match stations {
                     Some(_) => format!(
                         "{}: station not in the station table, report left out",
@@ -269,6 +272,7 @@ fn read_awc_csv(path: &Path, lines: &[&str], header_index: usize) -> Result<RawF
             Err(e) => {
                 warnings.push(LineWarning {
                     line,
+                    kind: WarningKind::BadRow,
                     message: format!("CSV row skipped: {e}"),
                 });
                 continue;
@@ -279,6 +283,7 @@ fn read_awc_csv(path: &Path, lines: &[&str], header_index: usize) -> Result<RawF
         if text.is_empty() {
             warnings.push(LineWarning {
                 line,
+                kind: WarningKind::BadRow,
                 message: "row has no raw_text, skipped".to_string(),
             });
             continue;
@@ -365,6 +370,7 @@ fn read_plain(lines: &[&str]) -> RawFile {
         } else {
             warnings.push(LineWarning {
                 line: index + 1,
+                kind: WarningKind::NotAReport,
                 message: format!("not a METAR report, skipped: `{}`", shorten(t)),
             });
         }

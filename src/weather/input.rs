@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::error::WeatherError;
+use super::error::{Skipped, WeatherError};
 use super::field::{CloudTypeRule, FieldSettings, WeatherField};
 use super::files::{self, WeatherFile};
 use super::frame::LocalFrame;
@@ -53,6 +53,28 @@ impl WeatherInput {
             });
         }
         Ok(Self::Theme(theme::parse_theme(&text, path)?))
+    }
+
+    /// What the input left out and why, counted (nothing for a theme).
+    pub fn skipped(&self) -> Skipped {
+        match self {
+            Self::Reports(file) => {
+                Skipped::new(file.reports_found, file.reports.len(), &file.warnings)
+            }
+            Self::Theme(_) => Skipped::default(),
+        }
+    }
+
+    /// The input itself if it holds weather to build a sky from; a report file none of whose
+    /// reports could be used is [`WeatherError::NoUsableReport`], with what was skipped.
+    pub fn usable(self) -> Result<Self, WeatherError> {
+        match &self {
+            Self::Reports(file) if file.reports.is_empty() => Err(WeatherError::NoUsableReport {
+                path: file.path.clone(),
+                skipped: self.skipped(),
+            }),
+            _ => Ok(self),
+        }
     }
 
     /// The weather field of this input in `frame`.

@@ -5,6 +5,7 @@
 //! `field` triangulates the placed reports (spade, Delaunay) and interpolates by natural
 //! neighbours; `block` holds the per-block result the clouds stage consumes.
 
+pub mod air;
 pub mod block;
 pub mod cloud_type;
 pub mod error;
@@ -23,7 +24,7 @@ pub use block::{
     BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, METRES_PER_FOOT, TypeSource, Wind,
 };
 pub use cloud_type::CloudType;
-pub use error::{LineWarning, WeatherError};
+pub use error::{LineWarning, SkipCount, Skipped, WarningKind, WeatherError};
 pub use field::{CloudTypeRule, FieldSettings, WeatherField};
 pub use files::{FileFormat, PlacedReport, Position, WeatherFile};
 pub use frame::LocalFrame;

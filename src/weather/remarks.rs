@@ -258,8 +258,8 @@ mod bulk_file_tests {
         assert_eq!(types_of(&reports, "CYVO"), [Some(Fog)]);
         // KLAX has no cloud-type remark.
         assert!(types_of(&reports, "KLAX").iter().all(Option::is_none));
-        // The figures quoted in the README. The one remark that types no layer is CYRT's
-        // `BLSN2`: blowing snow over a sky with no cloud group.
+        // The figures quoted in the book (docs/src/weather.md). The one remark that types no
+        // layer is CYRT's `BLSN2`: blowing snow over a sky with no cloud group.
         let typed = reports
             .iter()
             .filter(|p| {

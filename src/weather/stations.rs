@@ -8,11 +8,18 @@
 //! latitude/longitude pair from field 7 on, and the elevation four fields after the latitude.
 //! Rows that still cannot be read are skipped with a [`LineWarning`]; a file with no station at
 //! all is an error.
+//!
+//! The library carries the table itself ([`StationTable::builtin`]): `weather/nsd_cccc.txt`
+//! gzipped into `assets/stations/nsd_cccc.txt.gz` (179 KB in the binary instead of 526 KB; the
+//! `png` decoder already links `flate2`), decompressed and parsed once, on first use. A host
+//! passes its own table where it has a newer one.
 
 use std::collections::HashMap;
+use std::io::Read;
 use std::path::Path;
+use std::sync::{Arc, OnceLock};
 
-use super::error::{LineWarning, WeatherError};
+use super::error::{LineWarning, WarningKind, WeatherError};
 
 /// One station of the table.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,7 +44,23 @@ pub struct StationTable {
     pub skipped: Vec<LineWarning>,
 }
 
+/// NOAA's table as the library ships it: `gzip -9 -n -c weather/nsd_cccc.txt`
+/// (a test checks it holds the same bytes as the file).
+const BUILTIN_GZ: &[u8] = include_bytes!("../../assets/stations/nsd_cccc.txt.gz");
+
 impl StationTable {
+    /// NOAA's station table as shipped inside the library (6,510 stations from its 6,519
+    /// rows): decompressed and parsed on the first call, shared after.
+    pub fn builtin() -> Arc<StationTable> {
+        static TABLE: OnceLock<Arc<StationTable>> = OnceLock::new();
+        Arc::clone(TABLE.get_or_init(|| {
+            // The bytes are the library's own and checked by its tests: a failure here is a
+            // broken build, and an empty table (every report then unplaced, each warned about)
+            // is the safe answer.
+            let text = builtin_text().unwrap_or_default();
+            Arc::new(Self::parse(Path::new("nsd_cccc.txt (built in)"), &text).unwrap_or_default())
+        }))
+    }
     /// Reads a station table from disk.
     pub fn load(path: &Path) -> Result<Self, WeatherError> {
         let bytes = std::fs::read(path).map_err(|source| WeatherError::Io {
@@ -61,7 +84,11 @@ impl StationTable {
                     // The first row of an id wins; the real table has no duplicates.
                     table.stations.entry(station.id.clone()).or_insert(station);
                 }
-                Err(message) => table.skipped.push(LineWarning { line, message }),
+                Err(message) => table.skipped.push(LineWarning {
+                    line,
+                    kind: WarningKind::BadRow,
+                    message,
+                }),
             }
         }
         if table.stations.is_empty() {
@@ -93,6 +120,13 @@ impl StationTable {
     pub fn is_empty(&self) -> bool {
         self.stations.is_empty()
     }
+}
+
+/// The shipped table's text.
+fn builtin_text() -> std::io::Result<String> {
+    let mut text = String::new();
+    flate2::read::GzDecoder::new(BUILTIN_GZ).read_to_string(&mut text)?;
+    Ok(text)
 }
 
 /// One row, or why it cannot be read.
@@ -174,6 +208,21 @@ AGGH;91;520;Honiara / Henderson;;Solomon Islands;5;09-25S;160-03E;;;8;9;P\r\n\
 KCIR;--;---;Cairo, Cairo Regional Airport,IL;United States;4;37-03-52N;089-13-10W;;;98;;\r\n\
 KORS;--;---;Eastsound, Orcas Island Airport;WA;United States;4;48-42-29;122-54-37W;;;9;;\r\n\
 CXBK;71;569;Bratts Lake, Sask.;;Canada;4;50-12N;104-42W;;580;;\r\n";
+
+    #[test]
+    fn the_builtin_table_is_the_shipped_file() {
+        let file =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/weather/nsd_cccc.txt"))
+                .unwrap();
+        assert!(
+            builtin_text().unwrap() == file,
+            "assets/stations/nsd_cccc.txt.gz is stale"
+        );
+        let table = StationTable::builtin();
+        assert_eq!(table.len(), 6_510, "{:?}", table.skipped);
+        let egll = table.get("EGLL").unwrap();
+        assert!((egll.latitude_deg - 51.47).abs() < 0.02, "{egll:?}");
+    }
 
     fn table() -> StationTable {
         StationTable::parse(Path::new("nsd_cccc.txt"), EXCERPT).unwrap()

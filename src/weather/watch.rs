@@ -179,11 +179,8 @@ pub fn load_whole(path: &Path, stations: Option<&StationTable>) -> Result<Weathe
                 "{shown}:{line}: ends in the middle of a line: cut short"
             ));
         }
-        if file.reports.is_empty() {
-            return Err(format!("{shown}: no report could be placed"));
-        }
     }
-    Ok(input)
+    input.usable().map_err(|err| err.to_string())
 }
 
 /// The `<n> results` line of a bulk CSV's preamble: its 1-based line and `n`.

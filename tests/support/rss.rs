@@ -1,5 +1,5 @@
-//! The process's resident memory, for the tests that hold it flat (`tests/memory.rs`, the soak
-//! in `tests/live.rs`).
+//! The process's resident memory, for the tests that hold it flat (`tests/memory.rs`,
+//! `tests/soak.rs`).
 
 /// Resident memory of this process, bytes; panics where /proc cannot say (a test of memory that
 /// measures nothing must not pass).

@@ -4,10 +4,14 @@
 //!
 //! A reported layer is reproduced when the field has a layer whose base is within
 //! max(200 ft, 10%) of it and whose cover seen from below
-//! ([`skycast::weather::block::cover_seen_from_below_oktas`]) is within 1 okta of the reported
-//! cover (FEW 2, SCT 4, BKN 6, OVC and OVX 8 oktas; by the summation principle the largest cover
-//! reported at or below the base). The ceiling is the lowest base where the cover seen from below
-//! reaches 5 oktas (BKN); it is right when both are absent or the bases agree as above. The
+//! ([`skycast::weather::block::cover_seen_from_below_oktas`], over the field's layers that are not
+//! reported CB/TCU) is within 1 okta of the reported cover (FEW 2, SCT 4, BKN 6, OVC and OVX 8
+//! oktas; by the summation principle the largest such cover reported at or below the base). A CB
+//! or TCU group (read from the raw text, before any trend or remark) stands outside that
+//! principle (ICAO Annex 3): it is reproduced by a reported CB/TCU layer whose own coverage is
+//! within 1 okta of the group's amount. The ceiling is the lowest base where the cover seen from
+//! below, or a CB/TCU group's own amount, reaches 5 oktas (BKN); it is right when both are absent
+//! or the bases agree as above. The
 //! field is asked at each station and, the way the clouds stage asks it, for the 4 km block
 //! that holds the station.
 //!
@@ -17,7 +21,7 @@ use std::collections::HashMap;
 use std::io::BufRead;
 use std::path::Path;
 
-use skycast::weather::block::{BlockLayer, ceiling_ft, cover_seen_from_below_oktas};
+use skycast::weather::block::{BlockLayer, TypeSource, ceiling_ft, cover_seen_from_below_oktas};
 use skycast::weather::{
     CloudTypeRule, FieldSettings, LocalFrame, StationTable, WeatherField, files,
 };
@@ -27,13 +31,26 @@ const BULK_FILE: &str = concat!(
     "/weather/awc-metars-2025-01-27T22Z.cache.csv"
 );
 
-/// One row of the service's decode: position, time and the sky layers (oktas, base ft AGL).
+/// One row of the service's decode: position, time and the sky layers (oktas, base ft AGL,
+/// whether the raw text marks the group CB or TCU).
 struct Row {
     station: String,
     time: String,
     lat_deg: f64,
     lon_deg: f64,
-    layers: Vec<(f32, f32)>,
+    layers: Vec<(f32, f32, bool)>,
+}
+
+/// Whether the observation part of the raw report (before a trend or the remarks) has the group
+/// of `cover` at `base_ft` marked CB or TCU.
+fn convective_in(raw: &str, cover: &str, base_ft: f32) -> bool {
+    let group = format!("{cover}{:03}", (base_ft / 100.0).round() as u32);
+    raw.split_whitespace()
+        .take_while(|t| !matches!(*t, "TEMPO" | "BECMG" | "NOSIG" | "RMK"))
+        .any(|t| {
+            t.strip_prefix(&group)
+                .is_some_and(|kind| kind.starts_with("CB") || kind.starts_with("TCU"))
+        })
 }
 
 fn oktas(cover: &str) -> Option<f32> {
@@ -56,7 +73,8 @@ fn read_rows() -> Vec<Row> {
     let mut csv = csv::Reader::from_reader(reader);
     let header = csv.headers().expect("header").clone();
     let col = |name: &str| header.iter().position(|h| h == name).expect(name);
-    let (station, time, lat, lon) = (
+    let (raw, station, time, lat, lon) = (
+        col("raw_text"),
         col("station_id"),
         col("observation_time"),
         col("latitude"),
@@ -76,7 +94,7 @@ fn read_rows() -> Vec<Row> {
             .filter_map(|&i| {
                 let o = oktas(&record[i])?;
                 let base: f32 = record.get(i + 1)?.parse().ok()?;
-                Some((o, base))
+                Some((o, base, convective_in(&record[raw], &record[i], base)))
             })
             .collect();
         rows.push(Row {
@@ -104,19 +122,32 @@ struct Score {
 impl Score {
     fn add(&mut self, row: &Row, field: &[BlockLayer]) {
         let within = |a: f32, b: f32| (a - b).abs() <= 200f32.max(0.1 * b);
+        let reported = |l: &BlockLayer| l.type_source == TypeSource::Reported;
+        let plain: Vec<BlockLayer> = field.iter().filter(|l| !reported(l)).copied().collect();
         let mut below = 0.0f32;
         let mut ceiling = None;
-        for &(cover, base) in &row.layers {
-            // The summation principle: the cover seen from below never shrinks upwards.
-            below = below.max(cover);
-            if below >= 5.0 && ceiling.is_none() {
+        for &(cover, base, convective) in &row.layers {
+            // The summation principle: the cover seen from below never shrinks upwards; CB and
+            // TCU amounts are their own.
+            if !convective {
+                below = below.max(cover);
+            }
+            if below.max(if convective { cover } else { 0.0 }) >= 5.0 && ceiling.is_none() {
                 ceiling = Some(base);
             }
             self.layers += 1;
-            let ok = field.iter().any(|l| {
-                within(l.base_ft_agl, base)
-                    && (cover_seen_from_below_oktas(field, l.base_ft_agl) - below).abs() <= 1.0
-            });
+            let ok = if convective {
+                field.iter().any(|l| {
+                    reported(l)
+                        && within(l.base_ft_agl, base)
+                        && (l.coverage_oktas - cover).abs() <= 1.0
+                })
+            } else {
+                plain.iter().any(|l| {
+                    within(l.base_ft_agl, base)
+                        && (cover_seen_from_below_oktas(&plain, l.base_ft_agl) - below).abs() <= 1.0
+                })
+            };
             if ok {
                 self.layers_ok += 1;
             } else if self.misses.len() < 20 {
@@ -281,7 +312,8 @@ fn timika_has_isolated_cb_cells_beside_a_broken_deck() {
     assert!(cb.base_ft_agl + cb.thickness_ft >= 25_000.0, "{cb:?}");
     assert_ne!(deck.cloud_type, CloudType::Cumulonimbus);
     assert_eq!(deck.base_ft_agl, 1300.0);
-    assert!((cover_seen_from_below_oktas(&w.layers, 1300.0) - 6.0).abs() < 1e-4);
+    // The deck's BKN is its own 6 oktas: the Cb's FEW stands outside the summation.
+    assert_eq!(deck.coverage_oktas, 6.0);
     assert_eq!(ceiling_ft(&w.layers, 5.0), Some(1300.0));
     assert_eq!(w.visibility_m, 4000.0);
 }
@@ -297,4 +329,28 @@ fn belo_horizonte_cb_tops_pass_25000_ft() {
     assert_eq!(cb.base_ft_agl, 4500.0);
     assert!(cb.base_ft_agl + cb.thickness_ft > 25_000.0, "{cb:?}");
     assert_eq!(ceiling_ft(&w.layers, 5.0), Some(4500.0));
+}
+
+#[test]
+fn a_cb_group_keeps_its_own_amount_and_an_unknown_one_is_few() {
+    // SLSV 272200Z 36006KT 9999 BKN017 FEW025CB BKN200 26/24 Q1007: ICAO Annex 3 reports the
+    // Cb with its own amount, so 1-2 oktas of Cb above the broken deck, not the 0.5 okta the
+    // summation principle would leave it.
+    use skycast::weather::CloudType;
+    let w = at_station("SLSV");
+    let cb = w
+        .layers
+        .iter()
+        .find(|l| l.cloud_type == CloudType::Cumulonimbus)
+        .unwrap_or_else(|| panic!("no Cb: {:?}", w.layers));
+    assert_eq!((cb.base_ft_agl, cb.coverage_oktas), (2500.0, 2.0), "{cb:?}");
+    // LFRL 272200Z AUTO 22025G38KT 9999 BKN024/// BKN030/// BKN045/// //////CB 10/07 Q0983:
+    // an automatic station's Cb of unknown amount is drawn as FEW.
+    let w = at_station("LFRL");
+    let cb = w
+        .layers
+        .iter()
+        .find(|l| l.cloud_type == CloudType::Cumulonimbus)
+        .unwrap_or_else(|| panic!("no Cb: {:?}", w.layers));
+    assert_eq!(cb.coverage_oktas, 2.0, "{cb:?}");
 }

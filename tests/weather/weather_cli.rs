@@ -220,3 +220,56 @@ fn themes_and_remarks_show_where_each_type_came_from() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("not a weather theme"), "{}", stderr(&o));
 }
+
+/// `--at` with `--alt-ft`: the air data under `"air"` with every field the issue names; at Vigo's
+/// elevation (830 ft in the field) the wind and temperature are LEVX's report (33016G27KT 07/05
+/// Q1011).
+#[test]
+fn the_air_at_vigo_is_its_report_at_the_ground_and_veered_above() {
+    let air = |ft: &str| {
+        let o = skycast(&[
+            "weather",
+            BULK,
+            "--at",
+            "42.239,-8.624",
+            "--alt-ft",
+            ft,
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("JSON");
+        v["air"].clone()
+    };
+    let ground = air("830");
+    for key in [
+        "wind_from_deg",
+        "wind_kt",
+        "gust_kt",
+        "temperature_c",
+        "dewpoint_c",
+        "pressure_hpa",
+        "pressure_altitude_ft",
+        "visibility_m",
+        "in_cloud",
+        "turbulence",
+        "icing",
+        "precipitation_mm_h",
+    ] {
+        assert!(!ground[key].is_null(), "no {key}: {ground}");
+    }
+    let f = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap();
+    assert_eq!(
+        (f(&ground, "wind_from_deg"), f(&ground, "wind_kt")),
+        (330.0, 16.0)
+    );
+    assert_eq!(
+        (f(&ground, "gust_kt"), f(&ground, "temperature_c")),
+        (27.0, 7.0)
+    );
+    assert!((f(&ground, "qnh_hpa") - 1011.0).abs() < 0.5, "{ground}");
+    // 2,000 ft above it: the gradient wind, 30 degrees veered (northern hemisphere).
+    let above = air("2830");
+    let off = (f(&above, "wind_from_deg") - 360.0 + 540.0).rem_euclid(360.0) - 180.0;
+    assert!(off.abs() < 1.0, "{above}");
+    assert!(f(&above, "temperature_c") < 7.0);
+}

@@ -237,6 +237,10 @@ impl Viewer {
             .host
             .camera(a.position_m, a.heading_deg, a.pitch_deg);
         let utc_unix_s = self.setup.start_unix_s + self.clock_s + self.time_offset_s;
+        // The first frame is the warm-up, as in `render`: it waits for the clouds around.
+        // After it no frame waits: blocks arrive as they are generated.
+        let first = self.frame == 0;
+        running.host.sky.world_mut().set_synchronous_clouds(first);
         let (stats, changes) = running.host.step(&camera, utc_unix_s, dt_s, true)?;
         for change in changes {
             match change {

@@ -9,11 +9,13 @@
 //! 3. Cover seen from below at that base: every neighbour's report read there (the cover of the
 //!    layer itself where the neighbour has it, else the neighbour's cover at that height, the
 //!    summation principle), weighted; never less than at the layer below. A layer only one
-//!    station has fades out with that station's weight.
+//!    station has fades out with that station's weight. Only fog and plain layers take part:
+//!    ICAO Annex 3 reports CB and TCU with their own amount, outside the summation principle.
 //! 4. Own coverage: what the layer must add to the sky seen from below, clouds of different layers
 //!    overlapping at random ([`own_coverage_oktas`]); at least `min_added_oktas` x presence for a
 //!    layer that adds no cover (`BKN010 BKN020`); above an overcast its stations' own covers.
-//!    A CB/TCU layer needs `convective.weight_min` of presence, as before the blending.
+//!    A CB/TCU layer keeps its stations' own amounts, weighted (`FEW025CB` over a broken deck is
+//!    2 oktas of Cb at the station), and needs `convective.weight_min` of presence.
 //! 5. Type: CB/TCU as reported; else a type a remark or theme names (with `weight_min` of the
 //!    presence); else the height rule on the cover seen from below.
 //! 6. Extent by type ([`Extent`](super::settings::Extent)): CB and TCU tops, fair-weather cumulus
@@ -72,7 +74,8 @@ pub(super) fn blend(
         return Vec::new();
     }
     let l = &settings.layers;
-    // (layer, reported kind) of the kept layers; the running cover seen from below.
+    // (layer, reported kind) of the kept layers; the running cover of fog and plain layers seen
+    // from below (convective layers stand outside it).
     let mut kept: Vec<(BlockLayer, LayerKind, bool)> = Vec::new();
     let mut below = 0.0f64;
     for m in &matched {
@@ -82,6 +85,13 @@ pub(super) fn blend(
             continue;
         }
         let base = m.base_ft();
+        if convective {
+            let layer = convective_layer(m, base, total_weight, settings, rule, surface);
+            if layer.coverage_oktas >= l.min_coverage_oktas as f32 && layer.coverage_oktas > 0.0 {
+                kept.push((layer, m.kind, false));
+            }
+            continue;
+        }
         let reported: f64 = w
             .iter()
             .map(|&(index, weight)| {
@@ -147,6 +157,35 @@ pub(super) fn blend(
     kept.into_iter().map(|k| k.0).collect()
 }
 
+/// A CB or TCU layer: its stations' own amounts weighted by their share of the natural-neighbour
+/// weight (a station's report exactly at the station), with a tower's extent.
+fn convective_layer(
+    m: &Matched,
+    base_ft: f64,
+    total_weight: f64,
+    settings: &FieldSettings,
+    rule: &CloudTypeRule,
+    surface: Surface,
+) -> BlockLayer {
+    let own = (m
+        .members
+        .iter()
+        .map(|x| x.1 * x.2.cover_below_oktas)
+        .sum::<f64>()
+        / total_weight)
+        .min(8.0);
+    let (cloud_type, type_source) = layer_type(m, base_ft, own, settings, rule, surface);
+    let thickness_ft = weighted_thickness(m)
+        .unwrap_or_else(|| thickness_ft(cloud_type, base_ft, own, settings, surface));
+    BlockLayer {
+        cloud_type,
+        type_source,
+        coverage_oktas: own as f32,
+        base_ft_agl: base_ft as f32,
+        thickness_ft: thickness_ft as f32,
+    }
+}
+
 /// The band of the type rule a base is in (low, middle, high).
 fn band_of(base_ft: f64, settings: &FieldSettings) -> Band {
     if base_ft < settings.bands.low_top_ft {
@@ -196,8 +235,8 @@ fn match_layers<'a>(
             }),
         }
     }
-    // At one base a reported CB/TCU comes before the deck beside it (`FEW033CB BKN033`): the
-    // cells keep their own cover and the deck adds what the report's cover still needs.
+    // At one base a reported CB/TCU comes before the deck beside it (`FEW033CB BKN033`), so the
+    // order of the layers is the report's whatever the blending.
     let rank = |k: LayerKind| match k {
         LayerKind::Fog => 0,
         LayerKind::Cb => 1,

@@ -174,6 +174,11 @@ impl WeatherField {
         }
     }
 
+    /// The settings the field was built with.
+    pub fn settings(&self) -> &FieldSettings {
+        &self.settings
+    }
+
     /// The frame the field lives in.
     pub fn frame(&self) -> &LocalFrame {
         &self.frame
@@ -237,6 +242,16 @@ impl WeatherField {
             precipitation: precipitation as f32,
             ground_elevation_m: value(&|s| s.elevation_m, d.ground_elevation_m) as f32,
         }
+    }
+
+    /// The gust excess (knots above the mean wind, interpolated over the stations that report a
+    /// wind) and the QNH (hPa, over those that report one; `default_qnh_hpa` where none does) at
+    /// a local point: what [`crate::weather::air::SurfaceAir`] needs beyond the block weather.
+    pub fn gust_and_qnh_at(&self, point_m: DVec2, default_qnh_hpa: f64) -> (f64, f64) {
+        let w = weights(&self.surface, point_m);
+        let gust = weighted(&w, &self.samples, &|s| s.gust_excess_kt).unwrap_or(0.0);
+        let qnh = weighted(&w, &self.samples, &|s| s.qnh_hpa).unwrap_or(default_qnh_hpa);
+        (gust, qnh)
     }
 
     fn layers_at(&self, point_m: DVec2, surface: layers::Surface) -> Vec<BlockLayer> {

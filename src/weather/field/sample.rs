@@ -44,8 +44,11 @@ pub struct StationLayer {
     pub kind: LayerKind,
     /// Base, feet AGL.
     pub base_ft: f64,
-    /// The cover seen from below at the base, oktas: the report's cover, which counts all cloud
-    /// at and below the base (the summation principle).
+    /// The report's cover, oktas. For a fog or plain layer it is the cover seen from below at
+    /// the base, which counts all fog and plain cloud at and below it (the summation principle).
+    /// For a CB or TCU layer it is the cells' own amount: ICAO Annex 3 reports convective cloud
+    /// outside that principle (`SCT008 BKN017 FEW025CB` is 1-2 oktas of Cb), so it is neither
+    /// summed into the layers above nor counts the ones below.
     pub cover_below_oktas: f64,
     /// Base to top when the source says (a theme's layer, a VV depth), feet.
     pub thickness_ft: Option<f64>,
@@ -73,6 +76,11 @@ pub struct StationSample {
     pub precipitation: f64,
     /// Station elevation, metres.
     pub elevation_m: Option<f64>,
+    /// Gusts above the mean wind, knots: 0 for a reported wind without gusts, `None` without
+    /// a wind.
+    pub gust_excess_kt: Option<f64>,
+    /// Altimeter setting (QNH), hPa.
+    pub qnh_hpa: Option<f64>,
 }
 
 impl StationSample {
@@ -104,6 +112,11 @@ impl StationSample {
             dewpoint_c: r.dewpoint_c.map(f64::from),
             precipitation: precipitation(r, settings),
             elevation_m: placed.position.elevation_m,
+            gust_excess_kt: r.wind.and_then(|w| {
+                let speed = f64::from(w.speed_kt?);
+                Some(w.gust_kt.map_or(0.0, |g| (f64::from(g) - speed).max(0.0)))
+            }),
+            qnh_hpa: r.altimeter_hpa.map(f64::from),
         })
     }
 
@@ -150,17 +163,22 @@ impl StationSample {
                 ThemePrecipitation::Heavy => p.heavy,
             },
             elevation_m: Some(f64::from(weather.ground_elevation_m)),
+            gust_excess_kt: Some(0.0),
+            qnh_hpa: None,
         }
     }
 
-    /// The cover seen from below at `height_ft` by this station's report, oktas: the largest
-    /// cover of its layers based at or under it (the summation principle; a report whose covers
-    /// shrink upwards is read as the largest below).
+    /// The cover of fog and plain cloud seen from below at `height_ft` by this station's report,
+    /// oktas: the largest cover of those layers based at or under it (the summation principle; a
+    /// report whose covers shrink upwards is read as the largest below). CB and TCU layers are
+    /// left out: their amounts are their own (ICAO Annex 3).
     pub fn cover_below_oktas(&self, height_ft: f64) -> f64 {
         self.sky
             .iter()
             .flatten()
-            .filter(|l| l.base_ft <= height_ft)
+            .filter(|l| {
+                l.base_ft <= height_ft && matches!(l.kind, LayerKind::Fog | LayerKind::Plain)
+            })
             .map(|l| l.cover_below_oktas)
             .fold(0.0, f64::max)
     }
@@ -309,6 +327,8 @@ mod tests {
         // The FEW250 under an overcast: the sky seen from below stays overcast.
         assert_eq!(sample.cover_below_oktas(30000.0), 8.0);
         assert_eq!(sample.cover_below_oktas(3000.0), 4.0);
+        // The BKN033TCU is the towers' own amount, not the sky's: still the SCT028 above it.
+        assert_eq!(sample.cover_below_oktas(4000.0), 4.0);
         assert_eq!(sample.cover_below_oktas(2000.0), 0.0);
     }
 

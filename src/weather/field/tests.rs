@@ -437,5 +437,61 @@ fn covers_follow_the_summation_principle_and_tops_the_type() {
     // 10 degrees C: a third of the way from 25,000 to 40,000 ft.
     assert!((cells.base_ft_agl + cells.thickness_ft - 30_000.0).abs() < 1.0);
     assert_eq!(deck.cloud_type, CloudType::Stratocumulus);
-    assert!((cover_seen_from_below_oktas(&layers, 2500.0) - 6.0).abs() < 1e-4);
+    // The BKN025 is the deck's own 6 oktas: the FEW020CB stands outside the summation (ICAO
+    // Annex 3), so the deck does not count the cells' 2 oktas as part of its cover.
+    assert_eq!(deck.coverage_oktas, 6.0);
+}
+
+#[test]
+fn cb_and_tcu_keep_their_own_amount_above_a_deck() {
+    use crate::weather::metar::Cover::{Bkn, Few, Sct};
+    // SCT008 BKN017 FEW025CB BKN100 (a real Brazilian report): 1-2 oktas of Cb, not the 0.5
+    // okta a Cb summed into the broken deck under it would add.
+    let brazil = vec![
+        layer(Sct, 800, None),
+        layer(Bkn, 1700, None),
+        layer(Few, 2500, Some(ConvectiveKind::Cb)),
+        layer(Bkn, 10000, None),
+    ];
+    // BKN010 SCT030TCU and a Cb of unknown amount and base (`//////CB`): the towers their own
+    // 4 oktas, the Cb drawn as FEW.
+    let unknown = vec![
+        layer(Bkn, 1000, None),
+        layer(Sct, 3000, Some(ConvectiveKind::Tcu)),
+        CloudGroup {
+            cover: None,
+            base_ft: None,
+            kind: Some(ConvectiveKind::Cb),
+        },
+    ];
+    let f = pair(brazil, unknown);
+    let layers = f.weather_at_lat_lon(LAT0, 7.5).layers;
+    let own: Vec<(CloudType, f32, f32)> = layers
+        .iter()
+        .map(|l| (l.cloud_type, l.base_ft_agl, l.coverage_oktas))
+        .collect();
+    assert_eq!(layers.len(), 4, "{own:?}");
+    assert_eq!(
+        (own[2].0, own[2].1, own[2].2),
+        (CloudType::Cumulonimbus, 2500.0, 2.0)
+    );
+    // The plain layers sum among themselves: 4 oktas, then 6 seen from below at 1,700 ft.
+    let plain: Vec<_> = layers
+        .iter()
+        .filter(|l| l.cloud_type != CloudType::Cumulonimbus)
+        .copied()
+        .collect();
+    let seen = crate::weather::block::cover_seen_from_below_oktas(&plain, 1700.0);
+    assert!((seen - 6.0).abs() < 1e-4, "{own:?}");
+    let layers = f.weather_at_lat_lon(LAT0, 8.5).layers;
+    let towers = layers
+        .iter()
+        .find(|l| l.cloud_type == CloudType::CumulusCongestus)
+        .expect("the TCU layer");
+    assert_eq!((towers.base_ft_agl, towers.coverage_oktas), (3000.0, 4.0));
+    let cells = layers
+        .iter()
+        .find(|l| l.cloud_type == CloudType::Cumulonimbus)
+        .expect("the CB layer");
+    assert_eq!(cells.coverage_oktas, 2.0, "{layers:?}");
 }

@@ -1,0 +1,261 @@
+//! The air data on the shipped themes and on real reports (Done means 3 and 4 of issue 33), and
+//! lines of sight through generated clouds.
+
+use std::path::{Path, PathBuf};
+
+use glam::{DVec2, DVec3};
+
+use super::*;
+use crate::clouds::probe::CloudBox;
+use crate::flight::WorldSettings;
+use crate::weather::field::{CloudTypeRule, FieldSettings};
+use crate::weather::{LocalFrame, WeatherInput};
+
+fn path(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+const REAL: &str = "weather/awc-metars-2025-01-27T22Z.cache.csv";
+
+/// A world of `file` around `lat,lon`, its clouds generated out to 14 km.
+fn world(file: &str, lat: f64, lon: f64, clouds: bool) -> World {
+    let input = WeatherInput::load(&path(file), None).unwrap();
+    let field = input.field(
+        LocalFrame::new(lat, lon),
+        &FieldSettings::default(),
+        &CloudTypeRule::default(),
+    );
+    let mut w = World::new(
+        field,
+        &WorldSettings {
+            cloud_radius_m: 14_000.0,
+            ..WorldSettings::default()
+        },
+    );
+    if clouds {
+        w.settle_clouds_around(DVec3::ZERO).unwrap();
+    }
+    w
+}
+
+/// The boxes (ground frame) of the generated clouds of a type.
+fn boxes_of(w: &World, t: CloudType) -> Vec<CloudBox> {
+    let field = w.living_field().unwrap();
+    let d = field.drift_m();
+    field
+        .blocks()
+        .flat_map(|(_, g)| g.block.clouds.iter().enumerate())
+        .filter(|(_, c)| c.cloud_type == t)
+        .filter_map(|(i, c)| CloudBox::of(c, i))
+        .map(|mut b| {
+            b.centre_m += DVec3::new(d.x, d.y, 0.0);
+            b
+        })
+        .collect()
+}
+
+const UP: DVec3 = DVec3::Z;
+
+#[test]
+fn at_a_stations_elevation_the_air_is_its_report() {
+    let input = WeatherInput::load(&path(REAL), None).unwrap();
+    let WeatherInput::Reports(file) = &input else {
+        panic!("a report file");
+    };
+    let frame = LocalFrame::new(42.239, -8.624);
+    let w = World::new(
+        input.field(frame, &FieldSettings::default(), &CloudTypeRule::default()),
+        &WorldSettings::default(),
+    );
+    // Co-located reports (CYSM and CZSM) are one station in the field, the latest report's.
+    let key = |p: &crate::weather::PlacedReport| {
+        (
+            p.position.latitude_deg.to_bits(),
+            p.position.longitude_deg.to_bits(),
+        )
+    };
+    let mut at_position = std::collections::HashMap::new();
+    for p in &file.reports {
+        *at_position.entry(key(p)).or_insert(0) += 1;
+    }
+    let mut checked = 0;
+    for p in file.reports.iter().filter(|p| at_position[&key(p)] == 1) {
+        let r = &p.report;
+        let (Some(wind), Some(t)) = (r.wind, r.temperature_c) else {
+            continue;
+        };
+        let (Some(dir), Some(speed)) = (wind.dir_deg, wind.speed_kt) else {
+            continue;
+        };
+        let at = frame.to_local_m(p.position.latitude_deg, p.position.longitude_deg);
+        let ground = w.field().weather_at(at).ground_elevation_m;
+        let a = w.air_at(at.extend(f64::from(ground)), UP);
+        let off = (a.wind_from_deg - f64::from(dir) + 540.0).rem_euclid(360.0) - 180.0;
+        if speed >= 1.0 {
+            assert!(off.abs() <= 10.0, "{}: {a:?}", r.station);
+        }
+        assert!(
+            (a.wind_kt - f64::from(speed)).abs() <= 2.0,
+            "{}: {a:?}",
+            r.station
+        );
+        assert_eq!(a.temperature_c, f64::from(t), "{}", r.station);
+        checked += 1;
+    }
+    assert!(checked > 4000, "{checked}");
+}
+
+#[test]
+fn above_the_boundary_layer_the_wind_is_the_documented_profile() {
+    // LEVX 33016G27KT (northern hemisphere, veers) and SBPA 29006KT (southern, backs).
+    for (lat, lon, dir, speed, turn) in [
+        (42.239, -8.624, 330.0f64, 16.0, 30.0),
+        (-29.994, -51.171, 290.0, 6.0, -30.0),
+    ] {
+        let w = world(REAL, lat, lon, false);
+        let ground = f64::from(w.field().weather_at(DVec2::ZERO).ground_elevation_m);
+        let s = w.air_settings().wind;
+        let growth = (s.boundary_layer_top_m / s.reference_height_m).powf(s.power_law_exponent);
+        for above_m in [s.boundary_layer_top_m, 2000.0, 6000.0] {
+            let a = w.air_at(DVec3::new(0.0, 0.0, ground + above_m), UP);
+            let want = (dir + turn).rem_euclid(360.0);
+            assert!((a.wind_from_deg - want).abs() < 0.5, "{lat}: {a:?}");
+            assert!((a.wind_kt - speed * growth).abs() < 0.05, "{lat}: {a:?}");
+            assert_eq!(a.gust_kt, a.wind_kt, "no gusts above the boundary layer");
+        }
+    }
+}
+
+/// Turbulence in and near the cumulonimbus of a world, and the icing in them.
+fn check_cbs(w: &World, what: &str) {
+    let cbs = boxes_of(w, CloudType::Cumulonimbus);
+    assert!(!cbs.is_empty(), "{what}: no cumulonimbus generated");
+    for b in cbs.iter().take(5) {
+        let inside = w.air_at(b.centre_m, UP);
+        assert!(inside.in_cloud > 0.9, "{what}: {inside:?}");
+        assert_eq!(
+            inside.turbulence_category,
+            TurbulenceCategory::Severe,
+            "{what}"
+        );
+        // 2 km east of its box, at the same height: near it.
+        let near = b.centre_m + DVec3::new(b.half_m.x + 2_000.0, 0.0, 0.0);
+        let a = w.air_at(near, UP);
+        assert!(
+            a.turbulence_category >= TurbulenceCategory::Moderate,
+            "{what}: {a:?}"
+        );
+    }
+}
+
+#[test]
+fn turbulence_is_severe_in_a_cb_and_moderate_near_on_the_theme_and_a_real_ts_report() {
+    check_cbs(
+        &world("weather/themes/thunderstorm_cells.toml", 27.0, -81.0, true),
+        "thunderstorm_cells",
+    );
+    // LEVX 272222Z 33016G27KT 300V010 2500 TSRA FEW011 SCT017CB BKN023 07/05 Q1011.
+    check_cbs(&world(REAL, 42.239, -8.624, true), "LEVX TSRA");
+}
+
+#[test]
+fn still_clear_air_has_no_turbulence_and_no_icing() {
+    let w = world(
+        "weather/themes/fair_weather_cumulus.toml",
+        40.0,
+        -100.0,
+        true,
+    );
+    let weather = w.field().weather_at(DVec2::ZERO);
+    // Between the cumulus tops and the cirrus.
+    let cu = &weather.layers[0];
+    let top_ft = cu.base_ft_agl + cu.thickness_ft;
+    let ground = f64::from(weather.ground_elevation_m);
+    // Above the cumulus, in clear air at -10 C or so: nothing.
+    let alt = ground + metres(f64::from(top_ft)) + 3_000.0;
+    let a = w.air_at(DVec3::new(0.0, 0.0, alt), UP);
+    assert!(
+        feet(alt) < f64::from(weather.layers[1].base_ft_agl),
+        "{a:?}"
+    );
+    assert_eq!(a.in_cloud, 0.0, "{a:?}");
+    assert_eq!(a.turbulence, 0.0, "{a:?}");
+    assert_eq!(a.turbulence_category, TurbulenceCategory::None);
+    assert!((-20.0..=0.0).contains(&a.temperature_c), "{a:?}");
+    assert!(!a.icing, "clear air is no icing risk: {a:?}");
+    // In a cumulus (warm): light turbulence at most moderate, no icing above 0 C.
+    let cu = boxes_of(&w, CloudType::CumulusMediocris)
+        .into_iter()
+        .chain(boxes_of(&w, CloudType::CumulusHumilis))
+        .next()
+        .unwrap();
+    let a = w.air_at(cu.centre_m, UP);
+    assert!(a.in_cloud > 0.9, "{a:?}");
+    assert!(
+        (TurbulenceCategory::Light..=TurbulenceCategory::Moderate).contains(&a.turbulence_category),
+        "{a:?}"
+    );
+    assert!(a.temperature_c > 0.0 && !a.icing, "{a:?}");
+}
+
+#[test]
+fn icing_only_in_cloud_or_precipitation_at_0_to_minus_20() {
+    let w = world(REAL, 42.239, -8.624, true);
+    let cb = boxes_of(&w, CloudType::Cumulonimbus)[0];
+    let ground = f64::from(w.field().weather_at(DVec2::ZERO).ground_elevation_m);
+    // Up the middle of the Cb: icing exactly where it is 0 to -20 C.
+    let (lo, hi) = (
+        cb.centre_m.z - 0.97 * cb.half_m.z,
+        cb.centre_m.z + 0.97 * cb.half_m.z,
+    );
+    let (mut iced, mut warm, mut cold) = (0, 0, 0);
+    for k in 0..=40 {
+        let z = lo + (hi - lo) * f64::from(k) / 40.0;
+        let a = w.air_at(DVec3::new(cb.centre_m.x, cb.centre_m.y, z), UP);
+        assert!(a.in_cloud > 0.0, "{a:?}");
+        let in_range = (-20.0..=0.0).contains(&a.temperature_c);
+        assert_eq!(a.icing, in_range, "{z:.0} m: {a:?}");
+        iced += usize::from(a.icing);
+        warm += usize::from(a.temperature_c > 0.0);
+        cold += usize::from(a.temperature_c < -20.0);
+    }
+    assert!(iced > 0 && warm > 0 && cold > 0, "{iced} {warm} {cold}");
+    // In the rain under the storm at -5 C there is no cloud but there is icing risk; the same
+    // air with the rain stopped has none. (5,000 m above the ground is -25 C: too cold.)
+    let a = w.air_at(DVec3::new(0.0, 0.0, ground + 1_850.0), UP);
+    if a.in_cloud == 0.0 {
+        assert!(a.precipitation_mm_h > 0.0 && a.icing, "{a:?}");
+    }
+}
+
+#[test]
+fn a_line_of_sight_meets_the_first_cloud_at_its_near_boundary_and_clear_air_none() {
+    let w = world("weather/themes/thunderstorm_cells.toml", 27.0, -81.0, true);
+    let cb = boxes_of(&w, CloudType::Cumulonimbus)[0];
+    // From 6 km west of its box to its centre, through its middle.
+    let to = cb.centre_m;
+    let from = to - DVec3::new(cb.half_m.x + 6_000.0, 0.0, 0.0);
+    let hit = w.line_of_sight(from, to).expect("a hit");
+    let boundary = 6_000.0;
+    assert!(hit.distance_m <= boundary * 1.1, "{hit:?}");
+    if hit.cloud_type == CloudType::Cumulonimbus {
+        assert!(
+            (hit.distance_m - boundary).abs() <= 0.1 * boundary,
+            "{hit:?}"
+        );
+    }
+    assert!(hit.optical_depth > 1.0, "{hit:?}");
+    // Far above every top: clear air.
+    let high = DVec3::new(-20_000.0, 0.0, 15_000.0);
+    assert_eq!(w.line_of_sight(high, high + DVec3::X * 40_000.0), None);
+    // And the sun straight up through the storm is hidden.
+    assert!(w.sun_occlusion(cb.centre_m, UP) > 0.99);
+}
+
+#[test]
+fn the_in_cloud_settings_are_the_renderers() {
+    let air = AirSettings::default().in_cloud;
+    let render = crate::render::RenderSettings::default().in_cloud;
+    assert_eq!(air.visibility_m, render.visibility_m);
+    assert_eq!(air.ramp_fraction, render.ramp_fraction);
+}
