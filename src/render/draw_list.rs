@@ -171,13 +171,16 @@ pub fn sprites_back_to_front(cloud: &SkyCloud, cam_local_m: Vec3) -> Vec<(usize,
     order
 }
 
-/// Squared distances (as bits) and sprite indices of a cloud being sorted.
-type SortKeys = Vec<(u32, u32)>;
+/// Sort keys of a cloud's sprites: the complement of the squared distance's bits above the
+/// sprite's index, so that one ascending sort of plain integers puts the farthest first and
+/// equally far sprites by index.
+type SortKeys = Vec<u64>;
 
 /// Writes the cloud's sprite slots (`base` + index), farthest from the camera first, into
 /// `slots` (`cam_local_m`: the camera relative to the cloud centre). The same order as
 /// [`sprites_back_to_front`], on integer keys (squared distances are positive floats, whose bits
-/// sort as integers) and a reused buffer: this runs for a hundred clouds a frame.
+/// sort as integers; packed with the index into one `u64`, which sorts about twice as fast as a
+/// pair with a comparator) and a reused buffer: this runs for a hundred clouds a frame.
 fn order_into(
     cloud: &SkyCloud,
     cam_local_m: Vec3,
@@ -186,16 +189,13 @@ fn order_into(
     keys: &mut SortKeys,
 ) {
     keys.clear();
-    keys.extend(
-        cloud
-            .sprites
-            .iter()
-            .enumerate()
-            .map(|(i, s)| (s.offset_m.distance_squared(cam_local_m).to_bits(), i as u32)),
-    );
-    keys.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
-    for (slot, &(_, i)) in slots.iter_mut().zip(keys.iter()) {
-        *slot = base + i;
+    keys.extend(cloud.sprites.iter().enumerate().map(|(i, s)| {
+        let far = !s.offset_m.distance_squared(cam_local_m).to_bits();
+        (u64::from(far) << 32) | i as u64
+    }));
+    keys.sort_unstable();
+    for (slot, &key) in slots.iter_mut().zip(keys.iter()) {
+        *slot = base + key as u32;
     }
 }
 
@@ -509,6 +509,8 @@ pub(super) struct RingOrders {
     /// cloud index): found once, when it starts, so that its later frames look at nothing else.
     gather: Option<u64>,
     todo: Vec<(u64, usize)>,
+    /// Scratch for the clouds a frame leaves to the next.
+    left: Vec<(u64, usize)>,
 }
 
 /// One cloud's order seen from a ring centre.
@@ -589,8 +591,13 @@ impl RingOrders {
             }
         }
         let mut sorted = 0u32;
-        let mut left = Vec::new();
-        for (id, ci) in std::mem::take(&mut self.todo) {
+        let mut left = std::mem::take(&mut self.left);
+        left.clear();
+        for (id, ci) in self.todo.drain(..) {
+            if *budget == 0 {
+                left.push((id, ci));
+                continue;
+            }
             // A block gone since (or off the GPU) is not in the view either.
             let Some(r) = blocks.get(&id).filter(|r| r.place.is_some()) else {
                 continue;
@@ -605,18 +612,18 @@ impl RingOrders {
             *budget -= state.sprites;
             sorted += state.sprites;
             let rel = from_m - (state.centre_m + r.motion.offset_m);
-            let mut order = vec![0u32; cloud.sprites.len()];
-            order_into(cloud, rel.as_vec3(), 0, &mut order, &mut self.keys);
-            self.kept.insert(
-                (id, ci),
-                RingOrder {
-                    from_rel_m: rel,
-                    at_s: when.time_s,
-                    order,
-                },
-            );
+            // A kept order's buffer is sorted into again.
+            let kept = self.kept.entry((id, ci)).or_insert_with(|| RingOrder {
+                from_rel_m: rel,
+                at_s: when.time_s,
+                order: Vec::new(),
+            });
+            kept.order.resize(cloud.sprites.len(), 0);
+            order_into(cloud, rel.as_vec3(), 0, &mut kept.order, &mut self.keys);
+            (kept.from_rel_m, kept.at_s) = (rel, when.time_s);
         }
-        self.todo = left;
+        // What is left, kept in `left`'s place for the next frame (no allocation a frame).
+        self.left = std::mem::replace(&mut self.todo, left);
         (self.todo.is_empty(), sorted)
     }
 

@@ -27,7 +27,8 @@
 mod layout;
 
 use std::cell::Cell;
-use std::collections::BTreeSet;
+use std::collections::HashSet;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::{DVec3, Vec3};
 use wgpu::util::DeviceExt;
@@ -35,7 +36,7 @@ use wgpu::util::DeviceExt;
 pub use layout::{
     IMPOSTOR_FOV_DEG, IMPOSTORS, ImpostorSettings, impostor_view_proj, is_far, needs_rebuild,
 };
-use layout::{impostor_camera, in_sector};
+use layout::{impostor_camera, sectors_of};
 
 use super::build::{SpriteBuild, chunks};
 use super::draw_list::{RingOrders, RingSort};
@@ -54,11 +55,33 @@ const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
 struct RingState {
     centre_m: DVec3,
     sun: Vec3,
-    /// Ids of the blocks drawn into this ring.
-    far_ids: BTreeSet<u64>,
+    /// Ids of the blocks drawn into this ring (looked up for every block every frame).
+    far_ids: HashSet<u64, BuildHasherDefault<IdHasher>>,
     /// Mean distance of those blocks from the centre (the ring radius if none), metres: the
     /// first guess of the ring pass's depth reprojection.
     far_mean_m: f64,
+}
+
+/// A hasher for block ids, which are looked up for every block every frame: one multiply
+/// (Fibonacci hashing) instead of SipHash, whose protection against chosen keys the sky's own
+/// ids do not need.
+#[derive(Default)]
+struct IdHasher(u64);
+
+impl Hasher for IdHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(8) ^ b as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        }
+    }
+
+    fn write_u64(&mut self, id: u64) {
+        self.0 = (self.0 ^ id).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
 }
 
 struct Build {
@@ -67,6 +90,9 @@ struct Build {
     state: RingState,
     /// The ring's clock when it started (orders sorted since are good for it).
     since_s: f64,
+    /// Each impostor's blocks (of `state.far_ids`, in its sector), found in one pass when the
+    /// build starts: the frames that gather its orders look at no other block.
+    sectors: [Vec<u64>; IMPOSTORS],
 }
 
 /// The ring: two sets of 8 textures (displayed and building), their passes and quads.
@@ -538,7 +564,16 @@ impl ImpostorRing {
         } else {
             far.iter().map(|f| f.1).sum::<f64>() / far.len() as f64
         };
-        let far_ids: BTreeSet<u64> = far.iter().map(|f| f.0).collect();
+        let far_ids: HashSet<u64, _> = far.iter().map(|f| f.0).collect();
+        let mut sectors: [Vec<u64>; IMPOSTORS] = Default::default();
+        for r in blocks.values().filter(|r| far_ids.contains(&r.block.id)) {
+            let bits = sectors_of(camera_m, r.centre_m());
+            for (i, sector) in sectors.iter_mut().enumerate() {
+                if bits & (1 << i) != 0 {
+                    sector.push(r.block.id);
+                }
+            }
+        }
         let first = self.shown.is_none();
         if first {
             // Before the first ring exists it is built this frame, so its blocks are far
@@ -555,6 +590,7 @@ impl ImpostorRing {
             ring,
             next: 0,
             since_s: self.clock_s,
+            sectors,
             state: RingState {
                 centre_m: camera_m,
                 sun,
@@ -611,15 +647,10 @@ impl ImpostorRing {
             for _ in 0..count {
                 let i = build.next;
                 let centre = build.state.centre_m;
-                let sector: Vec<u64> = blocks
-                    .values()
-                    .filter(|r| build.state.far_ids.contains(&r.block.id))
-                    .filter(|r| in_sector(i, centre, r.centre_m()))
-                    .map(|r| r.block.id)
-                    .collect();
+                let sector = &build.sectors[i];
                 when.gather = self.builds * IMPOSTORS as u64 + i as u64;
                 let (sorted_all, sorted) =
-                    self.sorts.sort(blocks, &sector, reach, &when, &mut budget);
+                    self.sorts.sort(blocks, sector, reach, &when, &mut budget);
                 stats.ring_sprites_sorted += sorted;
                 if !sorted_all {
                     // The rest next frame; the shown ring stays meanwhile.
@@ -627,7 +658,7 @@ impl ImpostorRing {
                 }
                 let sprites = self.sorts.view(
                     blocks,
-                    &sector,
+                    sector,
                     reach,
                     &mut self.draws,
                     &mut self.lists,
