@@ -170,6 +170,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "sprites_recomputed",
         "ring_sprites_sorted",
         "gpu_wait_us",
+        "preempted",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
@@ -194,6 +195,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         // The first frame is the warm-up: it waits for the clouds around, so the flight starts
         // under its whole sky; after it blocks arrive as they are generated.
         host.sky.world_mut().set_synchronous_clouds(k == 0);
+        let switches_before = involuntary_switches();
         let (stats, changes) = host.step(&camera, start_unix_s + time_s, step_s, write)?;
         let mut applied = String::new();
         for change in changes {
@@ -224,6 +226,11 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         let air_at_us = air_start.elapsed().as_micros() as u64;
         let sight_hits = sight_fan(&host.sky, pose.position_m, pose.heading_deg);
         stats.air_us = air_start.elapsed().as_micros() as u64;
+        // Whether the system took the core away meanwhile (then the frame's times hold another
+        // process's time slice too): a fact about the machine's load, reported, never excluded.
+        let preempted = switches_before
+            .zip(involuntary_switches())
+            .map_or_else(String::new, |(a, b)| b.saturating_sub(a).to_string());
         summary.add(&stats);
         let p = pose.position_m;
         csv.write_record([
@@ -275,6 +282,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             stats.sprites_recomputed.to_string(),
             stats.ring_sprites_sorted.to_string(),
             stats.gpu_wait_us.to_string(),
+            preempted,
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);
@@ -380,6 +388,17 @@ impl Summary {
 }
 
 /// The process's peak resident memory (Linux: `VmHWM` of /proc/self/status).
+/// Involuntary context switches of the calling thread so far (Linux: the thread's
+/// `nonvoluntary_ctxt_switches`), `None` elsewhere: a frame with more at its end than at its
+/// start was preempted (the system ran something else on its core meanwhile).
+fn involuntary_switches() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/thread-self/status").ok()?;
+    let line = status
+        .lines()
+        .find(|l| l.starts_with("nonvoluntary_ctxt_switches:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
 fn peak_rss_bytes() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
