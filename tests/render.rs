@@ -1054,6 +1054,57 @@ fn ring_rebuilds_over_eight_frames_then_crossfades() {
         .unwrap();
 }
 
+/// The frames that rebuild the ring sort no more sprites on the CPU than any other frame: the
+/// far clouds' orders from the new ring centre (6 cumulus of 60 sprites, 30 km north) are sorted
+/// within `[vertex_cache] max_sorted_sprites_per_frame` (100 here), shared with the sky camera's
+/// own clouds, over several frames, and the ring is still rebuilt and faded in. Sorting the whole
+/// sector on the frame that renders it (the ring's `fresh_view` before) sorts 360 at once.
+#[test]
+fn ring_rebuild_frames_sort_within_the_frames_budget() {
+    let mut settings = RenderSettings::default();
+    settings.vertex_cache.max_sorted_sprites_per_frame = 100;
+    let mut rig = Rig::with_settings(flat_ground(0.0), settings);
+    let far = DVec3::new(0.0, 30_000.0, 1500.0);
+    let mut blocks = ring_blocks(false);
+    blocks.push(SkyBlock {
+        id: 2,
+        centre_m: far,
+        clouds: (0..6)
+            .map(|k| cumulus(far + DVec3::new(k as f64 * 900.0 - 2250.0, 0.0, 0.0)))
+            .collect(),
+    });
+    rig.set_clouds(blocks);
+    let mut step = |y: f64| {
+        let cam = rig.camera(DVec3::new(0.0, y, 1000.0), 0.0, 3.0);
+        rig.host.draw(&cam, &sun(), 0.25, 40_000.0).unwrap()
+    };
+    // The first ring, with nothing to show meanwhile, is built whole at once.
+    let first = step(0.0);
+    assert_eq!(first.impostors_rebuilt, 8, "{first:?}");
+    // 3,100 m on: a rebuild, its orders sorted a budget at a time.
+    let (mut rendered, mut sorting_frames, mut sorted, mut faded) = (0, 0, 0, false);
+    for frame in 0..60 {
+        let s = step(3100.0);
+        assert!(
+            s.sprites_recomputed + s.ring_sprites_sorted <= 100,
+            "frame {frame} sorted {} + {} sprites: {s:?}",
+            s.sprites_recomputed,
+            s.ring_sprites_sorted
+        );
+        rendered += s.impostors_rebuilt;
+        sorting_frames += (s.ring_sprites_sorted > 0) as u32;
+        sorted += s.ring_sprites_sorted;
+        faded |= s.crossfade_weight > 0.0;
+        if faded && s.crossfade_weight == 0.0 {
+            break;
+        }
+    }
+    assert_eq!(rendered, 8, "every impostor rendered");
+    assert!(faded, "the new ring faded in");
+    assert_eq!(sorted, 360, "the far clouds sorted once each");
+    assert!(sorting_frames >= 4, "{sorting_frames} frames sorted them");
+}
+
 /// Beyond Wang: the impostors keep each texel's cloud depth. A 3,000 m ridge 45 km north stands
 /// in front of a cloud 60 km out (hidden where the ridge is) and behind one 30 km out (drawn over
 /// the ridge), both in the impostors (ring radius 20 km), as the all-sprites frame has them.

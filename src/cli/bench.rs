@@ -352,8 +352,9 @@ fn fly(
         .collect())
 }
 
-/// Draws frames at one sample until the ring is up to date there (8 rebuild frames and a
-/// crossfade at most, plus slack); the last is the steady one. False when the frames were timed
+/// Draws frames at one sample until the ring is up to date there (the frames that sort its
+/// orders a budget at a time, 8 rebuild frames and a crossfade at most, plus slack); the last is
+/// the steady one. False when the frames were timed
 /// by the wall clock (no GPU timestamps).
 fn draw_to_steady(
     host: &mut DemoHost,
@@ -363,7 +364,7 @@ fn draw_to_steady(
 ) -> anyhow::Result<bool> {
     let camera = host.camera(p, 90.0, PITCH_DEG);
     let mut timestamps = true;
-    for _ in 0..64 {
+    for _ in 0..512 {
         let start = Instant::now();
         let stats = host.draw(&camera, sun, dt_s, visibility_m)?;
         let (frame_ms, sky_ms) = match host.last_gpu_split_ms() {
@@ -376,7 +377,9 @@ fn draw_to_steady(
                 ((wall - stats.cpu_update_us as f64 / 1e3).max(0.0), f64::NAN)
             }
         };
-        let steady = stats.impostors_rebuilt == 0 && stats.crossfade_weight == 0.0;
+        let steady = stats.impostors_rebuilt == 0
+            && stats.crossfade_weight == 0.0
+            && stats.ring_sprites_sorted == 0;
         records.push(FrameRecord {
             steady,
             distance_m,

@@ -456,12 +456,14 @@ impl World {
             if arrives {
                 living.arriving.insert(fb.serial, now);
             }
-            let arrival = living
-                .arriving
-                .get(&fb.serial)
+            // Arrivals are few and brief (the first frames, a jump): with none, the field's
+            // thousands of blocks cost no lookup each a frame.
+            let arrival = (!living.arriving.is_empty())
+                .then(|| living.arriving.get(&fb.serial))
+                .flatten()
                 .map(|&since| ((now - since) / fade_in_s) as f32)
                 .filter(|&p| p < 1.0);
-            if arrival.is_none() {
+            if arrival.is_none() && !living.arriving.is_empty() {
                 living.arriving.remove(&fb.serial);
             }
             let fade = match fb.phase {

@@ -824,9 +824,11 @@ impl Sky {
 
     /// CPU work of a frame: advances time by `dt_s`, uploads blocks that arrived, sorts blocks
     /// and clouds, recomputes the sprite orders Wang's cache says are stale, and writes the draw
-    /// list and this frame's uniforms (only what changed goes to the GPU); impostor renders go in
-    /// a submission of their own. A frame prepared and never recorded is flushed by the next
-    /// prepare, so nothing piles up however the host drives it.
+    /// list and this frame's uniforms (only what changed goes to the GPU). It submits nothing of
+    /// its own to the device (the impostor renders of a ring rebuild go into the next
+    /// [`Self::record`]), except that a frame prepared and never recorded is flushed by the next
+    /// prepare, so nothing piles up however the host drives it; the time that flush holds the
+    /// frame thread is `gpu_wait_us`, not in `cpu_update_us`.
     pub fn prepare(
         &mut self,
         queue: &wgpu::Queue,
@@ -853,9 +855,14 @@ impl Sky {
         let i = if id.0 < self.views.len() { id.0 } else { 0 };
         let camera: SkyView = view.into();
         self.views[i].projection = Some(camera.projection);
+        let mut gpu_wait_us = 0;
         if !self.views[i].recorded.replace(false) {
-            // The last frame's writes never reached a submit: send them, so they are freed.
+            // The last frame's writes never reached a submit: send them, so they are freed. A
+            // device still busy with earlier work can hold the submit (lavapipe waits in it for
+            // the submission before): timed apart, as a wait.
+            let wait = Instant::now();
             queue.submit([]);
+            gpu_wait_us = wait.elapsed().as_micros() as u64;
         }
         // The frame's clock is the main view's; the others use `dt_s` for their ring's
         // crossfade only.
@@ -909,6 +916,9 @@ impl Sky {
         self.views[i]
             .ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
+        // The frame's sorting budget, shared with a ring that is being rebuilt.
+        let sort_budget = self.settings.vertex_cache.max_sorted_sprites_per_frame;
+        let sort_budget = sort_budget - self.views[i].ring.sort_reserve(sort_budget);
         let resident = &mut self.resident;
         let v = &mut self.views[i];
         let inside = main_view(
@@ -921,7 +931,7 @@ impl Sky {
             },
             (camera.position_m, &camera.frustum()),
             self.elapsed_s,
-            &self.settings,
+            (&self.settings, sort_budget),
             &mut v.locks,
             &mut v.draws,
             &mut stats,
@@ -1020,6 +1030,7 @@ impl Sky {
             template: &frame,
             view: &light,
             camera_m: camera.position_m,
+            cache: &self.settings.vertex_cache,
         };
         upload_bytes += self.views[i]
             .ring
@@ -1042,27 +1053,16 @@ impl Sky {
         }
         self.build.reserve(&self.device, most);
         stats.upload_bytes = upload_bytes;
-        // Impostor renders (8 frames of a rebuild) need no host target: they go in a submission
-        // of the sky's own, ahead of the host's frame, with the patch of changed orders they
-        // read.
-        if self.views[i].ring.has_pending() || self.shadows.has_pending() {
+        // The shadow map, when due (rarely: see `shadow`), goes in a submission of its own with
+        // the patch of changed orders it reads, applied but kept for the host's frame. The
+        // ring's impostor renders go in the host's encoder (`record_view`).
+        if self.shadows.has_pending() {
             let mut encoder = self
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("sky.impostors"),
+                    label: Some("sky.cloud_shadows"),
                 });
-            if self.views[i].ring.has_pending() {
-                self.scatter.record(&mut encoder);
-            } else {
-                self.scatter.record_kept(&mut encoder);
-            }
-            self.views[i].ring.record_builds(
-                &mut encoder,
-                &self.sheet_group,
-                &self.build,
-                &self.resident.group,
-                &self.quads.0,
-            );
+            self.scatter.record_kept(&mut encoder);
             let resident = &self.resident.group;
             (self.shadows).record(
                 &mut encoder,
@@ -1071,7 +1071,11 @@ impl Sky {
                 resident,
                 &self.quads.0,
             );
+            // lavapipe runs the submission on the frame thread: counted as a wait, as the
+            // flush above is.
+            let wait = Instant::now();
             queue.submit([encoder.finish()]);
+            gpu_wait_us += wait.elapsed().as_micros() as u64;
         }
         stats.cloud_scale = self.views[i].clouds.scale();
         stats.cloud_target_bytes = self.views[i].clouds.gpu_bytes();
@@ -1080,8 +1084,9 @@ impl Sky {
             + self.build.gpu_bytes()
             + self.views[i].view.gpu_bytes();
         stats.field_us = std::mem::take(&mut self.field_us);
-        stats.cpu_update_us =
-            start.elapsed().as_micros() as u64 + std::mem::take(&mut self.pending_us);
+        stats.gpu_wait_us = gpu_wait_us;
+        stats.cpu_update_us = (start.elapsed().as_micros() as u64).saturating_sub(gpu_wait_us)
+            + std::mem::take(&mut self.pending_us);
         stats
     }
 
@@ -1152,6 +1157,16 @@ impl Sky {
         };
         stamp(encoder, Stamp::Start);
         self.scatter.record(encoder);
+        // The impostors this view's frame (and any frames prepared since its last recorded
+        // one) rebuilt: in the host's submission, never in one of the sky's own, which could
+        // hold the host's frame thread while the device is busy.
+        v.ring.record_builds(
+            encoder,
+            &self.sheet_group,
+            &self.build,
+            &self.resident.group,
+            &self.quads.0,
+        );
         let view_group = v.view.group().filter(|_| v.sprites_to_draw > 0);
         let parts: Vec<(u32, u32, u32)> = view_group
             .map(|_| chunks(v.sprites_to_draw).collect())
