@@ -3,7 +3,7 @@
 use glam::camera::rh::{proj::directx as proj, view::look_at_mat4};
 use glam::{Mat4, Vec3};
 use skycast::{HostCamera, HostPosition, HostTargets, SkySystem, ViewId, Weather};
-use wgpu::{TextureFormat, TextureUsages as Usage, util::DeviceExt};
+use wgpu::{TextureFormat, TextureUsages as Usage};
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 
 /// Under the fair-weather cumulus theme near Los Angeles, looking up a little; 320 x 180.
@@ -16,12 +16,19 @@ pub const W: u32 = 320;
 pub const H: u32 = 180;
 pub const UNIX_S: f64 = 1_738_015_200.0; // 2025-01-27T22:00:00Z
 
-/// The host's ground: a 120 km square at sea level, one colour.
-const GROUND: &str = "@group(0) @binding(0) var<uniform> view_proj: mat4x4<f32>;
-@vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-  let corner = vec2(f32(i & 1u), f32(i >> 1u)) * 2.0 - 1.0;
-  return view_proj * vec4(corner * 60000.0, -ALT, 1.0); }
-@fragment fn fs() -> @location(0) vec4<f32> { return vec4(0.18, 0.24, 0.12, 1.0); }";
+/// The host's ground: a 120 km square at sea level, one colour, its sunlit share dimmed by the
+/// clouds' shadows: the sky's shadow map holds their optical depth tau along the sun's ray.
+const GROUND: &str = "struct Ground { view_proj: mat4x4<f32>, shadow_uv: mat4x4<f32> };
+@group(0) @binding(0) var<uniform> g: Ground;
+@group(0) @binding(1) var shadow_map: texture_2d<f32>;
+@group(0) @binding(2) var shadow_sampler: sampler;
+struct Out { @builtin(position) position: vec4<f32>, @location(0) rel: vec3<f32> };
+@vertex fn vs(@builtin(vertex_index) i: u32) -> Out {
+  let rel = vec3((vec2(f32(i & 1u), f32(i >> 1u)) * 2.0 - 1.0) * 60000.0, -ALT);
+  return Out(g.view_proj * vec4(rel, 1.0), rel); }
+@fragment fn fs(i: Out) -> @location(0) vec4<f32> {
+  let tau = textureSample(shadow_map, shadow_sampler, (g.shadow_uv * vec4(i.rel, 1.0)).xy).r;
+  return vec4(vec3(0.18, 0.24, 0.12) * (0.35 + 0.65 * exp(-tau)), 1.0); }";
 
 /// A simulator's renderer in miniature: device, targets, ground pipeline, and the sky.
 pub struct Host {
@@ -33,7 +40,7 @@ pub struct Host {
     pub depth: wgpu::Texture,
     /// The single-sample copy of `colour` (itself when not multisampled).
     pub resolved: wgpu::Texture,
-    ground: (wgpu::RenderPipeline, wgpu::BindGroup),
+    ground: (wgpu::RenderPipeline, wgpu::Buffer, wgpu::Sampler),
     pub camera: HostCamera,
     /// The air where the camera is, read every frame after the sky's update (what a flight
     /// model and its systems take: wind, temperature, pressure, in-cloud, turbulence, icing).
@@ -102,7 +109,7 @@ impl Host {
             view: look(HEADING_DEG, PITCH_DEG),
             projection,
         };
-        let ground = ground(&device, &targets, camera.projection * camera.view);
+        let ground = ground(&device, &targets);
         Ok(Self {
             device,
             queue,
@@ -117,8 +124,42 @@ impl Host {
         })
     }
 
-    /// The ground into colour and depth (cleared to the host's far value).
+    /// The sky's frame step: weather, clouds, sun, its CPU share and its own GPU work (the
+    /// shadow map among it), before the host draws its frame.
+    /// The air where the camera is is read after it.
+    pub fn update(&mut self) -> Result<skycast::FrameStats> {
+        let (stats, _) = self.sky.update(&self.queue, &self.camera, UNIX_S, 0.0)?;
+        self.air = Some(self.sky.air_at(self.camera.position));
+        Ok(stats)
+    }
+
+    /// The ground into colour and depth (cleared to the host's far value), in the clouds'
+    /// shadows of the last update.
     pub fn draw_ground(&self, encoder: &mut wgpu::CommandEncoder) {
+        let (pipeline, uniform, sampler) = &self.ground;
+        let shadows = self.sky.cloud_shadows();
+        let view_proj = self.camera.projection * self.camera.view;
+        let matrices = [view_proj, shadows.uv_from_camera_relative];
+        self.queue
+            .write_buffer(uniform, 0, bytemuck::cast_slice(&matrices));
+        let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniform.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(shadows.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(sampler),
+                },
+            ],
+        });
         let (colour, depth) = (
             self.colour.create_view(&Default::default()),
             self.depth.create_view(&Default::default()),
@@ -144,15 +185,13 @@ impl Host {
             }),
             ..Default::default()
         });
-        pass.set_pipeline(&self.ground.0);
-        pass.set_bind_group(0, &self.ground.1, &[]);
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &group, &[]);
         pass.draw(0..4, 0..1);
     }
 
-    /// The sky's frame step, then its passes over the host's colour, reading its depth.
-    pub fn draw_sky(&mut self, encoder: &mut wgpu::CommandEncoder) -> Result<skycast::FrameStats> {
-        let (stats, _) = self.sky.update(&self.queue, &self.camera, UNIX_S, 0.0)?;
-        self.air = Some(self.sky.air_at(self.camera.position));
+    /// The sky's passes over the host's colour, reading its depth (after [`Self::update`]).
+    pub fn draw_sky(&mut self, encoder: &mut wgpu::CommandEncoder) -> Result<()> {
         let (colour, depth) = (
             self.colour.create_view(&Default::default()),
             self.depth.create_view(&Default::default()),
@@ -161,14 +200,15 @@ impl Host {
         if self.targets.sample_count > 1 {
             resolve(encoder, &colour, &self.resolved);
         }
-        Ok(stats)
+        Ok(())
     }
 
-    /// The frame: ground, then sky; RGBA8 sRGB bytes read back.
+    /// The frame: the sky's step, then the ground, then the sky; RGBA8 sRGB bytes read back.
     pub fn frame(&mut self) -> Result<Vec<u8>> {
+        let stats = self.update()?;
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.draw_ground(&mut encoder);
-        let stats = self.draw_sky(&mut encoder)?;
+        self.draw_sky(&mut encoder)?;
         println!(
             "{} sprites, sky CPU {} us",
             stats.sprites_drawn,
@@ -218,7 +258,7 @@ impl Host {
     }
 
     /// The view's share of the frame step, then its passes into `encoder` (after
-    /// [`Self::draw_sky`]'s, in the same encoder or another).
+    /// [`Self::update`], and [`Self::draw_sky`]'s passes in the same encoder or another).
     pub fn draw_view(
         &mut self,
         view: &SecondView,
@@ -315,12 +355,12 @@ fn resolve(
     });
 }
 
-/// The ground pipeline (depth tested the host's way) and its uniform.
+/// The ground pipeline (depth tested the host's way), its uniform (view-projection, shadow
+/// lookup) and the shadow map's sampler (linear, clamped to its edge).
 fn ground(
     device: &wgpu::Device,
     targets: &HostTargets,
-    view_proj: Mat4,
-) -> (wgpu::RenderPipeline, wgpu::BindGroup) {
+) -> (wgpu::RenderPipeline, wgpu::Buffer, wgpu::Sampler) {
     let source = wgpu::ShaderSource::Wgsl(GROUND.replace("ALT", &format!("{ALT_M:.1}")).into());
     let module = &device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: None,
@@ -365,22 +405,18 @@ fn ground(
             targets: &[Some(targets.colour_format.into())],
         }),
     });
-    let contents = bytemuck::bytes_of(&view_proj);
-    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+    let uniform = device.create_buffer(&wgpu::BufferDescriptor {
         label: None,
-        contents,
-        usage: wgpu::BufferUsages::UNIFORM,
+        size: 2 * std::mem::size_of::<Mat4>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
     });
-    let entries = [wgpu::BindGroupEntry {
-        binding: 0,
-        resource: uniform.as_entire_binding(),
-    }];
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &entries,
+    let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
     });
-    (pipeline, group)
+    (pipeline, uniform, sampler)
 }
 
 /// Submits `encoder` with a copy of a 4-byte-texel texture and reads it back (rows unpadded).
@@ -458,6 +494,7 @@ fn main() -> Result<()> {
     // A second view of the same sky, looking back over the tail, recorded into the same
     // encoder as the main one: its own draw list, ring and cloud target.
     let back = host.add_view(HEADING_DEG + 180.0, 8.0);
+    host.update()?;
     let mut encoder = host.device.create_command_encoder(&Default::default());
     host.draw_ground(&mut encoder);
     host.draw_sky(&mut encoder)?;

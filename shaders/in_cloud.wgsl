@@ -1,6 +1,6 @@
 // Pass `sky.in_cloud`: inside a cloud, density fog over everything (Wang 7.1's proposed fix), so
 // the inside is as opaque as the outside suggests. Opacity grows with the host's depth at each
-// pixel; the sky (far plane) is fully covered. Shared structs: shared/frame.wgsl.
+// pixel and with the in-cloud measure. Shared structs: shared/frame.wgsl.
 
 struct FogOut {
     @builtin(position) position: vec4<f32>,
@@ -29,7 +29,12 @@ fn in_cloud_fog(frag_xy: vec2<f32>) -> vec4<f32> {
     // Where the host drew nothing this is its far plane's distance (1e9 for a far plane at
     // infinity): at the fog's tens of metres of visibility, opaque to within a millionth.
     let dist_m = scene_m_at(frag_xy);
-    let density = 1.0 - exp(-dist_m / frame.params.w);
-    let alpha = clamp(density * frame.in_cloud_rgba.a, 0.0, 1.0);
+    // The air data's visibility (src/flight/air.rs: in_cloud.visibility_m / in_cloud): extinction
+    // in_cloud / visibility_m over at most visibility_m / (1 - in_cloud) of cloud, the path a
+    // cloud holds at this depth (at its edge one visibility, so the sky fades in with the measure
+    // as before; deep inside all of it, so nothing of the scene shows).
+    let k = frame.in_cloud_rgba.a;
+    let reach_m = frame.params.w / max(1.0 - k, 1e-6);
+    let alpha = clamp(1.0 - exp(-min(dist_m, reach_m) * k / frame.params.w), 0.0, 1.0);
     return vec4<f32>(frame.in_cloud_rgba.rgb * alpha, alpha);
 }

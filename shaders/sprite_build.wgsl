@@ -49,7 +49,8 @@ struct ListCloud {
     cloud: u32,
     first: u32,
     order_base: u32,
-    pad: u32,
+    // Every how many of its sprites are built (0 or 1: all; the shadow map's far clouds).
+    stride: u32,
 };
 
 // Keep in sync with `GpuLock`.
@@ -97,7 +98,8 @@ struct BuiltCorner {
     // xyz: metres from the camera; w: 1 drawn, 0 not (faded out).
     position_visible: vec4<f32>,
     uv: vec2<f32>,
-    pad: vec2<f32>,
+    // x: how many sprites of its cloud it stands for (1 but in the shadow map's far clouds).
+    stands_for: vec2<f32>,
     colour: vec4<f32>,
 };
 
@@ -352,7 +354,11 @@ fn build_sprite(k: u32, at: u32) {
     let b = draws.blocks[block_of(k)];
     let in_block = k - b.first;
     let entry = lists[cloud_of(b, in_block)];
-    let slot = orders[entry.order_base + (in_block - entry.first)];
+    // In the cloud's order, or (the shadow map, `hl_deck.y`) in its slots' own: sums that do not
+    // change with the camera's sort. A `select`, not an `if` on the uniform (see below).
+    let stride = max(entry.stride, 1u);
+    let in_order = entry.order_base + (in_block - entry.first) * stride;
+    let slot = select(orders[in_order], in_order, view.hl_deck.y > 0.5);
     let s = sprites[slot];
     let cloud = clouds[entry.cloud];
     let flat_radius = cloud.level4_radius_flat;
@@ -470,7 +476,8 @@ fn build_sprite(k: u32, at: u32) {
         built[at + c] = BuiltCorner(
             vec4<f32>(centre_rel + p, 1.0),
             cell_uv(cell, across),
-            vec2<f32>(0.0),
+            // x: the stride its cloud was built at (one sprite stands for that many).
+            vec2<f32>(f32(stride), 0.0),
             vec4<f32>(select(lit, rain_rgb, rain), ambient.a * morph * alpha),
         );
     }

@@ -39,6 +39,13 @@ fn vs_sprite(v: VertexIn) -> VertexOut {
         return o;
     }
     o.colour = v.colour;
+    // A lightning flash inside the cell: light falling off with distance from it (Gaussian in
+    // its reach, per corner), a little blue-white, on top of the cloud's own light.
+    if (frame.flash.w > 0.0) {
+        let d = distance(v.position_visible.xyz, frame.flash.xyz) / max(frame.flash_reach.x, 1.0);
+        let glow = frame.flash.w * exp(-d * d);
+        o.colour = vec4<f32>(v.colour.rgb + glow * vec3<f32>(0.92, 0.94, 1.0), v.colour.a);
+    }
     // On the round Earth (`earth_curved`): at 100 km a sprite sits 0.8 km below the flat frame.
     let rel = earth_curved(v.position_visible.xyz);
     o.position = frame.view_proj * vec4<f32>(rel, 1.0);

@@ -1,5 +1,6 @@
 // Pass `host.terrain` of the demo host: a height-field mesh with sun light and distance fog,
-// writing colour and depth. Not part of the sky; any host draws its own ground.
+// writing colour and depth, its sunlight dimmed by the clouds' shadows (the sky's shadow map).
+// Not part of the sky; any host draws its own ground.
 
 // Keep in sync with `GpuTerrainFrame` in src/render/gpu_types.rs.
 struct TerrainFrame {
@@ -12,9 +13,14 @@ struct TerrainFrame {
     // The altitude haze (shared/frame.wgsl `haze`); origin_rel.w: the camera's height above its
     // base.
     haze: vec4<f32>,
+    // Camera-relative position to the cloud shadow map's texture coordinates.
+    shadow_uv: mat4x4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> terrain: TerrainFrame;
+// The sky's cloud shadow map: optical depth along the sun's ray (src/render/shadow/mod.rs).
+@group(0) @binding(1) var shadow_map: texture_2d<f32>;
+@group(0) @binding(2) var shadow_sampler: sampler;
 
 // Keep in sync with `GpuTerrainVertex` in src/render/gpu_types.rs.
 struct TerrainVertex {
@@ -140,7 +146,9 @@ fn fs_terrain(i: TerrainOut) -> @location(0) vec4<f32> {
     let slope = 1.0 - n.z;
     let footprint_m = length(fwidth(i.ground_xy));
     let albedo = ground_albedo(i.ground_xy, i.height_m, slope, footprint_m);
-    let sun = max(dot(n, terrain.sun_dir.xyz), 0.0);
+    // The clouds' shadow: their optical depth along the sun's ray through this point.
+    let tau = textureSample(shadow_map, shadow_sampler, (terrain.shadow_uv * vec4<f32>(i.rel_m, 1.0)).xy).r;
+    let sun = max(dot(n, terrain.sun_dir.xyz), 0.0) * exp(-tau);
     var lit = albedo * (terrain.sun_rgb.rgb * sun + vec3<f32>(terrain.sun_dir.w));
     // The water mirrors the sky a little, most at grazing angles (Schlick), and glints.
     let view = normalize(-i.rel_m);

@@ -175,6 +175,7 @@ fn host_frame(mode: &str) -> (Vec<u8>, bool) {
     let mut h = host::Host::new(mode, Some(Path::new(host::THEME))).expect(mode);
     let copyable = h.targets.sample_count == 1;
     let encoder = |h: &host::Host| h.device.create_command_encoder(&Default::default());
+    h.update().expect("update");
     let mut ground = encoder(&h);
     h.draw_ground(&mut ground);
     let before = if copyable {
@@ -227,6 +228,7 @@ fn the_example_host_draws_the_clouds_render_draws_in_every_depth_convention() {
     for mode in ["standard", "reversed", "msaa"] {
         let (pixels, depth_unchanged) = host_frame(mode);
         let agree = agreement(&cloud_mask(&pixels, &clear), &reference);
+        eprintln!("{mode}: clouds agree on {agree:.4} of the pixels");
         assert!(
             agree >= 0.95,
             "{mode}: clouds agree on {agree:.3} of the pixels"
@@ -457,9 +459,10 @@ fn the_sky_system_counts_its_recording_in_the_frame_cpu() {
     let mut records = Vec::new();
     let mut stats = Vec::new();
     for _ in 0..2 {
+        stats.push(h.update().expect("update"));
         let mut encoder = h.device.create_command_encoder(&Default::default());
         h.draw_ground(&mut encoder);
-        stats.push(h.draw_sky(&mut encoder).expect("sky"));
+        h.draw_sky(&mut encoder).expect("sky");
         records.push(h.sky.last_record_us());
         h.queue.submit([encoder.finish()]);
     }
@@ -560,6 +563,7 @@ fn two_views_recorded_into_one_encoder_each_show_their_own_clouds() {
     h.draw_view(&back, &mut e).expect("back");
     let back_alone = read(&h, e, &back.colour);
     // Both updated, then both recorded into one encoder, one submit.
+    h.update().expect("update");
     let mut e = encoder(&h);
     h.draw_ground(&mut e);
     h.draw_sky(&mut e).expect("front");
@@ -583,4 +587,47 @@ fn two_views_recorded_into_one_encoder_each_show_their_own_clouds() {
     let grown = h.sky.gpu_buffer_bytes() - sky_bytes;
     eprintln!("a view adds {bytes} bytes of GPU memory; the sky's buffers grew by {grown}");
     assert!(bytes > 0 && grown <= bytes, "{grown} > {bytes}");
+}
+
+#[test]
+fn the_host_drains_flashes_of_a_ts_theme_and_none_without_ts() {
+    use skycast::Weather;
+    use skycast::weather::storms::FlashKind;
+    let theme = Path::new("weather/themes/thunderstorm_cells.toml");
+    let mut h = host::Host::new("standard", Some(theme)).expect("host");
+    let mut flashes = Vec::new();
+    // Two minutes in 10 s frames, drained each frame as a host does.
+    for _ in 0..12 {
+        h.sky
+            .update(&h.queue, &h.camera, host::UNIX_S, 10.0)
+            .expect("update");
+        flashes.extend(h.sky.drain_flashes());
+    }
+    let cells = h
+        .sky
+        .world()
+        .living_field()
+        .map_or(0, |f| f.cells().iter().filter(|c| c.thunder > 0).count());
+    assert!(cells > 0, "the theme's TS cells");
+    // At least one flash a minute per cell (the theme's TS: 4 a minute on average).
+    assert!(
+        flashes.len() >= 2 * cells,
+        "{} flashes of {cells} cells in 2 minutes",
+        flashes.len()
+    );
+    assert!(flashes.windows(2).all(|w| w[0].time_s <= w[1].time_s));
+    assert!(flashes.iter().any(|f| f.kind == FlashKind::InCloud));
+    assert!(h.sky.drain_flashes().is_empty(), "drained");
+    // Weather without TS: the cells and their flashes go.
+    h.sky
+        .set_weather(Weather::File(Path::new(
+            "weather/themes/fair_weather_cumulus.toml",
+        )))
+        .expect("weather");
+    for _ in 0..12 {
+        h.sky
+            .update(&h.queue, &h.camera, host::UNIX_S, 10.0)
+            .expect("update");
+    }
+    assert!(h.sky.drain_flashes().is_empty(), "no TS, no flash");
 }

@@ -382,7 +382,11 @@ fn thin_ridge_in_front_of_a_deck_has_no_halo() {
         clouds: vec![overcast(DVec2::new(0.0, 6000.0), 1000.0)],
     };
     for scale in CLOUD_SCALES {
-        let mut rig = Rig::with_settings(fin.clone(), at_scale(scale));
+        // Without the clouds' shadows: the deck's shadow on the fin is no halo, and the fin's
+        // colour is what tells one.
+        let mut settings = at_scale(scale);
+        settings.cloud_shadows.enabled = false;
+        let mut rig = Rig::with_settings(fin.clone(), settings);
         let cam = rig.camera(DVec3::new(0.0, 0.0, 100.0), 0.0, 12.0);
         rig.set_clouds(Vec::new());
         let (bare, _) = rig.frame(&format!("fin_bare_{scale}"), &cam);
@@ -766,9 +770,10 @@ fn fly_command_writes_frames_and_csv() {
 
 /// The air data agrees with the pictures (issue 33, Done means 1): along the approach through
 /// the San Antonio deck (`skycast fly`, every frame drawn, 96 x 54), the frames whose air data
-/// says wholly in cloud (0.99 and more) are one flat grey (luminance standard deviation under
-/// 0.01), those above 0.9 nearly (under 0.02: the issue's 0.01 is missed at 0.93, 0.0104, by
-/// the renderer's own fog, whose measure this is), and the frames under 0.1 are not; and at the camera it is the renderer's own `in_cloud`.
+/// says above 0.9 in cloud are one flat grey (luminance standard deviation under 0.01; 0.0104
+/// at 0.93 while the fog's opacity was capped at the measure, none since its extinction is the
+/// air data's visibility: shaders/in_cloud.wgsl), and the frames under 0.1 are not; and at the
+/// camera it is the renderer's own `in_cloud`.
 #[test]
 fn fly_air_in_cloud_agrees_with_the_pictures() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("fly-air");
@@ -810,17 +815,10 @@ fn fly_air_in_cloud_agrees_with_the_pictures() {
             .collect();
         let mean = lum.iter().sum::<f32>() / lum.len() as f32;
         let std = (lum.iter().map(|l| (l - mean).powi(2)).sum::<f32>() / lum.len() as f32).sqrt();
-        if air >= 0.99 {
+        if air > 0.9 {
             inside += 1;
             assert!(
                 std < 0.01,
-                "{}: in cloud {air}, luminance std {std}",
-                png.display()
-            );
-        } else if air > 0.9 {
-            // Not quite whole: a trace of the scene shows (0.0104 measured at 0.93).
-            assert!(
-                std < 0.02,
                 "{}: in cloud {air}, luminance std {std}",
                 png.display()
             );
@@ -834,7 +832,7 @@ fn fly_air_in_cloud_agrees_with_the_pictures() {
         }
     }
     assert!(
-        inside >= 2 && outside >= 10,
+        inside >= 3 && outside >= 10,
         "inside {inside}, outside {outside}"
     );
 }
@@ -1055,6 +1053,57 @@ fn ring_rebuilds_over_eight_frames_then_crossfades() {
     frame
         .write_png(&dir.join("ring_after_rebuild.png"))
         .unwrap();
+}
+
+/// The frames that rebuild the ring sort no more sprites on the CPU than any other frame: the
+/// far clouds' orders from the new ring centre (6 cumulus of 60 sprites, 30 km north) are sorted
+/// within `[vertex_cache] max_sorted_sprites_per_frame` (100 here), shared with the sky camera's
+/// own clouds, over several frames, and the ring is still rebuilt and faded in. Sorting the whole
+/// sector on the frame that renders it (the ring's `fresh_view` before) sorts 360 at once.
+#[test]
+fn ring_rebuild_frames_sort_within_the_frames_budget() {
+    let mut settings = RenderSettings::default();
+    settings.vertex_cache.max_sorted_sprites_per_frame = 100;
+    let mut rig = Rig::with_settings(flat_ground(0.0), settings);
+    let far = DVec3::new(0.0, 30_000.0, 1500.0);
+    let mut blocks = ring_blocks(false);
+    blocks.push(SkyBlock {
+        id: 2,
+        centre_m: far,
+        clouds: (0..6)
+            .map(|k| cumulus(far + DVec3::new(k as f64 * 900.0 - 2250.0, 0.0, 0.0)))
+            .collect(),
+    });
+    rig.set_clouds(blocks);
+    let mut step = |y: f64| {
+        let cam = rig.camera(DVec3::new(0.0, y, 1000.0), 0.0, 3.0);
+        rig.host.draw(&cam, &sun(), 0.25, 40_000.0).unwrap()
+    };
+    // The first ring, with nothing to show meanwhile, is built whole at once.
+    let first = step(0.0);
+    assert_eq!(first.impostors_rebuilt, 8, "{first:?}");
+    // 3,100 m on: a rebuild, its orders sorted a budget at a time.
+    let (mut rendered, mut sorting_frames, mut sorted, mut faded) = (0, 0, 0, false);
+    for frame in 0..60 {
+        let s = step(3100.0);
+        assert!(
+            s.sprites_recomputed + s.ring_sprites_sorted <= 100,
+            "frame {frame} sorted {} + {} sprites: {s:?}",
+            s.sprites_recomputed,
+            s.ring_sprites_sorted
+        );
+        rendered += s.impostors_rebuilt;
+        sorting_frames += (s.ring_sprites_sorted > 0) as u32;
+        sorted += s.ring_sprites_sorted;
+        faded |= s.crossfade_weight > 0.0;
+        if faded && s.crossfade_weight == 0.0 {
+            break;
+        }
+    }
+    assert_eq!(rendered, 8, "every impostor rendered");
+    assert!(faded, "the new ring faded in");
+    assert_eq!(sorted, 360, "the far clouds sorted once each");
+    assert!(sorting_frames >= 4, "{sorting_frames} frames sorted them");
 }
 
 /// Beyond Wang: the impostors keep each texel's cloud depth. A 3,000 m ridge 45 km north stands

@@ -18,6 +18,11 @@ struct Frame {
     haze: vec4<f32>,
     // The host projection's depth to metres: -(a d + b) / (c d + e) for (a, b, c, e).
     depth_to_view: vec4<f32>,
+    // A lightning flash lighting its cell from inside: xyz its centre, camera-relative metres;
+    // w the light it adds at the centre (0: none).
+    flash: vec4<f32>,
+    // x: the reach of `flash` (its Gaussian's 1/e distance), metres; yzw unused.
+    flash_reach: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> frame: Frame;

@@ -49,8 +49,11 @@ use super::weather::DEFAULT_STATIONS;
 mod passes;
 mod plot;
 
-/// The scenarios, in the order of the table.
-const SCENARIOS: [&str; 3] = ["sparse", "scattered", "overcast"];
+/// The scenarios, in the order of the table: the first three run by default, `storm` (a
+/// thunderstorm report: the weather field's storm cells) when asked for with `--scenario`.
+const SCENARIOS: [&str; 4] = ["sparse", "scattered", "overcast", "storm"];
+/// The scenario run only when asked for.
+const ON_REQUEST: &str = "storm";
 /// The path: due east, centred on the station, this long, at this height above its ground.
 const PATH_LENGTH_M: f64 = 12_000.0;
 const CRUISE_FT_AGL: f64 = 5_000.0;
@@ -70,7 +73,7 @@ pub struct BenchArgs {
     /// Directory for bench.csv, frames.csv and frame_time.png (created).
     #[arg(long, default_value = "out/bench")]
     pub out: PathBuf,
-    /// Directory holding sparse.metar, scattered.metar and overcast.metar.
+    /// Directory holding sparse.metar, scattered.metar, overcast.metar and storm.metar.
     #[arg(long, default_value = "weather/scenarios")]
     pub scenarios: PathBuf,
     /// Station table placing the scenario reports.
@@ -94,9 +97,9 @@ pub struct BenchArgs {
     /// UTC time, RFC 3339 (default: the shipped weather file's time).
     #[arg(long, value_parser = parse_time)]
     pub time: Option<f64>,
-    /// Run only this scenario (sparse, scattered or overcast); repeat for more (default: all
-    /// three).
-    #[arg(long = "scenario", value_parser = ["sparse", "scattered", "overcast"])]
+    /// Run only this scenario (sparse, scattered, overcast, or storm: SBBH's TSRA BKN045CB);
+    /// repeat for more (default: sparse, scattered and overcast).
+    #[arg(long = "scenario", value_parser = ["sparse", "scattered", "overcast", "storm"])]
     pub scenarios_only: Vec<String>,
     /// Camera height above the scenario's station, feet (the cruise-altitude case: 35000).
     #[arg(long, default_value_t = CRUISE_FT_AGL)]
@@ -114,6 +117,10 @@ pub struct BenchArgs {
     /// timestamps between passes.
     #[arg(long)]
     pub passes: bool,
+    /// The clouds' shadows on the ground: `on` or `off` (default: the renderer settings'
+    /// `[cloud_shadows] enabled`).
+    #[arg(long, value_name = "on|off", value_parser = super::render::parse_on_off)]
+    pub cloud_shadows: Option<bool>,
 }
 
 /// One frame of one run.
@@ -369,8 +376,9 @@ fn fly(
         .collect())
 }
 
-/// Draws frames at one sample until the ring is up to date there (8 rebuild frames and a
-/// crossfade at most, plus slack); the last is the steady one. False when the frames were timed
+/// Draws frames at one sample until the ring is up to date there (the frames that sort its
+/// orders a budget at a time, 8 rebuild frames and a crossfade at most, plus slack); the last is
+/// the steady one. False when the frames were timed
 /// by the wall clock (no GPU timestamps).
 fn draw_to_steady(
     host: &mut DemoHost,
@@ -380,7 +388,7 @@ fn draw_to_steady(
 ) -> anyhow::Result<bool> {
     let camera = host.camera(p, 90.0, PITCH_DEG);
     let mut timestamps = true;
-    for _ in 0..64 {
+    for _ in 0..512 {
         let start = Instant::now();
         let stats = host.draw(&camera, sun, dt_s, visibility_m)?;
         let (frame_ms, sky_ms) = match host.last_gpu_split_ms() {
@@ -393,7 +401,9 @@ fn draw_to_steady(
                 ((wall - stats.cpu_update_us as f64 / 1e3).max(0.0), f64::NAN)
             }
         };
-        let steady = stats.impostors_rebuilt == 0 && stats.crossfade_weight == 0.0;
+        let steady = stats.impostors_rebuilt == 0
+            && stats.crossfade_weight == 0.0
+            && stats.ring_sprites_sorted == 0;
         records.push(FrameRecord {
             steady,
             distance_m,
@@ -421,11 +431,14 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     if args.frames < 2 {
         anyhow::bail!("--frames {} is less than 2", args.frames);
     }
-    let (settings, table) = load_look(
+    let (mut settings, table) = load_look(
         args.render_settings.as_ref(),
         args.time_of_day.as_ref(),
         args.cloud_scale,
     )?;
+    if let Some(on) = args.cloud_shadows {
+        settings.cloud_shadows.enabled = on;
+    }
     // The chosen scale first, then full resolution to compare with.
     let mut scales = vec![settings.clouds.resolution_scale];
     if scales[0] != 1.0 {
@@ -476,7 +489,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         _ => &[true, false],
     };
     for scenario in SCENARIOS {
-        if !args.scenarios_only.is_empty() && !args.scenarios_only.iter().any(|s| s == scenario) {
+        let asked = args.scenarios_only.iter().any(|s| s == scenario);
+        if (!args.scenarios_only.is_empty() || scenario == ON_REQUEST) && !asked {
             continue;
         }
         let (mut world, at) =

@@ -83,6 +83,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     super::fly::run(&super::fly::FlyArgs {
         weather: args.weather.clone(),
         stations: args.stations.clone(),
+        winds_aloft: None,
         path: args.flight.clone(),
         out: args.out.clone(),
         size: args.size,

@@ -34,6 +34,10 @@ pub struct FlyArgs {
     /// Station table placing reports the file does not place.
     #[arg(long, default_value = DEFAULT_STATIONS)]
     pub stations: PathBuf,
+    /// NOAA's winds and temperatures aloft (FB, e.g. FD1US1) for the air data above the
+    /// boundary layer, its sites placed through `--stations`.
+    #[arg(long, value_name = "FILE")]
+    pub winds_aloft: Option<PathBuf>,
     /// The flight path (TOML, see config/flights/).
     #[arg(long)]
     pub path: PathBuf,
@@ -101,6 +105,16 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     }
     let mut host = DemoHost::new(args.size.0, args.size.1, &ground, config)?;
     host.sky.set_weather_field(field);
+    if let Some(path) = &args.winds_aloft {
+        let fb = skycast::weather::winds_aloft::WindsAloft::load(path)?;
+        let table = StationTable::load(&args.stations)?;
+        let (placed, _) = host.sky.world_mut().set_winds_aloft(Some(&fb), &table);
+        eprintln!(
+            "winds aloft: {}: {placed} of {} sites placed",
+            path.display(),
+            fb.sites.len()
+        );
+    }
     if let Some(path) = &args.clouds {
         host.sky
             .world_mut()
@@ -167,6 +181,11 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "turbulence",
         "icing",
         "sight_hits",
+        "flashes",
+        "sprites_recomputed",
+        "ring_sprites_sorted",
+        "gpu_wait_us",
+        "preempted",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
@@ -191,6 +210,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         // The first frame is the warm-up: it waits for the clouds around, so the flight starts
         // under its whole sky; after it blocks arrive as they are generated.
         host.sky.world_mut().set_synchronous_clouds(k == 0);
+        let switches_before = involuntary_switches();
         let (stats, changes) = host.step(&camera, start_unix_s + time_s, step_s, write)?;
         let mut applied = String::new();
         for change in changes {
@@ -221,6 +241,11 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         let air_at_us = air_start.elapsed().as_micros() as u64;
         let sight_hits = sight_fan(&host.sky, pose.position_m, pose.heading_deg);
         stats.air_us = air_start.elapsed().as_micros() as u64;
+        // Whether the system took the core away meanwhile (then the frame's times hold another
+        // process's time slice too): a fact about the machine's load, reported, never excluded.
+        let preempted = switches_before
+            .zip(involuntary_switches())
+            .map_or_else(String::new, |(a, b)| b.saturating_sub(a).to_string());
         summary.add(&stats);
         let p = pose.position_m;
         csv.write_record([
@@ -269,6 +294,12 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             format!("{:.2}", air.turbulence),
             (air.icing as u8).to_string(),
             sight_hits.to_string(),
+            // The lightning flashes this frame, drained as a host drains them.
+            host.sky.drain_flashes().len().to_string(),
+            stats.sprites_recomputed.to_string(),
+            stats.ring_sprites_sorted.to_string(),
+            stats.gpu_wait_us.to_string(),
+            preempted,
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);
@@ -307,34 +338,53 @@ fn sight_fan(sky: &skycast::SkySystem, at_m: glam::DVec3, heading_deg: f64) -> u
     hits
 }
 
-/// The flight's figures, printed when it ends: the sky's CPU a frame (`sky_cpu_us`), how much of
-/// the sort order came from the cache, the frame thread's time on weather, peak memory.
+/// The flight's figures, printed when it ends: the sky's CPU a frame (`sky_cpu_us`), over all
+/// frames and over those that rebuild an impostor, the waits for the GPU apart from it, how much
+/// of the sort order came from the cache, the frame thread's time on weather, peak memory.
 #[derive(Default)]
 struct Summary {
     sky_cpu_us: Vec<u64>,
+    /// `sky_cpu_us` of the frames that rebuild an impostor.
+    rebuild_cpu_us: Vec<u64>,
+    /// `gpu_wait_us` of the frames that waited.
+    gpu_wait_us: Vec<u64>,
     cache_hit_rate: Vec<f32>,
     weather_us_max: u64,
+}
+
+/// The median and the 99th percentile (nearest rank) of `v`, sorted in place; 0 when empty.
+fn median_p99(v: &mut [u64]) -> (u64, u64) {
+    v.sort_unstable();
+    let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+    if v.is_empty() {
+        (0, 0)
+    } else {
+        (at(0.5), at(0.99))
+    }
 }
 
 impl Summary {
     fn add(&mut self, stats: &skycast::render::FrameStats) {
         self.sky_cpu_us.push(stats.sky_cpu_us());
+        if stats.impostors_rebuilt > 0 {
+            self.rebuild_cpu_us.push(stats.sky_cpu_us());
+        }
+        if stats.gpu_wait_us > 0 {
+            self.gpu_wait_us.push(stats.gpu_wait_us);
+        }
         self.cache_hit_rate.push(stats.cache_hit_rate);
         self.weather_us_max = self.weather_us_max.max(stats.weather_us);
     }
 
     fn line(&mut self) -> String {
-        self.sky_cpu_us.sort_unstable();
+        let (median, p99) = median_p99(&mut self.sky_cpu_us);
+        let (rebuild_median, rebuild_p99) = median_p99(&mut self.rebuild_cpu_us);
+        let (_, wait_p99) = median_p99(&mut self.gpu_wait_us);
+        let wait_max = self.gpu_wait_us.last().copied().unwrap_or(0);
         self.cache_hit_rate.sort_by(f32::total_cmp);
-        let at = |n: usize, q: f64| ((n.saturating_sub(1)) as f64 * q).round() as usize;
-        let n = self.sky_cpu_us.len();
-        let (median, p99) = match n {
-            0 => (0, 0),
-            _ => (self.sky_cpu_us[at(n, 0.5)], self.sky_cpu_us[at(n, 0.99)]),
-        };
         let hit = self
             .cache_hit_rate
-            .get(at(self.cache_hit_rate.len(), 0.5))
+            .get(((self.cache_hit_rate.len().saturating_sub(1)) as f64 * 0.5).round() as usize)
             .copied()
             .unwrap_or(0.0);
         let peak = peak_rss_bytes().map_or_else(
@@ -342,8 +392,12 @@ impl Summary {
             |b| format!("{:.0} MB", b as f64 / 1e6),
         );
         format!(
-            "sky CPU a frame: median {median} us, p99 {p99} us; order cache hit rate, median: \
-             {:.1}%; weather on the frame thread: at most {} us; peak memory (RSS): {peak}",
+            "sky CPU a frame: median {median} us, p99 {p99} us (the {} frames that rebuild an \
+             impostor: median {rebuild_median} us, p99 {rebuild_p99} us); waiting for the GPU, \
+             apart: {} frames, p99 {wait_p99} us, at most {wait_max} us; order cache hit rate, \
+             median: {:.1}%; weather on the frame thread: at most {} us; peak memory (RSS): {peak}",
+            self.rebuild_cpu_us.len(),
+            self.gpu_wait_us.len(),
             hit * 100.0,
             self.weather_us_max
         )
@@ -351,6 +405,17 @@ impl Summary {
 }
 
 /// The process's peak resident memory (Linux: `VmHWM` of /proc/self/status).
+/// Involuntary context switches of the calling thread so far (Linux: the thread's
+/// `nonvoluntary_ctxt_switches`), `None` elsewhere: a frame with more at its end than at its
+/// start was preempted (the system ran something else on its core meanwhile).
+fn involuntary_switches() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/thread-self/status").ok()?;
+    let line = status
+        .lines()
+        .find(|l| l.starts_with("nonvoluntary_ctxt_switches:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
 fn peak_rss_bytes() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;

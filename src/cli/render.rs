@@ -74,6 +74,10 @@ pub struct LookArgs {
     /// time-of-day table's `[shading] model`).
     #[arg(long, value_parser = parse_shading)]
     pub shading: Option<ShadingModel>,
+    /// The clouds' shadows on the ground: `on` or `off` (default: the renderer settings'
+    /// `[cloud_shadows] enabled`).
+    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
+    pub cloud_shadows: Option<bool>,
 }
 
 impl LookArgs {
@@ -84,9 +88,12 @@ impl LookArgs {
             self.time_of_day.as_ref(),
             self.cloud_scale,
         )
-        .map(|(settings, mut table)| {
+        .map(|(mut settings, mut table)| {
             if let Some(model) = self.shading {
                 table.shading.model = model;
+            }
+            if let Some(on) = self.cloud_shadows {
+                settings.cloud_shadows.enabled = on;
             }
             (settings, table)
         })
@@ -194,6 +201,15 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
 pub fn parse_shading(text: &str) -> Result<ShadingModel, String> {
     ShadingModel::from_name(text.trim())
         .ok_or_else(|| format!("`{text}` is not a shading model: wang or harris-lastra"))
+}
+
+/// Parses an `on` or `off` flag (`--cloud-shadows`).
+pub fn parse_on_off(text: &str) -> Result<bool, String> {
+    match text.trim() {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("`{text}` is neither on nor off")),
+    }
 }
 
 /// Parses `--cloud-scale`: 1, 1/2 or 1/4 (or 0.5, 0.25).

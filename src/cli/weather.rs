@@ -1,4 +1,4 @@
-//! `skycast weather FILE [--stations FILE] [--at LAT,LON [--alt-ft FT]] [--json]`: what a
+//! `skycast weather FILE [--stations FILE] [--at LAT,LON [--alt-ft FT] [--cells-km R]] [--json]`: what a
 //! weather file holds and, with `--at`, the interpolated weather of the 4 km block there; with
 //! `--alt-ft` too, the air data at that altitude (wind, temperature, pressure, visibility, cloud,
 //! turbulence, icing: `skycast::flight::air`), the clouds around generated as a flight would.
@@ -8,16 +8,18 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use serde::Serialize;
 use skycast::flight::{AirData, World, WorldSettings};
 use skycast::shading::{FogSettings, sun_position};
 use skycast::weather::air::AirSettings;
-use skycast::weather::block::{BlockLayer, TypeSource, ceiling_ft, cover_seen_from_below_oktas};
+use skycast::weather::block::{BlockLayer, ceiling_ft, cover_seen_from_below_oktas};
 use skycast::weather::field::{CloudTypeRule, FieldSettings};
 use skycast::weather::files::WeatherFile;
 use skycast::weather::metar::{ConvectiveKind, Cover, SkyCode};
+use skycast::weather::storms::{StormContext, cells_over};
 use skycast::weather::theme::{self, Theme};
+use skycast::weather::winds_aloft::WindsAloft;
 use skycast::weather::{
     BlockIndex, BlockWeather, LineWarning, LocalFrame, StationTable, WeatherInput,
 };
@@ -43,12 +45,19 @@ pub struct WeatherArgs {
     /// Air-data settings (default: the shipped config/air.toml).
     #[arg(long)]
     pub air_settings: Option<PathBuf>,
+    /// With `--alt-ft`: NOAA's winds and temperatures aloft (FB, e.g. FD1US1) for the air above
+    /// the boundary layer, its sites placed through `--stations`.
+    #[arg(long, value_name = "FILE", requires = "alt_ft")]
+    pub winds_aloft: Option<PathBuf>,
     /// Cloud-type rule (default: the shipped config/cloud_type_rule.toml).
     #[arg(long)]
     pub rule: Option<PathBuf>,
     /// Field settings (default: the shipped config/weather_field.toml).
     #[arg(long)]
     pub field_settings: Option<PathBuf>,
+    /// With `--at`: list the storm cells within this many km of the point (`"cells"` in JSON).
+    #[arg(long, value_name = "KM", requires = "at")]
+    pub cells_km: Option<f64>,
     /// One JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -85,6 +94,8 @@ struct ThemeJsonOut<'a> {
     at: Option<&'a AtBlock>,
     #[serde(skip_serializing_if = "Option::is_none")]
     air: Option<&'a AirData>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cells: Option<&'a [CellOut]>,
 }
 
 /// Counts over the located reports of a file.
@@ -166,6 +177,8 @@ struct JsonOut<'a> {
     at: Option<&'a AtBlock>,
     #[serde(skip_serializing_if = "Option::is_none")]
     air: Option<&'a AirData>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cells: Option<&'a [CellOut]>,
 }
 
 /// Everything `skycast weather` needs, loaded: the weather, the rule and the settings.
@@ -230,13 +243,21 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
         args.field_settings.as_deref(),
     )?;
     let at = args.at.map(|(lat, lon)| at_block(&loaded, lat, lon));
+    let cells = match (args.at, args.cells_km) {
+        (Some((lat, lon)), Some(km)) => Some(cells_near(&loaded, lat, lon, km)),
+        _ => None,
+    };
     let air = match (args.at, args.alt_ft) {
         (Some((lat, lon)), Some(alt_ft)) => {
             let settings = match &args.air_settings {
                 Some(path) => AirSettings::load(path)?,
                 None => AirSettings::default(),
             };
-            Some(air_at(&loaded, lat, lon, alt_ft, settings)?)
+            let aloft = match &args.winds_aloft {
+                Some(path) => Some((WindsAloft::load(path)?, StationTable::load(&args.stations)?)),
+                None => None,
+            };
+            Some(air_at(&loaded, lat, lon, alt_ft, settings, aloft.as_ref())?)
         }
         _ => None,
     };
@@ -252,6 +273,7 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
                     points: theme.points.len(),
                     at: at.as_ref(),
                     air: air.as_ref(),
+                    cells: cells.as_deref(),
                 };
                 println!("{}", serde_json::to_string(&out)?);
             } else {
@@ -261,6 +283,9 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
                 }
                 if let Some(air) = &air {
                     print!("{}", describe_air(air));
+                }
+                if let Some(cells) = &cells {
+                    print!("{}", describe_cells(cells));
                 }
             }
             return Ok(());
@@ -277,6 +302,7 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
             summary: &summary,
             at: at.as_ref(),
             air: air.as_ref(),
+            cells: cells.as_deref(),
         };
         println!("{}", serde_json::to_string(&out)?);
         return Ok(());
@@ -288,7 +314,99 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
     if let Some(air) = &air {
         print!("{}", describe_air(air));
     }
+    if let Some(cells) = &cells {
+        print!("{}", describe_cells(cells));
+    }
     Ok(())
+}
+
+/// One storm cell as `--cells-km` lists it.
+#[derive(Debug, Clone, Serialize)]
+pub struct CellOut {
+    /// Base centre east of the point, metres.
+    pub east_m: f64,
+    /// Base centre north of the point, metres.
+    pub north_m: f64,
+    /// Base diameter, metres.
+    pub base_width_m: f64,
+    /// Base, feet AGL.
+    pub base_ft_agl: f32,
+    /// Top, feet MSL.
+    pub top_ft_msl: f32,
+    /// Anvil diameter, metres.
+    pub anvil_width_m: f64,
+    /// How far downwind the anvil's centre lies from the base's, metres.
+    pub anvil_offset_m: f64,
+    /// Towards which the anvil spreads, degrees true.
+    pub anvil_towards_deg: f64,
+    /// The cell's cloud type.
+    pub cloud_type: &'static str,
+    /// Thunder: 0 none, 1 -TS, 2 TS, 3 +TS.
+    pub thunder: u8,
+}
+
+/// The storm cells whose base centre lies within `radius_km` of a point, nearest first: a
+/// frame with its origin there, decided as the cloud field of a flight decides them.
+pub fn cells_near(loaded: &Loaded, lat_deg: f64, lon_deg: f64, radius_km: f64) -> Vec<CellOut> {
+    let frame = LocalFrame::new(lat_deg, lon_deg);
+    let field = loaded.input.field(frame, &loaded.settings, &loaded.rule);
+    let ctx = StormContext {
+        lat_deg,
+        ..StormContext::default()
+    };
+    let r = radius_km * 1000.0;
+    let mut cells: Vec<_> = cells_over(
+        DVec2::splat(-r),
+        DVec2::splat(r),
+        &mut |p| field.block_weather(BlockIndex::containing(p)),
+        &ctx,
+        WorldSettings::default().seed,
+    )
+    .into_iter()
+    .filter(|c| c.centre().length() <= r)
+    .collect();
+    cells.sort_by(|a, b| a.centre().length().total_cmp(&b.centre().length()));
+    cells
+        .iter()
+        .map(|c| {
+            let off = c.anvil_offset();
+            CellOut {
+                east_m: c.centre_m[0].round(),
+                north_m: c.centre_m[1].round(),
+                base_width_m: c.base_width_m.round(),
+                base_ft_agl: c.base_ft_agl.round(),
+                top_ft_msl: c.top_ft_msl.round(),
+                anvil_width_m: c.anvil_width_m.round(),
+                anvil_offset_m: off.length().round(),
+                anvil_towards_deg: off.x.atan2(off.y).to_degrees().rem_euclid(360.0).round(),
+                cloud_type: c.cloud_type.name(),
+                thunder: c.thunder,
+            }
+        })
+        .collect()
+}
+
+/// `--cells-km` as text.
+pub fn describe_cells(cells: &[CellOut]) -> String {
+    use std::fmt::Write as _;
+    let mut out = format!("  {} storm cells\n", cells.len());
+    for c in cells {
+        let _ = writeln!(
+            out,
+            "  {} at {:.1} km east, {:.1} km north: base {:.1} km across at {:.0} ft AGL, top {:.0} ft MSL, anvil {:.1} km across, {:.1} km downwind (towards {:.0} deg){}",
+            c.cloud_type,
+            c.east_m / 1000.0,
+            c.north_m / 1000.0,
+            c.base_width_m / 1000.0,
+            c.base_ft_agl,
+            c.top_ft_msl,
+            c.anvil_width_m / 1000.0,
+            c.anvil_offset_m / 1000.0,
+            c.anvil_towards_deg,
+            ["", ", -TS", ", TS", ", +TS"][c.thunder.min(3) as usize]
+        );
+    }
+    out
 }
 
 /// The air data at a point and altitude: a world whose frame has its origin there, its clouds
@@ -299,6 +417,7 @@ pub fn air_at(
     lon_deg: f64,
     alt_ft: f64,
     settings: AirSettings,
+    aloft: Option<&(WindsAloft, StationTable)>,
 ) -> anyhow::Result<AirData> {
     let frame = LocalFrame::new(lat_deg, lon_deg);
     let field = loaded.input.field(frame, &loaded.settings, &loaded.rule);
@@ -309,6 +428,15 @@ pub fn air_at(
     };
     let mut world = World::new(field, &world_settings);
     world.set_air_settings(settings, FogSettings::default());
+    if let Some((fb, table)) = aloft {
+        let (placed, unplaced) = world.set_winds_aloft(Some(fb), table);
+        eprintln!(
+            "winds aloft: {}: {placed} of {} sites placed (not in the station table: {})",
+            fb.path.display(),
+            fb.sites.len(),
+            unplaced.join(" ")
+        );
+    }
     let point = DVec3::new(0.0, 0.0, alt_ft * skycast::weather::METRES_PER_FOOT);
     world
         .settle_clouds_around(point)
@@ -453,11 +581,10 @@ pub fn describe_block(at: &AtBlock) -> String {
     }
     // The layers a report's covers sum over: CB and TCU are reported with their own amount
     // (ICAO Annex 3), outside the summation principle.
-    let convective = |l: &BlockLayer| l.type_source == TypeSource::Reported;
     let summed: Vec<BlockLayer> = w
         .layers
         .iter()
-        .filter(|l| !convective(l))
+        .filter(|l| !l.has_own_amount())
         .copied()
         .collect();
     for l in &w.layers {
@@ -465,7 +592,7 @@ pub fn describe_block(at: &AtBlock) -> String {
             .ok()
             .and_then(|v| v.as_str().map(str::to_string))
             .unwrap_or_default();
-        let cover = if convective(l) {
+        let cover = if l.has_own_amount() {
             "its own amount, not summed".to_string()
         } else {
             format!(

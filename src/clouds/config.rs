@@ -150,6 +150,34 @@ pub struct AnvilConfig {
     pub width_scale: f32,
 }
 
+/// How a storm cell of the weather field (`weather::storms`) is drawn: a budget of sprites
+/// however wide the cell, so a 10 km cell costs about what a 2 km chimney did.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StormCellConfig {
+    /// Sprites of one whole cell (base, turrets and anvil) before the cull, 50..=4000.
+    pub sprites: u32,
+    /// Sprite width over the cell's base width, range.
+    pub sprite_over_base: [f32; 2],
+    /// Share of the sprites that go to the anvil, 0..1.
+    pub anvil_share: f32,
+    /// The cell's five ambient colour levels, lowest first, heights as fractions of the cell's
+    /// height (the type's own levels where absent).
+    #[serde(default)]
+    pub colour_levels: Option<[ColourLevelConfig; 5]>,
+    /// The share of the cell's height, from its base up, in the shadow of the body above (the
+    /// type's `shaded_base_m` is for a chimney: a cell's sprites are taller than it), 0..=1.
+    #[serde(default)]
+    pub shaded_share: f32,
+    /// Opacity factor of the anvil's sprites, in its middle and at its rim, 0..=1.
+    #[serde(default = "opaque")]
+    pub anvil_alpha: [f32; 2],
+}
+
+fn opaque() -> [f32; 2] {
+    [1.0, 1.0]
+}
+
 /// Precipitation falling from a cloud's base where the weather reports it (rain or snow
 /// shafts; virga, evaporating before the ground, where the air below is dry).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -193,6 +221,9 @@ pub struct CloudTypeConfig {
     /// The anvil, for cumulonimbus.
     #[serde(default)]
     pub anvil: Option<AnvilConfig>,
+    /// Cumulonimbus: how the field's storm cells are drawn.
+    #[serde(default)]
+    pub cell: Option<StormCellConfig>,
     /// Rain or snow shafts under the type's clouds where the weather has precipitation.
     #[serde(default)]
     pub precipitation: Option<PrecipitationConfig>,
@@ -518,6 +549,20 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
             anvil.from > 0.0 && anvil.from < 1.0 && anvil.width_scale >= 1.0,
             "anvil",
             "needs 0 < from < 1 and width_scale >= 1",
+        )?;
+    }
+    if let Some(cell) = c.cell {
+        v.check(
+            (50..=4000).contains(&cell.sprites)
+                && cell.sprite_over_base[0] > 0.0
+                && cell.sprite_over_base[0] <= cell.sprite_over_base[1]
+                && cell.sprite_over_base[1] <= 1.0
+                && cell.anvil_share > 0.0
+                && cell.anvil_share < 1.0
+                && (0.0..=1.0).contains(&cell.shaded_share)
+                && cell.anvil_alpha.iter().all(|a| (0.0..=1.0).contains(a)),
+            "cell",
+            "needs sprites 50..=4000, 0 < sprite_over_base low <= high <= 1, 0 < anvil_share < 1, 0 <= shaded_share <= 1, anvil_alpha within 0..=1",
         )?;
     }
     if let Some(p) = c.precipitation {

@@ -24,9 +24,11 @@ use rayon::prelude::*;
 use super::CloudsError;
 use super::block::CloudBlock;
 use super::config::{CloudTypes, CloudsConfig};
-use super::generate::generate_block;
+use super::generate::{generate_block, generate_block_in_field};
 use super::lifecycle::{Phase, phase_at};
-use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockWeather};
+use super::storm::CellCache;
+use crate::weather::storms::{StormCell, StormContext, cells_over};
+use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockWeather, CloudType};
 
 /// A finished generation job.
 #[derive(Debug, Clone, PartialEq)]
@@ -46,6 +48,7 @@ pub struct BlockGenerator {
     tx: Sender<Generated>,
     rx: Receiver<Generated>,
     pending: usize,
+    cells: Arc<CellCache>,
 }
 
 impl std::fmt::Debug for BlockGenerator {
@@ -77,6 +80,7 @@ impl BlockGenerator {
             tx,
             rx,
             pending: 0,
+            cells: Arc::new(CellCache::default()),
         }
     }
 
@@ -88,6 +92,29 @@ impl BlockGenerator {
         self.pool.spawn(move || {
             let block = generate_block(index, &weather, seed, &types);
             // The receiver is gone only when the generator was dropped: nobody wants the block.
+            let _ = tx.send(Generated {
+                index,
+                weather,
+                block,
+            });
+        });
+    }
+
+    /// Queues one block of the cloud field, whose cumulonimbus are the storm `cells` that reach
+    /// over it ([`super::generate::generate_block_in_field`]); returns at once.
+    pub fn submit_in_field(
+        &mut self,
+        index: BlockIndex,
+        weather: BlockWeather,
+        cells: Vec<StormCell>,
+        seed: u64,
+    ) {
+        let tx = self.tx.clone();
+        let types = Arc::clone(&self.types);
+        let cache = Arc::clone(&self.cells);
+        self.pending += 1;
+        self.pool.spawn(move || {
+            let block = generate_block_in_field(index, &weather, &cells, &cache, seed, &types);
             let _ = tx.send(Generated {
                 index,
                 weather,
@@ -209,6 +236,10 @@ pub struct CloudField {
     membership: u64,
     /// Generations forming or dissipating: while none are, advancing time touches no block.
     unsettled: usize,
+    /// What the weather field's storm cells are decided with.
+    storms: StormContext,
+    /// The storm cells over the field, as last decided (in the moving air's frame).
+    cells: Vec<StormCell>,
 }
 
 impl CloudField {
@@ -236,7 +267,49 @@ impl CloudField {
             next_serial: 0,
             membership: 0,
             unsettled: 0,
+            storms: StormContext::default(),
+            cells: Vec::new(),
         }
+    }
+
+    /// What the storm cells are decided with.
+    pub fn storms(&self) -> &StormContext {
+        &self.storms
+    }
+
+    /// The storm cells over the field as last decided, in the moving air's frame (add
+    /// [`Self::drift_m`] for the ground's).
+    pub fn cells(&self) -> &[StormCell] {
+        &self.cells
+    }
+
+    /// The field's seed (the cells' and the flashes').
+    pub fn seed(&self) -> u64 {
+        self.config.field.seed
+    }
+
+    /// Decides the storm cells with `storms` (the settings, the air data's wind profile and
+    /// the frame's latitude) from now on.
+    pub fn set_storms(&mut self, storms: StormContext) {
+        self.storms = storms;
+    }
+
+    /// The storm cells that reach over the rectangle `min_m`..`max_m` of the moving air, with
+    /// `weather` giving the weather of a ground block (as [`Self::update`] takes it).
+    pub fn storm_cells(
+        &self,
+        min_m: DVec2,
+        max_m: DVec2,
+        weather: &dyn Fn(BlockIndex) -> BlockWeather,
+    ) -> Vec<StormCell> {
+        let drift = self.drift_m;
+        cells_over(
+            min_m,
+            max_m,
+            &mut |p| weather(BlockIndex::containing(p + drift)),
+            &self.storms,
+            self.config.field.seed,
+        )
     }
 
     /// Asks for the blocks around `centre_m` (ground metres), with `weather` giving the weather
@@ -249,12 +322,42 @@ impl CloudField {
         let radius = self.config.field.radius_m;
         let seed = self.config.field.seed;
         let wanted = blocks_within(air_centre, radius);
-        for &index in &wanted {
-            let ground = BlockIndex::containing(index.centre_m() + self.drift_m);
-            let w = weather(ground);
-            match self.slots.get_mut(&index) {
+        // The storm cells over the field, decided once for the blocks this call queues: only
+        // where the field's weather holds a cumulonimbus.
+        let has_cb = |w: &BlockWeather| {
+            w.layers
+                .iter()
+                .any(|l| l.cloud_type == CloudType::Cumulonimbus)
+        };
+        let asked: Vec<(BlockIndex, BlockWeather)> = wanted
+            .iter()
+            .map(|&index| {
+                let ground = BlockIndex::containing(index.centre_m() + self.drift_m);
+                (index, weather(ground))
+            })
+            .collect();
+        let cb_seen =
+            self.slots.values().any(|s| has_cb(&s.weather)) || asked.iter().any(|(_, w)| has_cb(w));
+        let mut cells: Option<Vec<StormCell>> = None;
+        let mut cells_for = |field: &Self, index: BlockIndex| {
+            if cells.is_none() && cb_seen {
+                let reach = DVec2::splat(radius + BLOCK_SIZE_M);
+                cells = Some(field.storm_cells(air_centre - reach, air_centre + reach, weather));
+            }
+            let lo = index.min_corner_m();
+            let hi = lo + DVec2::splat(BLOCK_SIZE_M);
+            cells
+                .iter()
+                .flatten()
+                .filter(|c| c.reaches(lo, hi))
+                .copied()
+                .collect::<Vec<_>>()
+        };
+        for (index, w) in asked {
+            match self.slots.get(&index) {
                 None => {
-                    self.generator.submit(index, w.clone(), seed);
+                    let mine = cells_for(self, index);
+                    self.generator.submit_in_field(index, w.clone(), mine, seed);
                     // From the blocks with clouds beside it: not from those joining with it,
                     // which have none yet, so the same in any order.
                     let joins = self.joining_phase(index);
@@ -268,11 +371,19 @@ impl CloudField {
                     );
                 }
                 Some(slot) if weather_changed(&slot.weather, &w) => {
-                    self.generator.submit(index, w.clone(), seed);
-                    slot.weather = w;
+                    let mine = cells_for(self, index);
+                    self.generator.submit_in_field(index, w.clone(), mine, seed);
+                    if let Some(slot) = self.slots.get_mut(&index) {
+                        slot.weather = w;
+                    }
                 }
                 Some(_) => {}
             }
+        }
+        if !cb_seen {
+            self.cells.clear();
+        } else if let Some(decided) = cells {
+            self.cells = decided;
         }
         // Blocks a block beyond the rim leave the field.
         let keep = radius + BLOCK_SIZE_M;

@@ -24,6 +24,8 @@ use super::config::{CloudTypeConfig, CloudTypes, TextureCategory};
 use super::heap::heap_sprites;
 use super::rain::add_shafts;
 use super::rng::{SplitMix64, hash_keys};
+use super::storm::{CellCache, part_in_block};
+use crate::weather::storms::StormCell;
 use crate::weather::{
     BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, CloudType, METRES_PER_FOOT,
 };
@@ -34,10 +36,51 @@ const GRID: usize = 40;
 /// Layers at or above this coverage are placed on the lattice, whatever their type.
 const OVERCAST_OKTAS: f32 = 7.5;
 
-/// Generates the clouds of one block. Pure: equal inputs give byte-identical blocks.
+/// Generates the clouds of one block. Pure: equal inputs give byte-identical blocks. Its
+/// cumulonimbus layers are drawn as the block's own heaps: a block of the cloud field draws
+/// the field's storm cells instead ([`generate_block_in_field`]).
 pub fn generate_block(
     index: BlockIndex,
     weather: &BlockWeather,
+    seed: u64,
+    types: &CloudTypes,
+) -> CloudBlock {
+    generate_layers(index, weather, false, seed, types)
+}
+
+/// Generates the clouds of one block of the cloud field, whose cumulonimbus are the weather
+/// field's storm `cells` (`weather::storms`): the block draws its part of each (the cells that
+/// reach over it) instead of heaps of its own. Pure, as [`generate_block`]; `cache` only saves
+/// drawing a cell again for each block it spans.
+pub fn generate_block_in_field(
+    index: BlockIndex,
+    weather: &BlockWeather,
+    cells: &[StormCell],
+    cache: &CellCache,
+    seed: u64,
+    types: &CloudTypes,
+) -> CloudBlock {
+    let mut block = generate_layers(index, weather, true, seed, types);
+    let config = types.get(CloudType::Cumulonimbus);
+    let layer = weather
+        .layers
+        .iter()
+        .position(|l| l.cloud_type == CloudType::Cumulonimbus)
+        .unwrap_or(weather.layers.len())
+        .min(u8::MAX as usize) as u8;
+    for cell in cells {
+        let whole = cache.whole(cell, config, weather);
+        if let Some(part) = part_in_block(&whole, index, layer) {
+            block.clouds.push(part);
+        }
+    }
+    block
+}
+
+fn generate_layers(
+    index: BlockIndex,
+    weather: &BlockWeather,
+    cells_decided: bool,
     seed: u64,
     types: &CloudTypes,
 ) -> CloudBlock {
@@ -59,7 +102,9 @@ pub fn generate_block(
             wind_axis_deg: 90.0 - weather.wind.from_deg as f64,
         };
         let first = block.clouds.len();
-        let (covered, boxes) = if layer.coverage_oktas <= 0.0 {
+        // The field's cells are its cumulonimbus: no heaps of the block's own.
+        let cells_instead = cells_decided && layer.cloud_type == CloudType::Cumulonimbus;
+        let (covered, boxes) = if layer.coverage_oktas <= 0.0 || cells_instead {
             (0.0, 0)
         } else if config.continuous || layer.coverage_oktas >= OVERCAST_OKTAS {
             lattice_layer(index, &ctx, seed, &mut block.clouds)
@@ -104,9 +149,9 @@ pub fn generate_block(
 const RAIN_KEY: u64 = 0x7261_696e;
 
 /// Vertical placement of one layer, metres above mean sea level.
-struct LayerFrame {
-    base_m: f64,
-    thickness_m: f64,
+pub(super) struct LayerFrame {
+    pub(super) base_m: f64,
+    pub(super) thickness_m: f64,
 }
 
 impl LayerFrame {
@@ -319,18 +364,20 @@ pub(super) struct Raw {
     /// Stands on the cloud base: takes the first texture band (small rotation), this category of
     /// it where the band has it (flat-bottomed on the rim, foggy under the inside).
     pub(super) base: Option<TextureCategory>,
+    /// A set texture category, whatever the band (a storm's fibrous anvil edge).
+    pub(super) category: Option<TextureCategory>,
 }
 
 /// Builds one cloud of `d` metres diameter centred (horizontally) at `centre`; returns the cloud
 /// and the number of boxes it used.
 /// What every cloud of one layer shares.
-struct LayerCtx<'a> {
-    config: &'a CloudTypeConfig,
-    layer: &'a BlockLayer,
-    li: usize,
-    frame: &'a LayerFrame,
+pub(super) struct LayerCtx<'a> {
+    pub(super) config: &'a CloudTypeConfig,
+    pub(super) layer: &'a BlockLayer,
+    pub(super) li: usize,
+    pub(super) frame: &'a LayerFrame,
     /// Direction of the wind's axis, degrees anticlockwise from east (streaks lie along it).
-    wind_axis_deg: f64,
+    pub(super) wind_axis_deg: f64,
 }
 
 fn build_cloud(
@@ -437,6 +484,7 @@ fn build_cloud(
                 group: group - 1,
                 rotation_deg: streak.map(|_| ctx.wind_axis_deg),
                 base: None,
+                category: None,
             });
         }
     }
@@ -450,7 +498,7 @@ fn build_cloud(
 }
 
 /// Wang 2003 §3.1: traverse the list, drop a sprite closer than the cull radius to a kept one.
-fn cull(raws: Vec<Raw>, fraction: f64) -> Vec<Raw> {
+pub(super) fn cull(raws: Vec<Raw>, fraction: f64) -> Vec<Raw> {
     let mut kept: Vec<Raw> = Vec::with_capacity(raws.len());
     for r in raws {
         let radius = fraction * r.height;
@@ -463,7 +511,12 @@ fn cull(raws: Vec<Raw>, fraction: f64) -> Vec<Raw> {
 }
 
 /// Textures, rotations, shading groups and colour levels; positions made relative to the centre.
-fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMix64) -> Cloud {
+pub(super) fn finish_cloud(
+    ctx: &LayerCtx,
+    centre: DVec2,
+    kept: Vec<Raw>,
+    rng: &mut SplitMix64,
+) -> Cloud {
     let LayerCtx {
         config,
         layer,
@@ -505,8 +558,9 @@ fn finish_cloud(ctx: &LayerCtx, centre: DVec2, kept: Vec<Raw>, rng: &mut SplitMi
             _ => (&[TextureCategory::Wispy][..], [0.0, 360.0]),
         };
         let pick = rng.range_u32(0, categories.len() as u32 - 1) as usize;
-        let category = match r.base {
-            Some(wanted) if categories.contains(&wanted) => wanted,
+        let category = match (r.category, r.base) {
+            (Some(set), _) => set,
+            (None, Some(wanted)) if categories.contains(&wanted) => wanted,
             _ => categories[pick],
         };
         let cells = category.cells();

@@ -79,6 +79,7 @@ pub(super) fn heap_sprites(
                 } else {
                     TextureCategory::FlatBottom
                 }),
+                category: None,
             });
         }
     }
@@ -149,6 +150,7 @@ pub(super) fn heap_sprites(
                 group: group - 1,
                 rotation_deg: None,
                 base: None,
+                category: None,
             });
         }
     }
@@ -188,6 +190,7 @@ pub(super) fn heap_sprites(
                 group: group - 1,
                 rotation_deg: None,
                 base: None,
+                category: None,
             });
         }
     }

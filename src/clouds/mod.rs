@@ -31,6 +31,7 @@ pub mod probe;
 pub mod rain;
 pub mod rng;
 pub mod sheet;
+pub mod storm;
 
 pub use block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};
 pub use config::{CloudTypeConfig, CloudTypes, CloudsConfig, LifecycleConfig, TextureCategory};

@@ -129,7 +129,7 @@ fn slab(a: DVec3, b: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64)> {
     Some((t0, t1))
 }
 
-/// The boxes of one generation and the bounds of them all.
+/// The boxes of one generation, the bounds of them all and a grid over them.
 #[derive(Debug)]
 pub struct GenerationBoxes {
     /// One per cloud with cloud sprites.
@@ -138,11 +138,13 @@ pub struct GenerationBoxes {
     pub lo_m: DVec3,
     /// See `lo_m`.
     pub hi_m: DVec3,
+    /// The boxes' footprints on a horizontal grid, for lines of sight.
+    grid: BoxGrid,
 }
 
 impl GenerationBoxes {
-    /// The boxes of a generation's clouds.
-    pub fn of(clouds: &[Cloud]) -> Self {
+    /// The boxes of a generation's clouds, gridded in cells of `cell_m`.
+    pub fn of(clouds: &[Cloud], cell_m: f64) -> Self {
         let boxes: Vec<CloudBox> = clouds
             .iter()
             .enumerate()
@@ -155,11 +157,61 @@ impl GenerationBoxes {
             lo = lo.min((b.centre_m - b.half_m).min(b.cloud_centre_m - r));
             hi = hi.max((b.centre_m + b.half_m).max(b.cloud_centre_m + r));
         }
+        let grid = BoxGrid::of(&boxes, cell_m);
         Self {
             boxes,
             lo_m: lo,
             hi_m: hi,
+            grid,
         }
+    }
+
+    /// The boxes the segment `a..b` enters, each once, nearest cells first:
+    /// `hit(box, t in, t out)` says whether it counts (a faded-out cloud does not). With
+    /// `whole` false it stops once no box left can be entered before the nearest counted one
+    /// (or `best_t`, the nearest found elsewhere).
+    fn crossed(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        best_t: f64,
+        whole: bool,
+        mut hit: impl FnMut(&CloudBox, f64, f64) -> bool,
+    ) {
+        let Some((from, to)) = slab(a, b, self.lo_m, self.hi_m) else {
+            return;
+        };
+        let mut best = best_t;
+        // A box is tested the first time a cell lists it (a big box is listed in many cells),
+        // and counted once; once the nearest entry is before the cell is left, no box not yet
+        // met can be entered earlier (its entry point lies in a later cell, which lists it).
+        // On the stack for up to 2,048 boxes (a block holds a few hundred clouds).
+        let mut stack = [0u64; 32];
+        let mut heap = Vec::new();
+        let words = self.boxes.len().div_ceil(64);
+        let met: &mut [u64] = if words <= stack.len() {
+            &mut stack[..words]
+        } else {
+            heap.resize(words, 0u64);
+            &mut heap
+        };
+        self.grid.walk(a, b, from, to, |list, _, cell_out| {
+            for &index in list {
+                let (word, bit) = (index as usize / 64, 1u64 << (index % 64));
+                if met[word] & bit != 0 {
+                    continue;
+                }
+                met[word] |= bit;
+                let bx = &self.boxes[index as usize];
+                let Some((t0, t1)) = bx.segment(a, b) else {
+                    continue;
+                };
+                if hit(bx, t0, t1) {
+                    best = best.min(t0);
+                }
+            }
+            whole || best >= cell_out
+        });
     }
 
     fn distance_m(&self, p: DVec3) -> f64 {
@@ -172,22 +224,227 @@ impl GenerationBoxes {
     }
 }
 
-/// The boxes of the generations asked about, by serial; shared by the queries of a frame.
+/// The most cells a side of a [`BoxGrid`] has (a generation's clouds spread over a few blocks at
+/// most; a coarser grid beyond that).
+const GRID_MAX_SIDE: usize = 64;
+
+/// A uniform horizontal grid over boxes: each cell lists the boxes whose footprint (padded by a
+/// metre against rounding) overlaps it, so a segment walked through the cells it crosses
+/// (Amanatides and Woo 1987, "A fast voxel traversal algorithm for ray tracing") tests only the
+/// boxes near it, nearest cells first.
+#[derive(Debug)]
+struct BoxGrid {
+    /// South-west corner, air frame metres.
+    origin_m: DVec2,
+    /// Cell side, metres.
+    cell_m: f64,
+    /// Cells east and north.
+    nx: usize,
+    ny: usize,
+    /// Where each cell's list starts in `items` (`nx * ny + 1` entries).
+    starts: Vec<u32>,
+    /// Box indices, cell after cell.
+    items: Vec<u32>,
+}
+
+impl BoxGrid {
+    fn of(boxes: &[CloudBox], cell_m: f64) -> Self {
+        let pad = DVec2::splat(1.0);
+        let mut lo = DVec2::splat(f64::MAX);
+        let mut hi = DVec2::splat(f64::MIN);
+        for b in boxes {
+            lo = lo.min((b.centre_m - b.half_m).truncate() - pad);
+            hi = hi.max((b.centre_m + b.half_m).truncate() + pad);
+        }
+        if boxes.is_empty() {
+            (lo, hi) = (DVec2::ZERO, DVec2::ONE);
+        }
+        let size = hi - lo;
+        let cell_m = cell_m
+            .max(size.max_element() / GRID_MAX_SIDE as f64)
+            .max(1.0);
+        let nx = ((size.x / cell_m).ceil() as usize).clamp(1, GRID_MAX_SIDE);
+        let ny = ((size.y / cell_m).ceil() as usize).clamp(1, GRID_MAX_SIDE);
+        let cells = |b: &CloudBox| {
+            let a = ((b.centre_m - b.half_m).truncate() - pad - lo) / cell_m;
+            let z = ((b.centre_m + b.half_m).truncate() + pad - lo) / cell_m;
+            let clamp = |v: f64, n: usize| (v.floor().max(0.0) as usize).min(n - 1);
+            (
+                clamp(a.x, nx)..=clamp(z.x, nx),
+                clamp(a.y, ny)..=clamp(z.y, ny),
+            )
+        };
+        // Counted, then filled: one allocation for every list.
+        let mut counts = vec![0u32; nx * ny + 1];
+        for b in boxes {
+            let (xs, ys) = cells(b);
+            for y in ys {
+                for x in xs.clone() {
+                    counts[y * nx + x + 1] += 1;
+                }
+            }
+        }
+        for k in 1..counts.len() {
+            counts[k] += counts[k - 1];
+        }
+        let starts = counts.clone();
+        let mut items = vec![0u32; counts[nx * ny] as usize];
+        for (index, b) in boxes.iter().enumerate() {
+            let (xs, ys) = cells(b);
+            for y in ys {
+                for x in xs.clone() {
+                    let at = &mut counts[y * nx + x];
+                    items[*at as usize] = index as u32;
+                    *at += 1;
+                }
+            }
+        }
+        Self {
+            origin_m: lo,
+            cell_m,
+            nx,
+            ny,
+            starts,
+            items,
+        }
+    }
+
+    /// Walks the cells the segment `a + t (b - a)` crosses for t in `t_from..=t_to`, in order:
+    /// `visit(boxes of the cell, t entering it, t leaving it)`, the first cell entered at
+    /// minus infinity and the last left at plus infinity (so every t belongs to one cell);
+    /// stops when `visit` says false.
+    fn walk(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        t_from: f64,
+        t_to: f64,
+        mut visit: impl FnMut(&[u32], f64, f64) -> bool,
+    ) {
+        let (a2, d) = (a.truncate(), (b - a).truncate());
+        let hi = self.origin_m + DVec2::new(self.nx as f64, self.ny as f64) * self.cell_m;
+        // The part of the segment over the grid.
+        let Some((t0, t1)) = slab(
+            a2.extend(0.0),
+            (a2 + d).extend(0.0),
+            self.origin_m.extend(-1.0),
+            hi.extend(1.0),
+        ) else {
+            return;
+        };
+        let (t0, t1) = (t0.max(t_from), t1.min(t_to));
+        if t0 > t1 {
+            return;
+        }
+        let start = (a2 + d * t0 - self.origin_m) / self.cell_m;
+        let mut cell = [
+            (start.x.floor().max(0.0) as usize).min(self.nx - 1) as i64,
+            (start.y.floor().max(0.0) as usize).min(self.ny - 1) as i64,
+        ];
+        let n = [self.nx as i64, self.ny as i64];
+        let mut step = [0i64; 2];
+        let mut next = [f64::INFINITY; 2];
+        let mut delta = [f64::INFINITY; 2];
+        for k in 0..2 {
+            if d[k].abs() > 1e-12 {
+                step[k] = if d[k] > 0.0 { 1 } else { -1 };
+                let edge =
+                    self.origin_m[k] + (cell[k] + i64::from(d[k] > 0.0)) as f64 * self.cell_m;
+                next[k] = (edge - a2[k]) / d[k];
+                delta[k] = self.cell_m / d[k].abs();
+            }
+        }
+        let mut enter = f64::NEG_INFINITY;
+        loop {
+            let k = usize::from(next[1] < next[0]);
+            let last = next[k] >= t1 || !(0..n[k]).contains(&(cell[k] + step[k]));
+            let leave = if last { f64::INFINITY } else { next[k] };
+            let c = cell[1] as usize * self.nx + cell[0] as usize;
+            let list = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
+            if !visit(list, enter, leave) || last {
+                return;
+            }
+            enter = leave;
+            cell[k] += step[k];
+            next[k] += delta[k];
+        }
+    }
+}
+
+/// The boxes of the generations asked about, by serial, and per block the generations with
+/// the bounds of them all; shared by the queries of a frame. The per-block lists hold while the
+/// field's membership ([`CloudField::membership`]) does: a query then looks a block up once
+/// and passes over it on its bounds, without the field's own look-ups.
 #[derive(Debug, Default)]
 pub struct BoxCache {
-    map: Mutex<HashMap<u64, Arc<GenerationBoxes>>>,
+    state: Mutex<CacheState>,
+}
+
+#[derive(Debug, Default)]
+struct CacheState {
+    /// Boxes by generation serial.
+    boxes: HashMap<u64, Arc<GenerationBoxes>, BuildFast>,
+    /// The field (its address) and membership the block lists are of.
+    key: Option<(usize, u64)>,
+    /// Per block: the generations' serials and boxes, and the bounds of them all.
+    blocks: HashMap<BlockIndex, BlockBoxes, BuildFast>,
+}
+
+#[derive(Debug)]
+struct BlockBoxes {
+    lo_m: DVec3,
+    hi_m: DVec3,
+    generations: Vec<(u64, Arc<GenerationBoxes>)>,
+}
+
+/// A multiplicative hash (the Fx hash of rustc) for the cache's small integer keys: the default
+/// SipHash was a tenth of a line of sight's time.
+#[derive(Debug, Default, Clone, Copy)]
+struct BuildFast;
+
+#[derive(Debug, Default)]
+struct FastHasher(u64);
+
+impl std::hash::BuildHasher for BuildFast {
+    type Hasher = FastHasher;
+    fn build_hasher(&self) -> FastHasher {
+        FastHasher(0)
+    }
+}
+
+impl std::hash::Hasher for FastHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x517c_c1b7_2722_0a95);
+    }
+    fn write_i32(&mut self, x: i32) {
+        self.write_u64(u64::from(x as u32));
+    }
 }
 
 impl BoxCache {
-    /// Forgets the generations the field no longer holds, once it holds many more than it has.
+    /// Forgets the generations the field no longer holds, once it holds many more than it has,
+    /// and the block lists when its membership changed.
     fn prune(&self, field: &CloudField) {
-        let Ok(mut map) = self.map.lock() else {
+        let Ok(mut state) = self.state.lock() else {
             return;
         };
-        if map.len() > 2 * field.block_count() + 64 {
+        let key = (std::ptr::from_ref(field) as usize, field.membership());
+        if state.key != Some(key) {
+            state.key = Some(key);
+            state.blocks.clear();
+        }
+        if state.boxes.len() > 2 * field.block_count() + 64 {
             let live: std::collections::HashSet<u64> =
                 field.blocks().map(|(_, g)| g.serial).collect();
-            map.retain(|serial, _| live.contains(serial));
+            state.boxes.retain(|serial, _| live.contains(serial));
         }
     }
 }
@@ -249,21 +506,28 @@ impl<'a> CloudProbe<'a> {
 
     /// Every generation of the blocks whose square reaches within `reach_m` of the air-frame
     /// box `lo..hi` (horizontally) and passes `wanted` (its square padded by a block, for the
-    /// clouds that overhang it), with its boxes. The cache is locked once for the query.
-    fn generations(
+    /// clouds that overhang it) and whose clouds' bounds pass `near`, as `keep` makes of it
+    /// and its boxes (`None`: left out). The cache is locked once for the query.
+    fn generations<T>(
         &self,
         lo: DVec2,
         hi: DVec2,
         reach_m: f64,
         wanted: impl Fn(DVec2, DVec2) -> bool,
-    ) -> Vec<(&'a FieldBlock, Arc<GenerationBoxes>)> {
+        near: impl Fn(DVec3, DVec3) -> bool,
+        mut keep: impl FnMut(&'a FieldBlock, &Arc<GenerationBoxes>) -> Option<T>,
+    ) -> Vec<T> {
         // Clouds overhang their block by up to a block.
         let pad = reach_m + BLOCK_SIZE_M;
         let a = BlockIndex::containing(lo - DVec2::splat(pad));
         let b = BlockIndex::containing(hi + DVec2::splat(pad));
-        let mut map = self.cache.map.lock().ok();
-        let mut out = Vec::new();
         let field: &'a CloudField = self.field;
+        let cell_m = self.settings.grid_cell_m;
+        let mut out = Vec::new();
+        let Ok(mut guard) = self.cache.state.lock() else {
+            return out;
+        };
+        let state = &mut *guard;
         for j in a.j..=b.j {
             for i in a.i..=b.i {
                 let index = BlockIndex::new(i, j);
@@ -275,18 +539,41 @@ impl<'a> CloudProbe<'a> {
                 if !wanted(square.0, square.1) {
                     continue;
                 }
-                for g in field.generations(index) {
-                    if g.phase == Phase::Gone || g.block.clouds.is_empty() {
-                        continue;
+                let entry = state.blocks.entry(index).or_insert_with(|| {
+                    let mut lo = DVec3::splat(f64::MAX);
+                    let mut hi = DVec3::splat(f64::MIN);
+                    let generations = field
+                        .generations(index)
+                        .iter()
+                        .filter(|g| g.phase != Phase::Gone && !g.block.clouds.is_empty())
+                        .map(|g| {
+                            let boxes =
+                                Arc::clone(state.boxes.entry(g.serial).or_insert_with(|| {
+                                    Arc::new(GenerationBoxes::of(&g.block.clouds, cell_m))
+                                }));
+                            if !boxes.boxes.is_empty() {
+                                lo = lo.min(boxes.lo_m);
+                                hi = hi.max(boxes.hi_m);
+                            }
+                            (g.serial, boxes)
+                        })
+                        .collect();
+                    BlockBoxes {
+                        lo_m: lo,
+                        hi_m: hi,
+                        generations,
                     }
-                    let boxes = match map.as_mut() {
-                        Some(map) => Arc::clone(
-                            map.entry(g.serial)
-                                .or_insert_with(|| Arc::new(GenerationBoxes::of(&g.block.clouds))),
-                        ),
-                        None => Arc::new(GenerationBoxes::of(&g.block.clouds)),
-                    };
-                    out.push((g, boxes));
+                });
+                if entry.generations.is_empty() || !near(entry.lo_m, entry.hi_m) {
+                    continue;
+                }
+                let live = field.generations(index);
+                for (serial, boxes) in &entry.generations {
+                    if let Some(g) = live.iter().find(|g| g.serial == *serial)
+                        && let Some(kept) = keep(g, boxes)
+                    {
+                        out.push(kept);
+                    }
                 }
             }
         }
@@ -316,7 +603,12 @@ impl<'a> CloudProbe<'a> {
         let mut nearest = f64::INFINITY;
         let mut nearest_cb = f64::INFINITY;
         let all = |_: DVec2, _: DVec2| true;
-        for (g, boxes) in self.generations(q.truncate(), q.truncate(), reach, all) {
+        let near = |lo: DVec3, hi: DVec3| {
+            let (c, h) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+            ((q - c).abs() - h).max(DVec3::ZERO).length() <= reach
+        };
+        let keep = |g, b: &Arc<GenerationBoxes>| Some((g, Arc::clone(b)));
+        for (g, boxes) in self.generations(q.truncate(), q.truncate(), reach, all, near, keep) {
             if boxes.distance_m(q) > reach.min(nearest.max(nearest_cb)) {
                 continue;
             }
@@ -386,33 +678,35 @@ impl<'a> CloudProbe<'a> {
             )
             .is_some()
         };
-        let mut near: Vec<(f64, &FieldBlock, Arc<GenerationBoxes>)> = self
-            .generations(lo.truncate(), hi.truncate(), 0.0, crosses)
-            .into_iter()
-            .filter_map(|(g, boxes)| {
-                slab(qa, qb, boxes.lo_m, boxes.hi_m).map(|(t0, _)| (t0, g, boxes))
-            })
-            .collect();
+        let mut near: Vec<(f64, &FieldBlock, Arc<GenerationBoxes>)> = self.generations(
+            lo.truncate(),
+            hi.truncate(),
+            0.0,
+            crosses,
+            |lo, hi| slab(qa, qb, lo, hi).is_some(),
+            |g, boxes| {
+                slab(qa, qb, boxes.lo_m, boxes.hi_m).map(|(t0, _)| (t0, g, Arc::clone(boxes)))
+            },
+        );
         near.sort_by(|x, y| x.0.total_cmp(&y.0));
         for (enter, g, boxes) in near {
             if !whole && first.is_some_and(|f| enter > f.0) {
                 break;
             }
-            for bx in &boxes.boxes {
-                let Some((t0, t1)) = bx.segment(qa, qb) else {
-                    continue;
-                };
+            let best = first.map_or(f64::INFINITY, |f| f.0);
+            boxes.crossed(qa, qb, best, whole, |bx, t0, t1| {
                 let mid = qa.lerp(qb, 0.5 * (t0 + t1));
                 let fade = f64::from(self.fade(g, bx, mid));
                 if fade <= 0.0 {
-                    continue;
+                    return false;
                 }
                 let depth = sigma * (t1 - t0) * length * fade;
                 total += depth;
                 if first.is_none_or(|f| t0 < f.0) {
                     first = Some((t0, depth, bx.cloud_type));
                 }
-            }
+                true
+            });
         }
         first.map(|(t, depth, cloud_type)| SightHit {
             distance_m: t * length,
@@ -504,5 +798,77 @@ mod tests {
         assert_eq!(b.inside(DVec3::new(500.0, 0.0, 2000.0), 0.35), 0.0);
         assert_eq!(b.inside(DVec3::new(1000.0, 0.0, 2000.0), 0.35), 1.0);
         assert!((b.distance_m(DVec3::new(0.0, 0.0, 2000.0)) - 500.0).abs() < 1e-9);
+    }
+
+    /// The grid a line of sight walks finds what testing every box finds: on 300 clouds of
+    /// random size and place and 3,000 segments (level, upright, axis-aligned, starting inside
+    /// and outside the clouds), every box entered is met exactly once, and the nearest entry
+    /// (the first cloud) is the same, for a fine, the shipped and a coarse grid.
+    #[test]
+    fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rand = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let clouds: Vec<Cloud> = (0..300)
+            .map(|_| {
+                let c = DVec3::new(
+                    rand() * 12_000.0 - 2_000.0,
+                    rand() * 8_000.0,
+                    500.0 + rand() * 2_500.0,
+                );
+                let half = (30.0 + rand() * 1_500.0 * rand()) as f32;
+                cube_cloud(c, half, CloudType::CumulusMediocris)
+            })
+            .collect();
+        let mut met_first = 0;
+        for cell_m in [120.0, 500.0, 4_000.0] {
+            let boxes = GenerationBoxes::of(&clouds, cell_m);
+            for k in 0..3_000 {
+                let mut a = DVec3::new(
+                    rand() * 16_000.0 - 4_000.0,
+                    rand() * 12_000.0 - 2_000.0,
+                    rand() * 3_500.0,
+                );
+                let mut b = a + DVec3::new(
+                    (rand() - 0.5) * 20_000.0,
+                    (rand() - 0.5) * 20_000.0,
+                    (rand() - 0.5) * 3_000.0,
+                );
+                match k % 6 {
+                    0 => b.z = a.z,
+                    1 => b = a.with_z(a.z + 3_000.0),
+                    2 => b.x = a.x,
+                    3 => a = boxes.boxes[k % boxes.boxes.len()].centre_m,
+                    _ => {}
+                }
+                let mut all: Vec<(f64, usize)> = boxes
+                    .boxes
+                    .iter()
+                    .filter_map(|bx| bx.segment(a, b).map(|(t0, _)| (t0, bx.cloud)))
+                    .collect();
+                all.sort_by_key(|x| x.1);
+                let mut seen = Vec::new();
+                boxes.crossed(a, b, f64::INFINITY, true, |bx, t0, _| {
+                    seen.push((t0, bx.cloud));
+                    true
+                });
+                seen.sort_by_key(|x| x.1);
+                assert_eq!(seen, all, "cell {cell_m} m, segment {k}: {a} to {b}");
+                let nearest = all.iter().map(|h| h.0).fold(f64::INFINITY, f64::min);
+                let mut first = f64::INFINITY;
+                boxes.crossed(a, b, f64::INFINITY, false, |_, t0, _| {
+                    first = first.min(t0);
+                    true
+                });
+                assert_eq!(first, nearest, "cell {cell_m} m, segment {k}");
+                met_first += nearest.is_finite() as usize;
+            }
+        }
+        // Both kinds of segment were asked about.
+        assert!((1_000..8_000).contains(&met_first), "{met_first}");
     }
 }

@@ -147,6 +147,7 @@ mod tests {
             temperature_c: 24.0,
             dewpoint_c: 24.0 - spread_c,
             precipitation,
+            thunder: 0.0,
             ground_elevation_m: 100.0,
         }
     }

@@ -31,8 +31,9 @@ pub struct DemoHost {
     timer: Option<GpuTimer>,
 }
 
-/// Five timestamps: around the sky's own submission from `prepare`, then before the frame's
-/// passes, between the ground and the sky, after; where the device has timestamp queries.
+/// Five timestamps: around the sky's `prepare` (which submits work of its own only to flush a
+/// frame it prepared and never recorded), then before the frame's passes, between the ground
+/// and the sky, after; where the device has timestamp queries.
 struct GpuTimer {
     stamps: Timestamps,
 }
@@ -43,16 +44,15 @@ impl GpuTimer {
         Some(Self { stamps })
     }
 
-    /// Writes timestamp `index` in a submission of its own (around the sky's `prepare`, which
-    /// submits the sky's own work).
+    /// Writes timestamp `index` in a submission of its own (around the sky's `prepare`).
     fn stamp(&self, gpu: &HeadlessGpu, index: u32) {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         self.stamps.write(&mut encoder, index);
         gpu.queue.submit([encoder.finish()]);
     }
 
-    /// Milliseconds of the ground and of the sky (its own submission from `prepare` and its
-    /// passes in the frame) of the last submitted frame (waits for it).
+    /// Milliseconds of the ground and of the sky (anything `prepare` submitted, and its passes
+    /// in the frame, impostor renders included) of the last submitted frame (waits for it).
     fn read_ms(&self, gpu: &HeadlessGpu) -> Option<[f64; 2]> {
         let t = self.stamps.read_ms(&gpu.device)?;
         let ms = |a: usize, b: usize| (t[b] - t[a]).max(0.0);
@@ -186,8 +186,9 @@ impl DemoHost {
         mut stats: FrameStats,
     ) -> Result<FrameStats, RenderError> {
         let light = self.sky.light();
+        let shadows = self.sky.cloud_shadows();
         self.terrain.prepare(
-            &self.gpu.queue,
+            (&self.gpu.device, &self.gpu.queue),
             camera,
             &TerrainLight {
                 sun_dir,
@@ -197,6 +198,7 @@ impl DemoHost {
                 haze: self.sky.ground_haze(visibility_m),
                 camera_radius_m: self.sky.earth().camera_radius_m(camera.position_m.z),
             },
+            &shadows,
         );
         let mut encoder = self
             .gpu

@@ -11,7 +11,7 @@ use wgpu::util::DeviceExt;
 
 use super::headless::DEPTH_FORMAT;
 use crate::render::gpu_types::{GpuTerrainFrame, GpuTerrainVertex};
-use crate::render::{Camera, RenderError};
+use crate::render::{Camera, CloudShadowMap, RenderError};
 
 /// A square grid of heights, plain data.
 #[derive(Debug, Clone, PartialEq)]
@@ -171,7 +171,10 @@ pub fn procedural_relief_m(point_m: DVec2, amplitude_m: f64, seed: u32) -> f64 {
 pub struct Terrain {
     pipeline: wgpu::RenderPipeline,
     frame_buffer: wgpu::Buffer,
-    frame_group: wgpu::BindGroup,
+    layout: wgpu::BindGroupLayout,
+    shadow_sampler: wgpu::Sampler,
+    /// Its uniform and the sky's shadow map of this frame (made by [`Self::prepare`]).
+    frame_group: Option<wgpu::BindGroup>,
     vertex_buffer: wgpu::Buffer,
     index_buffer: wgpu::Buffer,
     index_count: u32,
@@ -213,24 +216,42 @@ impl Terrain {
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("host.terrain_layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
                 },
-                count: None,
-            }],
+                // The sky's cloud shadow map (optical depth, R16Float) and a linear sampler
+                // clamped to its edge.
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
         });
-        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("host.terrain_group"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: frame_buffer.as_entire_binding(),
-            }],
+        let shadow_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("host.terrain_shadow_sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("host.terrain"),
@@ -286,7 +307,9 @@ impl Terrain {
         Self {
             pipeline,
             frame_buffer,
-            frame_group,
+            layout,
+            shadow_sampler,
+            frame_group: None,
             vertex_buffer,
             index_buffer,
             index_count: indices.len() as u32,
@@ -294,8 +317,15 @@ impl Terrain {
         }
     }
 
-    /// Writes this frame's uniforms.
-    pub fn prepare(&self, queue: &wgpu::Queue, camera: &Camera, light: &TerrainLight) {
+    /// Writes this frame's uniforms and binds the sky's cloud shadow map of this frame
+    /// (`shadows`: [`crate::render::Sky::cloud_shadows`]), which dims the ground's sunlight.
+    pub fn prepare(
+        &mut self,
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
+        camera: &Camera,
+        light: &TerrainLight,
+        shadows: &CloudShadowMap,
+    ) {
         let origin_rel =
             (DVec3::new(self.centre_m.x, self.centre_m.y, 0.0) - camera.position_m).as_vec3();
         let frame = GpuTerrainFrame {
@@ -307,8 +337,27 @@ impl Terrain {
             sun_rgb: light.sun_rgb.extend(1.0).to_array(),
             fog_rgb: light.fog_rgb.extend(light.camera_radius_m).to_array(),
             haze: light.haze.to_gpu(),
+            shadow_uv: shadows.uv_from_camera_relative.to_cols_array_2d(),
         };
         queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&frame));
+        self.frame_group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("host.terrain_group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.frame_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(shadows.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&self.shadow_sampler),
+                },
+            ],
+        }));
     }
 
     /// Clears colour and depth and draws the ground.
@@ -341,8 +390,12 @@ impl Terrain {
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        let Some(group) = &self.frame_group else {
+            // Not prepared yet: the cleared target only.
+            return;
+        };
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.frame_group, &[]);
+        pass.set_bind_group(0, group, &[]);
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.index_count, 0, 0..1);

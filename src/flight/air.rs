@@ -25,8 +25,10 @@ use serde::Serialize;
 
 use crate::clouds::probe::{BoxCache, CloudProbe, CloudsAtPoint, SightHit};
 use crate::shading::FogSettings;
-use crate::weather::air::{AirSettings, SurfaceAir, air_at, feet};
+use crate::weather::StationTable;
+use crate::weather::air::{AirSettings, SurfaceAir, air_at_aloft, feet};
 use crate::weather::block::ceiling_ft;
+use crate::weather::winds_aloft::{AloftColumn, WindsAloft, WindsAloftField};
 use crate::weather::{BlockWeather, CloudType, METRES_PER_FOOT};
 
 use super::world::World;
@@ -136,6 +138,21 @@ impl World {
         &self.air.settings
     }
 
+    /// Uses the winds and temperatures aloft of an FB product above the boundary layer (`None`:
+    /// the documented profile), its sites placed through `table`; returns how many sites were
+    /// placed and the ids of those that were not.
+    pub fn set_winds_aloft(
+        &mut self,
+        fb: Option<&WindsAloft>,
+        table: &StationTable,
+    ) -> (usize, Vec<String>) {
+        self.air.aloft = fb.map(|fb| WindsAloftField::build(self.field().frame(), fb, table));
+        self.air
+            .aloft
+            .as_ref()
+            .map_or((0, Vec::new()), |f| (f.placed, f.unplaced.clone()))
+    }
+
     /// Uses `air` and `fog` settings for the air data.
     pub fn set_air_settings(&mut self, air: AirSettings, fog: FogSettings) {
         self.air.settings = air;
@@ -200,9 +217,15 @@ impl World {
             .field()
             .gust_and_qnh_at(point_m.truncate(), s.pressure.default_qnh_hpa);
         let surface = SurfaceAir::of(&weather, gust, qnh);
+        let aloft = self
+            .air
+            .aloft
+            .as_ref()
+            .map(|f| f.column_at(point_m.truncate()));
         air_data(
             &weather,
             &surface,
+            aloft.as_ref(),
             &clouds,
             point_m.z,
             lat_deg,
@@ -222,6 +245,8 @@ pub struct AirState {
     settings: AirSettings,
     fog: FogSettings,
     cache: BoxCache,
+    /// The FB product's winds and temperatures aloft, placed in the world's frame.
+    aloft: Option<WindsAloftField>,
 }
 
 /// The air data of a point from its weather, surface air and clouds.
@@ -229,6 +254,7 @@ pub struct AirState {
 fn air_data(
     weather: &BlockWeather,
     surface: &SurfaceAir,
+    aloft: Option<&AloftColumn>,
     clouds: &CloudsAtPoint,
     alt_m_msl: f64,
     lat_deg: f64,
@@ -239,7 +265,7 @@ fn air_data(
     moderate: f64,
     heavy: f64,
 ) -> AirData {
-    let column = air_at(surface, alt_m_msl, lat_deg, s);
+    let column = air_at_aloft(surface, alt_m_msl, lat_deg, s, aloft);
     let ground = surface.ground_m_msl;
     let layer = |l: &crate::weather::BlockLayer| AirLayer {
         cloud_type: l.cloud_type,
@@ -430,6 +456,14 @@ impl super::SkySystem {
     ) -> Option<SightHit> {
         self.world()
             .line_of_sight(self.local_m(from), self.local_m(to))
+    }
+
+    /// Uses the winds and temperatures aloft of an FB product ([`World::set_winds_aloft`]),
+    /// its sites placed through the built-in station table; returns how many were placed and
+    /// the ids of those that were not.
+    pub fn set_winds_aloft(&mut self, fb: Option<&WindsAloft>) -> (usize, Vec<String>) {
+        self.world_mut()
+            .set_winds_aloft(fb, &StationTable::builtin())
     }
 
     /// How much of the sun's disc the clouds hide from a position, 0..=1.

@@ -201,7 +201,11 @@ fn still_clear_air_has_no_turbulence_and_no_icing() {
 #[test]
 fn icing_only_in_cloud_or_precipitation_at_0_to_minus_20() {
     let w = world(REAL, 42.239, -8.624, true);
-    let cb = boxes_of(&w, CloudType::Cumulonimbus)[0];
+    // A storm cell is drawn in parts, one a block: the part holding most of the tower's height.
+    let cb = boxes_of(&w, CloudType::Cumulonimbus)
+        .into_iter()
+        .max_by(|a, b| a.half_m.z.total_cmp(&b.half_m.z))
+        .unwrap();
     let ground = f64::from(w.field().weather_at(DVec2::ZERO).ground_elevation_m);
     // Up the middle of the Cb: icing exactly where it is 0 to -20 C.
     let (lo, hi) = (
@@ -258,4 +262,43 @@ fn the_in_cloud_settings_are_the_renderers() {
     let render = crate::render::RenderSettings::default().in_cloud;
     assert_eq!(air.visibility_m, render.visibility_m);
     assert_eq!(air.ramp_fraction, render.ramp_fraction);
+}
+
+/// With the shipped FB product, at San Antonio (KSAT, FB site SAT) at each FB level above the
+/// boundary layer the air data is the FB forecast: its wind and, where given, its temperature;
+/// without the product the same points follow the documented profile instead.
+#[test]
+fn at_an_fb_site_and_level_the_air_is_the_fb_forecast() {
+    use crate::weather::winds_aloft::WindsAloft;
+    let fb = WindsAloft::load(&path("weather/fd1us1-2026-01-31T06Z.txt")).unwrap();
+    let table = crate::weather::StationTable::builtin();
+    let ksat = table.get("KSAT").unwrap();
+    let mut w = world(REAL, ksat.latitude_deg, ksat.longitude_deg, false);
+    let profile: Vec<AirData> = fb
+        .levels_ft
+        .iter()
+        .map(|ft| w.air_at(DVec3::new(0.0, 0.0, metres(*ft)), UP))
+        .collect();
+    let (placed, unplaced) = w.set_winds_aloft(Some(&fb), &table);
+    assert_eq!((placed, unplaced.len()), (157, 19));
+    let sat = fb.sites.iter().find(|s| s.id == "SAT").unwrap();
+    let mut differs = 0;
+    for ((ft, level), before) in fb.levels_ft.iter().zip(&sat.levels).zip(&profile) {
+        let level = level.unwrap();
+        let a = w.air_at(DVec3::new(0.0, 0.0, metres(*ft)), UP);
+        assert!(
+            a.height_agl_ft > 2_000.0,
+            "{ft} ft is above the boundary layer"
+        );
+        let turn = (a.wind_from_deg - level.from_deg + 540.0).rem_euclid(360.0) - 180.0;
+        assert!(turn.abs() < 0.01, "{ft} ft: {a:?} {level:?}");
+        assert!((a.wind_kt - level.speed_kt).abs() < 0.01, "{ft} ft: {a:?}");
+        assert_eq!(a.gust_kt, a.wind_kt);
+        if let Some(t) = level.temperature_c {
+            assert!((a.temperature_c - t).abs() < 1e-9, "{ft} ft: {a:?}");
+        }
+        // Without the product: the profile, which is not the forecast here.
+        differs += ((before.wind_kt - level.speed_kt).abs() > 2.0) as usize;
+    }
+    assert!(differs >= 7, "{differs}");
 }

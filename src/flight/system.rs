@@ -188,8 +188,16 @@ impl From<&Camera> for HostCamera {
 pub struct HostLighting {
     /// Unit vector towards the sun, east-north-up.
     pub sun_direction: Vec3,
-    /// Direct sunlight colour, dimmed under cloud cover.
+    /// Direct sunlight colour: the clear sun, with the cloud shadows on or off. The host
+    /// multiplies it by the shadow map's `exp(-tau)` ([`Sky::cloud_shadows`]) where clouds stop
+    /// it; with the shadows off the clouds cast none and the ground has this sun everywhere.
     pub sun_rgb: Vec3,
+    /// The mean share (0..=1) of the direct sun the cloud cover over the camera lets through
+    /// ([`Sky::sun_cover_transmittance`]). Not applied to `sun_rgb`: for a host that draws
+    /// without the shadow map and wants its ground dimmed evenly under a cover instead
+    /// (`sun_rgb * sun_cover_transmittance`). skycast's own ground and `examples/host.rs` use the
+    /// map and do not apply it.
+    pub sun_cover_transmittance: f32,
     /// Ambient light as a fraction of full daylight.
     pub ambient: f32,
     /// Sky colour straight up and at the horizon.
@@ -400,6 +408,7 @@ impl SkySystem {
                 self.sky.set_far_map(queue, &map, fade_s);
             }
         }
+        self.sky.set_flash(self.world.flash_now());
         self.sky
             .set_weather_overhead(&self.world.weather_over(position_m));
         let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
@@ -416,6 +425,14 @@ impl SkySystem {
         // This frame is not recorded yet: the last recording is the previous frame's.
         stats.record_us = self.sky.last_record_us();
         Ok((stats, changes))
+    }
+
+    /// The lightning flashes since the last call (each an in-cloud flash or a stroke to the
+    /// ground, with its time and place in the local frame), oldest first: drain it each frame,
+    /// for thunder and for lighting the host's own scene. Only cells under a report with TS
+    /// (or a theme's `thunder`) flash.
+    pub fn drain_flashes(&mut self) -> Vec<crate::weather::storms::Flash> {
+        self.world.drain_flashes()
     }
 
     /// Records the sky's passes into the host's encoder after the host drew its scene: the sky
@@ -493,6 +510,7 @@ impl SkySystem {
         HostLighting {
             sun_direction: self.sun_direction,
             sun_rgb: light.directional_rgb,
+            sun_cover_transmittance: self.sky.sun_cover_transmittance(),
             ambient: light.ambient_percent,
             zenith_rgb: light.sky_zenith_rgb,
             horizon_rgb: light.sky_horizon_rgb,

@@ -21,6 +21,7 @@ use crate::render::scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite};
 use crate::render::{RenderError, Sky, SpriteSheet};
 use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
+use crate::weather::storms::{Flash, FlashKind, flashes_between};
 use crate::weather::{BlockIndex, BlockWeather};
 use std::sync::Arc;
 
@@ -128,7 +129,14 @@ pub struct World {
     field_version: u64,
     /// Settings and caches of the air data ([`super::air`]).
     pub(super) air: super::air::AirState,
+    /// Lightning flashes not yet drained by the host, oldest first.
+    flashes: std::collections::VecDeque<Flash>,
+    /// The latest in-cloud flash, lighting its cell while it lasts.
+    lit: Option<Flash>,
 }
+
+/// Flashes kept for a host that does not drain them, at most (the oldest go first).
+const FLASHES_KEPT: usize = 1024;
 
 impl World {
     /// The world of `field` (whose frame origin is the world's centre).
@@ -143,6 +151,53 @@ impl World {
             synchronous_clouds: false,
             field_version: 0,
             air: Default::default(),
+            flashes: std::collections::VecDeque::new(),
+            lit: None,
+        }
+    }
+
+    /// The in-cloud flash lighting its cell now, as the sky draws it: its light fades from the
+    /// settings' `brightness` to none over `duration_s` (`config/storms.toml`).
+    pub fn flash_now(&self) -> Option<crate::render::SkyFlash> {
+        let field = &self.living.as_ref()?.field;
+        let f = self.lit?;
+        let l = field.storms().settings.lightning;
+        let age = field.time_s() - f.time_s;
+        (0.0..l.duration_s)
+            .contains(&age)
+            .then(|| crate::render::SkyFlash {
+                position_m: DVec3::from_array(f.position_m),
+                reach_m: l.reach_m as f32,
+                light: (l.brightness * (1.0 - age / l.duration_s)) as f32,
+            })
+    }
+
+    /// The lightning flashes since the last call, oldest first, positions in the local frame
+    /// (metres east, north, up MSL): for thunder and for lighting the host's own scene. At most
+    /// the last 1,024 are kept between calls.
+    pub fn drain_flashes(&mut self) -> Vec<Flash> {
+        self.flashes.drain(..).collect()
+    }
+
+    /// The flashes that started in the last `dt_s` seconds of the living field, queued.
+    fn queue_flashes(&mut self, dt_s: f64) {
+        let Some(living) = self.living.as_ref() else {
+            return;
+        };
+        let field = &living.field;
+        let now = field.time_s();
+        let drift = field.drift_m();
+        let lightning = field.storms().settings.lightning;
+        for mut f in flashes_between(field.cells(), now - dt_s, now, &lightning, field.seed()) {
+            f.position_m[0] += drift.x;
+            f.position_m[1] += drift.y;
+            if f.kind == FlashKind::InCloud {
+                self.lit = Some(f);
+            }
+            if self.flashes.len() >= FLASHES_KEPT {
+                self.flashes.pop_front();
+            }
+            self.flashes.push_back(f);
         }
     }
 
@@ -283,8 +338,14 @@ impl World {
             true => 0,
             false => std::thread::available_parallelism().map_or(1, |n| n.get().max(2) - 1),
         };
-        let field = CloudField::new(config, Arc::new(self.types.clone()), threads)
+        let mut field = CloudField::new(config, Arc::new(self.types.clone()), threads)
             .map_err(|e| RenderError::Clouds(e.to_string()))?;
+        // Storm anvils spread along the wind aloft of the air data's own profile.
+        field.set_storms(crate::weather::storms::StormContext {
+            wind: self.air_settings().wind,
+            lat_deg: self.field.frame().to_lat_lon_deg(DVec2::ZERO).0,
+            ..Default::default()
+        });
         self.clouds_config = config;
         self.living = Some(LivingClouds {
             field,
@@ -364,6 +425,10 @@ impl World {
             living.field.wait_for_pending();
         }
         living.field.advance(dt_s);
+        self.queue_flashes(dt_s);
+        let Some(living) = self.living.as_mut() else {
+            return Ok(());
+        };
         let drift = living.field.drift_m();
         let offset_m = DVec3::new(drift.x, drift.y, 0.0);
         let now = living.field.time_s();
@@ -403,12 +468,14 @@ impl World {
             if arrives {
                 living.arriving.insert(fb.serial, now);
             }
-            let arrival = living
-                .arriving
-                .get(&fb.serial)
+            // Arrivals are few and brief (the first frames, a jump): with none, the field's
+            // thousands of blocks cost no lookup each a frame.
+            let arrival = (!living.arriving.is_empty())
+                .then(|| living.arriving.get(&fb.serial))
+                .flatten()
                 .map(|&since| ((now - since) / fade_in_s) as f32)
                 .filter(|&p| p < 1.0);
-            if arrival.is_none() {
+            if arrival.is_none() && !living.arriving.is_empty() {
                 living.arriving.remove(&fb.serial);
             }
             let fade = match fb.phase {

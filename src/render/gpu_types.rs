@@ -32,8 +32,13 @@ pub struct GpuFrame {
     pub haze: [f32; 4],
     /// The host projection's depth to metres along the view axis ([`super::SkyView::depth_to_view`]).
     pub depth_to_view: [f32; 4],
+    /// A lightning flash lighting its cell from inside: xyz its centre, camera-relative
+    /// metres; w the light it adds at the centre (0: none). Its reach is `flash_reach[0]` metres.
+    pub flash: [f32; 4],
+    /// x: the reach of `flash` (its Gaussian's 1/e distance), metres; yzw unused.
+    pub flash_reach: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuFrame>() == 256);
+const _: () = assert!(std::mem::size_of::<GpuFrame>() == 288);
 
 /// One sprite as it lives on the GPU from the moment its block arrives until the block goes
 /// (written once, never per frame), packed into 32 bytes: at a million sprites within 100 km
@@ -70,8 +75,9 @@ pub struct GpuSpriteVertex {
     pub position_visible: [f32; 4],
     /// Texture coordinate on the sheet.
     pub uv: [f32; 2],
-    /// Padding to 16 bytes.
-    pub _pad: [f32; 2],
+    /// x: how many sprites of its cloud it stands for (1 but in the shadow map's far clouds,
+    /// built every few sprites); y: padding.
+    pub stands_for: [f32; 2],
     /// Wang 5.3 vertex colour `(C_amb + C_dir)` and alpha (ambient alpha times the fades).
     pub colour: [f32; 4],
 }
@@ -159,8 +165,8 @@ pub struct GpuListCloud {
     pub first: u32,
     /// Where its back-to-front sprite order starts in the bound order buffer.
     pub order_base: u32,
-    /// Unused.
-    pub _pad: u32,
+    /// Every how many of its sprites are built (0 or 1: all; the shadow map's far clouds).
+    pub stride: u32,
 }
 const _: () = assert!(std::mem::size_of::<GpuListCloud>() == 16);
 
@@ -207,7 +213,9 @@ pub struct GpuSpriteView {
     /// ambient grey.
     pub hl_sky: [f32; 4],
     /// Harris and Lastra: x the part of a deck's optical depth that takes the sun's total
-    /// light (direct and scattered forward) away: `1 - forward_fraction`; yzw unused.
+    /// light (direct and scattered forward) away: `1 - forward_fraction`; y: 1 to take each
+    /// cloud's sprites in their slots' order instead of the bound order (the shadow map); zw
+    /// unused.
     pub hl_deck: [f32; 4],
     /// x, y: the distance from the view's camera over which sprites seen above the horizon fade
     /// out (start, end), metres; z, w: sines of the angles over which layer sprites take their
@@ -235,8 +243,11 @@ pub struct GpuTerrainFrame {
     pub fog_rgb: [f32; 4],
     /// The altitude haze ([`crate::shading::AltitudeHaze::to_gpu`]).
     pub haze: [f32; 4],
+    /// Camera-relative position to the cloud shadow map's texture coordinates
+    /// ([`crate::render::CloudShadowMap`]).
+    pub shadow_uv: [[f32; 4]; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuTerrainFrame>() == 144);
+const _: () = assert!(std::mem::size_of::<GpuTerrainFrame>() == 208);
 
 /// One terrain vertex, relative to the mesh origin. Keep in sync with `shaders/terrain.wgsl`.
 #[repr(C)]

@@ -25,6 +25,8 @@
 //!   the sphere; the shaders' `earth_curved`).
 //! - `far_field`: the clouds beyond the ring out to the horizon: two curved layers of the
 //!   weather's cloud map (`crate::clouds::far_map`), one full-screen pass.
+//! - `shadow`: the clouds drawn from the sun into a shadow map a host multiplies into its
+//!   ground's sunlight.
 //! - `pass_timing`: GPU time of each of the sky's passes, a profiling aid (off by default).
 //!
 //! Positions are f64 on the CPU and camera-relative f32 on the GPU. Units: metres, degrees,
@@ -47,6 +49,7 @@ mod resident;
 mod scatter;
 pub mod scene;
 pub mod settings;
+pub mod shadow;
 mod sheet_crop;
 pub mod sky;
 mod slots;
@@ -61,7 +64,8 @@ pub use readback::SpriteCorner;
 pub use resident::{BYTES_PER_SPRITE, resident_slots_bound};
 pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};
 pub use settings::RenderSettings;
-pub use sky::{Sky, SkyConfig, SpriteSheet};
+pub use shadow::{CloudShadowMap, ShadowImage, ShadowSettings};
+pub use sky::{Sky, SkyConfig, SkyFlash, SpriteSheet};
 pub use stats::{FrameStats, Lighting, SkyMemory};
 pub use targets::{HostTargets, SkyView};
 pub use view::ViewId;

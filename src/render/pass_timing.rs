@@ -25,12 +25,20 @@ pub struct PassTimes {
     /// Below full resolution the composite over the host's colour (with the sky background);
     /// 0 at full resolution.
     pub composite_ms: f64,
+    /// The cloud shadow map's draw (its corner builds and sprites), in the sky's own submission
+    /// from `prepare`; 0 on frames that did not draw it.
+    pub shadow_ms: f64,
 }
 
 impl PassTimes {
     /// All the sky's passes of the frame.
     pub fn total_ms(&self) -> f64 {
-        self.build_ms + self.background_ms + self.ring_ms + self.sprites_ms + self.composite_ms
+        self.build_ms
+            + self.background_ms
+            + self.ring_ms
+            + self.sprites_ms
+            + self.composite_ms
+            + self.shadow_ms
     }
 }
 
@@ -148,5 +156,6 @@ pub(super) fn pass_times(stamps_ms: &[f64]) -> Option<PassTimes> {
         ring_ms: ms(Stamp::Background, Stamp::Ring)?,
         sprites_ms: ms(Stamp::Ring, Stamp::Sprites)?,
         composite_ms: ms(Stamp::Sprites, Stamp::Composite)?,
+        shadow_ms: 0.0,
     })
 }

@@ -147,6 +147,15 @@ impl Scatter {
     /// one; the next [`Self::prepare`] starts a new patch.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
         self.applied.set(true);
+        self.record_kept(encoder);
+    }
+
+    /// Records the patch's pass like [`Self::record`] but keeps the patch for the next
+    /// [`Self::prepare`] to add to (the values are absolute, so applying them again is
+    /// harmless): for a submission of the sky's own that only some frames make (the cloud
+    /// shadow map's), so the patches, and the buffer they grow, are those of the frames the
+    /// host records whether or not it comes.
+    pub fn record_kept(&self, encoder: &mut wgpu::CommandEncoder) {
         let Some(group) = &self.group else {
             return;
         };

@@ -169,6 +169,9 @@ pub struct RenderSettings {
     /// The far field (`[far_field]`); the built-in defaults when the table is absent.
     #[serde(default)]
     pub far_field: super::far_field::FarFieldSettings,
+    /// The clouds' shadows on the host's ground; built-in defaults when the table is absent.
+    #[serde(default)]
+    pub cloud_shadows: super::shadow::ShadowSettings,
 }
 
 impl Default for RenderSettings {
@@ -239,6 +242,9 @@ impl RenderSettings {
             return Err(ConfigError::at_key(path, text, field, message));
         }
         if let Some((field, message)) = s.impostors.invalid_field() {
+            return Err(ConfigError::at_key(path, text, field, message));
+        }
+        if let Some((field, message)) = s.cloud_shadows.invalid_field() {
             return Err(ConfigError::at_key(path, text, field, message));
         }
         let c = &s.clouds;
@@ -338,6 +344,11 @@ mod tests {
         let err = error_with("resolution_scale = 0.5", "resolution_scale = 0.3");
         names(&err, "clouds.resolution_scale");
         assert!(err.contains("must be 1, 0.5 or 0.25"), "{err}");
+        let err = error_with("size_px = 1024", "size_px = 2048");
+        names(&err, "cloud_shadows.size_px");
+        assert!(err.contains("4 MiB"), "{err}");
+        let err = error_with("update_interval_s = 1.0", "update_interval_s = -2.0");
+        names(&err, "cloud_shadows.update_interval_s");
         // Files written before the upright fade (and the later keys left out here) existed still
         // load, with their defaults.
         let old = DEFAULT_RENDER_TOML

@@ -138,14 +138,34 @@ pub struct Sky {
     queue: wgpu::Queue,
     /// The time-of-day light of the last frame, clear sky: what the clouds are lit with.
     clear_light: TimeOfDay,
-    /// `clear_light` under the cloud cover over the camera: the sky colours and the host's light.
+    /// The host's light: the clear sun (the shadow map dims it where clouds stop it, or
+    /// nothing does with the shadows off) and the sky colours under the cover over the camera.
     seen_light: TimeOfDay,
+    /// The mean share of the direct sun the cover over the camera lets through (1 - the share
+    /// of the sky it hides): the sky's own sun glow, and for a host without the map.
+    cover_transmittance: f32,
     /// The weather over the camera: its cloud layers and ground elevation, metres.
     overhead: (Vec<BlockLayer>, f32),
     /// The fog settings and the weather over the camera they read (visibility, obscuration).
     fog: (crate::shading::FogSettings, BlockWeather),
     /// The cover and visibility frames show, eased through a change of the weather in time.
     overhead_ease: OverheadEase,
+    /// The clouds' shadow map for the host's ground (`shadow`): one for every view, as the
+    /// sun is; the main view's prepare draws it.
+    shadows: super::shadow::CloudShadows,
+    /// The lightning flash lighting a cell now, if any.
+    flash: Option<SkyFlash>,
+}
+
+/// A lightning flash lighting its cell from inside, as the sprites draw it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkyFlash {
+    /// Its centre, metres east/north/up in the local frame.
+    pub position_m: glam::DVec3,
+    /// How far its light reaches (the Gaussian's 1/e distance), metres.
+    pub reach_m: f32,
+    /// The light it adds at its centre now, 0..=4 (fraction of white).
+    pub light: f32,
 }
 
 const SKY_WGSL: &str = include_str!("../../shaders/sky.wgsl");
@@ -333,6 +353,13 @@ impl Sky {
                 view_layout: &view_layout,
             },
         );
+        let shadows = super::shadow::CloudShadows::new(
+            device,
+            queue,
+            config.settings.cloud_shadows,
+            &sheet_layout,
+            &view_layout,
+        );
         Ok(Self {
             device: device.clone(),
             settings: config.settings,
@@ -362,6 +389,7 @@ impl Sky {
             queue: queue.clone(),
             clear_light: light,
             seen_light: light,
+            cover_transmittance: 1.0,
             overhead: (Vec::new(), 0.0),
             fog: (
                 Default::default(),
@@ -371,6 +399,8 @@ impl Sky {
                 },
             ),
             overhead_ease: OverheadEase::default(),
+            shadows,
+            flash: None,
         })
     }
 
@@ -487,6 +517,7 @@ impl Sky {
         for r in self.resident.blocks.values_mut() {
             r.motion.offset_m = offset_m;
         }
+        self.shadows.set_drift(offset_m);
     }
 
     /// Sets where a block is in its life, keeping its drift; false if the sky does not hold it.
@@ -594,13 +625,48 @@ impl Sky {
         } else {
             None
         };
+        self.shadows
+            .set_timing(&self.queue, self.pass_timer.is_some());
         self.pass_timer.is_some()
     }
 
     /// GPU time of each group of passes of the last recorded frame, once it was submitted:
     /// waits for the device. `None` while pass timing is off or if the times cannot be read.
     pub fn pass_times(&self) -> Option<super::PassTimes> {
-        super::pass_timing::pass_times(&self.pass_timer.as_ref()?.read_ms(&self.device)?)
+        let times =
+            super::pass_timing::pass_times(&self.pass_timer.as_ref()?.read_ms(&self.device)?);
+        let shadow_ms = self.shadows.last_ms().unwrap_or(0.0);
+        times.map(|t| super::PassTimes { shadow_ms, ..t })
+    }
+
+    /// The clouds' shadow map of the last prepared frame and the matrix a host looks it up with
+    /// ([`super::CloudShadowMap`]): the host multiplies its ground's direct sunlight by
+    /// `exp(-tau)`. Take it every frame (after [`Self::prepare`]): the lookup follows the camera
+    /// and the clouds' drift, and the texture is replaced when the shadows are switched.
+    pub fn cloud_shadows(&self) -> super::CloudShadowMap<'_> {
+        self.shadows.map()
+    }
+
+    /// Switches the cloud shadows on (drawn from the next [`Self::prepare`]) or off (the map a
+    /// single texel of open sun).
+    pub fn set_cloud_shadows(&mut self, on: bool) {
+        self.shadows.set_enabled(&self.queue, on);
+        self.settings.cloud_shadows.enabled = on;
+    }
+
+    /// Draws the cloud shadow map at the next [`Self::prepare`] whatever changed (it is drawn
+    /// again by itself when the camera has gone far, the sun turned, blocks came or went, or,
+    /// while clouds form or dissipate, after `update_interval_s`).
+    pub fn redraw_cloud_shadows(&mut self) {
+        self.shadows.redraw();
+    }
+
+    /// The shadow map's optical depth read back (tests and tools); waits for the device.
+    pub fn read_back_cloud_shadows(
+        &self,
+        queue: &wgpu::Queue,
+    ) -> Result<super::ShadowImage, RenderError> {
+        self.shadows.read_back(queue)
     }
 
     /// CPU time of the last [`Self::record`], microseconds.
@@ -724,6 +790,11 @@ impl Sky {
         self.settings.earth
     }
 
+    /// Lights the sprites near a lightning flash from inside this frame on (`None`: no flash).
+    pub fn set_flash(&mut self, flash: Option<SkyFlash>) {
+        self.flash = flash;
+    }
+
     /// [`Self::fog`] with a view's rain.
     fn fog_for(&self, in_rain: f32) -> crate::shading::Fog {
         let mut air = self.fog.0.fog(&self.fog.1, self.seen_light.sky_horizon_rgb);
@@ -749,10 +820,25 @@ impl Sky {
         self.seen_light.sky_horizon_rgb
     }
 
-    /// The light of the last prepared frame under the cloud cover (see [`Self::set_weather_overhead`]):
-    /// what a host lights its own scene with.
+    /// The light of the last prepared frame (see [`Self::set_weather_overhead`]): what a host
+    /// lights its own scene with. Its sun (`directional_rgb`) is the clear direct sun, with the
+    /// cloud shadows on or off: the host dims it by the shadow map ([`Self::cloud_shadows`])
+    /// where the clouds stop it. With the shadows off the clouds cast none (the map lets all
+    /// the sun through), so the ground is in the clear sun everywhere, as open ground is with
+    /// them on. The sky colours are those under the cover over the camera. A host that draws
+    /// without the map and wants the cover to dim its ground evenly multiplies the sun by
+    /// [`Self::sun_cover_transmittance`]; skycast's own ground does not.
     pub fn light(&self) -> TimeOfDay {
         self.seen_light
+    }
+
+    /// The mean share (0..=1) of the direct sun the cloud cover over the camera lets through,
+    /// of the last prepared frame: 1 minus the share of the sky it hides, eased through a
+    /// change of the weather. Not applied to [`Self::light`]'s sun: it is for a host that does
+    /// not look up the shadow map and wants its ground dimmed evenly under a cover instead
+    /// (skycast's ground before the shadow map). The sky's own sun glow is dimmed by it.
+    pub fn sun_cover_transmittance(&self) -> f32 {
+        self.cover_transmittance
     }
 
     /// The time-of-day light for a sun position (for hosts lighting their own scene).
@@ -768,6 +854,7 @@ impl Sky {
             + self.quads.0.size()
             + self.build.gpu_bytes()
             + self.scatter.gpu_bytes()
+            + self.shadows.gpu_bytes()
     }
 
     /// Every buffer and texture the sky holds now (the ring and the off-screen cloud target
@@ -787,6 +874,7 @@ impl Sky {
                 + self.scatter.gpu_bytes(),
             ring_bytes: self.views.iter().map(|v| v.ring.gpu_bytes()).sum(),
             cloud_target_bytes: self.views.iter().map(|v| v.clouds.gpu_bytes()).sum(),
+            shadow_bytes: self.shadows.gpu_bytes(),
             sheet_bytes: self.sheet_bytes,
             far_field_bytes: self.far_field.gpu_bytes(),
             blocks,
@@ -800,9 +888,11 @@ impl Sky {
 
     /// CPU work of a frame: advances time by `dt_s`, uploads blocks that arrived, sorts blocks
     /// and clouds, recomputes the sprite orders Wang's cache says are stale, and writes the draw
-    /// list and this frame's uniforms (only what changed goes to the GPU); impostor renders go in
-    /// a submission of their own. A frame prepared and never recorded is flushed by the next
-    /// prepare, so nothing piles up however the host drives it.
+    /// list and this frame's uniforms (only what changed goes to the GPU). It submits nothing of
+    /// its own to the device (the impostor renders of a ring rebuild go into the next
+    /// [`Self::record`]), except that a frame prepared and never recorded is flushed by the next
+    /// prepare, so nothing piles up however the host drives it; the time that flush holds the
+    /// frame thread is `gpu_wait_us`, not in `cpu_update_us`.
     pub fn prepare(
         &mut self,
         queue: &wgpu::Queue,
@@ -829,9 +919,14 @@ impl Sky {
         let i = if id.0 < self.views.len() { id.0 } else { 0 };
         let camera: SkyView = view.into();
         self.views[i].projection = Some(camera.projection);
+        let mut gpu_wait_us = 0;
         if !self.views[i].recorded.replace(false) {
-            // The last frame's writes never reached a submit: send them, so they are freed.
+            // The last frame's writes never reached a submit: send them, so they are freed. A
+            // device still busy with earlier work can hold the submit (lavapipe waits in it for
+            // the submission before): timed apart, as a wait.
+            let wait = Instant::now();
             queue.submit([]);
+            gpu_wait_us = wait.elapsed().as_micros() as u64;
         }
         // The frame's clock is the main view's; the others use `dt_s` for their ring's
         // crossfade only.
@@ -847,6 +942,12 @@ impl Sky {
         self.seen_light = self
             .clear_light
             .under_cover(hidden, &self.time_of_day.overcast);
+        // The host's sun is the clear sun, on or off: the shadow map dims it where the clouds
+        // stop it, and with the shadows off nothing does (off casts no shadows; it does not
+        // dim the ground evenly). The cover's mean dimming is kept apart for a host without
+        // the map.
+        self.cover_transmittance = 1.0 - hidden.clamp(0.0, 1.0);
+        self.seen_light.directional_rgb = self.clear_light.directional_rgb;
         let sun_dir = sun.direction_enu().as_vec3();
         let lighting = Lighting {
             sun_dir,
@@ -879,6 +980,9 @@ impl Sky {
         self.views[i]
             .ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
+        // The frame's sorting budget, shared with a ring that is being rebuilt.
+        let sort_budget = self.settings.vertex_cache.max_sorted_sprites_per_frame;
+        let sort_budget = sort_budget - self.views[i].ring.sort_reserve(sort_budget);
         let resident = &mut self.resident;
         let v = &mut self.views[i];
         let inside = main_view(
@@ -891,7 +995,7 @@ impl Sky {
             },
             (camera.position_m, &camera.frustum()),
             self.elapsed_s,
-            &self.settings,
+            (&self.settings, sort_budget),
             &mut v.locks,
             &mut v.draws,
             &mut stats,
@@ -958,9 +1062,9 @@ impl Sky {
             sun_dir: sun_dir
                 .extend(sun_cfg.disc_radius_deg.to_radians().cos())
                 .to_array(),
-            sun_rgb: self
-                .seen_light
-                .directional_rgb
+            // The sky's own sun glow and disc behind the clouds: dimmed by the cover as a
+            // whole, the same with the shadows on or off.
+            sun_rgb: (self.seen_light.directional_rgb * self.cover_transmittance)
                 .extend(sun_cfg.glow_radius_deg.to_radians().cos())
                 .to_array(),
             // w: the camera's height above the haze's base; its distance from the Earth's
@@ -983,7 +1087,14 @@ impl Sky {
                 self.settings.in_cloud.visibility_m,
             ],
             haze: cloud_haze.to_gpu(),
+            flash_reach: [self.flash.map_or(0.0, |f| f.reach_m), 0.0, 0.0, 0.0],
             depth_to_view: camera.depth_to_view(),
+            flash: self.flash.map_or([0.0; 4], |f| {
+                (f.position_m - camera.position_m)
+                    .as_vec3()
+                    .extend(f.light)
+                    .to_array()
+            }),
         };
         queue.write_buffer(&self.views[i].frame_buffer, 0, bytemuck::bytes_of(&frame));
         self.far_field
@@ -994,15 +1105,22 @@ impl Sky {
             template: &frame,
             view: &light,
             camera_m: camera.position_m,
+            cache: &self.settings.vertex_cache,
         };
         upload_bytes += self.views[i]
             .ring
             .prepare_builds(queue, &ring_frame, &mut stats);
+        if i == ViewId::MAIN.0 {
+            // One map for all views (the sun is shared), around the main view's camera.
+            let at = (camera.position_m, sun_dir, self.elapsed_s);
+            upload_bytes += (self.shadows).prepare(queue, &self.resident, &light, at, &mut stats);
+        }
         // Quad indices and built corners for the largest draw of the frame (the sprites, an
-        // impostor's sector).
+        // impostor's sector, the shadow map's chunk).
         let most = stats
             .sprites_drawn
             .max(self.views[i].ring.most_sprites_pending())
+            .max(self.shadows.pending_sprites())
             .min(CHUNK);
         if most > self.quads.1 {
             let sprites = most.next_power_of_two();
@@ -1010,24 +1128,29 @@ impl Sky {
         }
         self.build.reserve(&self.device, most);
         stats.upload_bytes = upload_bytes;
-        // Impostor renders (8 frames of a rebuild) need no host target: they go in a submission
-        // of the sky's own, ahead of the host's frame, with the patch of changed orders they
-        // read.
-        if self.views[i].ring.has_pending() {
+        // The shadow map, when due (rarely: see `shadow`), goes in a submission of its own with
+        // the patch of changed orders it reads, applied but kept for the host's frame. The
+        // ring's impostor renders go in the host's encoder (`record_view`).
+        if self.shadows.has_pending() {
             let mut encoder = self
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("sky.impostors"),
+                    label: Some("sky.cloud_shadows"),
                 });
-            self.scatter.record(&mut encoder);
-            self.views[i].ring.record_builds(
+            self.scatter.record_kept(&mut encoder);
+            let resident = &self.resident.group;
+            (self.shadows).record(
                 &mut encoder,
                 &self.sheet_group,
                 &self.build,
-                &self.resident.group,
+                resident,
                 &self.quads.0,
             );
+            // lavapipe runs the submission on the frame thread: counted as a wait, as the
+            // flush above is.
+            let wait = Instant::now();
             queue.submit([encoder.finish()]);
+            gpu_wait_us += wait.elapsed().as_micros() as u64;
         }
         stats.cloud_scale = self.views[i].clouds.scale();
         stats.cloud_target_bytes = self.views[i].clouds.gpu_bytes();
@@ -1036,8 +1159,9 @@ impl Sky {
             + self.build.gpu_bytes()
             + self.views[i].view.gpu_bytes();
         stats.field_us = std::mem::take(&mut self.field_us);
-        stats.cpu_update_us =
-            start.elapsed().as_micros() as u64 + std::mem::take(&mut self.pending_us);
+        stats.gpu_wait_us = gpu_wait_us;
+        stats.cpu_update_us = (start.elapsed().as_micros() as u64).saturating_sub(gpu_wait_us)
+            + std::mem::take(&mut self.pending_us);
         stats
     }
 
@@ -1108,6 +1232,16 @@ impl Sky {
         };
         stamp(encoder, Stamp::Start);
         self.scatter.record(encoder);
+        // The impostors this view's frame (and any frames prepared since its last recorded
+        // one) rebuilt: in the host's submission, never in one of the sky's own, which could
+        // hold the host's frame thread while the device is busy.
+        v.ring.record_builds(
+            encoder,
+            &self.sheet_group,
+            &self.build,
+            &self.resident.group,
+            &self.quads.0,
+        );
         let view_group = v.view.group().filter(|_| v.sprites_to_draw > 0);
         let parts: Vec<(u32, u32, u32)> = view_group
             .map(|_| chunks(v.sprites_to_draw).collect())

@@ -25,13 +25,23 @@ pub struct FrameStats {
     pub clouds_drawn: u32,
     /// Clouds whose back-to-front sprite order was recomputed this frame (Wang 6.1's cache).
     pub clouds_recomputed: u32,
-    /// Sprites of those clouds (the sorting work of the frame).
+    /// Sprites of those clouds (the sky camera's sorting work of the frame).
     pub sprites_recomputed: u32,
+    /// Sprites of far clouds sorted this frame for the impostor ring's next impostor (from the
+    /// ring centre). With `sprites_recomputed` within `[vertex_cache]
+    /// max_sorted_sprites_per_frame`, except on the frame that builds a first ring (the sky's
+    /// first, or the ring switched on), which sorts it whole.
+    pub ring_sprites_sorted: u32,
     /// Fraction of drawn clouds served from the cache, 0..=1 (1 when nothing was drawn).
     pub cache_hit_rate: f32,
-    /// CPU time of [`crate::render::Sky::prepare`] plus the block changes handed to the sky since
-    /// the last one (inserts, removals, motions), microseconds.
+    /// CPU time of [`crate::render::Sky::prepare`] (less `gpu_wait_us`) plus the block changes
+    /// handed to the sky since the last one (inserts, removals, motions), microseconds.
     pub cpu_update_us: u64,
+    /// Time [`crate::render::Sky::prepare`] spent waiting for the device, microseconds: the
+    /// submit that flushes the writes of a frame that was prepared and never recorded, which a
+    /// busy device can hold (lavapipe waits in it for the submission before to finish). Not part
+    /// of `cpu_update_us` or [`Self::sky_cpu_us`]; 0 on frames after a recorded one.
+    pub gpu_wait_us: u64,
     /// CPU time the host's cloud field spent on the frame thread for this frame (drift,
     /// lifecycle, the blocks handed over), microseconds, as reported to the sky with
     /// [`crate::render::Sky::add_field_cpu_us`].
@@ -75,6 +85,14 @@ pub struct FrameStats {
     pub sprites_lit: u32,
     /// CPU time of that light, microseconds (part of `cpu_update_us`).
     pub light_us: u64,
+    /// Bytes of the cloud shadow map's texture and buffers (`[cloud_shadows]`; a texel while
+    /// switched off).
+    pub shadow_gpu_bytes: u64,
+    /// Whether the cloud shadow map was drawn this frame (else its last drawing, moved with the
+    /// clouds' drift, is looked up).
+    pub shadow_redrawn: bool,
+    /// Sprites drawn into the shadow map this frame (0 when it was not drawn).
+    pub shadow_sprites: u32,
     /// CPU time of the host's air-data queries this frame (`SkySystem::air_at`, lines of
     /// sight), microseconds: set by the host that asks (`skycast fly` does), 0 otherwise.
     pub air_us: u64,
@@ -82,7 +100,8 @@ pub struct FrameStats {
 
 impl FrameStats {
     /// All the CPU time the sky cost the frame thread: the cloud field, the update, the
-    /// recording and the host's air-data queries, microseconds.
+    /// recording and the host's air-data queries, microseconds; waits for the device
+    /// (`gpu_wait_us`) are not in it.
     pub fn sky_cpu_us(&self) -> u64 {
         self.field_us + self.cpu_update_us + self.record_us + self.air_us
     }
@@ -119,6 +138,8 @@ pub struct SkyMemory {
     pub ring_bytes: u64,
     /// The off-screen cloud target's textures at the last recorded frame size (0 at scale 1).
     pub cloud_target_bytes: u64,
+    /// The cloud shadow map's texture and buffers (one for all views; a texel while off).
+    pub shadow_bytes: u64,
     /// The sprite sheet texture, every mip level.
     pub sheet_bytes: u64,
     /// The far field's cloud map and uniform (0 with the far field off or no map yet).
@@ -144,6 +165,7 @@ impl SkyMemory {
             + self.draw_bytes
             + self.ring_bytes
             + self.cloud_target_bytes
+            + self.shadow_bytes
             + self.sheet_bytes
             + self.far_field_bytes
     }

@@ -28,6 +28,7 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use super::block::{BlockWeather, Wind};
+use super::winds_aloft::AloftColumn;
 use crate::config::{ConfigError, parse_toml};
 
 /// The shipped settings file, built in.
@@ -116,6 +117,8 @@ pub struct InCloudAirSettings {
     pub visibility_m: f32,
     /// How far the nearest cloud is looked for, metres.
     pub search_radius_m: f64,
+    /// Cell size of the grid a line of sight walks through a generation's cloud boxes, metres.
+    pub grid_cell_m: f64,
 }
 
 /// Precipitation rate and type (`[precipitation]`).
@@ -246,6 +249,9 @@ impl AirSettings {
         if !positive(c.search_radius_m) {
             return Err(bad("in_cloud.search_radius_m", "must be above 0"));
         }
+        if !(c.grid_cell_m >= 50.0 && c.grid_cell_m <= 10_000.0) {
+            return Err(bad("in_cloud.grid_cell_m", "must be within 50..=10000"));
+        }
         let p = &s.precipitation;
         if !(0.0 <= p.light_mm_h
             && p.light_mm_h <= p.moderate_mm_h
@@ -368,14 +374,70 @@ pub fn air_at(
     lat_deg: f64,
     settings: &AirSettings,
 ) -> AirColumnSample {
+    air_at_aloft(surface, alt_m_msl, lat_deg, settings, None)
+}
+
+/// [`air_at`] with the winds and temperatures aloft of an FB product over the point
+/// ([`super::winds_aloft`]): above the boundary layer the wind goes over linearly (as a vector)
+/// from the gradient wind at its top to the FB wind at the lowest FB level above it, follows
+/// the FB levels linearly in altitude above that and holds the highest one's above it (the
+/// `[wind.aloft]` setting then unused); the temperature likewise from the lapse's at the top of
+/// the boundary layer to the FB temperatures. Inside the boundary layer and without FB: the
+/// documented profile.
+pub fn air_at_aloft(
+    surface: &SurfaceAir,
+    alt_m_msl: f64,
+    lat_deg: f64,
+    settings: &AirSettings,
+    aloft: Option<&AloftColumn>,
+) -> AirColumnSample {
     let height_agl_m = (alt_m_msl - surface.ground_m_msl).max(0.0);
     let t = &settings.temperature;
-    let temperature_c = temperature_c(surface, alt_m_msl, t);
+    let top_m = settings.wind.boundary_layer_top_m;
+    let top_msl = surface.ground_m_msl + top_m;
+    let mut temperature = temperature_c(surface, alt_m_msl, t);
+    let mut wind = wind_at(surface, height_agl_m, alt_m_msl, lat_deg, &settings.wind);
+    if let Some(column) = aloft
+        && height_agl_m > top_m
+    {
+        let gradient = wind_at(
+            surface,
+            top_m,
+            top_msl,
+            lat_deg,
+            &WindSettings {
+                aloft: None,
+                ..settings.wind
+            },
+        );
+        let winds: Vec<(f64, DVec2)> = column
+            .levels
+            .iter()
+            .filter(|l| l.alt_m_msl >= top_msl)
+            .filter_map(|l| l.velocity_kt.map(|v| (l.alt_m_msl, v)))
+            .collect();
+        let base = velocity_kt(gradient.from_deg, gradient.speed_kt);
+        if let Some(v) = through_levels(&winds, top_msl, base, alt_m_msl) {
+            let (from, speed) = from_velocity_kt(v);
+            wind = sample(from, speed, 0.0);
+        }
+        let temperatures: Vec<(f64, f64)> = column
+            .levels
+            .iter()
+            .filter(|l| l.alt_m_msl >= top_msl)
+            .filter_map(|l| l.temperature_c.map(|c| (l.alt_m_msl, c)))
+            .collect();
+        let at_top = temperature_c(surface, top_msl, t);
+        if let Some(c) = through_levels(&temperatures, top_msl, at_top, alt_m_msl) {
+            temperature = c;
+        }
+    }
+    let temperature_c = temperature;
     let dewpoint_c =
         (surface.dewpoint_c - t.dewpoint_lapse_c_per_km * height_agl_m / 1000.0).min(temperature_c);
     let pressure_hpa = pressure_hpa(surface.qnh_hpa, alt_m_msl);
     AirColumnSample {
-        wind: wind_at(surface, height_agl_m, alt_m_msl, lat_deg, &settings.wind),
+        wind,
         temperature_c,
         dewpoint_c,
         pressure_hpa,
@@ -383,6 +445,28 @@ pub fn air_at(
         density_altitude_ft: density_altitude_ft(pressure_hpa, temperature_c),
         height_agl_m,
     }
+}
+
+/// A value through `levels` (altitude, value; lowest first) at `alt`: linear from `base` at
+/// `base_alt` to the lowest level, between levels, the highest's above; `None` without levels.
+fn through_levels<T>(levels: &[(f64, T)], base_alt: f64, base: T, alt: f64) -> Option<T>
+where
+    T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
+{
+    let mut below = (base_alt, base);
+    for &(level_alt, value) in levels {
+        if alt <= level_alt {
+            let span = level_alt - below.0;
+            let f = if span > 0.0 {
+                ((alt - below.0) / span).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            return Some(below.1 * (1.0 - f) + value * f);
+        }
+        below = (level_alt, value);
+    }
+    levels.last().map(|l| l.1)
 }
 
 /// The temperature at `alt_m_msl`: the surface's, less the lapse up to the tropopause.

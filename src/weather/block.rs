@@ -83,6 +83,14 @@ pub struct BlockLayer {
     pub thickness_ft: f32,
 }
 
+impl BlockLayer {
+    /// Whether this is a reported CB or TCU layer: one with its own amount (ICAO Annex 3),
+    /// outside the summation principle that the other layers' covers follow.
+    pub fn has_own_amount(&self) -> bool {
+        self.type_source == TypeSource::Reported
+    }
+}
+
 /// What the report says obscures the view near the ground (present weather BR, FG, HZ, FU,
 /// DU/SA/DS/SS): with the visibility it sets the fog a host draws and the haze of the clouds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -161,6 +169,9 @@ pub struct BlockWeather {
     pub dewpoint_c: f32,
     /// Precipitation intensity 0 (none) ..= 1 (heavy), from the reports' present weather.
     pub precipitation: f32,
+    /// Thunder, 0 (none) ..= 3 (`+TS`): 1 `-TS`, 2 `TS`, interpolated between the reports.
+    #[serde(default)]
+    pub thunder: f32,
     /// Ground elevation under the block, metres above mean sea level (from station elevations).
     pub ground_elevation_m: f32,
 }
@@ -196,14 +207,17 @@ pub fn own_coverage_oktas(below_oktas: f64, total_oktas: f64) -> Option<f64> {
 /// its own amount (ICAO Annex 3) and makes a ceiling only when that amount is broken itself.
 /// `None` when there is none.
 pub fn ceiling_ft(layers: &[BlockLayer], broken_oktas: f32) -> Option<f32> {
-    let convective = |l: &BlockLayer| l.type_source == TypeSource::Reported;
-    let summed: Vec<BlockLayer> = layers.iter().filter(|l| !convective(l)).copied().collect();
+    let summed: Vec<BlockLayer> = layers
+        .iter()
+        .filter(|l| !l.has_own_amount())
+        .copied()
+        .collect();
     let mut bases: Vec<f32> = layers.iter().map(|l| l.base_ft_agl).collect();
     bases.sort_by(f32::total_cmp);
     bases.into_iter().find(|&b| {
         cover_seen_from_below_oktas(&summed, b) >= broken_oktas - 1e-4
             || layers.iter().any(|l| {
-                convective(l) && l.base_ft_agl <= b && l.coverage_oktas >= broken_oktas - 1e-4
+                l.has_own_amount() && l.base_ft_agl <= b && l.coverage_oktas >= broken_oktas - 1e-4
             })
     })
 }

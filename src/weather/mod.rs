@@ -17,8 +17,10 @@ pub mod live;
 pub mod metar;
 pub mod remarks;
 pub mod stations;
+pub mod storms;
 pub mod theme;
 pub mod watch;
+pub mod winds_aloft;
 
 pub use block::{
     BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, METRES_PER_FOOT, TypeSource, Wind,

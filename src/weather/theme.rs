@@ -56,6 +56,9 @@ pub struct ThemeWeather {
     pub dewpoint_c: f32,
     /// Precipitation, as a METAR intensity (the field settings turn it into 0..=1).
     pub precipitation: Precipitation,
+    /// Thunder, as METAR grades `TS` (`light` is `-TS`, `heavy` is `+TS`): what makes the
+    /// theme's cumulonimbus cells flash.
+    pub thunder: Precipitation,
     /// Ground elevation, metres above mean sea level.
     pub ground_elevation_m: f32,
 }
@@ -92,6 +95,7 @@ struct SurfaceFile {
     temperature_c: f32,
     dewpoint_c: f32,
     precipitation: Precipitation,
+    thunder: Precipitation,
     ground_elevation_m: f32,
 }
 
@@ -104,6 +108,7 @@ impl Default for SurfaceFile {
             temperature_c: 15.0,
             dewpoint_c: 5.0,
             precipitation: Precipitation::None,
+            thunder: Precipitation::None,
             ground_elevation_m: 0.0,
         }
     }
@@ -245,6 +250,7 @@ impl Ctx<'_> {
             temperature_c: surface.temperature_c,
             dewpoint_c: surface.dewpoint_c,
             precipitation: surface.precipitation,
+            thunder: surface.thunder,
             ground_elevation_m: surface.ground_elevation_m,
         })
     }

@@ -21,7 +21,7 @@ use std::collections::HashMap;
 use std::io::BufRead;
 use std::path::Path;
 
-use skycast::weather::block::{BlockLayer, TypeSource, ceiling_ft, cover_seen_from_below_oktas};
+use skycast::weather::block::{BlockLayer, ceiling_ft, cover_seen_from_below_oktas};
 use skycast::weather::{
     CloudTypeRule, FieldSettings, LocalFrame, StationTable, WeatherField, files,
 };
@@ -122,8 +122,11 @@ struct Score {
 impl Score {
     fn add(&mut self, row: &Row, field: &[BlockLayer]) {
         let within = |a: f32, b: f32| (a - b).abs() <= 200f32.max(0.1 * b);
-        let reported = |l: &BlockLayer| l.type_source == TypeSource::Reported;
-        let plain: Vec<BlockLayer> = field.iter().filter(|l| !reported(l)).copied().collect();
+        let plain: Vec<BlockLayer> = field
+            .iter()
+            .filter(|l| !l.has_own_amount())
+            .copied()
+            .collect();
         let mut below = 0.0f32;
         let mut ceiling = None;
         for &(cover, base, convective) in &row.layers {
@@ -138,7 +141,7 @@ impl Score {
             self.layers += 1;
             let ok = if convective {
                 field.iter().any(|l| {
-                    reported(l)
+                    l.has_own_amount()
                         && within(l.base_ft_agl, base)
                         && (l.coverage_oktas - cover).abs() <= 1.0
                 })

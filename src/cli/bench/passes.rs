@@ -10,12 +10,13 @@ use super::{Run, quantile, scale_text};
 type Read = fn(&PassTimes) -> f64;
 
 /// The groups, as the table and `frames.csv` name them, and how to read each.
-pub const COLUMNS: [(&str, Read); 5] = [
+pub const COLUMNS: [(&str, Read); 6] = [
     ("build_ms", |p| p.build_ms),
     ("background_ms", |p| p.background_ms),
     ("ring_ms", |p| p.ring_ms),
     ("sprites_ms", |p| p.sprites_ms),
     ("composite_ms", |p| p.composite_ms),
+    ("shadow_ms", |p| p.shadow_ms),
 ];
 
 /// The table of the runs' medians per group (nothing when no frame was timed by pass).
@@ -32,7 +33,7 @@ pub fn print(runs: &[Run]) {
         "where the sky's GPU time goes (medians of the steady frames, ms; the ring and the sprites in passes of their own):"
     );
     println!(
-        "{:<10} {:>9} {:>5} {:>8} {:>11} {:>8} {:>8} {:>10} {:>8}",
+        "{:<10} {:>9} {:>5} {:>8} {:>11} {:>8} {:>8} {:>10} {:>8} {:>8}",
         "scenario",
         "impostors",
         "scale",
@@ -41,14 +42,16 @@ pub fn print(runs: &[Run]) {
         "ring",
         "sprites",
         "composite",
+        "shadows",
         "sum"
     );
     for (run, passes) in timed {
         let median =
             |read: Read| quantile(&passes.iter().map(|p| read(p)).collect::<Vec<_>>(), 0.5);
-        let [build, background, ring, sprites, composite] = COLUMNS.map(|(_, read)| median(read));
+        let [build, background, ring, sprites, composite, shadows] =
+            COLUMNS.map(|(_, read)| median(read));
         println!(
-            "{:<10} {:>9} {:>5} {:>8.2} {:>11.2} {:>8.2} {:>8.2} {:>10.2} {:>8.2}",
+            "{:<10} {:>9} {:>5} {:>8.2} {:>11.2} {:>8.2} {:>8.2} {:>10.2} {:>8.2} {:>8.2}",
             run.scenario,
             if run.impostors { "on" } else { "off" },
             scale_text(run.cloud_scale),
@@ -57,6 +60,7 @@ pub fn print(runs: &[Run]) {
             ring,
             sprites,
             composite,
+            shadows,
             median(PassTimes::total_ms),
         );
     }

@@ -146,14 +146,24 @@ pub(super) fn impostor_camera(i: usize, centre_m: DVec3, s: &ImpostorSettings) -
 
 /// Whether a block at `block_m` can show in impostor `i` seen from `centre_m` (its sector plus
 /// the block's angular size).
+#[cfg(test)]
 pub(super) fn in_sector(i: usize, centre_m: DVec3, block_m: DVec3) -> bool {
+    sectors_of(centre_m, block_m) & (1 << i) != 0
+}
+
+/// The sectors a block is in ([`in_sector`] for every impostor at once, bit `i` for impostor
+/// `i`): its bearing and margin worked out once, for the pass over the far blocks that starts a
+/// ring build.
+pub(super) fn sectors_of(centre_m: DVec3, block_m: DVec3) -> u8 {
     let rel = (block_m - centre_m).truncate();
     let d = rel.length().max(1.0);
     let bearing = rel.x.atan2(rel.y).to_degrees();
-    let off = (bearing - heading_deg(i) + 540.0).rem_euclid(360.0) - 180.0;
     // A 4 km block reaches about 2.9 km from its centre, plus cloud overhang.
     let margin = (4000.0 / d).min(1.0).asin().to_degrees();
-    off.abs() <= IMPOSTOR_FOV_DEG * 0.5 + margin
+    (0..IMPOSTORS).fold(0, |bits, i| {
+        let off = (bearing - heading_deg(i) + 540.0).rem_euclid(360.0) - 180.0;
+        bits | (((off.abs() <= IMPOSTOR_FOV_DEG * 0.5 + margin) as u8) << i)
+    })
 }
 
 /// The projection of impostor `i`'s camera (for tests: a far point projects where its quad is).

@@ -26,7 +26,9 @@
 
 mod layout;
 
-use std::collections::BTreeSet;
+use std::cell::Cell;
+use std::collections::HashSet;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::{DVec3, Vec3};
 use wgpu::util::DeviceExt;
@@ -34,13 +36,14 @@ use wgpu::util::DeviceExt;
 pub use layout::{
     IMPOSTOR_FOV_DEG, IMPOSTORS, ImpostorSettings, impostor_view_proj, is_far, needs_rebuild,
 };
-use layout::{impostor_camera, in_sector};
+use layout::{impostor_camera, sectors_of};
 
 use super::build::{SpriteBuild, chunks};
-use super::draw_list::fresh_view;
+use super::draw_list::{RingOrders, RingSort};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuRing, GpuSpriteVertex};
 use super::pipeline::{PassDesc, SceneDepth, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
+use super::settings::VertexCacheSettings;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
 
@@ -52,17 +55,44 @@ const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
 struct RingState {
     centre_m: DVec3,
     sun: Vec3,
-    /// Ids of the blocks drawn into this ring.
-    far_ids: BTreeSet<u64>,
+    /// Ids of the blocks drawn into this ring (looked up for every block every frame).
+    far_ids: HashSet<u64, BuildHasherDefault<IdHasher>>,
     /// Mean distance of those blocks from the centre (the ring radius if none), metres: the
     /// first guess of the ring pass's depth reprojection.
     far_mean_m: f64,
+}
+
+/// A hasher for block ids, which are looked up for every block every frame: one multiply
+/// (Fibonacci hashing) instead of SipHash, whose protection against chosen keys the sky's own
+/// ids do not need.
+#[derive(Default)]
+struct IdHasher(u64);
+
+impl Hasher for IdHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(8) ^ b as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        }
+    }
+
+    fn write_u64(&mut self, id: u64) {
+        self.0 = (self.0 ^ id).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
 }
 
 struct Build {
     ring: usize,
     next: usize,
     state: RingState,
+    /// The ring's clock when it started (orders sorted since are good for it).
+    since_s: f64,
+    /// Each impostor's blocks (of `state.far_ids`, in its sector), found in one pass when the
+    /// build starts: the frames that gather its orders look at no other block.
+    sectors: [Vec<u64>; IMPOSTORS],
 }
 
 /// The ring: two sets of 8 textures (displayed and building), their passes and quads.
@@ -79,8 +109,9 @@ pub struct ImpostorRing {
     depth_views: Vec<Vec<wgpu::TextureView>>,
     /// `[old ring][new ring]` bind groups of the ring pass (both rings' texture arrays).
     quad_groups: Vec<Vec<wgpu::BindGroup>>,
-    /// Per impostor slot: frame uniform, its bind group, and its view of the resident sprites
-    /// (draw list and sprite orders from the ring centre).
+    /// Per impostor of each ring (`[ring * IMPOSTORS + impostor]`): frame uniform, its bind
+    /// group, and its view of the resident sprites (draw list and sprite orders from the ring
+    /// centre).
     slot_frames: Vec<wgpu::Buffer>,
     slot_groups: Vec<wgpu::BindGroup>,
     slot_views: Vec<ViewBuffers>,
@@ -94,13 +125,21 @@ pub struct ImpostorRing {
     build: Option<Build>,
     /// The ring fading in and the fade so far, 0..=1.
     fade: Option<(usize, RingState, f64)>,
-    /// This frame's impostor renders: (ring, impostor, sprites).
+    /// The impostor renders prepared since the last recorded frame: (ring, impostor, sprites).
     pending: Vec<(usize, usize, u32)>,
+    /// Whether `pending` went into a recorded frame (then the next prepare starts afresh).
+    recorded: Cell<bool>,
     /// This frame's ring pass: (old ring, new ring), if any ring is shown.
     quads: Option<(usize, usize)>,
     /// Blocks drawn into the ring this frame.
     blocks_far: u32,
     bytes: u64,
+    /// The far clouds' orders from the ring centre, kept between builds.
+    sorts: RingOrders,
+    /// Time the ring has seen pass (the sum of the frames' steps), seconds.
+    clock_s: f64,
+    /// Builds started.
+    builds: u64,
 }
 
 const SPRITES_WGSL: &str = include_str!("../../../shaders/sprites.wgsl");
@@ -118,6 +157,9 @@ pub(super) struct RingFrame<'a> {
     pub view: &'a ViewLight<'a>,
     /// Camera position, metres.
     pub camera_m: DVec3,
+    /// The order cache's settings, whose `max_sorted_sprites_per_frame` the ring's sorting
+    /// shares with the sky camera's.
+    pub cache: &'a VertexCacheSettings,
 }
 
 /// The layouts and resources of the sky the ring shares.
@@ -317,8 +359,10 @@ impl ImpostorRing {
                     .collect()
             })
             .collect();
-        // The impostor passes have no scene: a depth of 1 (the far plane) everywhere.
-        let slots = if settings.enabled { IMPOSTORS } else { 0 };
+        // The impostor passes have no scene: a depth of 1 (the far plane) everywhere. One slot
+        // per impostor of each ring, so that a build into one ring never rewrites what a render
+        // of the other, still to be recorded, reads.
+        let slots = rings * IMPOSTORS;
         let no_scene = device.create_texture_with_data(
             queue,
             &wgpu::TextureDescriptor {
@@ -389,9 +433,13 @@ impl ImpostorRing {
             build: None,
             fade: None,
             pending: Vec::new(),
+            recorded: Cell::new(false),
             quads: None,
             blocks_far: 0,
             bytes,
+            sorts: RingOrders::default(),
+            clock_s: 0.0,
+            builds: 0,
         }
     }
 
@@ -406,6 +454,7 @@ impl ImpostorRing {
         self.shown = None;
         self.fade = None;
         self.build = None;
+        self.pending.clear();
         true
     }
 
@@ -435,6 +484,10 @@ impl ImpostorRing {
         dt_s: f64,
     ) {
         let s = self.settings;
+        self.clock_s += dt_s.max(0.0);
+        if self.recorded.replace(false) {
+            self.pending.clear();
+        }
         let blocks = &mut resident.blocks;
         self.blocks_far = 0;
         if !s.enabled {
@@ -498,6 +551,9 @@ impl ImpostorRing {
             return;
         }
         let ring = self.shown.as_ref().map_or(0, |(r, _)| 1 - r);
+        // Renders into that ring not recorded yet (frames prepared and never recorded) are of a
+        // ring no longer shown: this build replaces them.
+        self.pending.retain(|p| p.0 != ring);
         let far: Vec<(u64, f64)> = blocks
             .values()
             .filter(|r| is_far(r.centre_m(), camera_m, camera_m, &s))
@@ -508,7 +564,16 @@ impl ImpostorRing {
         } else {
             far.iter().map(|f| f.1).sum::<f64>() / far.len() as f64
         };
-        let far_ids: BTreeSet<u64> = far.iter().map(|f| f.0).collect();
+        let far_ids: HashSet<u64, _> = far.iter().map(|f| f.0).collect();
+        let mut sectors: [Vec<u64>; IMPOSTORS] = Default::default();
+        for r in blocks.values().filter(|r| far_ids.contains(&r.block.id)) {
+            let bits = sectors_of(camera_m, r.centre_m());
+            for (i, sector) in sectors.iter_mut().enumerate() {
+                if bits & (1 << i) != 0 {
+                    sector.push(r.block.id);
+                }
+            }
+        }
         let first = self.shown.is_none();
         if first {
             // Before the first ring exists it is built this frame, so its blocks are far
@@ -519,9 +584,13 @@ impl ImpostorRing {
                 self.blocks_far += !r.near as u32;
             }
         }
+        self.sorts.retain(blocks);
+        self.builds += 1;
         self.build = Some(Build {
             ring,
             next: 0,
+            since_s: self.clock_s,
+            sectors,
             state: RingState {
                 centre_m: camera_m,
                 sun,
@@ -531,9 +600,12 @@ impl ImpostorRing {
         });
     }
 
-    /// Writes this frame's impostor builds (all 8 for a first ring, else the next one): each
-    /// sector's draw list and sprite orders from the ring centre, with its uniforms; lays out
-    /// the quads and fills the ring's frame stats. Returns the bytes written.
+    /// Writes this frame's impostor builds (all 8 for a first ring, else the next one whose
+    /// sprite orders are all sorted): each sector's draw list and sprite orders from the ring
+    /// centre, with its uniforms; lays out the quads and fills the ring's frame stats. The
+    /// orders are sorted within what `stats.sprites_recomputed` left of the frame's sorting
+    /// budget (a first ring, with nothing to show meanwhile, is sorted whole). Returns the bytes
+    /// written.
     pub(super) fn prepare_builds(
         &mut self,
         queue: &wgpu::Queue,
@@ -545,9 +617,9 @@ impl ImpostorRing {
             template,
             view,
             camera_m,
+            cache,
         } = *frame_in;
         let blocks = &resident.blocks;
-        self.pending.clear();
         self.quads = None;
         stats.ring_gpu_bytes = self.gpu_bytes();
         if !self.settings.enabled {
@@ -557,21 +629,37 @@ impl ImpostorRing {
         let mut bytes = 0;
         let first = self.shown.is_none() && self.fade.is_none();
         if let Some(mut build) = self.build.take() {
-            let count = if first { IMPOSTORS } else { 1 };
+            let (count, mut budget, largest) = if first {
+                (IMPOSTORS, u32::MAX, u32::MAX)
+            } else {
+                let whole = cache.max_sorted_sprites_per_frame;
+                (1, whole.saturating_sub(stats.sprites_recomputed), whole)
+            };
+            let mut when = RingSort {
+                gather: 0,
+                since_s: build.since_s,
+                time_s: self.clock_s,
+                cache,
+                largest,
+            };
+            let reach = (build.state.centre_m, self.settings.view_radius_m);
+            let mut rendered = 0;
             for _ in 0..count {
                 let i = build.next;
                 let centre = build.state.centre_m;
-                let sector: Vec<u64> = blocks
-                    .values()
-                    .filter(|r| build.state.far_ids.contains(&r.block.id))
-                    .filter(|r| in_sector(i, centre, r.centre_m()))
-                    .map(|r| r.block.id)
-                    .collect();
-                let sprites = fresh_view(
-                    &resident.blocks,
-                    &sector,
-                    centre,
-                    self.settings.view_radius_m,
+                let sector = &build.sectors[i];
+                when.gather = self.builds * IMPOSTORS as u64 + i as u64;
+                let (sorted_all, sorted) =
+                    self.sorts.sort(blocks, sector, reach, &when, &mut budget);
+                stats.ring_sprites_sorted += sorted;
+                if !sorted_all {
+                    // The rest next frame; the shown ring stays meanwhile.
+                    break;
+                }
+                let sprites = self.sorts.view(
+                    blocks,
+                    sector,
+                    reach,
                     &mut self.draws,
                     &mut self.lists,
                     &mut self.orders,
@@ -582,7 +670,8 @@ impl ImpostorRing {
                     ..*view
                 };
                 let header = sprite_view::header(&light);
-                bytes += self.slot_views[i].write(
+                let slot = build.ring * IMPOSTORS + i;
+                bytes += self.slot_views[slot].write(
                     &self.device,
                     queue,
                     &self.view_layout,
@@ -611,12 +700,13 @@ impl ImpostorRing {
                     depth_to_view: cam.sky_view().depth_to_view(),
                     ..*template
                 };
-                queue.write_buffer(&self.slot_frames[i], 0, bytemuck::bytes_of(&frame));
+                queue.write_buffer(&self.slot_frames[slot], 0, bytemuck::bytes_of(&frame));
                 bytes += std::mem::size_of::<GpuFrame>() as u64;
                 self.pending.push((build.ring, i, sprites));
                 build.next += 1;
+                rendered += 1;
             }
-            stats.impostors_rebuilt = count as u32;
+            stats.impostors_rebuilt = rendered;
             if build.next >= IMPOSTORS {
                 if first {
                     self.shown = Some((build.ring, build.state));
@@ -661,19 +751,29 @@ impl ImpostorRing {
         bytes
     }
 
-    /// Whether this frame renders impostors.
-    pub(super) fn has_pending(&self) -> bool {
-        !self.pending.is_empty()
+    /// What of a frame's sorting budget (`whole` sprites) the ring keeps from the sky camera:
+    /// half while it rebuilds a ring with one shown, so that a sky camera whose clouds want more
+    /// than the budget for a long while (blocks forming all around) cannot hold the rebuild up;
+    /// else nothing. The ring also sorts whatever the camera leaves of its share.
+    pub(super) fn sort_reserve(&self, whole: u32) -> u32 {
+        let shown = self.shown.is_some() || self.fade.is_some();
+        if self.settings.enabled && shown && self.build.is_some() {
+            whole / 2
+        } else {
+            0
+        }
     }
 
-    /// The most sprites one of this frame's impostor renders draws.
+    /// The most sprites one of the impostor renders to record draws.
     pub(super) fn most_sprites_pending(&self) -> u32 {
         self.pending.iter().map(|p| p.2).max().unwrap_or(0)
     }
 
-    /// Records this frame's impostor renders (their own passes, before the sky pass): each
-    /// sector's corners built from the resident sprites (`resident`) by `build`, then drawn
-    /// (`indices`: the quad index buffer).
+    /// Records the impostor renders prepared since the last recorded frame (their own passes,
+    /// before the sky pass, in the host's encoder): each sector's corners built from the
+    /// resident sprites (`resident`) by `build`, then drawn (`indices`: the quad index buffer).
+    /// A frame that is prepared and never recorded leaves its renders to the next recorded one,
+    /// ahead of any ring pass that shows them.
     pub(super) fn record_builds(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -682,8 +782,10 @@ impl ImpostorRing {
         resident: &wgpu::BindGroup,
         indices: &wgpu::Buffer,
     ) {
+        self.recorded.set(true);
         for &(r, i, sprites) in &self.pending {
-            let view = self.slot_views[i].group().filter(|_| sprites > 0);
+            let slot = r * IMPOSTORS + i;
+            let view = self.slot_views[slot].group().filter(|_| sprites > 0);
             let parts: Vec<(u32, u32, u32)> = chunks(sprites).collect();
             // The impostor is cleared, then its sprites drawn a chunk at a time.
             for k in 0..parts.len().max(1) {
@@ -716,7 +818,7 @@ impl ImpostorRing {
                 });
                 if let (Some(_), Some((_, _, n))) = (view, part) {
                     pass.set_pipeline(&self.sprite_pipeline);
-                    pass.set_bind_group(0, &self.slot_groups[i], &[]);
+                    pass.set_bind_group(0, &self.slot_groups[slot], &[]);
                     pass.set_bind_group(1, sheet, &[]);
                     pass.set_vertex_buffer(0, build.vertices().slice(..));
                     pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);

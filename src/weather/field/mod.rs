@@ -224,6 +224,7 @@ impl WeatherField {
         let temperature_c = value(&|s| s.temperature_c, d.temperature_c);
         let dewpoint_c = value(&|s| s.dewpoint_c, d.dewpoint_c);
         let precipitation = value(&|s| Some(s.precipitation), 0.0);
+        let thunder = value(&|s| Some(s.thunder), 0.0);
         let east = value(&|s| s.wind_kt.map(|v| v[0]), 0.0);
         let north = value(&|s| s.wind_kt.map(|v| v[1]), 0.0);
         let wind = wind_from_velocity_kt(east, north);
@@ -240,6 +241,7 @@ impl WeatherField {
             temperature_c: temperature_c as f32,
             dewpoint_c: dewpoint_c as f32,
             precipitation: precipitation as f32,
+            thunder: thunder as f32,
             ground_elevation_m: value(&|s| s.elevation_m, d.ground_elevation_m) as f32,
         }
     }

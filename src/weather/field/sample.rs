@@ -74,6 +74,8 @@ pub struct StationSample {
     pub dewpoint_c: Option<f64>,
     /// Precipitation intensity 0..=1.
     pub precipitation: f64,
+    /// Thunder: 0 none, 1 `-TS`, 2 `TS`, 3 `+TS` (not `VCTS`: not at the station).
+    pub thunder: f64,
     /// Station elevation, metres.
     pub elevation_m: Option<f64>,
     /// Gusts above the mean wind, knots: 0 for a reported wind without gusts, `None` without
@@ -111,6 +113,7 @@ impl StationSample {
             temperature_c: r.temperature_c.map(f64::from),
             dewpoint_c: r.dewpoint_c.map(f64::from),
             precipitation: precipitation(r, settings),
+            thunder: thunder(r),
             elevation_m: placed.position.elevation_m,
             gust_excess_kt: r.wind.and_then(|w| {
                 let speed = f64::from(w.speed_kt?);
@@ -162,6 +165,12 @@ impl StationSample {
                 ThemePrecipitation::Moderate => p.moderate,
                 ThemePrecipitation::Heavy => p.heavy,
             },
+            thunder: match weather.thunder {
+                ThemePrecipitation::None => 0.0,
+                ThemePrecipitation::Light => 1.0,
+                ThemePrecipitation::Moderate => 2.0,
+                ThemePrecipitation::Heavy => 3.0,
+            },
             elevation_m: Some(f64::from(weather.ground_elevation_m)),
             gust_excess_kt: Some(0.0),
             qnh_hpa: None,
@@ -188,6 +197,21 @@ impl StationSample {
 fn wind_velocity_kt(from_deg: f64, speed_kt: f64) -> [f64; 2] {
     let to = (from_deg + 180.0).to_radians();
     [to.sin() * speed_kt, to.cos() * speed_kt]
+}
+
+/// The heaviest thunder of the report's present weather: 0 none, 1 `-TS`, 2 `TS`, 3 `+TS`
+/// (`VCTS`, in the vicinity, is not over the station).
+pub fn thunder(r: &Report) -> f64 {
+    r.weather
+        .iter()
+        .filter(|w| w.descriptor.as_deref() == Some("TS"))
+        .map(|w| match w.intensity {
+            Intensity::Light => 1.0,
+            Intensity::Moderate => 2.0,
+            Intensity::Heavy => 3.0,
+            Intensity::Vicinity => 0.0,
+        })
+        .fold(0.0, f64::max)
 }
 
 /// The heaviest precipitation of the report's present weather, 0..=1.

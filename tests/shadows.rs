@@ -1,0 +1,399 @@
+//! The clouds' shadows on the ground (`src/render/shadow/`): the shadow map read back and small
+//! frames (320 x 180) on whatever adapter there is (lavapipe here; a missing adapter fails them),
+//! under the real weather off Los Angeles (the shipped cruise). Frames and maps are written to
+//! `target/tmp/shadow-tests/` to look at.
+
+use std::path::{Path, PathBuf};
+
+use glam::{DVec2, DVec3, Vec2, Vec4Swizzles};
+use skycast::demo::terrain::{HeightField, Terrain};
+use skycast::demo::{DemoHost, Frame, GroundSettings, demo_ground, headless};
+use skycast::flight::{SkySystemConfig, Weather};
+use skycast::render::{Camera, ShadowImage};
+
+const W: u32 = 320;
+const H: u32 = 180;
+const METARS: &str = "weather/awc-metars-2025-01-27T22Z.cache.csv";
+/// The shipped weather file's time, 2025-01-27T22:00:00Z.
+const UNIX_S: f64 = 1_738_015_200.0;
+/// The cruise under the cumulus (`tests/reference/cruise_under_cumulus.png`'s place).
+const CRUISE: (f64, f64) = (33.90, -118.36);
+const FEET: f64 = 0.3048;
+
+fn out_dir() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("shadow-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The demo host over the real weather around the cruise, its ground the demo ground of the
+/// weather field (as `skycast render` has it); `configure` changes the sky's settings.
+fn cruise_host(configure: impl FnOnce(&mut SkySystemConfig)) -> DemoHost {
+    let mut config = SkySystemConfig::new(headless::TARGETS, CRUISE);
+    configure(&mut config);
+    let flat = HeightField::from_fn(DVec2::ZERO, 1_000.0, 2, |_| 0.0);
+    let mut host = DemoHost::new(W, H, &flat, config)
+        .unwrap_or_else(|e| panic!("shadow tests need an adapter: {e}"));
+    // Every cloud around in the first frame, as `skycast render` has it (a simulator's first
+    // frames wait for none and fade them in as they arrive).
+    host.sky.world_mut().set_synchronous_clouds(true);
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    host.sky
+        .set_weather(Weather::File(&manifest.join(METARS)))
+        .unwrap();
+    let ground = demo_ground(host.sky.world().field(), &GroundSettings::default());
+    host.terrain = Terrain::new(&host.gpu.device, headless::COLOUR_FORMAT, &ground);
+    host
+}
+
+/// The map as a picture: the sunlight it lets through, exp(-tau), white in open sun.
+fn save_map(map: &ShadowImage, name: &str) {
+    let pixels: Vec<u8> = map
+        .tau
+        .iter()
+        .map(|t| ((-t).exp() * 255.0).round() as u8)
+        .collect();
+    image::GrayImage::from_raw(map.size_px, map.size_px, pixels)
+        .unwrap()
+        .save(out_dir().join(format!("{name}.png")))
+        .unwrap();
+}
+
+fn luminance(p: [f32; 4]) -> f32 {
+    0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+}
+
+/// Camera-relative positions of the ground a frame shows (`None`: sky), from its depth.
+fn ground_points(frame: &Frame, camera: &Camera) -> Vec<Option<glam::Vec3>> {
+    let inverse = camera.view_proj_relative().inverse();
+    (0..frame.depth.len())
+        .map(|i| {
+            let d = frame.depth[i];
+            if d >= 1.0 {
+                return None;
+            }
+            let (x, y) = ((i as u32 % frame.width), (i as u32 / frame.width));
+            let ndc = glam::Vec4::new(
+                (x as f32 + 0.5) / frame.width as f32 * 2.0 - 1.0,
+                1.0 - (y as f32 + 0.5) / frame.height as f32 * 2.0,
+                d,
+                1.0,
+            );
+            let p = inverse * ndc;
+            Some(p.xyz() / p.w)
+        })
+        .collect()
+}
+
+/// Against the frame without shadows, over the ground whose optical depth along the sun's ray
+/// is at least 1 (`shaded`: how many pixels, and the median of their luminance with over
+/// without), and over the ground in open sun (tau 0 within a texel: the largest change).
+struct Darkening {
+    shaded: usize,
+    median_ratio: f32,
+    open: usize,
+    worst_open_change: f32,
+}
+
+/// Ground in open sun: the optical depth within a texel around it stops under 1% of the sun
+/// (a thin cirrus veil overhead leaves no ground at exactly 0).
+const OPEN_TAU: f32 = 0.01;
+
+fn darkening(on: &Frame, off: &Frame, taus: &[Option<(f32, f32)>]) -> Darkening {
+    let mut ratios = Vec::new();
+    let (mut open, mut worst) = (0, 0.0f32);
+    for (i, t) in taus.iter().enumerate() {
+        let Some((tau, tau_near_max)) = *t else {
+            continue;
+        };
+        let (a, b) = (luminance(on.rgba[i]), luminance(off.rgba[i]));
+        if tau >= 1.0 {
+            ratios.push(a / b.max(1e-6));
+        } else if tau_near_max < OPEN_TAU {
+            open += 1;
+            worst = worst.max((a / b.max(1e-6) - 1.0).abs());
+        }
+    }
+    ratios.sort_by(f32::total_cmp);
+    Darkening {
+        shaded: ratios.len(),
+        median_ratio: ratios.get(ratios.len() / 2).copied().unwrap_or(1.0),
+        open,
+        worst_open_change: worst,
+    }
+}
+
+/// Per ground pixel its optical depth and the largest within a texel around it.
+fn ground_taus(
+    frame: &Frame,
+    camera: &Camera,
+    map: &ShadowImage,
+    lookup: glam::Mat4,
+) -> Vec<Option<(f32, f32)>> {
+    let texel = 1.0 / map.size_px as f32;
+    ground_points(frame, camera)
+        .into_iter()
+        .map(|p| {
+            let uv = (lookup * p?.extend(1.0)).xy();
+            let near = [
+                (-1.0, -1.0),
+                (-1.0, 1.0),
+                (1.0, -1.0),
+                (1.0, 1.0),
+                (0.0, 0.0),
+            ]
+            .map(|(dx, dy)| map.sample(uv + Vec2::new(dx, dy) * texel * 1.5));
+            Some((map.sample(uv), near.into_iter().fold(0.0, f32::max)))
+        })
+        .collect()
+}
+
+/// The darkening of one view, `on` against `off`, classed by the map read back at each
+/// pixel's ground point: the shaded ground within 3 km (farther the demo ground's haze, 3 /
+/// visibility a metre over ground far darker than the haze, veils it, shadows and all), the
+/// open ground at any distance (the haze is the same in both frames).
+fn darkening_in_view(
+    on: &Frame,
+    off: &Frame,
+    camera: &Camera,
+    (map, lookup): (&ShadowImage, glam::Mat4),
+) -> Darkening {
+    let taus = ground_taus(on, camera, map, lookup);
+    let near: Vec<Option<(f32, f32)>> = taus
+        .iter()
+        .zip(ground_points(on, camera))
+        .map(|(t, p)| t.filter(|_| p.is_some_and(|p| p.length() <= 3000.0)))
+        .collect();
+    let (near, all) = (darkening(on, off, &near), darkening(on, off, &taus));
+    Darkening {
+        open: all.open,
+        worst_open_change: all.worst_open_change,
+        ..near
+    }
+}
+
+/// Done means 1: in the cruise under the cumulus (3,000 ft off Los Angeles, looking down 8
+/// degrees) and in `make demo`'s flight where it passes the same place (1,800 ft, heading 131,
+/// 5 degrees up), against `--cloud-shadows off` (the clouds cast no shadows: the clear sun
+/// everywhere, the sun `Sky::light` gives either way), ground within 3 km under a cloud whose
+/// optical depth along the sun's ray is at least 1 is at least 25% darker (the median of its
+/// pixels' luminance ratios), and ground in open sun changes by less than 3% (every pixel).
+/// The negative control in the test: the frame without shadows against itself (a map that
+/// shades nothing) fails the measure.
+#[test]
+fn shadows_darken_the_ground_under_clouds_and_only_there() {
+    let mut host = cruise_host(|_| {});
+    let views = [
+        ("cruise", 3000.0, 135.0, -8.0),
+        ("demo", 1800.0, 131.0, 5.0),
+    ];
+    for (name, alt_ft, heading_deg, pitch_deg) in views {
+        let camera = host.camera(DVec3::new(0.0, 0.0, alt_ft * FEET), heading_deg, pitch_deg);
+        host.sky.set_cloud_shadows(true);
+        let (on, stats) = host.step_frame(&camera, UNIX_S, 0.0).unwrap();
+        let map = host.sky.read_back_cloud_shadows(&host.gpu.queue).unwrap();
+        let lookup = host.sky.cloud_shadows().uv_from_camera_relative;
+        save_map(&map, &format!("{name}_map"));
+        on.write_png(&out_dir().join(format!("{name}_on.png")))
+            .unwrap();
+        assert!(
+            stats.shadow_redrawn && stats.shadow_sprites > 0,
+            "{stats:?}"
+        );
+        assert!(
+            stats.shadow_gpu_bytes <= 4 << 20,
+            "shadow memory {}",
+            stats.shadow_gpu_bytes
+        );
+        let light_on = host.sky.lighting();
+        host.sky.set_cloud_shadows(false);
+        let (off, _) = host.step_frame(&camera, UNIX_S, 0.0).unwrap();
+        off.write_png(&out_dir().join(format!("{name}_off.png")))
+            .unwrap();
+        // Off casts no shadows; it does not dim the sun: the host's sun is the same.
+        let light_off = host.sky.lighting();
+        assert_eq!(light_on.sun_rgb, light_off.sun_rgb, "{name}");
+        assert!(light_off.sun_cover_transmittance < 1.0, "{light_off:?}");
+        let map = (&map, lookup);
+        let d = darkening_in_view(&on, &off, &camera, map);
+        let itself = darkening_in_view(&off, &off, &camera, map);
+        eprintln!("{name}: shadow GPU memory {} bytes", stats.shadow_gpu_bytes);
+        for (what, d) in [("on/off", &d), ("off/off", &itself)] {
+            eprintln!(
+                "{name} {what}: shaded ground (tau >= 1) {} px, median luminance ratio {:.3}; open sun {} px, worst change {:.4}",
+                d.shaded, d.median_ratio, d.open, d.worst_open_change
+            );
+        }
+        assert!(
+            d.shaded >= 100,
+            "{name}: too little shaded ground: {}",
+            d.shaded
+        );
+        assert!(d.open >= 50, "{name}: too little open ground: {}", d.open);
+        assert!(
+            d.median_ratio <= 0.75,
+            "{name}: shaded ground {:.3} as bright as without shadows",
+            d.median_ratio
+        );
+        assert!(
+            d.worst_open_change < 0.03,
+            "{name}: open ground changed {}",
+            d.worst_open_change
+        );
+        // The measure fails a map that shades nothing.
+        assert!(
+            itself.median_ratio > 0.75,
+            "{name}: {}",
+            itself.median_ratio
+        );
+    }
+}
+
+/// The optical depth at ground points `points` (world metres) as a map and its lookup for the
+/// camera at `camera_m` give it.
+fn taus_at(map: &ShadowImage, lookup: glam::Mat4, camera_m: DVec3, points: &[DVec3]) -> Vec<f32> {
+    points
+        .iter()
+        .map(|p| map.sample((lookup * (*p - camera_m).as_vec3().extend(1.0)).xy()))
+        .collect()
+}
+
+/// Done means 2: the shadows move with the clouds. Two frames of the cruise's weather 60 s
+/// apart (a still camera, the clouds drifting with the wind): the shift that best lays the
+/// first frame's shadow pattern on the second's (searched over the ground, 10 m steps) is the
+/// clouds' drift, within 20%.
+#[test]
+fn shadows_move_with_the_clouds_drift() {
+    let mut host = cruise_host(|_| {});
+    let camera = host.camera(DVec3::new(0.0, 0.0, 3000.0 * FEET), 135.0, -8.0);
+    let drift = |host: &DemoHost| {
+        let d = host.sky.world().living_field().unwrap().drift_m();
+        DVec3::new(d.x, d.y, 0.0)
+    };
+    let mut frames = Vec::new();
+    for (t, dt) in [(0.0, 0.0), (60.0, 60.0)] {
+        // Drawn anew each time (steady clouds would keep the first drawing, moved by the
+        // lookup: this checks the drawing too).
+        host.sky.redraw_cloud_shadows();
+        let (stats, _) = host.step(&camera, UNIX_S + t, dt, false).unwrap();
+        assert!(stats.shadow_redrawn, "{stats:?}");
+        let map = host.sky.read_back_cloud_shadows(&host.gpu.queue).unwrap();
+        save_map(&map, &format!("drift_{t}"));
+        frames.push((
+            map,
+            host.sky.cloud_shadows().uv_from_camera_relative,
+            drift(&host),
+        ));
+    }
+    let moved = frames[1].2 - frames[0].2;
+    // The ground within 6 km of the camera, every 100 m (its height matters not: the lookup
+    // follows the sun's rays, and both frames look up the same points).
+    let points: Vec<DVec3> = (-60..=60)
+        .flat_map(|i| (-60..=60).map(move |j| DVec3::new(i as f64 * 100.0, j as f64 * 100.0, 0.0)))
+        .collect();
+    let after = taus_at(&frames[1].0, frames[1].1, camera.position_m, &points);
+    let error = |shift: DVec3| {
+        let before: Vec<DVec3> = points.iter().map(|p| *p - shift).collect();
+        let before = taus_at(&frames[0].0, frames[0].1, camera.position_m, &before);
+        before
+            .iter()
+            .zip(&after)
+            .map(|(a, b)| ((a - b) * (a - b)) as f64)
+            .sum::<f64>()
+    };
+    let search = |centre: DVec3, step: f64, steps: i32| {
+        let mut best = (f64::INFINITY, centre);
+        for i in -steps..=steps {
+            for j in -steps..=steps {
+                let shift = centre + DVec3::new(i as f64 * step, j as f64 * step, 0.0);
+                let e = error(shift);
+                if e < best.0 {
+                    best = (e, shift);
+                }
+            }
+        }
+        best.1
+    };
+    let coarse = search(DVec3::ZERO, 100.0, 15);
+    let found = search(coarse, 10.0, 10);
+    eprintln!(
+        "drift in 60 s: {:.0} m ({:.0}, {:.0}); the shadows' shift: ({:.0}, {:.0}), error {:.0} m; unshifted mismatch {:.1}, shifted {:.1}",
+        moved.length(),
+        moved.x,
+        moved.y,
+        found.x,
+        found.y,
+        (found - moved).length(),
+        error(DVec3::ZERO),
+        error(found)
+    );
+    assert!(moved.length() >= 200.0, "too little wind to tell: {moved}");
+    assert!(
+        (found - moved).length() <= 0.2 * moved.length(),
+        "shadows shifted {found}, the clouds drifted {moved}"
+    );
+}
+
+/// Done means 3: no shimmer. The map drawn anew every frame (`redraw_cloud_shadows`), the camera
+/// moved by half a texel across the sun's rays (0.4 along one axis, 0.3 along the other): the
+/// map is the same to the bit, and the ground's shadow values where the frames look stay the
+/// same (the sunlight let through within 0.001; bilinear lookups of the same texels).
+#[test]
+fn sub_texel_camera_moves_leave_the_shadows_unchanged() {
+    let mut host = cruise_host(|_| {});
+    // Mid-block (a camera on a block's edge that crosses it has the field change the blocks
+    // around it, at the rim of the map too).
+    let start = host.camera(DVec3::new(2000.0, 2000.0, 3000.0 * FEET), 135.0, -8.0);
+    // Until every block around is on the GPU (a frame uploads the nearest 32,768 sprites).
+    let mut last = u32::MAX;
+    for _ in 0..60 {
+        let (stats, _) = host.step(&start, UNIX_S, 0.0, false).unwrap();
+        if stats.shadow_sprites == last {
+            break;
+        }
+        last = stats.shadow_sprites;
+    }
+    let settings = *host.sky.settings();
+    let sun = host.sky.lighting().sun_direction.as_dvec3();
+    // The camera on a texel's centre, then four tenths of a texel off it.
+    let frame =
+        skycast::render::shadow::ShadowFrame::new(start.position_m, sun, &settings.cloud_shadows);
+    let (x, y) = frame.across(start.position_m);
+    let texel = settings.cloud_shadows.texel_m();
+    let on_texel = start.position_m - frame.right * x - frame.up * y;
+    let points: Vec<DVec3> = (-40..=40)
+        .flat_map(|i| (-40..=40).map(move |j| DVec3::new(i as f64 * 73.0, j as f64 * 73.0, 0.0)))
+        .collect();
+    let mut seen = Vec::new();
+    for offset in [DVec3::ZERO, (frame.right * 0.4 - frame.up * 0.3) * texel] {
+        let camera = host.camera(on_texel + offset, 135.0, -8.0);
+        host.sky.redraw_cloud_shadows();
+        let (on, stats) = host.step_frame(&camera, UNIX_S, 0.0).unwrap();
+        assert!(stats.shadow_redrawn, "{stats:?}");
+        let map = host.sky.read_back_cloud_shadows(&host.gpu.queue).unwrap();
+        let lookup = host.sky.cloud_shadows().uv_from_camera_relative;
+        let taus = taus_at(&map, lookup, camera.position_m, &points);
+        seen.push((map, taus, on));
+    }
+    let (a, b) = (&seen[0], &seen[1]);
+    assert!(a.0.tau.iter().any(|&t| t > 1.0), "no shadow in the map");
+    let differing = a.0.tau.iter().zip(&b.0.tau).filter(|(p, q)| p != q).count();
+    // The sunlight let through, exp(-tau), at the ground points.
+    let light = |t: f32| (-t).exp();
+    let worst =
+        a.1.iter()
+            .zip(&b.1)
+            .map(|(p, q)| (light(*p) - light(*q)).abs());
+    let worst = worst.fold(0.0, f32::max);
+    // Against it, how much a whole texel's shift changes the map (what shimmer would be).
+    let n = a.0.size_px as usize;
+    let shifted = (0..n * n - 1)
+        .map(|i| (light(a.0.tau[i]) - light(a.0.tau[i + 1])).abs())
+        .fold(0.0, f32::max);
+    eprintln!(
+        "texels differing: {differing}; the ground's sunlight changed by at most {worst:.6}; neighbouring texels differ by up to {shifted:.3}"
+    );
+    assert_eq!(differing, 0, "the map changed under a sub-texel move");
+    assert!(worst < 1e-3, "the ground's sunlight changed by {worst}");
+    assert!(shifted > 0.5, "a texel's shift would not show: {shifted}");
+}

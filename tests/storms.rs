@@ -1,0 +1,215 @@
+//! A storm cell of the weather field rendered headless (lavapipe, 320 x 180): how big it looks
+//! from 20 km, how dark its base is against the sky beside it, and an in-cloud lightning flash
+//! lighting it from inside. Frames are written to `target/tmp/storm-tests/` to look at.
+
+use std::path::PathBuf;
+
+use glam::{DVec2, DVec3};
+use skycast::clouds::CloudTypes;
+use skycast::clouds::storm::cell_cloud;
+use skycast::demo::terrain::HeightField;
+use skycast::demo::{DemoHost, Frame, headless};
+use skycast::render::{Camera, SkyBlock, SkyCloud, SkyConfig, SkyFlash};
+use skycast::shading::{FogSettings, SunPosition};
+use skycast::weather::storms::{StormCell, StormSettings};
+use skycast::weather::{BlockWeather, CloudType, Wind};
+
+const W: u32 = 320;
+const H: u32 = 180;
+/// The camera's height, metres: 1,000 ft, under the cell's 3,000 ft base.
+const EYE_M: f64 = 305.0;
+
+/// A 10 km cell 20 km north of the camera, its 30 km anvil 10.5 km downwind (east).
+fn cell() -> StormCell {
+    StormCell {
+        key: 7,
+        centre_m: [0.0, 20_000.0],
+        base_width_m: 10_000.0,
+        base_ft_agl: 3_000.0,
+        top_ft_msl: 38_000.0,
+        ground_m_msl: 0.0,
+        anvil_width_m: 30_000.0,
+        anvil_offset_m: [10_500.0, 0.0],
+        anvil_thickness_m: 2_500.0,
+        turrets: 5,
+        wind_aloft_m_s: [20.0, 0.0],
+        thunder: 2,
+        precipitation: 0.0,
+        cloud_type: CloudType::Cumulonimbus,
+    }
+}
+
+fn sun() -> SunPosition {
+    SunPosition {
+        elevation_deg: 35.0,
+        azimuth_deg: 200.0,
+        declination_deg: 0.0,
+    }
+}
+
+fn host() -> DemoHost {
+    let ground = HeightField::from_fn(DVec2::ZERO, 120_000.0, 64, |_| 0.0);
+    DemoHost::new(W, H, &ground, SkyConfig::new(headless::TARGETS))
+        .unwrap_or_else(|e| panic!("render tests need an adapter: {e}"))
+}
+
+fn frame(host: &mut DemoHost, name: &str, camera: &Camera) -> Frame {
+    let (frame, _) = host.frame(camera, &sun(), 0.0, 60_000.0).unwrap();
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("storm-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    frame.write_png(&dir.join(format!("{name}.png"))).unwrap();
+    frame
+}
+
+fn luminance(p: [f32; 4]) -> f32 {
+    0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+}
+
+/// Pixels the cell changed: against the same view without it.
+fn cell_mask(with: &Frame, without: &Frame) -> Vec<bool> {
+    with.rgba
+        .iter()
+        .zip(&without.rgba)
+        .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).sum::<f32>() > 0.06)
+        .collect()
+}
+
+#[test]
+fn a_10_km_cell_from_20_km_spans_25_degrees_on_a_dark_base_and_a_flash_lights_it() {
+    let types = CloudTypes::builtin();
+    let c = cell();
+    let weather = BlockWeather {
+        wind: Wind {
+            from_deg: 270.0,
+            speed_kt: 15.0,
+        },
+        ..BlockWeather::default()
+    };
+    let cloud = cell_cloud(&c, types.get(CloudType::Cumulonimbus), &weather);
+    let block = SkyBlock {
+        id: 1,
+        centre_m: DVec3::new(c.centre_m[0], c.centre_m[1], cloud.centre_m.z),
+        clouds: vec![SkyCloud::from(&cloud)],
+    };
+    let mut host = host();
+    // A report's 9999 (10 km or more) under the cell, drawn in clear air of 100 km visual
+    // range: storms are seen 50-80 km off (../shared/DESIGN.md), which the shipped 40 km of
+    // `clear_visibility_m` (config/fog.toml) hides; the figure under it is printed below.
+    host.sky.set_weather_overhead(&BlockWeather {
+        visibility_m: 9_999.0,
+        ..weather.clone()
+    });
+    let shipped = FogSettings::default();
+    host.sky.set_fog_settings(FogSettings {
+        clear_visibility_m: 100_000.0,
+        ..shipped
+    });
+    // Looking north at it, the view tilted up to hold base and top.
+    let camera = host.camera(DVec3::new(0.0, 0.0, EYE_M), 0.0, 15.0);
+    let clear = frame(&mut host, "clear", &camera);
+    host.sky.set_clouds(vec![block]);
+    let storm = frame(&mut host, "cell_from_20_km", &camera);
+    let mask = cell_mask(&storm, &clear);
+    let at = |x: u32, y: u32| (y * W + x) as usize;
+
+    // Its extent: the rows and columns it covers, as angles of the view.
+    let fov_y = camera.fov_y_deg as f64;
+    let fov_x = 2.0
+        * ((fov_y.to_radians() / 2.0).tan() * camera.aspect as f64)
+            .atan()
+            .to_degrees();
+    let rows: Vec<u32> = (0..H).filter(|&y| (0..W).any(|x| mask[at(x, y)])).collect();
+    let cols: Vec<u32> = (0..W).filter(|&x| (0..H).any(|y| mask[at(x, y)])).collect();
+    let (top, bottom) = (rows[0], *rows.last().unwrap());
+    let tall_deg = (bottom - top + 1) as f64 / H as f64 * fov_y;
+    // The body's width, at the rows of its lowest third (under the anvil).
+    let body_rows = bottom - (bottom - top) / 6..=bottom - (bottom - top) / 12;
+    let body_cols: Vec<u32> = (0..W)
+        .filter(|&x| body_rows.clone().any(|y| mask[at(x, y)]))
+        .collect();
+    let wide_deg = (body_cols.last().unwrap() - body_cols[0] + 1) as f64 / W as f64 * fov_x;
+    eprintln!(
+        "cell: {tall_deg:.1} deg tall, body {wide_deg:.1} deg wide, {} columns in all",
+        cols.len()
+    );
+
+    // The base: the cell's lowest rows in its middle half, against the sky beside it in the
+    // same rows (left of the cell, where the anvil downwind to the east does not reach).
+    let (lo, hi) = (body_cols[0], *body_cols.last().unwrap());
+    let middle = lo + (hi - lo) / 4..=hi - (hi - lo) / 4;
+    // The flat base seen nearly edge-on from under it and the lowest body: the cell's lowest
+    // rows but the last two (its soft lower edge, blended with the sky below).
+    let base_rows = bottom.saturating_sub(6)..=bottom.saturating_sub(2);
+    let mean = |px: Vec<[f32; 4]>| px.iter().map(|&p| luminance(p)).sum::<f32>() / px.len() as f32;
+    let base: Vec<usize> = base_rows
+        .clone()
+        .flat_map(|y| middle.clone().map(move |x| at(x, y)))
+        .filter(|&i| mask[i])
+        .collect();
+    let beside: Vec<usize> = base_rows
+        .flat_map(|y| (0..lo.saturating_sub(4)).map(move |x| at(x, y)))
+        .filter(|&i| !mask[i] && storm.depth[i] >= 1.0)
+        .collect();
+    assert!(
+        base.len() > 20 && beside.len() > 20,
+        "{} {}",
+        base.len(),
+        beside.len()
+    );
+    let ratio_in = |f: &Frame| {
+        mean(base.iter().map(|&i| f.rgba[i]).collect())
+            / mean(beside.iter().map(|&i| f.rgba[i]).collect())
+    };
+    let ratio = ratio_in(&storm);
+    eprintln!("base / sky beside: {ratio:.2}");
+    // The cell spans 25 degrees and more; its body, 10 km across, near the 28 degrees 10 km
+    // make at 20 km (its flanks fade into the sky).
+    assert!(
+        tall_deg >= 25.0 && wide_deg >= 22.5,
+        "a 10 km cell from 20 km: {tall_deg:.1} deg tall, body {wide_deg:.1} deg wide"
+    );
+    assert!(ratio <= 0.65, "the base is {ratio:.2} of the sky beside it");
+
+    // The same view in the shipped clear air (40 km): printed, for the book.
+    host.sky.set_fog_settings(shipped);
+    let hazed = frame(&mut host, "cell_from_20_km_shipped_fog", &camera);
+    eprintln!(
+        "base / sky beside in the shipped 40 km clear air: {:.2}",
+        ratio_in(&hazed)
+    );
+    host.sky.set_fog_settings(FogSettings {
+        clear_visibility_m: 100_000.0,
+        ..shipped
+    });
+
+    // An in-cloud flash in the middle of the tower: the cell brighter from inside, the sky
+    // around the same.
+    let lightning = StormSettings::default().lightning;
+    host.sky.set_flash(Some(SkyFlash {
+        position_m: DVec3::new(c.centre_m[0], c.centre_m[1], 4_500.0),
+        reach_m: lightning.reach_m as f32,
+        light: lightning.brightness as f32,
+    }));
+    let lit = frame(&mut host, "cell_flash", &camera);
+    host.sky.set_flash(None);
+    // The tower: the cell's pixels over the body's columns, base to mid-height.
+    let tower: Vec<usize> = ((top + bottom) / 2..=bottom)
+        .flat_map(|y| (lo..=hi).map(move |x| at(x, y)))
+        .filter(|&i| mask[i])
+        .collect();
+    let inside = |f: &Frame| mean(tower.iter().map(|&i| f.rgba[i]).collect());
+    let outside = |f: &Frame| {
+        mean(
+            (0..f.rgba.len())
+                .filter(|&i| !mask[i] && f.depth[i] >= 1.0)
+                .map(|i| f.rgba[i])
+                .collect(),
+        )
+    };
+    let (dark, bright) = (inside(&storm), inside(&lit));
+    eprintln!("cell luminance {dark:.3} without the flash, {bright:.3} with it");
+    assert!(bright > 1.1 * dark, "flash {bright:.3} vs {dark:.3}");
+    assert!((outside(&lit) - outside(&storm)).abs() < 0.01);
+    let after = frame(&mut host, "cell_after_flash", &camera);
+    assert!((inside(&after) - dark).abs() < 0.005, "the flash is over");
+}
