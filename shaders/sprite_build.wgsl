@@ -141,11 +141,11 @@ fn upright_facing(to_cam: vec3<f32>) -> Facing {
 // horizon, sprites fade out over the last stretch of that distance instead. Below the horizon (a
 // deck from above) they reach it whole, the deck running on to the haze. `to_cam`: from the
 // sprite to the view's camera.
-// While the far field is drawn (`hl_deck.y`), every sprite fades over its hand-over band, below
+// While the far field is drawn (`hl_deck.z`), every sprite fades over its hand-over band, below
 // the horizon too, as the far field fades in there (`shaders/far_field.wgsl`).
 fn far_fade(to_cam: vec3<f32>) -> f32 {
     let dist = length(to_cam);
-    let above_horizon = max(smoothstep(0.0, 0.02, -to_cam.z / max(dist, 1.0)), view.hl_deck.y);
+    let above_horizon = max(smoothstep(0.0, 0.02, -to_cam.z / max(dist, 1.0)), view.hl_deck.z);
     let fade = view.far_fade_layer_turn;
     return 1.0 - above_horizon * smoothstep(fade.x, max(fade.y, fade.x + 1.0), dist);
 }

@@ -214,8 +214,8 @@ pub struct GpuSpriteView {
     pub hl_sky: [f32; 4],
     /// Harris and Lastra: x the part of a deck's optical depth that takes the sun's total
     /// light (direct and scattered forward) away: `1 - forward_fraction`; y: 1 to take each
-    /// cloud's sprites in their slots' order instead of the bound order (the shadow map); zw
-    /// unused.
+    /// cloud's sprites in their slots' order instead of the bound order (the shadow map); z: 1
+    /// while the far field is drawn (every sprite fades over the hand-over band); w unused.
     pub hl_deck: [f32; 4],
     /// x, y: the distance from the view's camera over which sprites seen above the horizon fade
     /// out (start, end), metres; z, w: sines of the angles over which layer sprites take their

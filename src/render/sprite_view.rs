@@ -99,8 +99,9 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
             .to_array(),
         hl_deck: [
             1.0 - hl.forward_fraction(),
-            f32::from(u8::from(hand_over_m.is_some())),
+            // y is the shadow map's (its own sprite order), set there.
             0.0,
+            f32::from(u8::from(hand_over_m.is_some())),
             0.0,
         ],
         far_fade_layer_turn: [
