@@ -58,7 +58,7 @@ impl<T: Send + 'static> WeatherWatch<T> {
     /// Watches `path` for a file of any kind: after each change that settles for `settle`,
     /// `load` reads it on the watch's own thread and says what the caller keeps, or why the file
     /// cannot be used (one line naming the file). [`Self::start`] loads weather this way; the
-    /// winds aloft ([`super::winds_aloft::load_whole`]) go the same way.
+    /// winds aloft ([`super::winds_aloft::WindsAloft::load_whole`]) go the same way.
     pub fn start_loading(
         path: &Path,
         settle: Duration,
