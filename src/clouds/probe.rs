@@ -13,9 +13,10 @@
 //! (`3 / visibility_m`, Koschmieder) times the length inside, times the fade.
 //!
 //! The boxes of a generation are worked out once, the first time it is asked about
-//! ([`BoxCache`]); a query looks only at the blocks within reach of the point, and skips a
-//! block whose clouds' bounds are out of reach. Positions are ground metres (east, north, up
-//! MSL); the field's drift is taken off to find the clouds.
+//! ([`BoxCache`]). A point query looks only at the blocks within reach of the point, and skips
+//! a block whose clouds' bounds are out of reach; a line of sight walks one grid over every box
+//! of the field ([`SightBoxes`]), built again when the field's membership changes. Positions
+//! are ground metres (east, north, up MSL); the field's drift is taken off to find the clouds.
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
