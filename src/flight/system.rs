@@ -404,7 +404,8 @@ impl SkySystem {
     /// `dt_s` around the camera and hands the sky what changed, places the sun for `utc_unix_s`,
     /// and prepares the sky's frame. Returns the frame's stats (its CPU cost included, the
     /// weather's in `weather_us`, the previous frame's [`Self::record`] in `record_us`, all of
-    /// it in [`FrameStats::sky_cpu_us`]) and the weather files that arrived this frame: applied, or
+    /// it in [`FrameStats::sky_cpu_us`]) and the weather files (and watched winds aloft,
+    /// [`Self::watch_winds_aloft`]) that arrived this frame: applied, or
     /// rejected with the one line that says why (the last good sky stays). Call
     /// [`Self::record`] after it, in the frame's encoder.
     pub fn update(
