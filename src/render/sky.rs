@@ -1097,8 +1097,12 @@ impl Sky {
             }),
         };
         queue.write_buffer(&self.views[i].frame_buffer, 0, bytemuck::bytes_of(&frame));
-        self.far_field
-            .prepare(queue, camera.position_m, &self.clear_light, self.elapsed_s);
+        self.far_field.prepare(
+            queue,
+            (camera.position_m, frame.sky_horizon_rgb[3]),
+            &self.clear_light,
+            self.elapsed_s,
+        );
         upload_bytes += std::mem::size_of::<GpuFrame>() as u64;
         let ring_frame = RingFrame {
             resident: &self.resident,
