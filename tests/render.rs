@@ -1811,21 +1811,31 @@ fn from_fl350_the_clouds_reach_the_horizon() {
     assert!(today < 0.01, "the far field off still shows {today}");
 }
 
-/// Mean luminance change per pixel between successive frames of a flight north at 10 km, looking
-/// 8 degrees down, towards cumulus 58 to 62 km ahead (sprites: the ring off, drawn to 100 km)
-/// over a far field of heaped cloud: the clouds cross the end of the hand-over band at 60 km,
-/// where the sprites fade out and the far field fades in, over `band_m`. A frame's change is the
-/// sum over the pixels of their luminance's change; returned, each frame's change over the
-/// median change of the frames around it (three either side): above 1 where a frame changes
-/// more than the plain motion around it.
-fn hand_over_run(band_m: f32) -> Vec<f32> {
+/// Mean luminance change per pixel between successive frames of a flight north towards cumulus
+/// 58 to 62 km ahead over a far field of heaped cloud: the clouds cross the end of the hand-over
+/// band at 60 km, where the clouds drawn nearer fade out and the far field fades in, over
+/// `band_m`. `ring`: `None` flies at 10 km looking 8 degrees down, the ring off and the sprites
+/// drawn to 100 km (the sprite / far-field boundary); `Some(crossfade_s)` flies at 4.4 km,
+/// within the ring's height limit of the clouds, looking 3 degrees down, the ring on (its blocks
+/// beyond 20 km from its centre, rebuilt every 400 m and crossfaded over `crossfade_s`: the
+/// ring / far-field boundary, which moves with the ring's centre at each rebuild). A frame's
+/// change is the sum over the pixels of their luminance's change; returned, each frame's change
+/// over the median change of the frames around it (three either side): above 1 where a frame
+/// changes more than the plain motion around it.
+fn hand_over_run(band_m: f32, ring: Option<f64>) -> Vec<f32> {
     use skycast::clouds::far_map::FarMap;
     let mut settings = RenderSettings::default();
-    settings.impostors.enabled = false;
+    settings.impostors.enabled = ring.is_some();
+    settings.impostors.rebuild_move_fraction = 0.02;
+    settings.impostors.crossfade_s = ring.unwrap_or(1.0);
     settings.clouds.draw_distance_m = 100_000.0;
     settings.far_field.fade_end_m = 60_000.0;
     settings.far_field.fade_start_m = 60_000.0 - band_m;
     settings.camera.fov_y_deg = 20.0;
+    let (height, pitch, frames) = match ring {
+        None => (10_000.0, -8.0, 41),
+        Some(_) => (4_400.0, -3.0, 49),
+    };
     let ground = HeightField::from_fn(DVec2::ZERO, 400_000.0, 16, |_| 0.0);
     let mut rig = Rig::with_settings(ground, settings);
     rig.host.sky.set_far_map(
@@ -1856,10 +1866,12 @@ fn hand_over_run(band_m: f32) -> Vec<f32> {
     rig.set_clouds(blocks);
     let mut last: Option<Frame> = None;
     let mut out = Vec::new();
-    for k in 0..41 {
+    let mut ring_blocks = 0;
+    for k in 0..frames {
         // 25 m a frame (a tenth of a second at cruise).
-        let cam = rig.camera(DVec3::new(0.0, k as f64 * 25.0, 10_000.0), 0.0, -8.0);
-        let (frame, _) = rig.host.frame(&cam, &sun(), 0.05, 40_000.0).unwrap();
+        let cam = rig.camera(DVec3::new(0.0, k as f64 * 25.0, height), 0.0, pitch);
+        let (frame, stats) = rig.host.frame(&cam, &sun(), 0.05, 40_000.0).unwrap();
+        ring_blocks = ring_blocks.max(stats.blocks_far);
         if let Some(prev) = &last {
             let change = frame
                 .rgba
@@ -1872,12 +1884,20 @@ fn hand_over_run(band_m: f32) -> Vec<f32> {
         if k == 20 {
             let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
             std::fs::create_dir_all(&dir).unwrap();
-            frame
-                .write_png(&dir.join(format!("hand-over-{band_m}.png")))
-                .unwrap();
+            let name = format!(
+                "hand-over-{band_m}{}.png",
+                if ring.is_some() { "-ring" } else { "" }
+            );
+            frame.write_png(&dir.join(name)).unwrap();
         }
         last = Some(frame);
     }
+    // With the ring on, the clouds are the ring's.
+    assert_eq!(
+        ring_blocks > 0,
+        ring.is_some(),
+        "blocks in the ring: {ring_blocks}"
+    );
     (0..out.len())
         .map(|k| {
             let around: Vec<f32> = (k.saturating_sub(3)..(k + 4).min(out.len()))
@@ -1895,10 +1915,10 @@ fn hand_over_run(band_m: f32) -> Vec<f32> {
 /// it pop.
 #[test]
 fn the_far_field_hand_over_does_not_pop() {
-    let blended = hand_over_run(18_000.0);
+    let blended = hand_over_run(18_000.0, None);
     let worst = blended.iter().copied().fold(0.0, f32::max);
     eprintln!("hand-over 18 km: worst {worst} x the frames around, {blended:?}");
-    let hard = hand_over_run(1.0);
+    let hard = hand_over_run(1.0, None);
     let hard_worst = hard.iter().copied().fold(0.0, f32::max);
     eprintln!("hand-over 1 m: worst {hard_worst} x the frames around, {hard:?}");
     assert!(
@@ -1906,4 +1926,72 @@ fn the_far_field_hand_over_does_not_pop() {
         "a frame pops: {worst} x the plain motion around it"
     );
     assert!(hard_worst > 1.5, "without a blend: {hard_worst}");
+}
+
+/// Issue 31, popping across the ring / far-field hand-over: flying within the ring's height
+/// limit of the clouds, the ring holds them from 20 km out and fades them out over the hand-over
+/// band (from its centre) while the far field fades them in (from the camera); at each rebuild
+/// the ring's band moves with its centre, crossfaded. No frame changes more than 1.5x the plain
+/// motion of the frames around it. The negative control, no blend: a hand-over band of a metre
+/// and no crossfade (the ring's clouds near 60 km switch to the far field's at once as its
+/// centre jumps 400 m) pops.
+#[test]
+fn the_ring_to_far_field_hand_over_does_not_pop() {
+    let blended = hand_over_run(18_000.0, Some(1.0));
+    let worst = blended.iter().copied().fold(0.0, f32::max);
+    eprintln!(
+        "ring, hand-over 18 km, crossfade 1 s: worst {worst} x the frames around, {blended:?}"
+    );
+    let hard = hand_over_run(1.0, Some(0.0));
+    let hard_worst = hard.iter().copied().fold(0.0, f32::max);
+    eprintln!(
+        "ring, hand-over 1 m, no crossfade: worst {hard_worst} x the frames around, {hard:?}"
+    );
+    assert!(
+        worst <= 1.5,
+        "a frame pops: {worst} x the plain motion around it"
+    );
+    assert!(hard_worst > 1.5, "without a blend: {hard_worst}");
+}
+
+/// Issue 31: while the far field is drawn every sprite has faded out by the end of its
+/// hand-over band (60 km), and so has every impostor built from them: the ring holds no block
+/// beyond it (it was built and faded out to nothing). With the far field off the ring reaches
+/// its view radius (100 km) as before.
+#[test]
+fn with_the_far_field_on_the_ring_stops_at_the_hand_over() {
+    use skycast::clouds::far_map::FarMap;
+    let ring_blocks = |far_field: bool| {
+        let mut settings = RenderSettings::default();
+        settings.far_field.enabled = far_field;
+        let ground = HeightField::from_fn(DVec2::ZERO, 400_000.0, 16, |_| 0.0);
+        let mut rig = Rig::with_settings(ground, settings);
+        rig.host.sky.set_far_map(
+            &rig.host.gpu.queue,
+            &FarMap {
+                texels: 96,
+                texel_m: 10_000.0,
+                centre_m: DVec2::ZERO,
+                cells: vec![[0.15, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
+            },
+            None,
+        );
+        let blocks = [(1, 30_000.0), (2, 80_000.0)]
+            .into_iter()
+            .map(|(id, y)| {
+                let c = DVec3::new(0.0, y, 1500.0);
+                SkyBlock {
+                    id,
+                    centre_m: c,
+                    clouds: vec![big_cumulus(c, 3.0)],
+                }
+            })
+            .collect();
+        rig.set_clouds(blocks);
+        let cam = rig.camera(DVec3::new(0.0, 0.0, 3000.0), 0.0, 0.0);
+        let (_, stats) = rig.frame(&format!("ring-reach-{far_field}"), &cam);
+        stats.blocks_far
+    };
+    assert_eq!(ring_blocks(true), 1, "the far field on");
+    assert_eq!(ring_blocks(false), 2, "the far field off");
 }
