@@ -969,7 +969,7 @@ fn clouds_already_on_the_gpu_stay_drawn_when_the_buffers_grow() {
         .collect();
     let every: Vec<SkyBlock> = std::iter::once(near.clone()).chain(behind).collect();
 
-    let mut at_once = Rig::with_settings(flat_ground(0.0), settings.clone());
+    let mut at_once = Rig::with_settings(flat_ground(0.0), settings);
     let camera = at_once.camera(cam, 0.0, 3.0);
     at_once.set_clouds(every.clone());
     let (whole, _) = at_once.frame("grow_at_once", &camera);
