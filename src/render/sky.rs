@@ -974,6 +974,7 @@ impl Sky {
             self.settings.vertex_cache.max_uploaded_sprites_per_frame,
         );
         stats.blocks_left_out = left_out;
+        gpu_wait_us += self.resident.grow_wait_us;
         upload_bytes += placed_bytes;
         upload_bytes += self.resident.relight(queue, camera.position_m);
         (stats.sprites_lit, stats.light_us) = (self.resident.lit_sprites, self.resident.light_us);
