@@ -465,7 +465,7 @@ impl ResidentSet {
     ///
     /// Growing keeps every block where it is: the device copies the old buffers into the new
     /// ones (one submission, timed in [`Self::grow_wait_us`]) and the CPU writes only the orders
-    /// and lists it keeps copies of, 8 bytes a sprite slot. Placing and writing every block again
+    /// and lists it keeps copies of, 4 bytes a sprite slot. Placing and writing every block again
     /// instead (20 to 27 MB in one frame) made the frames where the buffers grew take 42 to
     /// 144 ms. A buffer that grows gets a sixteenth more than it needs.
     ///
