@@ -516,20 +516,13 @@ impl ResidentSet {
             return true;
         }
         self.repacked = true;
-        let b = buffers(&self.device, &self.layout, sprites, clouds);
-        self.sprite_buffer = b.sprites;
-        self.cloud_buffer = b.clouds;
-        self.light_buffer = b.lights;
-        self.order_buffer = b.orders;
-        self.list_buffer = b.lists;
-        self.group = b.group;
+        self.take_buffers(buffers(&self.device, &self.layout, sprites, clouds));
         self.sprite_slots = SlotRanges::new(sprites);
         self.cloud_slots = SlotRanges::new(clouds);
         self.orders_cpu = vec![0; sprites as usize];
         self.dirty_orders.clear();
         self.lists_cpu = vec![GpuListCloud::default(); clouds as usize];
         self.dirty_lists.clear();
-        self.generation += 1;
         let mut placed: Vec<u64> = self
             .blocks
             .values()
@@ -576,6 +569,12 @@ impl ResidentSet {
         let wait = std::time::Instant::now();
         queue.submit([encoder.finish()]);
         self.grow_wait_us += wait.elapsed().as_micros() as u64;
+        self.take_buffers(b);
+    }
+
+    /// Puts `b` in place of the buffers held; bind groups made with the old ones are made again
+    /// (a new generation).
+    fn take_buffers(&mut self, b: Buffers) {
         self.sprite_buffer = b.sprites;
         self.cloud_buffer = b.clouds;
         self.light_buffer = b.lights;
