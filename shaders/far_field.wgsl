@@ -8,7 +8,9 @@
 
 @group(1) @binding(0) var far_map: texture_2d_array<f32>;
 @group(1) @binding(1) var far_sampler: sampler;
-@group(1) @binding(2) var<uniform> ff: FarField;
+// Storage, not uniform: lavapipe would specialise this shader on every camera height its
+// branches see (src/render/far_field/mod.rs).
+@group(1) @binding(2) var<storage, read> ff: FarField;
 
 // Keep in sync with `GpuFarField` in src/render/far_field/mod.rs.
 struct FarField {
@@ -62,19 +64,26 @@ fn vs_far_field(@builtin(vertex_index) vi: u32) -> FarOut {
 
 // Where the ray `dir` (unit, from the camera) meets the layer `height_msl` metres above sea
 // level: the distance along it, or -1 where it does not (above the layer's horizon, or away
-// from a level layer). The sphere of radius `rc - camera + height` about the Earth's centre
-// (0, 0, -rc) when the Earth is round, the plane at that height when it is flat. From above a
-// ray that goes down through a round layer comes up through it again beyond its horizon (past
-// 330 km for a layer 8.7 km below: where a pilot sees far clouds' undersides through the gaps
-// of nearer ones, out to `sqrt(2 R h) + sqrt(2 R c)`); `far_side` asks for that crossing, unless
-// the ray meets the sea first.
+// from a level layer). The sphere of `ray_to_shell` when the Earth is round, the plane at that
+// height when it is flat (which has no far side). Chosen by `select`, never by a branch on
+// `rc`: lavapipe specialises a shader on the values of the uniforms its branches test and keeps
+// every copy, and `rc` (the camera's distance from the Earth's centre) is new every frame of a
+// climb or a descent: the process grew 3.4 MB a drawn frame (tests/memory.rs).
 fn ray_to_layer(dir: vec3<f32>, height_msl: f32, far_side: bool) -> f32 {
     let rc = frame.sky_horizon_rgb.w;
     let above = ff.lit_rgb.w - height_msl;
-    if (rc <= 0.0) {
-        let t = -above / dir.z;
-        return select(-1.0, t, t > 0.0 && abs(dir.z) > 1e-6);
-    }
+    let t_flat = -above / dir.z;
+    let flat = select(-1.0, t_flat, t_flat > 0.0 && abs(dir.z) > 1e-6 && !far_side);
+    return select(ray_to_shell(dir, max(rc, 1.0), above, far_side), flat, rc <= 0.0);
+}
+
+// Where the ray `dir` meets the sphere of radius `rc - above` about the Earth's centre
+// (0, 0, -rc), `above` metres below the camera (negative: above it), or -1. From above a ray
+// that goes down through a round layer comes up through it again beyond its horizon (past
+// 330 km for a layer 8.7 km below: where a pilot sees far clouds' undersides through the gaps
+// of nearer ones, out to `sqrt(2 R h) + sqrt(2 R c)`); `far_side` asks for that crossing, unless
+// the ray meets the sea first.
+fn ray_to_shell(dir: vec3<f32>, rc: f32, above: f32, far_side: bool) -> f32 {
     let b = rc * dir.z;
     // rc^2 - r^2, with the difference of the radii exact.
     let k = above * (2.0 * rc - above);
@@ -104,14 +113,13 @@ fn ray_to_layer(dir: vec3<f32>, height_msl: f32, far_side: bool) -> f32 {
 }
 
 // The flat frame's horizontal offset of a camera-relative point on the round Earth (the
-// inverse of `earth_curved`'s horizontal part: the arc along the Earth).
+// inverse of `earth_curved`'s horizontal part: the arc along the Earth). By `select`, as
+// `ray_to_layer`.
 fn flat_offset(p: vec3<f32>) -> vec2<f32> {
     let rc = frame.sky_horizon_rgb.w;
     let h = length(p.xy);
-    if (rc <= 0.0 || h <= 0.0) {
-        return p.xy;
-    }
-    return p.xy * (rc * atan2(h, rc + p.z) / h);
+    let arc = p.xy * (rc * atan2(h, rc + p.z) / max(h, 1.0e-6));
+    return select(arc, p.xy, rc <= 0.0 || h <= 0.0);
 }
 
 fn hash2(c: vec2<i32>) -> f32 {

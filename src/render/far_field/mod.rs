@@ -242,10 +242,13 @@ impl FarField {
                 },
                 wgpu::BindGroupLayoutEntry {
                     binding: 2,
-                    // The vertex stage reads the band's elevations.
+                    // The vertex stage reads the band's elevations. A read-only storage buffer,
+                    // not a uniform: lavapipe specialises a shader on the uniform values its
+                    // branches test (the camera's height, new every frame of a climb) and keeps
+                    // every copy (tests/memory.rs).
                     visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
                     ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
                         has_dynamic_offset: false,
                         min_binding_size: None,
                     },
@@ -293,7 +296,7 @@ impl FarField {
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("far_field.uniform"),
             size: std::mem::size_of::<GpuFarField>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Self {
