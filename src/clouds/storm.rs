@@ -356,7 +356,7 @@ fn cell_raws(
                 let y = rng.range_f64(-1.0, 1.0);
                 let z = rng.range_f64(if b.bottom { 0.0 } else { -1.0 }, 1.0);
                 let r2 = x * x + y * y + z * z;
-                if r2 > 1.0 || r2 < 1e-6 {
+                if !(1e-6..=1.0).contains(&r2) {
                     continue;
                 }
                 // On the shell: pushed out to between TOWER_SHELL_INNER and 1 of the radius.
