@@ -599,8 +599,9 @@ mod fill {
 
     /// Cells of 7, 10 and 15 km (the bench's BKN CB grows them to 15) are a shell of turrets
     /// and a slab of pancakes: at most 12 quads deep seen from the side where the tower is, 20
-    /// where the anvil is seen edge-on, 6 from below. Filled through, with square anvil
-    /// sprites (before), a 10 km cell was 23 deep from the side, its tower 19 and its anvil 19.
+    /// where the anvil is seen edge-on, 6 from below. Filled through (1,400 sprites, square
+    /// anvil sprites) a 10 km cell was 23 deep from the side and 5 from below; shells with that
+    /// budget and anvil, its tower 19 and its anvil 19 (this test fails on the tower).
     #[test]
     fn a_cell_is_a_shell_a_few_sprites_deep() {
         let types = CloudTypes::builtin();
