@@ -8,7 +8,9 @@
 
 @group(1) @binding(0) var far_map: texture_2d_array<f32>;
 @group(1) @binding(1) var far_sampler: sampler;
-@group(1) @binding(2) var<uniform> ff: FarField;
+// Storage, not uniform: lavapipe would specialise this shader on every camera height its
+// branches see (src/render/far_field/mod.rs).
+@group(1) @binding(2) var<storage, read> ff: FarField;
 
 // Keep in sync with `GpuFarField` in src/render/far_field/mod.rs.
 struct FarField {
@@ -31,32 +33,57 @@ struct FarField {
 
 struct FarOut {
     @builtin(position) position: vec4<f32>,
-    @location(0) ndc: vec2<f32>,
+    // The pixel's direction from the camera (not unit: a point of the band's quad on its ray).
+    @location(0) dir: vec3<f32>,
 };
 
+// Quads of the band around the horizon (keep in sync with `BAND_SEGMENTS` in
+// src/render/far_field/mod.rs).
+const BAND_SEGMENTS: u32 = 64u;
+
+// Vertex `vi` of the band of elevations `ff.fade.y..ff.fade.z` where the far field's clouds can
+// show (src/render/far_field/mod.rs `band_elevations`): two triangles a segment, directions at
+// infinity. Only the pixels of that band run the fragment shader, not the whole screen. Its
+// depth is held inside the clip volume in front of the camera (no depth test reads it); the
+// clipper cuts the band's far side at a twentieth of the view axis, off any screen.
 @vertex
 fn vs_far_field(@builtin(vertex_index) vi: u32) -> FarOut {
+    let corner = vi % 6u;
+    let next = corner == 1u || corner == 2u || corner == 4u;
+    let upper = corner == 2u || corner == 4u || corner == 5u;
+    let azimuth = f32(vi / 6u + select(0u, 1u, next)) * (6.2831853 / f32(BAND_SEGMENTS));
+    let e = select(ff.fade.y, ff.fade.z, upper);
+    let dir = vec3<f32>(cos(e) * cos(azimuth), cos(e) * sin(azimuth), sin(e));
+    var clip = frame.view_proj * vec4<f32>(dir, 0.0);
+    clip.z = clip.w - 0.05;
     var o: FarOut;
-    o.position = fullscreen_position(vi);
-    o.ndc = o.position.xy;
+    o.position = clip;
+    o.dir = dir;
     return o;
 }
 
 // Where the ray `dir` (unit, from the camera) meets the layer `height_msl` metres above sea
 // level: the distance along it, or -1 where it does not (above the layer's horizon, or away
-// from a level layer). The sphere of radius `rc - camera + height` about the Earth's centre
-// (0, 0, -rc) when the Earth is round, the plane at that height when it is flat. From above a
-// ray that goes down through a round layer comes up through it again beyond its horizon (past
-// 330 km for a layer 8.7 km below: where a pilot sees far clouds' undersides through the gaps
-// of nearer ones, out to `sqrt(2 R h) + sqrt(2 R c)`); `far_side` asks for that crossing, unless
-// the ray meets the sea first.
+// from a level layer). The sphere of `ray_to_shell` when the Earth is round, the plane at that
+// height when it is flat (which has no far side). Chosen by `select`, never by a branch on
+// `rc`: lavapipe specialises a shader on the values of the uniforms its branches test and keeps
+// every copy, and `rc` (the camera's distance from the Earth's centre) is new every frame of a
+// climb or a descent: the process grew 3.4 MB a drawn frame (tests/memory.rs).
 fn ray_to_layer(dir: vec3<f32>, height_msl: f32, far_side: bool) -> f32 {
     let rc = frame.sky_horizon_rgb.w;
     let above = ff.lit_rgb.w - height_msl;
-    if (rc <= 0.0) {
-        let t = -above / dir.z;
-        return select(-1.0, t, t > 0.0 && abs(dir.z) > 1e-6);
-    }
+    let t_flat = -above / dir.z;
+    let flat = select(-1.0, t_flat, t_flat > 0.0 && abs(dir.z) > 1e-6 && !far_side);
+    return select(ray_to_shell(dir, max(rc, 1.0), above, far_side), flat, rc <= 0.0);
+}
+
+// Where the ray `dir` meets the sphere of radius `rc - above` about the Earth's centre
+// (0, 0, -rc), `above` metres below the camera (negative: above it), or -1. From above a ray
+// that goes down through a round layer comes up through it again beyond its horizon (past
+// 330 km for a layer 8.7 km below: where a pilot sees far clouds' undersides through the gaps
+// of nearer ones, out to `sqrt(2 R h) + sqrt(2 R c)`); `far_side` asks for that crossing, unless
+// the ray meets the sea first.
+fn ray_to_shell(dir: vec3<f32>, rc: f32, above: f32, far_side: bool) -> f32 {
     let b = rc * dir.z;
     // rc^2 - r^2, with the difference of the radii exact.
     let k = above * (2.0 * rc - above);
@@ -86,14 +113,13 @@ fn ray_to_layer(dir: vec3<f32>, height_msl: f32, far_side: bool) -> f32 {
 }
 
 // The flat frame's horizontal offset of a camera-relative point on the round Earth (the
-// inverse of `earth_curved`'s horizontal part: the arc along the Earth).
+// inverse of `earth_curved`'s horizontal part: the arc along the Earth). By `select`, as
+// `ray_to_layer`.
 fn flat_offset(p: vec3<f32>) -> vec2<f32> {
     let rc = frame.sky_horizon_rgb.w;
     let h = length(p.xy);
-    if (rc <= 0.0 || h <= 0.0) {
-        return p.xy;
-    }
-    return p.xy * (rc * atan2(h, rc + p.z) / h);
+    let arc = p.xy * (rc * atan2(h, rc + p.z) / max(h, 1.0e-6));
+    return select(arc, p.xy, rc <= 0.0 || h <= 0.0);
 }
 
 fn hash2(c: vec2<i32>) -> f32 {
@@ -103,27 +129,39 @@ fn hash2(c: vec2<i32>) -> f32 {
     return f32(h & 0xffffu) / 65535.0;
 }
 
-// Value noise with a period of `period` cells (so the world-anchored pattern wraps exactly).
+// Value noise with a period of `period` cells, a power of two (so the world-anchored pattern
+// wraps exactly; the wrap a mask, not an integer division, which a software rasterizer's
+// vector units do one lane at a time).
 fn value_noise(p: vec2<f32>, period: i32) -> f32 {
     let i = vec2<i32>(floor(p));
     let f = fract(p);
     let u = f * f * (3.0 - 2.0 * f);
-    let w = vec2<i32>(period);
-    let a = hash2((i % w + w) % w);
-    let b = hash2(((i + vec2<i32>(1, 0)) % w + w) % w);
-    let c = hash2(((i + vec2<i32>(0, 1)) % w + w) % w);
-    let d = hash2(((i + vec2<i32>(1, 1)) % w + w) % w);
+    let m = vec2<i32>(period - 1);
+    let i0 = i & m;
+    let i1 = (i + vec2<i32>(1)) & m;
+    let a = hash2(i0);
+    let b = hash2(vec2<i32>(i1.x, i0.y));
+    let c = hash2(vec2<i32>(i0.x, i1.y));
+    let d = hash2(i1);
     return mix(mix(a, b, u.x), mix(c, d, u.x), u.y);
 }
 
-// Three octaves at `scale_m`, over the world point `world` (metres in the noise's period).
-fn cloud_noise(world: vec2<f32>, scale_m: f32) -> f32 {
+// Three octaves at `scale_m`, over the world point `world` (metres in the noise's period); the
+// finest (cells of a quarter of the scale) fades to its mean where a pixel's footprint on the
+// layer, `footprint_m`, no longer resolves it (far out and at a slant: beyond about 200 km
+// from FL350 at full resolution), which saves its four hashes there and keeps it from
+// shimmering.
+fn cloud_noise(world: vec2<f32>, scale_m: f32, footprint_m: f32) -> f32 {
     let period = ff.heights.w;
     let cells = i32(round(period / scale_m));
     var n = 0.5 * value_noise(world / scale_m, cells);
     n += 0.3 * value_noise(world / scale_m * 2.0 + vec2<f32>(17.3, 5.1), cells * 2);
-    n += 0.2 * value_noise(world / scale_m * 4.0 + vec2<f32>(3.7, 41.9), cells * 4);
-    return n;
+    let fine = 1.0 - smoothstep(0.5, 1.0, footprint_m * 4.0 / scale_m);
+    var finest = 0.5;
+    if (fine > 0.0) {
+        finest = mix(0.5, value_noise(world / scale_m * 4.0 + vec2<f32>(3.7, 41.9), cells * 4), fine);
+    }
+    return n + 0.2 * finest;
 }
 
 // One layer along the ray: premultiplied colour and the distance of its clouds.
@@ -132,7 +170,8 @@ struct FarHit {
     distance_m: f32,
 };
 
-fn far_layer(dir: vec3<f32>, layer: i32, frag_xy: vec2<f32>, far_side: bool) -> FarHit {
+// `pixel`: the angle a pixel spans, radians.
+fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_side: bool) -> FarHit {
     var none: FarHit;
     none.colour = vec4<f32>(0.0);
     none.distance_m = 0.0;
@@ -181,11 +220,12 @@ fn far_layer(dir: vec3<f32>, layer: i32, frag_xy: vec2<f32>, far_side: bool) -> 
     let heaped = cell.w > 0.5;
     let scale = select(ff.heights.z, ff.shade_rgb.w, heaped);
     let world = ff.noise_fade.xy + (ground_xy - ff.centre_rel_size.xy);
-    let n = cloud_noise(world, scale);
+    let sin_e = max(abs(dir.z), 0.01);
+    // A pixel's footprint on the layer: the mean of its widths across and along the ray.
+    let n = cloud_noise(world, scale, pixel * t / sqrt(sin_e));
     // Seen at a slant, heaped clouds' sides fill the gaps between them (a cumulus field runs
     // together towards the horizon): the cover of a slab `top - base` thick seen at the ray's
     // elevation, as if the sides hid the gaps at random (`1 - (1 - c)^k`).
-    let sin_e = max(abs(dir.z), 0.01);
     let sides = select(0.0, 0.5 * (cell.z - cell.y) / (ff.shade_rgb.w * sin_e), heaped);
     let cover = 1.0 - pow(1.0 - clamp(cell.x, 0.0, 1.0), 1.0 + min(sides, 8.0));
     let soft = select(0.12, 0.06, heaped);
@@ -219,22 +259,23 @@ fn far_layer(dir: vec3<f32>, layer: i32, frag_xy: vec2<f32>, far_side: bool) -> 
 }
 
 fn far_hit(i: FarOut) -> FarHit {
-    let far_pt = far_point(i.ndc);
-    let dir = normalize(far_pt.xyz / far_pt.w);
+    let dir = normalize(i.dir);
+    // In uniform control flow (the layers return early per pixel).
+    let pixel = length(fwidth(dir));
     // The low layer's far side (beyond its horizon, seen through the gaps) behind its near side.
-    let near_low = far_layer(dir, 0, i.position.xy, false);
+    let near_low = far_layer(dir, pixel, 0, i.position.xy, false);
     var beyond: FarHit;
     beyond.colour = vec4<f32>(0.0);
     beyond.distance_m = 0.0;
     if (near_low.colour.a < 0.99) {
-        beyond = far_layer(dir, 0, i.position.xy, true);
+        beyond = far_layer(dir, pixel, 0, i.position.xy, true);
     }
     var low = near_low;
     low.colour = near_low.colour + beyond.colour * (1.0 - near_low.colour.a);
     let low_weighted = near_low.distance_m * near_low.colour.a
         + beyond.distance_m * beyond.colour.a * (1.0 - near_low.colour.a);
     low.distance_m = low_weighted / max(low.colour.a, 1e-6);
-    let high = far_layer(dir, 1, i.position.xy, false);
+    let high = far_layer(dir, pixel, 1, i.position.xy, false);
     // The nearer layer over the farther one.
     var front = low;
     var back = high;

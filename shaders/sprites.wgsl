@@ -38,14 +38,13 @@ fn vs_sprite(v: VertexIn) -> VertexOut {
         o.position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return o;
     }
-    o.colour = v.colour;
     // A lightning flash inside the cell: light falling off with distance from it (Gaussian in
-    // its reach, per corner), a little blue-white, on top of the cloud's own light.
-    if (frame.flash.w > 0.0) {
-        let d = distance(v.position_visible.xyz, frame.flash.xyz) / max(frame.flash_reach.x, 1.0);
-        let glow = frame.flash.w * exp(-d * d);
-        o.colour = vec4<f32>(v.colour.rgb + glow * vec3<f32>(0.92, 0.94, 1.0), v.colour.a);
-    }
+    // its reach, per corner), a little blue-white, on top of the cloud's own light. Nothing
+    // when no flash is lit (`flash.w` 0); no branch on it, which lavapipe would specialise the
+    // shader on, a copy for each flash's brightness (far_field.wgsl).
+    let d = distance(v.position_visible.xyz, frame.flash.xyz) / max(frame.flash_reach.x, 1.0);
+    let glow = frame.flash.w * exp(-d * d);
+    o.colour = vec4<f32>(v.colour.rgb + glow * vec3<f32>(0.92, 0.94, 1.0), v.colour.a);
     // On the round Earth (`earth_curved`): at 100 km a sprite sits 0.8 km below the flat frame.
     let rel = earth_curved(v.position_visible.xyz);
     o.position = frame.view_proj * vec4<f32>(rel, 1.0);

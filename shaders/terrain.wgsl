@@ -45,14 +45,14 @@ struct TerrainOut {
 fn earth_curved(rel: vec3<f32>) -> vec3<f32> {
     let rc = terrain.fog_rgb.w;
     let s = length(rel.xy);
-    if (rc <= 0.0 || s <= 0.0) {
-        return rel;
-    }
-    let theta = s / rc;
+    // By select, not a branch on `rc`, which changes with the camera's height: lavapipe keeps a
+    // copy of a shader for each value of a uniform that a branch tests (far_field.wgsl).
+    let theta = s / max(rc, 1.0);
     let sin_half = sin(0.5 * theta);
     let drop = 2.0 * sin_half * sin_half;
-    let along = (rc + rel.z) * sin(theta) / s;
-    return vec3<f32>(rel.xy * along, rel.z * (1.0 - drop) - rc * drop);
+    let along = (rc + rel.z) * sin(theta) / max(s, 1.0e-6);
+    let curved = vec3<f32>(rel.xy * along, rel.z * (1.0 - drop) - rc * drop);
+    return select(curved, rel, rc <= 0.0 || s <= 0.0);
 }
 
 // The altitude haze (shared/frame.wgsl `haze_mean`: keep in sync).

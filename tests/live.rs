@@ -526,3 +526,75 @@ fn a_new_report_fogs_and_darkens_the_sky_as_its_clouds_form() {
         "{end_horizon}"
     );
 }
+
+/// A watched FB file of winds aloft reloads live: at San Antonio (FB site SAT) at 9,000 ft the
+/// air data is the file's forecast, then a rewritten file's; a file with a malformed field and
+/// one cut short are refused, each with one line naming the file (line and field), and the last
+/// good winds stay.
+#[test]
+fn a_watched_winds_aloft_file_reloads_and_a_broken_one_keeps_the_last_good_winds() {
+    let dir = temp_dir("aloft");
+    let path = dir.join("fb.txt");
+    let sample = std::fs::read_to_string(manifest("weather/fd1us1-2026-01-31T06Z.txt")).unwrap();
+    let sat_line = "SAT 3618 0122+03 3326-03 ";
+    assert!(sample.contains(sat_line));
+    std::fs::write(&path, &sample).unwrap();
+    let mut flight = Flight::new(field_of_text(&dir), 8_000.0, None, FORMATION_S);
+    let (placed, _) = flight
+        .host
+        .sky
+        .watch_winds_aloft(&path, Duration::from_millis(150))
+        .unwrap();
+    assert_eq!(placed, 157);
+    let ksat = stations().get("KSAT").unwrap().clone();
+    let at_sat = skycast::HostPosition::LatLonAlt {
+        lat_deg: ksat.latitude_deg,
+        lon_deg: ksat.longitude_deg,
+        alt_m: 9_000.0 * 0.3048,
+    };
+    let wind = |f: &Flight| {
+        let air = f.host.sky.air_at(at_sat);
+        (air.wind_from_deg.round(), air.wind_kt, air.temperature_c)
+    };
+    flight.step(0.5, false);
+    let (from, kt, c) = wind(&flight);
+    assert_eq!(from, 330.0);
+    assert!((kt - 26.0).abs() < 0.01 && c == -3.0, "{kt} kt {c} C");
+
+    // Rewritten by rename, as a download tool does: 200/45, -07 at 9,000 ft.
+    let staging = dir.join("download.tmp");
+    std::fs::write(
+        &staging,
+        sample.replace(sat_line, "SAT 3618 0122+03 2045-07 "),
+    )
+    .unwrap();
+    std::fs::rename(&staging, &path).unwrap();
+    let (changes, _, _) = fly_until_change(&mut flight, 400);
+    assert!(matches!(&changes[..], [Ok(p)] if p == &path), "{changes:?}");
+    let (from, kt, c) = wind(&flight);
+    assert_eq!(from, 200.0);
+    assert!((kt - 45.0).abs() < 0.01 && c == -7.0, "{kt} kt {c} C");
+
+    // A malformed field, then a file cut short: refused, the last good winds stay.
+    std::fs::write(&path, sample.replace(sat_line, "SAT 3618 0122+03 33X6-03 ")).unwrap();
+    let (changes, _, _) = fly_until_change(&mut flight, 400);
+    assert!(
+        matches!(&changes[..], [Err(m)] if m.ends_with("fb.txt:155: field SAT 9000 ft: `33X6-03` is not DDSS, DDSS+TT, DDSS-TT or DDSSTT")),
+        "{changes:?}"
+    );
+    std::fs::write(&path, &sample[..sample.find(sat_line).unwrap() + 10]).unwrap();
+    let (changes, _, _) = fly_until_change(&mut flight, 400);
+    assert!(
+        matches!(&changes[..], [Err(m)] if m.ends_with("fb.txt:155: ends in the middle of a line: cut short")),
+        "{changes:?}"
+    );
+    let (from, kt, _) = wind(&flight);
+    assert_eq!((from, kt.round()), (200.0, 45.0));
+}
+
+/// A few cumulus around San Antonio, from a report file written to `dir`.
+fn field_of_text(dir: &Path) -> WeatherField {
+    let path = dir.join("metars.txt");
+    std::fs::write(&path, reports("FEW045")).unwrap();
+    field_of(&path)
+}

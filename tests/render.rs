@@ -937,6 +937,72 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     assert!(!plain.host.sky.set_impostors(true));
 }
 
+/// Blocks that arrive when the resident buffers are full grow them, and the clouds already on
+/// the GPU stay as they were: the frame after the growth is the frame of a sky that got every
+/// block at once. (Placing everything again made the frames that grew take 42 to 144 ms; the
+/// blocks now stay where they are and the device copies them across.)
+#[test]
+fn clouds_already_on_the_gpu_stay_drawn_when_the_buffers_grow() {
+    let cam = DVec3::new(0.0, 0.0, 1000.0);
+    let mut settings = RenderSettings::default();
+    settings.impostors.enabled = false;
+    let near = SkyBlock {
+        id: 1,
+        centre_m: DVec3::new(-500.0, 5000.0, 1300.0),
+        clouds: vec![
+            cumulus(DVec3::new(-500.0, 5000.0, 1000.0)),
+            cumulus(DVec3::new(900.0, 6500.0, 1200.0)),
+        ],
+    };
+    // Behind the camera, out of view: 80 clouds of 60 sprites, more than the first 4,096 slots.
+    let behind: Vec<SkyBlock> = (0..8)
+        .map(|k| {
+            let centre = DVec3::new(-16_000.0 + 4000.0 * k as f64, -20_000.0, 1300.0);
+            SkyBlock {
+                id: 10 + k,
+                centre_m: centre,
+                clouds: (0..10)
+                    .map(|c| cumulus(centre + DVec3::new(300.0 * c as f64, 0.0, 0.0)))
+                    .collect(),
+            }
+        })
+        .collect();
+    let every: Vec<SkyBlock> = std::iter::once(near.clone()).chain(behind).collect();
+
+    let mut at_once = Rig::with_settings(flat_ground(0.0), settings);
+    let camera = at_once.camera(cam, 0.0, 3.0);
+    at_once.set_clouds(every.clone());
+    let (whole, _) = at_once.frame("grow_at_once", &camera);
+
+    let mut growing = Rig::with_settings(flat_ground(0.0), settings);
+    growing.set_clouds(vec![near]);
+    let (before, _) = growing.frame("grow_before", &camera);
+    let bytes_before = growing.host.sky.gpu_buffer_bytes();
+    growing.set_clouds(every);
+    // The blocks behind arrive within the frames' upload budget.
+    let mut after = before.clone();
+    for k in 0..4 {
+        after = growing.frame(&format!("grow_after_{k}"), &camera).0;
+    }
+    let bytes_after = growing.host.sky.gpu_buffer_bytes();
+    assert!(
+        bytes_after > bytes_before,
+        "the buffers grew: {bytes_before} -> {bytes_after}"
+    );
+    let cloud = fraction(&before, |i| cloud_like(before.rgba[i]));
+    assert!(cloud > 0.02, "the near clouds cover {cloud} of the frame");
+    assert_eq!(
+        changed_pixels(&after, &whole).0,
+        0,
+        "the grown sky differs from the whole one"
+    );
+    assert_eq!(
+        changed_pixels(&after, &before).0,
+        0,
+        "the near clouds changed as the buffers grew"
+    );
+}
+
 /// The far cloud (what `sprites` and `ring` add to `bare`) shows in the impostor with about the
 /// pixels it has as sprites (0.9-1.1x; measured 0.98-1.02x), its centroid within `tolerance_px`
 /// of theirs.
@@ -1811,21 +1877,31 @@ fn from_fl350_the_clouds_reach_the_horizon() {
     assert!(today < 0.01, "the far field off still shows {today}");
 }
 
-/// Mean luminance change per pixel between successive frames of a flight north at 10 km, looking
-/// 8 degrees down, towards cumulus 58 to 62 km ahead (sprites: the ring off, drawn to 100 km)
-/// over a far field of heaped cloud: the clouds cross the end of the hand-over band at 60 km,
-/// where the sprites fade out and the far field fades in, over `band_m`. A frame's change is the
-/// sum over the pixels of their luminance's change; returned, each frame's change over the
-/// median change of the frames around it (three either side): above 1 where a frame changes
-/// more than the plain motion around it.
-fn hand_over_run(band_m: f32) -> Vec<f32> {
+/// Mean luminance change per pixel between successive frames of a flight north towards cumulus
+/// 58 to 62 km ahead over a far field of heaped cloud: the clouds cross the end of the hand-over
+/// band at 60 km, where the clouds drawn nearer fade out and the far field fades in, over
+/// `band_m`. `ring`: `None` flies at 10 km looking 8 degrees down, the ring off and the sprites
+/// drawn to 100 km (the sprite / far-field boundary); `Some(crossfade_s)` flies at 4.4 km,
+/// within the ring's height limit of the clouds, looking 3 degrees down, the ring on (its blocks
+/// beyond 20 km from its centre, rebuilt every 400 m and crossfaded over `crossfade_s`: the
+/// ring / far-field boundary, which moves with the ring's centre at each rebuild). A frame's
+/// change is the sum over the pixels of their luminance's change; returned, each frame's change
+/// over the median change of the frames around it (three either side): above 1 where a frame
+/// changes more than the plain motion around it.
+fn hand_over_run(band_m: f32, ring: Option<f64>) -> Vec<f32> {
     use skycast::clouds::far_map::FarMap;
     let mut settings = RenderSettings::default();
-    settings.impostors.enabled = false;
+    settings.impostors.enabled = ring.is_some();
+    settings.impostors.rebuild_move_fraction = 0.02;
+    settings.impostors.crossfade_s = ring.unwrap_or(1.0);
     settings.clouds.draw_distance_m = 100_000.0;
     settings.far_field.fade_end_m = 60_000.0;
     settings.far_field.fade_start_m = 60_000.0 - band_m;
     settings.camera.fov_y_deg = 20.0;
+    let (height, pitch, frames) = match ring {
+        None => (10_000.0, -8.0, 41),
+        Some(_) => (4_400.0, -3.0, 49),
+    };
     let ground = HeightField::from_fn(DVec2::ZERO, 400_000.0, 16, |_| 0.0);
     let mut rig = Rig::with_settings(ground, settings);
     rig.host.sky.set_far_map(
@@ -1856,10 +1932,12 @@ fn hand_over_run(band_m: f32) -> Vec<f32> {
     rig.set_clouds(blocks);
     let mut last: Option<Frame> = None;
     let mut out = Vec::new();
-    for k in 0..41 {
+    let mut ring_blocks = 0;
+    for k in 0..frames {
         // 25 m a frame (a tenth of a second at cruise).
-        let cam = rig.camera(DVec3::new(0.0, k as f64 * 25.0, 10_000.0), 0.0, -8.0);
-        let (frame, _) = rig.host.frame(&cam, &sun(), 0.05, 40_000.0).unwrap();
+        let cam = rig.camera(DVec3::new(0.0, k as f64 * 25.0, height), 0.0, pitch);
+        let (frame, stats) = rig.host.frame(&cam, &sun(), 0.05, 40_000.0).unwrap();
+        ring_blocks = ring_blocks.max(stats.blocks_far);
         if let Some(prev) = &last {
             let change = frame
                 .rgba
@@ -1872,12 +1950,20 @@ fn hand_over_run(band_m: f32) -> Vec<f32> {
         if k == 20 {
             let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
             std::fs::create_dir_all(&dir).unwrap();
-            frame
-                .write_png(&dir.join(format!("hand-over-{band_m}.png")))
-                .unwrap();
+            let name = format!(
+                "hand-over-{band_m}{}.png",
+                if ring.is_some() { "-ring" } else { "" }
+            );
+            frame.write_png(&dir.join(name)).unwrap();
         }
         last = Some(frame);
     }
+    // With the ring on, the clouds are the ring's.
+    assert_eq!(
+        ring_blocks > 0,
+        ring.is_some(),
+        "blocks in the ring: {ring_blocks}"
+    );
     (0..out.len())
         .map(|k| {
             let around: Vec<f32> = (k.saturating_sub(3)..(k + 4).min(out.len()))
@@ -1895,15 +1981,88 @@ fn hand_over_run(band_m: f32) -> Vec<f32> {
 /// it pop.
 #[test]
 fn the_far_field_hand_over_does_not_pop() {
-    let blended = hand_over_run(18_000.0);
+    assert_only_the_hard_hand_over_pops(
+        ("hand-over 18 km", hand_over_run(18_000.0, None)),
+        ("hand-over 1 m", hand_over_run(1.0, None)),
+    );
+}
+
+/// Each frame's change against the plain motion around it: the blended flight's worst at most
+/// 1.5x, the unblended one's (the negative control) over it. Each given with its label.
+fn assert_only_the_hard_hand_over_pops(
+    (blended_label, blended): (&str, Vec<f32>),
+    (hard_label, hard): (&str, Vec<f32>),
+) {
     let worst = blended.iter().copied().fold(0.0, f32::max);
-    eprintln!("hand-over 18 km: worst {worst} x the frames around, {blended:?}");
-    let hard = hand_over_run(1.0);
+    eprintln!("{blended_label}: worst {worst} x the frames around, {blended:?}");
     let hard_worst = hard.iter().copied().fold(0.0, f32::max);
-    eprintln!("hand-over 1 m: worst {hard_worst} x the frames around, {hard:?}");
+    eprintln!("{hard_label}: worst {hard_worst} x the frames around, {hard:?}");
     assert!(
         worst <= 1.5,
         "a frame pops: {worst} x the plain motion around it"
     );
     assert!(hard_worst > 1.5, "without a blend: {hard_worst}");
+}
+
+/// Issue 31, popping across the ring / far-field hand-over: flying within the ring's height
+/// limit of the clouds, the ring holds them from 20 km out and fades them out over the hand-over
+/// band (from its centre) while the far field fades them in (from the camera); at each rebuild
+/// the ring's band moves with its centre, crossfaded. No frame changes more than 1.5x the plain
+/// motion of the frames around it. The negative control, no blend: a hand-over band of a metre
+/// and no crossfade (the ring's clouds near 60 km switch to the far field's at once as its
+/// centre jumps 400 m) pops.
+#[test]
+fn the_ring_to_far_field_hand_over_does_not_pop() {
+    assert_only_the_hard_hand_over_pops(
+        (
+            "ring, hand-over 18 km, crossfade 1 s",
+            hand_over_run(18_000.0, Some(1.0)),
+        ),
+        (
+            "ring, hand-over 1 m, no crossfade",
+            hand_over_run(1.0, Some(0.0)),
+        ),
+    );
+}
+
+/// Issue 31: while the far field is drawn every sprite has faded out by the end of its
+/// hand-over band (60 km), and so has every impostor built from them: the ring holds no block
+/// beyond it (it was built and faded out to nothing). With the far field off the ring reaches
+/// its view radius (100 km) as before.
+#[test]
+fn with_the_far_field_on_the_ring_stops_at_the_hand_over() {
+    use skycast::clouds::far_map::FarMap;
+    let ring_blocks = |far_field: bool| {
+        let mut settings = RenderSettings::default();
+        settings.far_field.enabled = far_field;
+        let ground = HeightField::from_fn(DVec2::ZERO, 400_000.0, 16, |_| 0.0);
+        let mut rig = Rig::with_settings(ground, settings);
+        rig.host.sky.set_far_map(
+            &rig.host.gpu.queue,
+            &FarMap {
+                texels: 96,
+                texel_m: 10_000.0,
+                centre_m: DVec2::ZERO,
+                cells: vec![[0.15, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
+            },
+            None,
+        );
+        let blocks = [(1, 30_000.0), (2, 80_000.0)]
+            .into_iter()
+            .map(|(id, y)| {
+                let c = DVec3::new(0.0, y, 1500.0);
+                SkyBlock {
+                    id,
+                    centre_m: c,
+                    clouds: vec![big_cumulus(c, 3.0)],
+                }
+            })
+            .collect();
+        rig.set_clouds(blocks);
+        let cam = rig.camera(DVec3::new(0.0, 0.0, 3000.0), 0.0, 0.0);
+        let (_, stats) = rig.frame(&format!("ring-reach-{far_field}"), &cam);
+        stats.blocks_far
+    };
+    assert_eq!(ring_blocks(true), 1, "the far field on");
+    assert_eq!(ring_blocks(false), 2, "the far field off");
 }

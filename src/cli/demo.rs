@@ -56,6 +56,9 @@ pub struct DemoArgs {
     /// Draw and write every Nth simulated frame (10 simulated frames a second).
     #[arg(long, default_value_t = 300)]
     pub every: u32,
+    /// The winds aloft for the air data in frames.csv.
+    #[command(flatten)]
+    pub aloft: super::weather::WindsAloftArgs,
 }
 
 /// The default flight of the demo.
@@ -83,7 +86,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     super::fly::run(&super::fly::FlyArgs {
         weather: args.weather.clone(),
         stations: args.stations.clone(),
-        winds_aloft: None,
+        aloft: args.aloft.clone(),
         path: args.flight.clone(),
         out: args.out.clone(),
         size: args.size,

@@ -23,7 +23,7 @@ use skycast::flight::{FlightPlan, HostPosition, Weather};
 use skycast::weather::{LocalFrame, StationTable, theme};
 
 use super::render::{ElevationArgs, LookArgs, parse_size, parse_time, sky_config, time_or_default};
-use super::weather::{DEFAULT_STATIONS, load};
+use super::weather::{DEFAULT_STATIONS, WindsAloftArgs, load};
 
 /// Flags of `skycast fly`.
 #[derive(Debug, Args)]
@@ -34,10 +34,9 @@ pub struct FlyArgs {
     /// Station table placing reports the file does not place.
     #[arg(long, default_value = DEFAULT_STATIONS)]
     pub stations: PathBuf,
-    /// NOAA's winds and temperatures aloft (FB, e.g. FD1US1) for the air data above the
-    /// boundary layer, its sites placed through `--stations`.
-    #[arg(long, value_name = "FILE")]
-    pub winds_aloft: Option<PathBuf>,
+    /// The winds aloft for the air data (watched with `--watch`).
+    #[command(flatten)]
+    pub aloft: WindsAloftArgs,
     /// The flight path (TOML, see config/flights/).
     #[arg(long)]
     pub path: PathBuf,
@@ -59,7 +58,8 @@ pub struct FlyArgs {
     /// The look: renderer settings, cloud scale, time-of-day table.
     #[command(flatten)]
     pub look: LookArgs,
-    /// Watch the weather file: when it changes, the sky follows (changed blocks re-form).
+    /// Watch the weather file: when it changes, the sky follows (changed blocks re-form); and
+    /// the `--winds-aloft` file: the air data takes a good new version, a broken one is refused.
     #[arg(long)]
     pub watch: bool,
     /// Quiet time after a change of the watched file before it is read, milliseconds.
@@ -105,13 +105,22 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     }
     let mut host = DemoHost::new(args.size.0, args.size.1, &ground, config)?;
     host.sky.set_weather_field(field);
-    if let Some(path) = &args.winds_aloft {
-        let fb = skycast::weather::winds_aloft::WindsAloft::load(path)?;
-        let table = StationTable::load(&args.stations)?;
+    if let Some(path) = &args.aloft.winds_aloft
+        && args.watch
+    {
+        // Placed through the sky's station table (`--stations` when watching reports).
+        let (placed, _) = host
+            .sky
+            .watch_winds_aloft(path, Duration::from_millis(args.settle_ms))?;
+        eprintln!(
+            "winds aloft: {}: {placed} sites placed; watching it",
+            path.display()
+        );
+    } else if let Some((fb, table)) = args.aloft.load(&args.stations)? {
         let (placed, _) = host.sky.world_mut().set_winds_aloft(Some(&fb), &table);
         eprintln!(
             "winds aloft: {}: {placed} of {} sites placed",
-            path.display(),
+            fb.path.display(),
             fb.sites.len()
         );
     }

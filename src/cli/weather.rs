@@ -45,10 +45,9 @@ pub struct WeatherArgs {
     /// Air-data settings (default: the shipped config/air.toml).
     #[arg(long)]
     pub air_settings: Option<PathBuf>,
-    /// With `--alt-ft`: NOAA's winds and temperatures aloft (FB, e.g. FD1US1) for the air above
-    /// the boundary layer, its sites placed through `--stations`.
-    #[arg(long, value_name = "FILE", requires = "alt_ft")]
-    pub winds_aloft: Option<PathBuf>,
+    /// With `--alt-ft`: the winds aloft.
+    #[command(flatten)]
+    pub aloft: WindsAloftArgs,
     /// Cloud-type rule (default: the shipped config/cloud_type_rule.toml).
     #[arg(long)]
     pub rule: Option<PathBuf>,
@@ -61,6 +60,29 @@ pub struct WeatherArgs {
     /// One JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `--winds-aloft FILE`, one definition for every command that works out air data
+/// (`weather --at --alt-ft`, `fly`, `demo`).
+#[derive(Debug, Clone, Default, Args)]
+pub struct WindsAloftArgs {
+    /// NOAA's winds and temperatures aloft (FB, e.g. FD1US1) for the air data above the
+    /// boundary layer, its sites placed through `--stations`.
+    #[arg(long, value_name = "FILE")]
+    pub winds_aloft: Option<PathBuf>,
+}
+
+impl WindsAloftArgs {
+    /// The FB product and the station table to place its sites with, if asked for.
+    pub fn load(&self, stations: &Path) -> anyhow::Result<Option<(WindsAloft, StationTable)>> {
+        let Some(path) = &self.winds_aloft else {
+            return Ok(None);
+        };
+        Ok(Some((
+            WindsAloft::load(path)?,
+            StationTable::load(stations)?,
+        )))
+    }
 }
 
 /// `LAT,LON` in degrees.
@@ -247,16 +269,16 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
         (Some((lat, lon)), Some(km)) => Some(cells_near(&loaded, lat, lon, km)),
         _ => None,
     };
+    if args.aloft.winds_aloft.is_some() && args.alt_ft.is_none() {
+        anyhow::bail!("--winds-aloft is for the air data: give --at and --alt-ft with it");
+    }
     let air = match (args.at, args.alt_ft) {
         (Some((lat, lon)), Some(alt_ft)) => {
             let settings = match &args.air_settings {
                 Some(path) => AirSettings::load(path)?,
                 None => AirSettings::default(),
             };
-            let aloft = match &args.winds_aloft {
-                Some(path) => Some((WindsAloft::load(path)?, StationTable::load(&args.stations)?)),
-                None => None,
-            };
+            let aloft = args.aloft.load(&args.stations)?;
             Some(air_at(&loaded, lat, lon, alt_ft, settings, aloft.as_ref())?)
         }
         _ => None,

@@ -13,9 +13,10 @@
 //! (`3 / visibility_m`, Koschmieder) times the length inside, times the fade.
 //!
 //! The boxes of a generation are worked out once, the first time it is asked about
-//! ([`BoxCache`]); a query looks only at the blocks within reach of the point, and skips a
-//! block whose clouds' bounds are out of reach. Positions are ground metres (east, north, up
-//! MSL); the field's drift is taken off to find the clouds.
+//! ([`BoxCache`]). A point query looks only at the blocks within reach of the point, and skips
+//! a block whose clouds' bounds are out of reach; a line of sight walks one grid over every box
+//! of the field ([`SightBoxes`]), built again when the field's membership changes. Positions
+//! are ground metres (east, north, up MSL); the field's drift is taken off to find the clouds.
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
@@ -129,7 +130,7 @@ fn slab(a: DVec3, b: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64)> {
     Some((t0, t1))
 }
 
-/// The boxes of one generation, the bounds of them all and a grid over them.
+/// The boxes of one generation and the bounds of them all.
 #[derive(Debug)]
 pub struct GenerationBoxes {
     /// One per cloud with cloud sprites.
@@ -138,13 +139,11 @@ pub struct GenerationBoxes {
     pub lo_m: DVec3,
     /// See `lo_m`.
     pub hi_m: DVec3,
-    /// The boxes' footprints on a horizontal grid, for lines of sight.
-    grid: BoxGrid,
 }
 
 impl GenerationBoxes {
-    /// The boxes of a generation's clouds, gridded in cells of `cell_m`.
-    pub fn of(clouds: &[Cloud], cell_m: f64) -> Self {
+    /// The boxes of a generation's clouds.
+    pub fn of(clouds: &[Cloud]) -> Self {
         let boxes: Vec<CloudBox> = clouds
             .iter()
             .enumerate()
@@ -157,61 +156,11 @@ impl GenerationBoxes {
             lo = lo.min((b.centre_m - b.half_m).min(b.cloud_centre_m - r));
             hi = hi.max((b.centre_m + b.half_m).max(b.cloud_centre_m + r));
         }
-        let grid = BoxGrid::of(&boxes, cell_m);
         Self {
             boxes,
             lo_m: lo,
             hi_m: hi,
-            grid,
         }
-    }
-
-    /// The boxes the segment `a..b` enters, each once, nearest cells first:
-    /// `hit(box, t in, t out)` says whether it counts (a faded-out cloud does not). With
-    /// `whole` false it stops once no box left can be entered before the nearest counted one
-    /// (or `best_t`, the nearest found elsewhere).
-    fn crossed(
-        &self,
-        a: DVec3,
-        b: DVec3,
-        best_t: f64,
-        whole: bool,
-        mut hit: impl FnMut(&CloudBox, f64, f64) -> bool,
-    ) {
-        let Some((from, to)) = slab(a, b, self.lo_m, self.hi_m) else {
-            return;
-        };
-        let mut best = best_t;
-        // A box is tested the first time a cell lists it (a big box is listed in many cells),
-        // and counted once; once the nearest entry is before the cell is left, no box not yet
-        // met can be entered earlier (its entry point lies in a later cell, which lists it).
-        // On the stack for up to 2,048 boxes (a block holds a few hundred clouds).
-        let mut stack = [0u64; 32];
-        let mut heap = Vec::new();
-        let words = self.boxes.len().div_ceil(64);
-        let met: &mut [u64] = if words <= stack.len() {
-            &mut stack[..words]
-        } else {
-            heap.resize(words, 0u64);
-            &mut heap
-        };
-        self.grid.walk(a, b, from, to, |list, _, cell_out| {
-            for &index in list {
-                let (word, bit) = (index as usize / 64, 1u64 << (index % 64));
-                if met[word] & bit != 0 {
-                    continue;
-                }
-                met[word] |= bit;
-                let bx = &self.boxes[index as usize];
-                let Some((t0, t1)) = bx.segment(a, b) else {
-                    continue;
-                };
-                if hit(bx, t0, t1) {
-                    best = best.min(t0);
-                }
-            }
-            whole || best >= cell_out
-        });
     }
 
     fn distance_m(&self, p: DVec3) -> f64 {
@@ -224,14 +173,132 @@ impl GenerationBoxes {
     }
 }
 
-/// The most cells a side of a [`BoxGrid`] has (a generation's clouds spread over a few blocks at
-/// most; a coarser grid beyond that).
-const GRID_MAX_SIDE: usize = 64;
+/// The most cells a side of a [`BoxGrid`] has: 128 km at the shipped 500 m, more than a field
+/// holds (`clouds.toml`'s radius plus a block each side); a coarser grid beyond that.
+const GRID_MAX_SIDE: usize = 256;
+
+/// Every cloud box of the field, the boxes of all its generations in one list, and one grid
+/// over them all for lines of sight: a segment walks one grid, not one per generation.
+#[derive(Debug)]
+pub struct SightBoxes {
+    /// Per box: its corners (the slab test reads only these, packed for the walk).
+    corners: Vec<[DVec3; 2]>,
+    /// Per box: the generation (an index into `generations`) and its box there.
+    owners: Vec<(u32, u32)>,
+    /// The generations' boxes, in the order `owners` counts them.
+    generations: Vec<Arc<GenerationBoxes>>,
+    /// Bounds of every box, air frame.
+    lo_m: DVec3,
+    /// See `lo_m`.
+    hi_m: DVec3,
+    /// The footprints of the boxes up to [`BIG_BOX_CELLS`] cells wide on a grid of the cells
+    /// asked for, and of the bigger ones (a cumulonimbus, an anvil, a stratus deck) on one
+    /// of cells [`BIG_BOX_CELLS`] times as wide: a big box listed in the fine cells filled
+    /// them (a storm's 1,800 boxes were 140,000 entries, each rebuilt with the membership).
+    grids: [BoxGrid; 2],
+}
+
+/// How many cells of the fine grid a box's footprint may span on a side before it goes to the
+/// coarse grid of [`SightBoxes`] (whose cells are this many times as wide).
+const BIG_BOX_CELLS: f64 = 8.0;
+
+impl SightBoxes {
+    /// One list and grid (cells of `cell_m`) over the boxes of `generations`.
+    pub fn of(generations: Vec<Arc<GenerationBoxes>>, cell_m: f64) -> Self {
+        let mut corners = Vec::new();
+        let mut owners = Vec::new();
+        for (g, boxes) in generations.iter().enumerate() {
+            for (k, b) in boxes.boxes.iter().enumerate() {
+                corners.push([b.centre_m - b.half_m, b.centre_m + b.half_m]);
+                owners.push((g as u32, k as u32));
+            }
+        }
+        let (lo_m, hi_m) = corners.iter().fold(
+            (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+            |(lo, hi), [a, z]| (lo.min(*a), hi.max(*z)),
+        );
+        let (big, small): (Vec<u32>, Vec<u32>) = (0..corners.len() as u32).partition(|&i| {
+            let [a, z] = corners[i as usize];
+            (z - a).truncate().max_element() > BIG_BOX_CELLS * cell_m
+        });
+        let grids = [
+            BoxGrid::of(&corners, &big, cell_m * BIG_BOX_CELLS),
+            BoxGrid::of(&corners, &small, cell_m),
+        ];
+        Self {
+            corners,
+            owners,
+            generations,
+            lo_m,
+            hi_m,
+            grids,
+        }
+    }
+
+    /// How many boxes.
+    pub fn len(&self) -> usize {
+        self.corners.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.corners.is_empty()
+    }
+
+    /// The boxes the segment `a..b` enters, each once, nearest cells first:
+    /// `hit(generation, box, t in, t out)` says whether it counts (a faded-out cloud does not).
+    /// With `whole` false it stops once no box left can be entered before the nearest counted
+    /// one. `seen` is scratch, one entry per box, and `stamp` a number it does not hold yet (a
+    /// box is tested the first time a cell lists it, and marked with the stamp: a big box is
+    /// listed in many cells).
+    fn crossed(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        whole: bool,
+        seen: &mut [u32],
+        stamp: u32,
+        mut hit: impl FnMut(usize, &CloudBox, f64, f64) -> bool,
+    ) {
+        let Some((from, to)) = slab(a, b, self.lo_m, self.hi_m) else {
+            return;
+        };
+        let mut best = f64::INFINITY;
+        // The big boxes first, then the small ones with the nearest big one's entry to beat.
+        // In each grid, once the nearest entry is before the cell is left, no box not yet met
+        // can be entered earlier (its entry point lies in a later cell, which lists it).
+        for grid in &self.grids {
+            grid.walk(a, b, from, to, |list, _, cell_out| {
+                for &index in list {
+                    let index = index as usize;
+                    if seen[index] == stamp {
+                        continue;
+                    }
+                    seen[index] = stamp;
+                    let [lo, hi] = self.corners[index];
+                    let Some((t0, t1)) = slab(a, b, lo, hi) else {
+                        continue;
+                    };
+                    if !whole && t0 >= best {
+                        continue;
+                    }
+                    let (g, k) = self.owners[index];
+                    let bx = &self.generations[g as usize].boxes[k as usize];
+                    if hit(g as usize, bx, t0, t1) {
+                        best = best.min(t0);
+                    }
+                }
+                whole || best >= cell_out
+            });
+        }
+    }
+}
 
 /// A uniform horizontal grid over boxes: each cell lists the boxes whose footprint (padded by a
-/// metre against rounding) overlaps it, so a segment walked through the cells it crosses
-/// (Amanatides and Woo 1987, "A fast voxel traversal algorithm for ray tracing") tests only the
-/// boxes near it, nearest cells first.
+/// metre against rounding) overlaps it, with the lowest bottom and highest top of them, so a
+/// segment walked through the cells it crosses (Amanatides and Woo 1987, "A fast voxel
+/// traversal algorithm for ray tracing") tests only the boxes near it, nearest cells first, and
+/// passes over a cell it crosses above or below all of them.
 #[derive(Debug)]
 struct BoxGrid {
     /// South-west corner, air frame metres.
@@ -245,18 +312,21 @@ struct BoxGrid {
     starts: Vec<u32>,
     /// Box indices, cell after cell.
     items: Vec<u32>,
+    /// Per cell: the lowest bottom and highest top of its boxes, metres (none: +inf, -inf).
+    heights_m: Vec<[f64; 2]>,
 }
 
 impl BoxGrid {
-    fn of(boxes: &[CloudBox], cell_m: f64) -> Self {
+    /// The grid over the boxes `indices` of `corners`.
+    fn of(corners: &[[DVec3; 2]], indices: &[u32], cell_m: f64) -> Self {
         let pad = DVec2::splat(1.0);
         let mut lo = DVec2::splat(f64::MAX);
         let mut hi = DVec2::splat(f64::MIN);
-        for b in boxes {
-            lo = lo.min((b.centre_m - b.half_m).truncate() - pad);
-            hi = hi.max((b.centre_m + b.half_m).truncate() + pad);
+        for [a, z] in indices.iter().map(|&i| &corners[i as usize]) {
+            lo = lo.min(a.truncate() - pad);
+            hi = hi.max(z.truncate() + pad);
         }
-        if boxes.is_empty() {
+        if indices.is_empty() {
             (lo, hi) = (DVec2::ZERO, DVec2::ONE);
         }
         let size = hi - lo;
@@ -265,9 +335,9 @@ impl BoxGrid {
             .max(1.0);
         let nx = ((size.x / cell_m).ceil() as usize).clamp(1, GRID_MAX_SIDE);
         let ny = ((size.y / cell_m).ceil() as usize).clamp(1, GRID_MAX_SIDE);
-        let cells = |b: &CloudBox| {
-            let a = ((b.centre_m - b.half_m).truncate() - pad - lo) / cell_m;
-            let z = ((b.centre_m + b.half_m).truncate() + pad - lo) / cell_m;
+        let cells = |[a, z]: &[DVec3; 2]| {
+            let a = (a.truncate() - pad - lo) / cell_m;
+            let z = (z.truncate() + pad - lo) / cell_m;
             let clamp = |v: f64, n: usize| (v.floor().max(0.0) as usize).min(n - 1);
             (
                 clamp(a.x, nx)..=clamp(z.x, nx),
@@ -276,11 +346,14 @@ impl BoxGrid {
         };
         // Counted, then filled: one allocation for every list.
         let mut counts = vec![0u32; nx * ny + 1];
-        for b in boxes {
-            let (xs, ys) = cells(b);
+        let mut heights_m = vec![[f64::INFINITY, f64::NEG_INFINITY]; nx * ny];
+        for c in indices.iter().map(|&i| &corners[i as usize]) {
+            let (xs, ys) = cells(c);
             for y in ys {
                 for x in xs.clone() {
                     counts[y * nx + x + 1] += 1;
+                    let h = &mut heights_m[y * nx + x];
+                    *h = [h[0].min(c[0].z), h[1].max(c[1].z)];
                 }
             }
         }
@@ -289,12 +362,12 @@ impl BoxGrid {
         }
         let starts = counts.clone();
         let mut items = vec![0u32; counts[nx * ny] as usize];
-        for (index, b) in boxes.iter().enumerate() {
-            let (xs, ys) = cells(b);
+        for &index in indices {
+            let (xs, ys) = cells(&corners[index as usize]);
             for y in ys {
                 for x in xs.clone() {
                     let at = &mut counts[y * nx + x];
-                    items[*at as usize] = index as u32;
+                    items[*at as usize] = index;
                     *at += 1;
                 }
             }
@@ -306,13 +379,14 @@ impl BoxGrid {
             ny,
             starts,
             items,
+            heights_m,
         }
     }
 
     /// Walks the cells the segment `a + t (b - a)` crosses for t in `t_from..=t_to`, in order:
     /// `visit(boxes of the cell, t entering it, t leaving it)`, the first cell entered at
-    /// minus infinity and the last left at plus infinity (so every t belongs to one cell);
-    /// stops when `visit` says false.
+    /// minus infinity and the last left at plus infinity (so every t belongs to one cell), no
+    /// boxes where the segment passes above or below them all; stops when `visit` says false.
     fn walk(
         &self,
         a: DVec3,
@@ -322,6 +396,7 @@ impl BoxGrid {
         mut visit: impl FnMut(&[u32], f64, f64) -> bool,
     ) {
         let (a2, d) = (a.truncate(), (b - a).truncate());
+        let dz = b.z - a.z;
         let hi = self.origin_m + DVec2::new(self.nx as f64, self.ny as f64) * self.cell_m;
         // The part of the segment over the grid.
         let Some((t0, t1)) = slab(
@@ -360,7 +435,14 @@ impl BoxGrid {
             let last = next[k] >= t1 || !(0..n[k]).contains(&(cell[k] + step[k]));
             let leave = if last { f64::INFINITY } else { next[k] };
             let c = cell[1] as usize * self.nx + cell[0] as usize;
-            let list = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
+            // The heights the segment has over the cell (a metre's margin, as the footprints).
+            let (z0, z1) = (a.z + dz * enter.max(t0), a.z + dz * leave.min(t1));
+            let [bottom, top] = self.heights_m[c];
+            let list = if z0.max(z1) + 1.0 < bottom || z0.min(z1) - 1.0 > top {
+                &[][..]
+            } else {
+                &self.items[self.starts[c] as usize..self.starts[c + 1] as usize]
+            };
             if !visit(list, enter, leave) || last {
                 return;
             }
@@ -371,10 +453,11 @@ impl BoxGrid {
     }
 }
 
-/// The boxes of the generations asked about, by serial, and per block the generations with
-/// the bounds of them all; shared by the queries of a frame. The per-block lists hold while the
-/// field's membership ([`CloudField::membership`]) does: a query then looks a block up once
-/// and passes over it on its bounds, without the field's own look-ups.
+/// The boxes of the generations asked about, by serial; per block the generations with the
+/// bounds of them all; and every box of the field in one grid for lines of sight: shared by the
+/// queries of a frame. The per-block lists and the grid hold while the field's membership
+/// ([`CloudField::membership`]) does: a point query then looks a block up once and passes over
+/// it on its bounds, without the field's own look-ups, and a line of sight walks one grid.
 #[derive(Debug, Default)]
 pub struct BoxCache {
     state: Mutex<CacheState>,
@@ -384,10 +467,25 @@ pub struct BoxCache {
 struct CacheState {
     /// Boxes by generation serial.
     boxes: HashMap<u64, Arc<GenerationBoxes>, BuildFast>,
-    /// The field (its address) and membership the block lists are of.
+    /// The field (its address) and membership the block lists and the grid are of.
     key: Option<(usize, u64)>,
     /// Per block: the generations' serials and boxes, and the bounds of them all.
     blocks: HashMap<BlockIndex, BlockBoxes, BuildFast>,
+    /// Every box of the field with its grid, built the first time a line of sight asks
+    /// (`None` after the membership changed), and the cell size asked for.
+    sight: Option<(f64, SightOf)>,
+    /// Scratch for [`SightBoxes::crossed`]: the stamp of the last line of sight that met each
+    /// box, and the stamp of the last line.
+    seen: Vec<u32>,
+    stamp: u32,
+}
+
+/// The field's boxes in one grid, with the generations they are of (block and serial, to find
+/// their phase now).
+#[derive(Debug)]
+struct SightOf {
+    boxes: SightBoxes,
+    generations: Vec<(BlockIndex, u64)>,
 }
 
 #[derive(Debug)]
@@ -440,6 +538,7 @@ impl BoxCache {
         if state.key != Some(key) {
             state.key = Some(key);
             state.blocks.clear();
+            state.sight = None;
         }
         if state.boxes.len() > 2 * field.block_count() + 64 {
             let live: std::collections::HashSet<u64> =
@@ -522,7 +621,6 @@ impl<'a> CloudProbe<'a> {
         let a = BlockIndex::containing(lo - DVec2::splat(pad));
         let b = BlockIndex::containing(hi + DVec2::splat(pad));
         let field: &'a CloudField = self.field;
-        let cell_m = self.settings.grid_cell_m;
         let mut out = Vec::new();
         let Ok(mut guard) = self.cache.state.lock() else {
             return out;
@@ -549,7 +647,7 @@ impl<'a> CloudProbe<'a> {
                         .map(|g| {
                             let boxes =
                                 Arc::clone(state.boxes.entry(g.serial).or_insert_with(|| {
-                                    Arc::new(GenerationBoxes::of(&g.block.clouds, cell_m))
+                                    Arc::new(GenerationBoxes::of(&g.block.clouds))
                                 }));
                             if !boxes.boxes.is_empty() {
                                 lo = lo.min(boxes.lo_m);
@@ -665,38 +763,52 @@ impl<'a> CloudProbe<'a> {
         let (qa, qb) = (self.air_point(a), self.air_point(b));
         let length = (qb - qa).length();
         let sigma = 3.0 / f64::from(self.settings.visibility_m);
-        let (lo, hi) = (qa.min(qb), qa.max(qb));
+        let cell_m = self.settings.grid_cell_m;
+        let field = self.field;
+        let Ok(mut guard) = self.cache.state.lock() else {
+            return None;
+        };
+        let state = &mut *guard;
+        if state.sight.as_ref().is_none_or(|s| s.0 != cell_m) {
+            let sight = sight_of(field, &mut state.boxes, cell_m);
+            state.seen = vec![0; sight.boxes.len()];
+            state.stamp = 0;
+            state.sight = Some((cell_m, sight));
+        }
+        let Some((_, sight)) = &state.sight else {
+            return None;
+        };
+        state.stamp = state.stamp.wrapping_add(1);
+        if state.stamp == 0 {
+            state.seen.fill(0);
+            state.stamp = 1;
+        }
         let mut first: Option<(f64, f64, CloudType)> = None;
         let mut total = 0.0;
-        // Only the blocks whose padded square the segment crosses, nearest along it first.
-        let crosses = |lo: DVec2, hi: DVec2| {
-            slab(
-                qa.with_z(0.0),
-                qb.with_z(0.0),
-                lo.extend(-1.0),
-                hi.extend(1.0),
-            )
-            .is_some()
-        };
-        let mut near: Vec<(f64, &FieldBlock, Arc<GenerationBoxes>)> = self.generations(
-            lo.truncate(),
-            hi.truncate(),
-            0.0,
-            crosses,
-            |lo, hi| slab(qa, qb, lo, hi).is_some(),
-            |g, boxes| {
-                slab(qa, qb, boxes.lo_m, boxes.hi_m).map(|(t0, _)| (t0, g, Arc::clone(boxes)))
-            },
-        );
-        near.sort_by(|x, y| x.0.total_cmp(&y.0));
-        for (enter, g, boxes) in near {
-            if !whole && first.is_some_and(|f| enter > f.0) {
-                break;
-            }
-            let best = first.map_or(f64::INFINITY, |f| f.0);
-            boxes.crossed(qa, qb, best, whole, |bx, t0, t1| {
+        // The generation of the last box met and its phase now (a box's neighbours along the
+        // line are mostly of the same generation).
+        let mut last: Option<(usize, Option<&FieldBlock>)> = None;
+        sight.boxes.crossed(
+            qa,
+            qb,
+            whole,
+            &mut state.seen,
+            state.stamp,
+            |g, bx, t0, t1| {
+                let block = match last {
+                    Some((at, block)) if at == g => block,
+                    _ => {
+                        let (index, serial) = sight.generations[g];
+                        let block = field.generations(index).iter().find(|b| b.serial == serial);
+                        last = Some((g, block));
+                        block
+                    }
+                };
+                let Some(block) = block else {
+                    return false;
+                };
                 let mid = qa.lerp(qb, 0.5 * (t0 + t1));
-                let fade = f64::from(self.fade(g, bx, mid));
+                let fade = f64::from(self.fade(block, bx, mid));
                 if fade <= 0.0 {
                     return false;
                 }
@@ -706,8 +818,8 @@ impl<'a> CloudProbe<'a> {
                     first = Some((t0, depth, bx.cloud_type));
                 }
                 true
-            });
-        }
+            },
+        );
         first.map(|(t, depth, cloud_type)| SightHit {
             distance_m: t * length,
             point_m: a.lerp(b, t),
@@ -715,6 +827,34 @@ impl<'a> CloudProbe<'a> {
             total_optical_depth: total,
             cloud_type,
         })
+    }
+}
+
+/// Every box of the living generations of `field` (their boxes from `boxes`, worked out there
+/// the first time) in one grid of cells of `cell_m`.
+fn sight_of(
+    field: &CloudField,
+    boxes: &mut HashMap<u64, Arc<GenerationBoxes>, BuildFast>,
+    cell_m: f64,
+) -> SightOf {
+    let mut generations = Vec::new();
+    let mut all = Vec::new();
+    for (index, g) in field.blocks() {
+        if g.phase == Phase::Gone || g.block.clouds.is_empty() {
+            continue;
+        }
+        let b = boxes
+            .entry(g.serial)
+            .or_insert_with(|| Arc::new(GenerationBoxes::of(&g.block.clouds)));
+        if b.boxes.is_empty() {
+            continue;
+        }
+        generations.push((index, g.serial));
+        all.push(Arc::clone(b));
+    }
+    SightOf {
+        boxes: SightBoxes::of(all, cell_m),
+        generations,
     }
 }
 
@@ -801,9 +941,10 @@ mod tests {
     }
 
     /// The grid a line of sight walks finds what testing every box finds: on 300 clouds of
-    /// random size and place and 3,000 segments (level, upright, axis-aligned, starting inside
-    /// and outside the clouds), every box entered is met exactly once, and the nearest entry
-    /// (the first cloud) is the same, for a fine, the shipped and a coarse grid.
+    /// random size and place in three generations (overlapping) and 3,000 segments (level,
+    /// upright, axis-aligned, starting inside and outside the clouds, grazing a box's top),
+    /// every box entered is met exactly once, and the nearest entry (the first cloud) is the
+    /// same, for a fine, the shipped and a coarse grid.
     #[test]
     fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
         let mut seed = 0x2545_f491_4f6c_dd1du64;
@@ -813,20 +954,33 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let clouds: Vec<Cloud> = (0..300)
+        let generations: Vec<Arc<GenerationBoxes>> = (0..3)
             .map(|_| {
-                let c = DVec3::new(
-                    rand() * 12_000.0 - 2_000.0,
-                    rand() * 8_000.0,
-                    500.0 + rand() * 2_500.0,
-                );
-                let half = (30.0 + rand() * 1_500.0 * rand()) as f32;
-                cube_cloud(c, half, CloudType::CumulusMediocris)
+                let clouds: Vec<Cloud> = (0..100)
+                    .map(|_| {
+                        let c = DVec3::new(
+                            rand() * 12_000.0 - 2_000.0,
+                            rand() * 8_000.0,
+                            500.0 + rand() * 2_500.0,
+                        );
+                        let half = (30.0 + rand() * 1_500.0 * rand()) as f32;
+                        cube_cloud(c, half, CloudType::CumulusMediocris)
+                    })
+                    .collect();
+                Arc::new(GenerationBoxes::of(&clouds))
             })
             .collect();
+        let every: Vec<(usize, &CloudBox)> = generations
+            .iter()
+            .enumerate()
+            .flat_map(|(g, b)| b.boxes.iter().map(move |bx| (g, bx)))
+            .collect();
         let mut met_first = 0;
+        let mut stamp = 0;
         for cell_m in [120.0, 500.0, 4_000.0] {
-            let boxes = GenerationBoxes::of(&clouds, cell_m);
+            let sight = SightBoxes::of(generations.clone(), cell_m);
+            assert_eq!(sight.len(), 300);
+            let mut seen = vec![0; sight.len()];
             for k in 0..3_000 {
                 let mut a = DVec3::new(
                     rand() * 16_000.0 - 4_000.0,
@@ -838,29 +992,36 @@ mod tests {
                     (rand() - 0.5) * 20_000.0,
                     (rand() - 0.5) * 3_000.0,
                 );
-                match k % 6 {
+                match k % 7 {
                     0 => b.z = a.z,
                     1 => b = a.with_z(a.z + 3_000.0),
                     2 => b.x = a.x,
-                    3 => a = boxes.boxes[k % boxes.boxes.len()].centre_m,
+                    3 => a = every[k % every.len()].1.centre_m,
+                    // Level, grazing a box's top: the cells' heights must hold it.
+                    4 => {
+                        let bx = every[k % every.len()].1;
+                        a.z = bx.centre_m.z + bx.half_m.z - 0.5;
+                        b.z = a.z;
+                    }
                     _ => {}
                 }
-                let mut all: Vec<(f64, usize)> = boxes
-                    .boxes
+                let mut all: Vec<(f64, usize, usize)> = every
                     .iter()
-                    .filter_map(|bx| bx.segment(a, b).map(|(t0, _)| (t0, bx.cloud)))
+                    .filter_map(|(g, bx)| bx.segment(a, b).map(|(t0, _)| (t0, *g, bx.cloud)))
                     .collect();
-                all.sort_by_key(|x| x.1);
-                let mut seen = Vec::new();
-                boxes.crossed(a, b, f64::INFINITY, true, |bx, t0, _| {
-                    seen.push((t0, bx.cloud));
+                all.sort_by_key(|x| (x.1, x.2));
+                let mut met = Vec::new();
+                stamp += 1;
+                sight.crossed(a, b, true, &mut seen, stamp, |g, bx, t0, _| {
+                    met.push((t0, g, bx.cloud));
                     true
                 });
-                seen.sort_by_key(|x| x.1);
-                assert_eq!(seen, all, "cell {cell_m} m, segment {k}: {a} to {b}");
+                met.sort_by_key(|x| (x.1, x.2));
+                assert_eq!(met, all, "cell {cell_m} m, segment {k}: {a} to {b}");
                 let nearest = all.iter().map(|h| h.0).fold(f64::INFINITY, f64::min);
                 let mut first = f64::INFINITY;
-                boxes.crossed(a, b, f64::INFINITY, false, |_, t0, _| {
+                stamp += 1;
+                sight.crossed(a, b, false, &mut seen, stamp, |_, _, t0, _| {
                     first = first.min(t0);
                     true
                 });

@@ -23,6 +23,8 @@ use crate::render::{
 use crate::shading::sun_position;
 use crate::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
 use crate::weather::live::{LiveChange, LiveWeather, Prepare};
+use crate::weather::watch::{WatchUpdate, WeatherWatch};
+use crate::weather::winds_aloft::WindsAloft;
 use crate::weather::{LocalFrame, Skipped, StationTable, WeatherError, WeatherInput};
 
 /// Why the sky could not be built or given its weather.
@@ -221,6 +223,8 @@ pub struct SkySystem {
     frame: LocalFrame,
     live: LiveWeather<(WeatherField, Skipped)>,
     prepare_field: Prepare<(WeatherField, Skipped)>,
+    /// A watched FB file of winds aloft ([`Self::watch_winds_aloft`]).
+    aloft_watch: Option<WeatherWatch<WindsAloft>>,
     /// What the weather in use left out, counted.
     skipped: Skipped,
     stations: Option<Arc<StationTable>>,
@@ -278,6 +282,7 @@ impl SkySystem {
             frame,
             live: LiveWeather::new(),
             prepare_field,
+            aloft_watch: None,
             skipped: Skipped::default(),
             stations: config.stations,
             clock_s: 0.0,
@@ -350,6 +355,45 @@ impl SkySystem {
         Ok(())
     }
 
+    /// Uses the winds aloft of an FB file (see [`Self::set_winds_aloft`], its sites placed
+    /// through the host's station table or the built-in one) and keeps watching it, as a
+    /// watched weather file: a new version is read and checked off the frame thread and taken
+    /// by the next [`Self::update`] (listed in its changes); a broken one is listed there with
+    /// the one line that says why (file, line and field) and the last good winds stay.
+    /// Returns how many sites were placed and the ids of those that were not.
+    pub fn watch_winds_aloft(
+        &mut self,
+        path: &Path,
+        settle: Duration,
+    ) -> Result<(usize, Vec<String>), SkyError> {
+        // Read now, so the air data has it from the next frame; a broken file is not watched.
+        let fb = WindsAloft::load(path)?;
+        self.aloft_watch = Some(WeatherWatch::start_loading(
+            path,
+            settle,
+            WindsAloft::load_whole,
+        )?);
+        Ok(self.world.set_winds_aloft(Some(&fb), &self.stations()))
+    }
+
+    /// The winds aloft of the watched FB file that arrived since the last frame, taken in.
+    fn take_winds_aloft(&mut self, changes: &mut Vec<Result<PathBuf, String>>) {
+        let Some(watch) = &self.aloft_watch else {
+            return;
+        };
+        let path = watch.path().to_path_buf();
+        for update in watch.poll() {
+            changes.push(match update {
+                WatchUpdate::Loaded(fb) => {
+                    self.world.set_winds_aloft(Some(&fb), &self.stations());
+                    Ok(path.clone())
+                }
+                // The watch logged it already.
+                WatchUpdate::Rejected(why) => Err(why),
+            });
+        }
+    }
+
     /// The station table reports without a position are placed with: the host's, or the one
     /// shipped inside the library.
     fn stations(&self) -> Arc<StationTable> {
@@ -360,7 +404,8 @@ impl SkySystem {
     /// `dt_s` around the camera and hands the sky what changed, places the sun for `utc_unix_s`,
     /// and prepares the sky's frame. Returns the frame's stats (its CPU cost included, the
     /// weather's in `weather_us`, the previous frame's [`Self::record`] in `record_us`, all of
-    /// it in [`FrameStats::sky_cpu_us`]) and the weather files that arrived this frame: applied, or
+    /// it in [`FrameStats::sky_cpu_us`]) and the weather files (and watched winds aloft,
+    /// [`Self::watch_winds_aloft`]) that arrived this frame: applied, or
     /// rejected with the one line that says why (the last good sky stays). Call
     /// [`Self::record`] after it, in the frame's encoder.
     pub fn update(
@@ -393,6 +438,7 @@ impl SkySystem {
                 LiveChange::Rejected(why) => Err(why),
             });
         }
+        self.take_winds_aloft(&mut changes);
         let weather_us = start.elapsed().as_micros() as u64;
         self.sky.add_field_cpu_us(weather_us);
         let position_m = self.local_m(camera.position);

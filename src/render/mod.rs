@@ -24,7 +24,8 @@
 //! - `earth`: the round Earth every far thing is drawn on (the flat frame's points dropped onto
 //!   the sphere; the shaders' `earth_curved`).
 //! - `far_field`: the clouds beyond the ring out to the horizon: two curved layers of the
-//!   weather's cloud map (`crate::clouds::far_map`), one full-screen pass.
+//!   weather's cloud map (`crate::clouds::far_map`), one pass over the band of elevations
+//!   they can show.
 //! - `shadow`: the clouds drawn from the sun into a shadow map a host multiplies into its
 //!   ground's sunlight.
 //! - `pass_timing`: GPU time of each of the sky's passes, a profiling aid (off by default).

@@ -974,9 +974,21 @@ impl Sky {
             self.settings.vertex_cache.max_uploaded_sprites_per_frame,
         );
         stats.blocks_left_out = left_out;
+        gpu_wait_us += self.resident.grow_wait_us;
         upload_bytes += placed_bytes;
         upload_bytes += self.resident.relight(queue, camera.position_m);
         (stats.sprites_lit, stats.light_us) = (self.resident.lit_sprites, self.resident.light_us);
+        // While the far field is drawn every sprite has faded out by the end of its hand-over
+        // band (a twentieth more: the band is horizontal, the draw distance along the ray):
+        // neither the ring nor the sprites go farther.
+        let hand_over_end_m = (self.far_field.hand_over_m()).map(|(_, end)| 1.05 * end);
+        let mut drawn = self.settings;
+        if let Some(end) = hand_over_end_m {
+            drawn.clouds.draw_distance_m = drawn.clouds.draw_distance_m.min(end);
+        }
+        self.views[i]
+            .ring
+            .set_reach_limit(hand_over_end_m.map(f64::from));
         self.views[i]
             .ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
@@ -995,7 +1007,7 @@ impl Sky {
             },
             (camera.position_m, &camera.frustum()),
             self.elapsed_s,
-            (&self.settings, sort_budget),
+            (&drawn, sort_budget),
             &mut v.locks,
             &mut v.draws,
             &mut stats,
@@ -1097,8 +1109,12 @@ impl Sky {
             }),
         };
         queue.write_buffer(&self.views[i].frame_buffer, 0, bytemuck::bytes_of(&frame));
-        self.far_field
-            .prepare(queue, camera.position_m, &self.clear_light, self.elapsed_s);
+        self.far_field.prepare(
+            queue,
+            (camera.position_m, frame.sky_horizon_rgb[3]),
+            &self.clear_light,
+            self.elapsed_s,
+        );
         upload_bytes += std::mem::size_of::<GpuFrame>() as u64;
         let ring_frame = RingFrame {
             resident: &self.resident,

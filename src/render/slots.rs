@@ -55,6 +55,19 @@ impl SlotRanges {
         want.min(u32::MAX as u64) as u32
     }
 
+    /// Adds the slots from today's capacity up to `capacity` (no less than today's) as free,
+    /// every range in use staying where it is.
+    pub fn extend_to(&mut self, capacity: u32) {
+        if capacity <= self.capacity {
+            return;
+        }
+        match self.free.last_mut() {
+            Some(last) if last.end == self.capacity => last.end = capacity,
+            _ => self.free.push(self.capacity..capacity),
+        }
+        self.capacity = capacity;
+    }
+
     /// A range of `len` slots, if one is free (`len` 0 gives an empty range).
     pub fn allocate(&mut self, len: u32) -> Option<Range<u32>> {
         if len == 0 {
@@ -91,6 +104,25 @@ impl SlotRanges {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn extending_keeps_the_ranges_in_use_and_frees_the_new_slots() {
+        let mut s = SlotRanges::new(10);
+        let a = s.allocate(6).unwrap();
+        let b = s.allocate(4).unwrap();
+        assert!(!s.fits(1));
+        s.extend_to(16);
+        assert_eq!((s.capacity(), s.used()), (16, 10));
+        assert_eq!(s.allocate(6), Some(10..16));
+        // A free range at the old end merges with the new slots.
+        s.release(b.clone());
+        s.release(10..16);
+        s.extend_to(20);
+        assert_eq!(s.allocate(10), Some(6..16));
+        s.extend_to(5); // never shrinks
+        assert_eq!(s.capacity(), 20);
+        assert_eq!(a, 0..6);
+    }
 
     #[test]
     fn ranges_are_disjoint_reused_and_merged() {

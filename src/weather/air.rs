@@ -117,7 +117,7 @@ pub struct InCloudAirSettings {
     pub visibility_m: f32,
     /// How far the nearest cloud is looked for, metres.
     pub search_radius_m: f64,
-    /// Cell size of the grid a line of sight walks through a generation's cloud boxes, metres.
+    /// Cell size of the grid a line of sight walks through the field's cloud boxes, metres.
     pub grid_cell_m: f64,
 }
 

@@ -50,6 +50,20 @@ impl<T: Send + 'static> WeatherWatch<T> {
         settle: Duration,
         prepare: impl Fn(WeatherInput) -> T + Send + 'static,
     ) -> Result<Self, WeatherError> {
+        Self::start_loading(path, settle, move |path| {
+            load_whole(path, stations.as_deref()).map(&prepare)
+        })
+    }
+
+    /// Watches `path` for a file of any kind: after each change that settles for `settle`,
+    /// `load` reads it on the watch's own thread and says what the caller keeps, or why the file
+    /// cannot be used (one line naming the file). [`Self::start`] loads weather this way; the
+    /// winds aloft ([`super::winds_aloft::WindsAloft::load_whole`]) go the same way.
+    pub fn start_loading(
+        path: &Path,
+        settle: Duration,
+        load: impl Fn(&Path) -> Result<T, String> + Send + 'static,
+    ) -> Result<Self, WeatherError> {
         let path = path.to_path_buf();
         let folder = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -81,7 +95,7 @@ impl<T: Send + 'static> WeatherWatch<T> {
         let worker_path = path.clone();
         thread::Builder::new()
             .name("skycast.weather_watch".to_string())
-            .spawn(move || worker(&worker_path, stations, settle, changed, updates_tx, prepare))
+            .spawn(move || worker(&worker_path, settle, changed, updates_tx, load))
             .map_err(|source| WeatherError::Io {
                 path: path.clone(),
                 source,
@@ -116,14 +130,14 @@ fn watch_error(path: &Path, err: &notify::Error) -> WeatherError {
     }
 }
 
-/// The watch thread: debounce, load, check, prepare, hand over; ends when either side is gone.
+/// The watch thread: debounce, load (check and prepare), hand over; ends when either side is
+/// gone.
 fn worker<T>(
     path: &Path,
-    stations: Option<Arc<StationTable>>,
     settle: Duration,
     changed: Receiver<()>,
     updates: Sender<WatchUpdate<T>>,
-    prepare: impl Fn(WeatherInput) -> T,
+    load: impl Fn(&Path) -> Result<T, String>,
 ) {
     while changed.recv().is_ok() {
         // Wait for the writer to finish: until no change has come for `settle`.
@@ -134,8 +148,8 @@ fn worker<T>(
                 Err(RecvTimeoutError::Disconnected) => return,
             }
         }
-        let update = match load_whole(path, stations.as_deref()) {
-            Ok(input) => WatchUpdate::Loaded(prepare(input)),
+        let update = match load(path) {
+            Ok(loaded) => WatchUpdate::Loaded(loaded),
             Err(message) => {
                 log::warn!("{message}; keeping the last good weather");
                 WatchUpdate::Rejected(message)

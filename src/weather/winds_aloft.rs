@@ -197,6 +197,32 @@ impl WindsAloft {
         })
     }
 
+    /// Reads an FB file as a watch does ([`super::watch::WeatherWatch::start_loading`]): once,
+    /// and only if it is whole (not empty, not still growing, ending with a complete line);
+    /// else why not, one line naming the file (and the line and field of a malformed one).
+    pub fn load_whole(path: &Path) -> Result<Self, String> {
+        let shown = path.display();
+        let before =
+            std::fs::metadata(path).map_err(|err| format!("{shown}: cannot read: {err}"))?;
+        let text =
+            std::fs::read_to_string(path).map_err(|err| format!("{shown}: cannot read: {err}"))?;
+        if before.len() != text.len() as u64 {
+            return Err(format!(
+                "{shown}: still being written (its size changed while reading)"
+            ));
+        }
+        if text.trim().is_empty() {
+            return Err(format!("{shown}: the file is empty"));
+        }
+        if !text.ends_with('\n') {
+            let line = text.lines().count();
+            return Err(format!(
+                "{shown}:{line}: ends in the middle of a line: cut short"
+            ));
+        }
+        Self::parse(&text, path).map_err(|err| err.to_string())
+    }
+
     /// Where each site is: the station table's `K` + id (US airports), else the id itself;
     /// `None` for a site with no entry (VOR and offshore points).
     pub fn positions(&self, table: &StationTable) -> Vec<Option<(f64, f64)>> {
@@ -497,6 +523,42 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("x.txt") && err.contains("FT line"), "{err}");
+    }
+
+    /// What a watch reads: the whole sample; a file cut mid-line, an empty one and a malformed
+    /// field each refused with one line naming the file (and line and field).
+    #[test]
+    fn a_whole_file_loads_and_a_broken_one_says_why() {
+        let dir = std::env::temp_dir().join(format!("skycast-fb-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("fb.txt");
+        let text =
+            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(SAMPLE)).unwrap();
+        std::fs::write(&path, &text).unwrap();
+        assert_eq!(WindsAloft::load_whole(&path).unwrap().sites.len(), 176);
+        let cut = text.find("ABQ              3513+00").unwrap() + 20;
+        std::fs::write(&path, &text[..cut]).unwrap();
+        let err = WindsAloft::load_whole(&path).unwrap_err();
+        assert!(
+            err.ends_with("fb.txt:10: ends in the middle of a line: cut short"),
+            "{err}"
+        );
+        std::fs::write(&path, "\n \n").unwrap();
+        let err = WindsAloft::load_whole(&path).unwrap_err();
+        assert!(err.ends_with("fb.txt: the file is empty"), "{err}");
+        std::fs::write(
+            &path,
+            text.replace("ABQ              3513+00", "ABQ              35X3+00"),
+        )
+        .unwrap();
+        let err = WindsAloft::load_whole(&path).unwrap_err();
+        assert!(
+            err.ends_with(
+                "fb.txt:10: field ABQ 9000 ft: `35X3+00` is not DDSS, DDSS+TT, DDSS-TT or DDSSTT"
+            ),
+            "{err}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -1,8 +1,9 @@
 //! The far field: the clouds beyond the sprites and the impostor ring, out to the horizon of
 //! the camera's altitude (docs/src/horizon.md). In: a [`FarMap`] (the weather field on a coarse
 //! grid, `src/clouds/far_map.rs`, built on the CPU a few rows a frame) and the frame's camera and
-//! light. Out: one full-screen pass (`shaders/far_field.wgsl`) drawn before the ring into the
-//! same target, which meets two curved layers (the low and middle clouds, the high ones) on the
+//! light. Out: one pass (`shaders/far_field.wgsl`) drawn before the ring into the same target,
+//! over the band of elevations where its clouds can show (a ring of [`BAND_SEGMENTS`] quads
+//! around the camera, not the whole screen: [`band_elevations`]), which meets two curved layers (the low and middle clouds, the high ones) on the
 //! round Earth ([`super::earth`]), cuts them into clouds with a world-anchored noise thresholded
 //! by the map's cover, and fades them in over the band where the sprites and the ring fade out.
 //! The map lives in one small texture (two RGBA half-float layers a cell: 96 x 96 cells of 10 km
@@ -18,6 +19,63 @@ use super::pipeline::{PassDesc, SceneDepth, premultiplied_over};
 
 /// The far field's shader.
 const WGSL: &str = include_str!("../../../shaders/far_field.wgsl");
+
+/// Quads of the band the pass is drawn over, around the horizon (keep in sync with
+/// `BAND_SEGMENTS` in `shaders/far_field.wgsl`).
+pub const BAND_SEGMENTS: u32 = 64;
+
+/// Radians the band is widened by on each side: its quads' edges are straight on the screen
+/// (great circles) where the band's are not (one 64th of a turn bends them by under 0.03
+/// degrees at 20 degrees from the horizon), and a pixel's footprint.
+const BAND_MARGIN_RAD: f32 = 0.01;
+
+/// The band of elevations (radians above the camera's level plane, lowest first) where the far
+/// field's layers can show: for each layer that has cloud, the `(lowest base, highest top)`
+/// metres above sea level in `layers`, the points between those heights from `s_min_m` to
+/// `s_max_m` horizontally from the camera (at `camera_m` above sea level; `camera_radius_m` its
+/// distance from the Earth's centre, 0 for the flat frame), placed on the round Earth as the
+/// shader meets them. `None` when no layer has cloud. The pass is drawn over this band alone:
+/// from FL350 over a low layer it is about a sixth of the screen's height, where the
+/// full-screen pass it replaces ran the shader on every pixel.
+pub fn band_elevations(
+    camera_m: f32,
+    camera_radius_m: f32,
+    layers: &[(f32, f32)],
+    (s_min_m, s_max_m): (f32, f32),
+) -> Option<(f32, f32)> {
+    let elevation = |s: f32, h: f32| {
+        let p = super::earth::curved_rel(Vec3::new(s, 0.0, h - camera_m), camera_radius_m);
+        p.z.atan2(p.x)
+    };
+    let mut band: Option<(f32, f32)> = None;
+    for &(low, high) in layers {
+        // A height's elevation falls from the nearest point, or rises to the layer's horizon
+        // (below the camera) and falls again beyond it: its extremes are at the ends of the
+        // range or at that horizon. Heights between the lowest and the highest lie between.
+        let mut samples: Vec<(f32, f32)> = [s_min_m, s_max_m]
+            .iter()
+            .flat_map(|&s| [(s, low), (s, high)])
+            .collect();
+        if camera_radius_m > 0.0 && high < camera_m {
+            let r = camera_radius_m - camera_m + high;
+            let s_horizon = camera_radius_m * (r / camera_radius_m).clamp(-1.0, 1.0).acos();
+            if (s_min_m..=s_max_m).contains(&s_horizon) {
+                samples.push((s_horizon, high));
+            }
+        }
+        for (s, h) in samples {
+            let e = elevation(s, h);
+            band = Some(band.map_or((e, e), |(lo, hi)| (lo.min(e), hi.max(e))));
+        }
+    }
+    let half_pi = std::f32::consts::FRAC_PI_2;
+    band.map(|(lo, hi)| {
+        (
+            (lo - BAND_MARGIN_RAD).max(-half_pi),
+            (hi + BAND_MARGIN_RAD).min(half_pi),
+        )
+    })
+}
 
 /// Settings of the far field (`[far_field]` of `config/render.toml`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -87,7 +145,8 @@ impl FarFieldSettings {
         None
     }
 
-    /// The noise's period, metres: a whole number of the heaped and the sheet cells.
+    /// The noise's period, metres: a power of two of the heaped and the sheet cells (1024 and
+    /// 256 of them; the shader wraps its octaves with a mask).
     fn noise_period_m(&self) -> f64 {
         1024.0 * f64::from(self.heaped_scale_m)
     }
@@ -109,7 +168,8 @@ pub struct GpuFarField {
     /// x, y: the low and high layers' mean middle height above sea level, metres; z: the
     /// sheets' noise scale, metres; w: the noise's period, metres.
     pub heights: [f32; 4],
-    /// x: how far the map has faded in, 0..=1; yzw unused.
+    /// x: how far the map has faded in, 0..=1; y, z: the band of elevations the pass is drawn
+    /// over, radians (lowest first; equal: nothing to draw); w unused.
     pub fade: [f32; 4],
 }
 const _: () = assert!(std::mem::size_of::<GpuFarField>() == 96);
@@ -136,6 +196,9 @@ struct MapOnGpu {
     texels: u32,
     /// Mean middle heights of the low and high layers, metres above sea level.
     heights: [f32; 2],
+    /// The lowest base and highest top of the cells with cloud of each layer that has any,
+    /// metres above sea level.
+    extents: Vec<(f32, f32)>,
 }
 
 /// The far field's pipelines, map and uniform (module docs).
@@ -179,9 +242,13 @@ impl FarField {
                 },
                 wgpu::BindGroupLayoutEntry {
                     binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    // The vertex stage reads the band's elevations. A read-only storage buffer,
+                    // not a uniform: lavapipe specialises a shader on the uniform values its
+                    // branches test (the camera's height, new every frame of a climb) and keeps
+                    // every copy (tests/memory.rs).
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
                     ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
                         has_dynamic_offset: false,
                         min_binding_size: None,
                     },
@@ -229,7 +296,7 @@ impl FarField {
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("far_field.uniform"),
             size: std::mem::size_of::<GpuFarField>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Self {
@@ -303,6 +370,16 @@ impl FarField {
             view_formats: &[],
         });
         let mut sums = [(0.0f64, 0.0f64); 2];
+        let mut extents = Vec::new();
+        for layer in 0..2usize {
+            // Cells the shader takes for cloud (its cover above 0.01).
+            let clouded = map.cells.iter().filter(|c| c[layer * 4] > 0.01);
+            let extent = clouded.fold(None, |e: Option<(f32, f32)>, c| {
+                let (base, top) = (c[layer * 4 + 1], c[layer * 4 + 2]);
+                Some(e.map_or((base, top), |(lo, hi)| (lo.min(base), hi.max(top))))
+            });
+            extents.extend(extent);
+        }
         for layer in 0..2u32 {
             let data: Vec<u16> = map
                 .cells
@@ -373,15 +450,17 @@ impl FarField {
             side_m: f64::from(n) * map.texel_m,
             texels: n,
             heights: [mean(sums[0], 1500.0), mean(sums[1], 9000.0)],
+            extents,
         });
     }
 
-    /// Writes this frame's uniform for a camera at `camera_m` under the light `light`, at
-    /// `now_s` of the sky's clock.
+    /// Writes this frame's uniform for a camera at `camera_m` (`camera_radius_m` from the
+    /// Earth's centre, 0 for the flat frame) under the light `light`, at `now_s` of the sky's
+    /// clock.
     pub(super) fn prepare(
         &self,
         queue: &wgpu::Queue,
-        camera_m: DVec3,
+        (camera_m, camera_radius_m): (DVec3, f32),
         light: &TimeOfDay,
         now_s: f64,
     ) {
@@ -401,6 +480,14 @@ impl FarField {
         let ambient = light.ambient_percent;
         let lit: Vec3 = Vec3::splat(0.9) * ambient + light.directional_rgb * 0.6;
         let shade: Vec3 = Vec3::splat(0.62) * ambient + light.directional_rgb * 0.12;
+        // The shader leaves out rays that meet a layer nearer than sqrt(0.8) of the band's
+        // start, or off the map.
+        let reach = (
+            0.8f32.sqrt() * s.fade_start_m,
+            centre_rel.length() + (map.side_m * std::f64::consts::FRAC_1_SQRT_2) as f32,
+        );
+        let band = band_elevations(camera_m.z as f32, camera_radius_m, &map.extents, reach)
+            .unwrap_or((0.0, 0.0));
         let gpu = GpuFarField {
             centre_rel_size: [
                 centre_rel.x,
@@ -421,8 +508,8 @@ impl FarField {
                 self.fade.map_or(1.0, |(start, over)| {
                     ((now_s - start) / over.max(1e-3)).clamp(0.0, 1.0) as f32
                 }),
-                0.0,
-                0.0,
+                band.0,
+                band.1,
                 0.0,
             ],
         };
@@ -441,7 +528,7 @@ impl FarField {
         };
         pass.set_pipeline(p);
         pass.set_bind_group(1, &map.group, &[]);
-        pass.draw(0..3, 0..1);
+        pass.draw(0..6 * BAND_SEGMENTS, 0..1);
     }
 
     /// Bytes of GPU memory it holds (the map texture and the uniform).
@@ -451,5 +538,48 @@ impl FarField {
                 let e = m.texture.size();
                 u64::from(e.width) * u64::from(e.height) * u64::from(e.depth_or_array_layers) * 8
             })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The elevation of a point `s` metres along the Earth (at the camera's radius) and `h` above
+    /// sea level, seen from a camera `c` above sea level: the sphere's own geometry in f64.
+    fn sphere_elevation(s: f64, h: f64, c: f64) -> f64 {
+        let r = 6_371_000.0;
+        let theta = s / (r + c);
+        let (x, z) = ((r + h) * theta.sin(), (r + h) * theta.cos() - (r + c));
+        z.atan2(x)
+    }
+
+    /// From FL350 over a layer from 1,000 to 3,000 m, out to 700 km: every point of the layer
+    /// the pass may draw lies inside the band (its highest near the layer's own horizon, 330 km
+    /// out), and the band is a narrow strip below the horizon, not the screen.
+    #[test]
+    fn the_band_holds_every_point_of_the_layers_and_little_else() {
+        let camera = 10_668.0f32;
+        let rc = 6_371_000.0 + camera;
+        let (lo, hi) =
+            band_elevations(camera, rc, &[(1000.0, 3000.0)], (37_600.0, 700_000.0)).unwrap();
+        for k in 0..=2000 {
+            let s = 37_600.0 + (700_000.0 - 37_600.0) * f64::from(k) / 2000.0;
+            for h in [1000.0, 2000.0, 3000.0] {
+                let e = sphere_elevation(s, h, f64::from(camera)) as f32;
+                assert!(
+                    e >= lo && e <= hi,
+                    "{s} m out at {h} m: {} deg outside {} to {} deg",
+                    e.to_degrees(),
+                    lo.to_degrees(),
+                    hi.to_degrees()
+                );
+            }
+        }
+        assert!(
+            hi < -2f32.to_radians() && hi - lo < 16f32.to_radians(),
+            "{lo} to {hi}"
+        );
+        assert!(band_elevations(camera, rc, &[], (37_600.0, 700_000.0)).is_none());
     }
 }

@@ -133,6 +133,10 @@ pub struct ImpostorRing {
     quads: Option<(usize, usize)>,
     /// Blocks drawn into the ring this frame.
     blocks_far: u32,
+    /// How far the ring reaches at most, metres, below its view radius (`None`: the view
+    /// radius): while the far field is drawn, the end of its hand-over band, beyond which the
+    /// ring's blocks would be built faded out to nothing.
+    reach_limit_m: Option<f64>,
     bytes: u64,
     /// The far clouds' orders from the ring centre, kept between builds.
     sorts: RingOrders,
@@ -432,6 +436,7 @@ impl ImpostorRing {
             shown: None,
             build: None,
             fade: None,
+            reach_limit_m: None,
             pending: Vec::new(),
             recorded: Cell::new(false),
             quads: None,
@@ -473,6 +478,24 @@ impl ImpostorRing {
             }
     }
 
+    /// Limits how far the ring reaches (`None`: its view radius). While the far field is
+    /// drawn, the sprites, and the impostors built from them, fade out by the end of its
+    /// hand-over band: the ring's blocks beyond it would be sorted and drawn into the
+    /// impostors to show nothing. A change of the limit changes the far set, so the ring is
+    /// rebuilt.
+    pub(super) fn set_reach_limit(&mut self, limit_m: Option<f64>) {
+        self.reach_limit_m = limit_m;
+    }
+
+    /// The settings with the view radius cut to the reach limit (kept beyond the ring radius).
+    fn reach_settings(&self) -> ImpostorSettings {
+        let mut s = self.settings;
+        if let Some(limit) = self.reach_limit_m {
+            s.view_radius_m = s.view_radius_m.min(limit.max(s.ring_radius_m * 1.01));
+        }
+        s
+    }
+
     /// Decides this frame's near blocks (marks `resident`'s blocks `near`: drawn as sprites) and
     /// starts or advances a rebuild. Call [`Self::prepare_builds`] after, with the frame's
     /// uniform. One pass over the blocks.
@@ -483,7 +506,7 @@ impl ImpostorRing {
         sun: Vec3,
         dt_s: f64,
     ) {
-        let s = self.settings;
+        let s = self.reach_settings();
         self.clock_s += dt_s.max(0.0);
         if self.recorded.replace(false) {
             self.pending.clear();
@@ -642,7 +665,8 @@ impl ImpostorRing {
                 cache,
                 largest,
             };
-            let reach = (build.state.centre_m, self.settings.view_radius_m);
+            let view_radius_m = self.reach_settings().view_radius_m;
+            let reach = (build.state.centre_m, view_radius_m);
             let mut rendered = 0;
             for _ in 0..count {
                 let i = build.next;
@@ -666,7 +690,7 @@ impl ImpostorRing {
                 );
                 let light = ViewLight {
                     camera_z_m: centre.z as f32,
-                    farthest_m: self.settings.view_radius_m as f32,
+                    farthest_m: view_radius_m as f32,
                     ..*view
                 };
                 let header = sprite_view::header(&light);
