@@ -2066,3 +2066,62 @@ fn with_the_far_field_on_the_ring_stops_at_the_hand_over() {
     assert_eq!(ring_blocks(true), 1, "the far field on");
     assert_eq!(ring_blocks(false), 2, "the far field off");
 }
+
+/// A block that arrives after the cloud shadow map was drawn is added to it (its own sprites
+/// drawn into the map, not every cloud again), and the map then holds what a whole drawing
+/// holds: the two agree within half-float rounding, and the new cloud's shadow is there.
+#[test]
+fn a_block_arriving_adds_its_shadow_to_the_map() {
+    let mut settings = RenderSettings::default();
+    settings.cloud_shadows.enabled = true;
+    let mut rig = Rig::with_settings(flat_ground(0.0), settings);
+    let camera = rig.camera(DVec3::new(0.0, 0.0, 1000.0), 0.0, 3.0);
+    let block = |id: u64, east: f64, clouds: usize| {
+        let centre = DVec3::new(east, 4000.0, 1300.0);
+        SkyBlock {
+            id,
+            centre_m: centre,
+            clouds: (0..clouds)
+                .map(|c| cumulus(centre + DVec3::new(0.0, 900.0 * c as f64, -300.0)))
+                .collect(),
+        }
+    };
+    let first = block(1, -2000.0, 3);
+    rig.set_clouds(vec![first.clone()]);
+    let (_, whole) = rig.frame("shadow_add_first", &camera);
+    assert!(
+        whole.shadow_redrawn && whole.shadow_sprites == 180,
+        "{whole:?}"
+    );
+    let queue = rig.host.gpu.queue.clone();
+    let before = rig.host.sky.read_back_cloud_shadows(&queue).unwrap();
+    rig.set_clouds(vec![first, block(2, 2000.0, 1)]);
+    let (_, added) = rig.frame("shadow_add_second", &camera);
+    assert!(
+        added.shadow_redrawn && added.shadow_sprites == 60,
+        "only the new block's 60 sprites drawn: {added:?}"
+    );
+    let grown = rig.host.sky.read_back_cloud_shadows(&queue).unwrap();
+    rig.host.sky.redraw_cloud_shadows();
+    let (_, again) = rig.frame("shadow_add_whole", &camera);
+    assert_eq!(again.shadow_sprites, 240, "{again:?}");
+    let redrawn = rig.host.sky.read_back_cloud_shadows(&queue).unwrap();
+    let new_shadow = grown
+        .tau
+        .iter()
+        .zip(&before.tau)
+        .filter(|(g, b)| *g - *b > 0.1)
+        .count();
+    let worst = grown
+        .tau
+        .iter()
+        .zip(&redrawn.tau)
+        .map(|(g, r)| (g - r).abs() / r.max(1.0))
+        .fold(0.0, f32::max);
+    eprintln!("texels the new cloud shadows: {new_shadow}; added against whole: {worst:.5}");
+    assert!(new_shadow > 20, "the new cloud casts no shadow in the map");
+    assert!(
+        worst < 2e-3,
+        "the added map differs from a whole drawing by {worst}"
+    );
+}

@@ -180,6 +180,18 @@ fn a_10_km_cell_from_20_km_spans_25_degrees_on_a_dark_base_and_a_flash_lights_it
         "base / sky beside in the shipped 40 km clear air: {:.2}",
         ratio_in(&hazed)
     );
+    // What the haze lifts the base to: the sprites fade into the horizon's colour, brighter
+    // than the sky a few degrees up beside the base (the lowest sky row against those rows).
+    let horizon_row = (0..H)
+        .rev()
+        .find(|&y| clear.depth[at(2, y)] >= 1.0)
+        .unwrap_or(0);
+    let horizon = mean((0..W).map(|x| clear.rgba[at(x, horizon_row)]).collect());
+    let sky_beside = mean(beside.iter().map(|&i| clear.rgba[i]).collect());
+    eprintln!(
+        "horizon sky / sky beside the base: {:.2}",
+        horizon / sky_beside
+    );
     host.sky.set_fog_settings(FogSettings {
         clear_visibility_m: 100_000.0,
         ..shipped

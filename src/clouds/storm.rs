@@ -31,6 +31,16 @@ use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, TypeSou
 /// Keys the randomness of a cell's drawing apart from its placement.
 const DRAW_KEY: u64 = 0x6472_6177;
 
+/// The turrets' shell: their sprites lie between this fraction of each ellipsoid's radius and
+/// its surface.
+const TOWER_SHELL_INNER: f64 = 0.6;
+
+/// The anvil's sprites' height over their width.
+const ANVIL_SPRITE_HEIGHT_OVER_WIDTH: f64 = 0.5;
+/// The anvil grid's step over its sprites' width: close, so the pancakes seen from below make one
+/// veil.
+const ANVIL_STEP_OVER_SPRITE: f64 = 0.55;
+
 /// The budget a type without a `cell` entry is drawn with.
 const FALLBACK: StormCellConfig = StormCellConfig {
     sprites: 700,
@@ -223,7 +233,7 @@ fn cell_raws(
 
     // The base: a close jittered grid of flat-bottomed sprites over the base disc (close, so
     // the base is one opaque, flat underside).
-    let step = 0.6 * s_mean;
+    let step = 0.45 * s_mean;
     let rim = (r_base - 0.15 * s_mean).max(0.3 * r_base);
     let m = ((2.0 * rim / step).ceil() as i64).clamp(1, 20);
     let cell_step = 2.0 * rim / m as f64;
@@ -318,28 +328,48 @@ fn cell_raws(
             });
         }
     }
-    let volume: f64 = boxes.iter().map(|b| b.half_w * b.half_w * b.half_h).sum();
-    for b in &boxes {
-        let n =
-            ((tower_budget as f64 * b.half_w * b.half_w * b.half_h / volume).round() as u32).max(2);
+    // Wang 2003 4.1 builds a cloud's shell, not its inside: a sprite deep in a turret (or in a
+    // neighbouring one) is hidden behind those around it from every side, yet blended all the
+    // same, and a 10 km cell filled through was 23 sprites deep seen from the side. So the
+    // turrets are shells: sprites on the outer quarter of each ellipsoid, none inside another,
+    // their share of the budget by surface, not volume.
+    let surface: f64 = boxes.iter().map(|b| b.half_w * (b.half_w + b.half_h)).sum();
+    let inside_other = |p: DVec3, own: usize, boxes: &[Box3]| {
+        boxes.iter().enumerate().any(|(k, o)| {
+            let d = p - o.centre;
+            let r2 =
+                (d.x * d.x + d.y * d.y) / (o.half_w * o.half_w) + d.z * d.z / (o.half_h * o.half_h);
+            k != own && r2 < TOWER_SHELL_INNER * TOWER_SHELL_INNER && (!o.bottom || d.z >= 0.0)
+        })
+    };
+    for (bi, b) in boxes.iter().enumerate() {
+        let n = ((tower_budget as f64 * b.half_w * (b.half_w + b.half_h) / surface).round() as u32)
+            .max(2);
         for s in 0..n {
             if s % 12 == 0 {
                 group += 1;
             }
             let (width, h) = sprite(rng);
+            let spread = (b.half_w - 0.25 * width).max(0.3 * b.half_w);
             let (x, y, z) = loop {
                 let x = rng.range_f64(-1.0, 1.0);
                 let y = rng.range_f64(-1.0, 1.0);
                 let z = rng.range_f64(if b.bottom { 0.0 } else { -1.0 }, 1.0);
                 let r2 = x * x + y * y + z * z;
-                if r2 <= 1.0 && rng.next_f64() < 1.0 - 0.35 * r2 {
-                    break (x, y, z);
+                if !(1e-6..=1.0).contains(&r2) {
+                    continue;
                 }
+                // On the shell: pushed out to between TOWER_SHELL_INNER and 1 of the radius.
+                let k = rng.range_f64(TOWER_SHELL_INNER, 1.0) / r2.sqrt();
+                break (x * k, y * k, z * k);
             };
-            let spread = (b.half_w - 0.25 * width).max(0.3 * b.half_w);
             let zc = (b.centre.z + z * b.half_h).clamp(0.5 * h, height - 0.5 * h);
+            let pos = DVec3::new(b.centre.x + x * spread, b.centre.y + y * spread, zc);
+            if inside_other(pos, bi, &boxes) {
+                continue;
+            }
             raws.push(Raw {
-                pos: DVec3::new(b.centre.x + x * spread, b.centre.y + y * spread, zc),
+                pos,
                 width,
                 height: h,
                 group: group - 1,
@@ -354,10 +384,11 @@ fn cell_raws(
     // the budget allows; the rim thinner and fibrous.
     let a = 0.5 * cell.anvil_width_m;
     let centre = cell.anvil_offset();
-    let s_anvil = (a * (std::f64::consts::PI / anvil_budget.max(1) as f64).sqrt() / 0.65)
+    let s_anvil = (a * (std::f64::consts::PI / anvil_budget.max(1) as f64).sqrt()
+        / ANVIL_STEP_OVER_SPRITE)
         .max(0.8 * anvil_t)
         .max(smin);
-    let step = 0.65 * s_anvil;
+    let step = ANVIL_STEP_OVER_SPRITE * s_anvil;
     let rim = (a - 0.3 * s_anvil).max(0.5 * a);
     let m = ((2.0 * rim / step).ceil() as i64).clamp(1, 24);
     let cell_step = 2.0 * rim / m as f64;
@@ -377,7 +408,10 @@ fn cell_raws(
             let x = cx + cell_step * rng.range_f64(-0.35, 0.35);
             let y = cy + cell_step * rng.range_f64(-0.35, 0.35);
             let width = s_anvil * rng.range_f64(0.85, 1.15);
-            let h = width.min(1.2 * anvil_t);
+            // Pancakes (wider than tall: the renderer's layer sprites, a thin strip seen from
+            // the side and round from below), so the slab seen edge-on is a few of them deep,
+            // not a wall of square sprites its whole length.
+            let h = (ANVIL_SPRITE_HEIGHT_OVER_WIDTH * width).min(0.8 * anvil_t);
             let edge = r2 > 0.6;
             // Flat bottom: no sprite reaches under the floor; the rim keeps to the top half.
             let lo = anvil_floor + 0.5 * h * if edge { 1.3 } else { 0.8 };
@@ -480,7 +514,7 @@ mod tests {
         // reach hangs below its floor.
         assert!(pts.iter().all(|p| p.z >= base - 1.0));
         let sprites = whole.sprites.iter().filter(|s| !s.precipitation).count();
-        // In the budget (713 after the cull today), not ten chimneys' worth.
+        // In the budget (454 after the cull today), not ten chimneys' worth.
         let budget = config.cell.map_or(FALLBACK.sprites, |c| c.sprites) as usize;
         assert!((300..=budget).contains(&sprites), "{sprites} sprites");
         assert!(
@@ -520,5 +554,92 @@ mod tests {
         // Drawn again (another block asks), the same cell.
         assert_eq!(cell_cloud(&c, config, &weather()), whole);
         let _ = StormContext::default();
+    }
+}
+
+#[cfg(test)]
+mod fill {
+    use super::*;
+    use crate::clouds::CloudTypes;
+    use crate::weather::{CloudType, Wind};
+
+    /// How many sprites deep a cloud's quads are where it is, seen from the side (along north,
+    /// a quad its width by its height) or from below (its width square): the quads' summed area
+    /// over the area they cover, on a 100 m grid. The GPU blends every quad it covers, hidden or
+    /// not: this is the fill a cell costs for its size on screen.
+    fn depth(c: &Cloud, side: bool, keep: &dyn Fn(&super::super::block::Sprite) -> bool) -> f64 {
+        let step = 100.0f32;
+        let mut grid = std::collections::HashSet::<(i32, i32)>::new();
+        let mut total = 0.0f64;
+        for s in c.sprites.iter().filter(|s| !s.precipitation && keep(s)) {
+            let (u, v, hw, hh) = if side {
+                (
+                    s.offset_m[0],
+                    s.offset_m[2],
+                    0.5 * s.width_m,
+                    0.5 * s.height_m,
+                )
+            } else {
+                (
+                    s.offset_m[0],
+                    s.offset_m[1],
+                    0.5 * s.width_m,
+                    0.5 * s.width_m,
+                )
+            };
+            total += (4.0 * hw * hh) as f64;
+            for i in ((u - hw) / step) as i32..=((u + hw) / step) as i32 {
+                for j in ((v - hh) / step) as i32..=((v + hh) / step) as i32 {
+                    grid.insert((i, j));
+                }
+            }
+        }
+        total / (grid.len() as f64 * (step * step) as f64)
+    }
+
+    /// Cells of 7, 10 and 15 km (the bench's BKN CB grows them to 15) are a shell of turrets
+    /// and a slab of pancakes: at most 12 quads deep seen from the side where the tower is, 20
+    /// where the anvil is seen edge-on, 6 from below. Filled through (1,400 sprites, square
+    /// anvil sprites) a 10 km cell was 23 deep from the side and 5 from below; shells with that
+    /// budget and anvil, its tower 19 and its anvil 19 (this test fails on the tower).
+    #[test]
+    fn a_cell_is_a_shell_a_few_sprites_deep() {
+        let types = CloudTypes::builtin();
+        let config = types.get(CloudType::Cumulonimbus);
+        for w in [7_000.0, 10_000.0, 15_000.0] {
+            let cell = StormCell {
+                key: 42,
+                centre_m: [0.0, 0.0],
+                base_width_m: w,
+                base_ft_agl: 4_500.0,
+                top_ft_msl: 38_700.0,
+                ground_m_msl: 800.0,
+                anvil_width_m: 3.0 * w,
+                anvil_offset_m: [w, 0.0],
+                anvil_thickness_m: 2_500.0,
+                turrets: 5,
+                wind_aloft_m_s: [20.0, 0.0],
+                thunder: 2,
+                precipitation: 0.6,
+                cloud_type: CloudType::Cumulonimbus,
+            };
+            let weather = BlockWeather {
+                wind: Wind {
+                    from_deg: 270.0,
+                    speed_kt: 10.0,
+                },
+                precipitation: 0.6,
+                ..Default::default()
+            };
+            let c = cell_cloud(&cell, config, &weather);
+            let floor = (0.5 * (cell.top_m_msl() - cell.base_m_msl()) - 2_500.0) as f32;
+            let tower = depth(&c, true, &|s| s.offset_m[2] < floor);
+            let anvil = depth(&c, true, &|s| s.offset_m[2] >= floor);
+            let below = depth(&c, false, &|_| true);
+            eprintln!("{w} m: tower {tower:.1}, anvil {anvil:.1}, from below {below:.1} deep");
+            assert!(tower <= 16.0, "{w} m: the tower is {tower:.1} quads deep");
+            assert!(anvil <= 20.0, "{w} m: the anvil is {anvil:.1} quads deep");
+            assert!(below <= 6.0, "{w} m: {below:.1} quads deep from below");
+        }
     }
 }

@@ -77,6 +77,9 @@ pub(super) struct Resident {
     /// Drawn as sprites this frame (not in the impostor ring); set by the ring's split.
     pub near: bool,
     pub clouds: Vec<CloudState>,
+    /// Lowest and highest heights of its clouds' sprites (their core boxes), metres relative
+    /// to the block's centre: a storm cell's part spans from its base to its anvil.
+    pub z_span_m: (f64, f64),
 }
 
 impl Resident {
@@ -102,10 +105,19 @@ impl Resident {
             .iter()
             .map(|c| (c.centre_m - block.centre_m).length() + c.radius_m as f64)
             .fold(0.0, f64::max);
+        let z_span_m = clouds
+            .iter()
+            .map(|c| {
+                let z = c.centre_m.z - block.centre_m.z + c.core_centre_m.z as f64;
+                (z - c.core_half_m.z as f64, z + c.core_half_m.z as f64)
+            })
+            .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+            .unwrap_or((0.0, 0.0));
         Self {
             block,
             motion,
             radius_m,
+            z_span_m,
             list: Vec::new(),
             list_sprites: 0,
             check: None,
@@ -129,6 +141,15 @@ impl Resident {
     /// Its centre now (with the drift), metres.
     pub fn centre_m(&self) -> DVec3 {
         self.block.centre_m + self.motion.offset_m
+    }
+
+    /// Its centre moved up or down to the height within its clouds' span nearest `height_m`:
+    /// how far above or below the camera the block is, for the impostor ring's height limit (a
+    /// storm cell 30 km off spans the camera's height although its middle is 4 km above it).
+    pub fn nearest_height_m(&self, height_m: f64) -> DVec3 {
+        let c = self.centre_m();
+        let (lo, hi) = self.z_span_m;
+        DVec3::new(c.x, c.y, height_m.clamp(c.z + lo, c.z + hi.max(lo)))
     }
 
     /// A fixed order for blocks as far from the camera as each other (a camera on the corner
@@ -746,4 +767,62 @@ pub fn quad_index_buffer(device: &wgpu::Device, sprites: u32) -> wgpu::Buffer {
         contents: bytemuck::cast_slice(&indices),
         usage: wgpu::BufferUsages::INDEX,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+    use crate::clouds::CloudTypes;
+    use crate::clouds::storm::{cell_cloud, part_in_block};
+    use crate::render::impostor::{ImpostorSettings, is_far};
+    use crate::weather::storms::StormCell;
+    use crate::weather::{BlockIndex, BlockWeather, CloudType};
+
+    /// A storm cell's part stands from its base to its anvil: its middle is more than 10,000
+    /// ft above a camera at its base's height, yet the cell 40 km off spans that height and
+    /// goes in the impostor ring (judged by its middle, every block of a field of storms stayed
+    /// a sprite out to the view radius: 295,000 sprites drawn in the storm bench). A camera far
+    /// above its top still keeps it out.
+    #[test]
+    fn a_block_spanning_the_camera_height_goes_in_the_ring() {
+        let types = CloudTypes::builtin();
+        let cell = StormCell {
+            key: 3,
+            centre_m: [2_000.0, 2_000.0],
+            base_width_m: 10_000.0,
+            base_ft_agl: 3_000.0,
+            top_ft_msl: 38_000.0,
+            ground_m_msl: 0.0,
+            anvil_width_m: 30_000.0,
+            anvil_offset_m: [10_000.0, 0.0],
+            anvil_thickness_m: 2_500.0,
+            turrets: 4,
+            wind_aloft_m_s: [20.0, 0.0],
+            thunder: 0,
+            precipitation: 0.0,
+            cloud_type: CloudType::Cumulonimbus,
+        };
+        let whole = cell_cloud(
+            &cell,
+            types.get(CloudType::Cumulonimbus),
+            &BlockWeather::default(),
+        );
+        let part = part_in_block(&whole, BlockIndex::new(0, 0), 0).expect("the cell's middle");
+        let sky = SkyCloud::from(&part);
+        let block = SkyBlock {
+            id: 1,
+            centre_m: sky.centre_m,
+            clouds: vec![sky],
+        };
+        let r = Resident::new(block, BlockMotion::default());
+        let s = ImpostorSettings::default();
+        let camera = DVec3::new(2_000.0, -38_000.0, 1_000.0);
+        assert!(r.centre_m().z - camera.z > s.max_height_difference_ft * 0.3048);
+        assert!(!is_far(r.centre_m(), camera, camera, &s));
+        assert!(is_far(r.nearest_height_m(camera.z), camera, camera, &s));
+        let above = DVec3::new(camera.x, camera.y, 11_583.0 + 4_000.0);
+        assert!(!is_far(r.nearest_height_m(above.z), above, above, &s));
+    }
 }

@@ -655,8 +655,9 @@ impl Sky {
     }
 
     /// Draws the cloud shadow map at the next [`Self::prepare`] whatever changed (it is drawn
-    /// again by itself when the camera has gone far, the sun turned, blocks came or went, or,
-    /// while clouds form or dissipate, after `update_interval_s`).
+    /// again by itself when the camera has gone far, the sun turned, a block near went (one
+    /// that arrives is added to it), or, while clouds form or dissipate, after
+    /// `update_interval_s`).
     pub fn redraw_cloud_shadows(&mut self) {
         self.shadows.redraw();
     }

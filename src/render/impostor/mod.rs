@@ -550,7 +550,7 @@ impl ImpostorRing {
                 far_count += in_far as u32;
                 if steady_shown
                     && let Some(st) = shown
-                    && is_far(r.centre_m(), st.centre_m, camera_m, &s)
+                    && is_far(r.nearest_height_m(camera_m.z), st.centre_m, camera_m, &s)
                 {
                     far_now += 1;
                     same &= in_far;
@@ -579,7 +579,7 @@ impl ImpostorRing {
         self.pending.retain(|p| p.0 != ring);
         let far: Vec<(u64, f64)> = blocks
             .values()
-            .filter(|r| is_far(r.centre_m(), camera_m, camera_m, &s))
+            .filter(|r| is_far(r.nearest_height_m(camera_m.z), camera_m, camera_m, &s))
             .map(|r| (r.block.id, (r.centre_m() - camera_m).length()))
             .collect();
         let far_mean_m = if far.is_empty() {

@@ -17,14 +17,18 @@
 //! the sprites' draw distance), centred on a texel of a grid fixed to the world, so a camera
 //! moving within a texel leaves every shadow as it was (no shimmer). It is drawn again after
 //! `update_interval_s` of sky time while a cloud it covers forms or dissipates, when the camera has gone
-//! `recentre_fraction` of the half extent, the sun has turned `rebuild_sun_deg`, or the blocks
-//! it covers changed; between draws the lookup matrix moves the map with the clouds' drift
+//! `recentre_fraction` of the half extent, the sun has turned `rebuild_sun_deg`, or a block
+//! that may shadow the ground within `full_detail_m` of the camera went; a block that arrives
+//! is added to the map (its own sprites drawn over it, the sums being additive), and one that
+//! goes farther off keeps its shadow until the next drawing. With the sun below 1 degree the
+//! map is drawn empty. Between draws the lookup matrix moves the map with the clouds' drift
 //! (SilverLining reuses its map across frames the same way). Its last texels are faded out, so
 //! the shadows end softly at the map's edge. Geometry and rules: `layout`. Units: metres.
 
 mod layout;
 
 use std::cell::Cell;
+use std::collections::{HashMap, HashSet};
 
 use glam::{DVec3, Mat4, Vec3};
 
@@ -126,8 +130,12 @@ pub struct CloudShadows {
     list_buffers_made: u64,
     /// The last drawing: where it stood, the sky time and the clouds' drift then.
     drawn: Option<(ShadowFrame, f64, DVec3)>,
-    /// The blocks the last drawing covered: how many and their ids summed.
-    covered: (usize, u64),
+    /// The blocks whose shadows the map holds (by id): their centre and radius when drawn.
+    /// Blocks that arrive later are added to the map; one that leaves is kept there until the
+    /// next whole drawing unless its shadow lies within `full_detail_m`.
+    in_map: HashMap<u64, (DVec3, f64)>,
+    /// Whether this frame's draw adds to the map (blocks that arrived) rather than clearing it.
+    adding: bool,
     /// Draw the map at the next prepare whatever changed ([`Self::redraw`]).
     force: bool,
     /// The clouds' drift now ([`super::Sky::set_drift`]).
@@ -291,7 +299,8 @@ impl CloudShadows {
             list_buffer: storage_buffer(device, "sky.cloud_shadow_lists", 4096 * 16),
             list_buffers_made: 0,
             drawn: None,
-            covered: (0, 0),
+            in_map: HashMap::new(),
+            adding: false,
             force: false,
             drift_m: DVec3::ZERO,
             pending: None,
@@ -390,17 +399,55 @@ impl CloudShadows {
         let sun = sun.as_dvec3();
         let s = self.settings;
         let blocks = &resident.blocks;
+        // A whole drawing when the map is due (moved, turned, aged, forced) or a block whose
+        // shadow lies near was taken away; else only the blocks that arrived since are drawn,
+        // added to the map (the sums are additive): a block arriving at the edge of the sprites'
+        // reach no longer costs a drawing of every cloud (most frames of the storm bench did).
+        let mut added: Option<HashSet<u64>> = None;
+        // The shadows fade out as the sun nears the horizon (they would reach for ever); with
+        // it below 1 degree nothing shows, and the map is drawn with no sprite.
+        let sun_up = smoothstep(1.0f64.to_radians().sin(), 5.0f64.to_radians().sin(), sun.z);
+        let dark = sun_up <= 0.0;
         let stale = match &self.drawn {
             None => true,
             Some((frame, at_s, _)) => {
-                let (count, ids, changing) = covered(blocks, frame);
+                let (now, changing) = covered(blocks, frame);
                 let times = (*at_s, now_s);
-                std::mem::take(&mut self.force)
-                    || needs_redraw(frame, times, camera_m, sun, changing, &s)
-                    || (count, ids) != self.covered
+                let due = std::mem::take(&mut self.force)
+                    || needs_redraw(frame, times, camera_m, sun, changing, &s);
+                let near_gone = self.in_map.iter().any(|(id, &(centre, radius))| {
+                    !now.contains(id) && shadow_is_near(frame, centre, radius, camera_m, &s)
+                });
+                // Nothing to add or take away while the sun is too low for shadows (the map
+                // is drawn empty then).
+                let near_gone = near_gone && !dark;
+                let arrived: HashSet<u64> = now
+                    .iter()
+                    .filter(|id| !self.in_map.contains_key(id))
+                    .copied()
+                    .collect();
+                if !(due || near_gone || dark || arrived.is_empty()) {
+                    added = Some(arrived);
+                }
+                due || near_gone
             }
         };
         let mut bytes = 0;
+        if let (false, Some(arrived), Some((frame, _, drift_then))) = (stale, &added, self.drawn) {
+            // The new blocks where they stood when the map was drawn (the lookup moves the map
+            // with the drift since).
+            let back = self.drift_m - drift_then;
+            let sprites = self.shadow_view(blocks, &frame, Some(arrived), back, false);
+            bytes += self.write_view(queue, resident, light, &frame, sprites);
+            for r in blocks.values().filter(|r| arrived.contains(&r.block.id)) {
+                self.in_map
+                    .insert(r.block.id, (r.centre_m() - back, r.radius_m));
+            }
+            self.adding = true;
+            self.pending = Some(sprites);
+            self.timed.set(self.timer.is_some());
+            stats.shadow_sprites = sprites;
+        }
         if stale {
             // The sun of the last drawing until it has turned `rebuild_sun_deg` (a shadow 2 km
             // under its cloud moves 17 m at 0.5 degrees): the sun a host gives follows the
@@ -413,54 +460,14 @@ impl CloudShadows {
                 _ => sun,
             };
             let frame = ShadowFrame::new(camera_m, sun, &s);
-            let sprites = self.shadow_view(blocks, &frame);
-            let (count, ids, _) = covered(blocks, &frame);
-            self.covered = (count, ids);
-            let mut header = sprite_view::header(&ViewLight {
-                camera_z_m: frame.eye_m.z as f32,
-                farthest_m: NO_FAR_FADE_M,
-                ..*light
-            });
-            // Seen from the sun: no facing locks (the eye is never near), upright base sprites
-            // never fade (from a high sun they are edge on anyway), no far fade.
-            header.forward_lock[1] = 0.0;
-            header.upright_lifecycle[0] = 2.0;
-            header.upright_lifecycle[1] = 3.0;
-            // Each cloud's sprites in their slots' order: the half-float sums then come out the
-            // same wherever the camera's sort has put them (a moved camera re-sorts clouds).
-            header.hl_deck[1] = 1.0;
-            header.far_fade_layer_turn[0] = NO_FAR_FADE_M;
-            header.far_fade_layer_turn[1] = 2.0 * NO_FAR_FADE_M;
-            let list_bytes = (self.lists.len() as u64 * 16).max(16);
-            if list_bytes > self.list_buffer.size() {
-                let size = list_bytes.next_power_of_two();
-                self.list_buffer = storage_buffer(&self.device, "sky.cloud_shadow_lists", size);
-                self.list_buffers_made += 1;
-            }
-            if !self.lists.is_empty() {
-                let data = bytemuck::cast_slice(&self.lists);
-                queue.write_buffer(&self.list_buffer, 0, data);
-                bytes += data.len() as u64;
-            }
-            bytes += self.sprites_view.write(
-                &self.device,
-                queue,
-                &self.view_layout,
-                &header,
-                None,
-                ViewData::Resident {
-                    counts: [self.draws.len() as u32, 0, sprites, 0],
-                    draws: &self.draws,
-                    lists: &self.list_buffer,
-                    orders: &resident.order_buffer,
-                    // A new group when either buffer was replaced.
-                    generation: resident
-                        .generation
-                        .wrapping_mul(1_000_003)
-                        .wrapping_add(self.list_buffers_made),
-                },
-            );
-            // The shadows fade out as the sun nears the horizon (they would reach for ever).
+            let sprites = self.shadow_view(blocks, &frame, None, DVec3::ZERO, dark);
+            self.in_map = blocks
+                .values()
+                .filter(|r| is_covered(r, &frame) && !dark)
+                .map(|r| (r.block.id, (r.centre_m(), r.radius_m)))
+                .collect();
+            bytes += self.write_view(queue, resident, light, &frame, sprites);
+            // The fade of the drawing's own sun (the last one's, within `rebuild_sun_deg`).
             let sun_up = smoothstep(1.0f64.to_radians().sin(), 5.0f64.to_radians().sin(), sun.z);
             let uniform = GpuCloudShadow {
                 clip_from_eye: frame.clip_from_eye_relative().to_cols_array_2d(),
@@ -469,6 +476,7 @@ impl CloudShadows {
             queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
             bytes += std::mem::size_of::<GpuCloudShadow>() as u64;
             self.drawn = Some((frame, now_s, self.drift_m));
+            self.adding = false;
             self.pending = Some(sprites);
             self.timed.set(self.timer.is_some());
             stats.shadow_sprites = sprites;
@@ -476,8 +484,66 @@ impl CloudShadows {
         if let Some((frame, _, drift_then)) = &self.drawn {
             self.lookup = frame.uv_from_camera_relative(camera_m, self.drift_m - *drift_then);
         }
-        stats.shadow_redrawn = stale;
+        stats.shadow_redrawn = stale || added.is_some();
         stats.shadow_gpu_bytes = self.gpu_bytes();
+        bytes
+    }
+
+    /// Writes the cloud lists and the view of the resident sprites for a drawing at `frame` of
+    /// `sprites` (the draw list `shadow_view` made); returns the bytes written.
+    fn write_view(
+        &mut self,
+        queue: &wgpu::Queue,
+        resident: &ResidentSet,
+        light: &ViewLight,
+        frame: &ShadowFrame,
+        sprites: u32,
+    ) -> u64 {
+        let mut bytes = 0;
+        let mut header = sprite_view::header(&ViewLight {
+            camera_z_m: frame.eye_m.z as f32,
+            farthest_m: NO_FAR_FADE_M,
+            ..*light
+        });
+        // Seen from the sun: no facing locks (the eye is never near), upright base sprites
+        // never fade (from a high sun they are edge on anyway), no far fade.
+        header.forward_lock[1] = 0.0;
+        header.upright_lifecycle[0] = 2.0;
+        header.upright_lifecycle[1] = 3.0;
+        // Each cloud's sprites in their slots' order: the half-float sums then come out the
+        // same wherever the camera's sort has put them (a moved camera re-sorts clouds).
+        header.hl_deck[1] = 1.0;
+        header.far_fade_layer_turn[0] = NO_FAR_FADE_M;
+        header.far_fade_layer_turn[1] = 2.0 * NO_FAR_FADE_M;
+        let list_bytes = (self.lists.len() as u64 * 16).max(16);
+        if list_bytes > self.list_buffer.size() {
+            let size = list_bytes.next_power_of_two();
+            self.list_buffer = storage_buffer(&self.device, "sky.cloud_shadow_lists", size);
+            self.list_buffers_made += 1;
+        }
+        if !self.lists.is_empty() {
+            let data = bytemuck::cast_slice(&self.lists);
+            queue.write_buffer(&self.list_buffer, 0, data);
+            bytes += data.len() as u64;
+        }
+        bytes += self.sprites_view.write(
+            &self.device,
+            queue,
+            &self.view_layout,
+            &header,
+            None,
+            ViewData::Resident {
+                counts: [self.draws.len() as u32, 0, sprites, 0],
+                draws: &self.draws,
+                lists: &self.list_buffer,
+                orders: &resident.order_buffer,
+                // A new group when either buffer was replaced.
+                generation: resident
+                    .generation
+                    .wrapping_mul(1_000_003)
+                    .wrapping_add(self.list_buffers_made),
+            },
+        );
         bytes
     }
 
@@ -493,13 +559,28 @@ impl CloudShadows {
 
     /// The draw list of the blocks the map covers (placed on the GPU, their drift included),
     /// with every cloud of theirs in its list (its sprites in the resident order); returns the
-    /// sprites.
-    fn shadow_view(&mut self, blocks: &Blocks, frame: &ShadowFrame) -> u32 {
+    /// sprites. `only`: just these blocks (added to a map drawn before), each moved back by
+    /// `back_m` (the clouds' drift since that drawing). `none`: no block (the sun is too low
+    /// for shadows).
+    fn shadow_view(
+        &mut self,
+        blocks: &Blocks,
+        frame: &ShadowFrame,
+        only: Option<&HashSet<u64>>,
+        back_m: DVec3,
+        none: bool,
+    ) -> u32 {
         self.draws.clear();
         self.lists.clear();
+        if none {
+            return 0;
+        }
         // A fixed order (by place, then id): the half-float sums come out the same every run.
-        let mut order: Vec<&super::resident::Resident> =
-            blocks.values().filter(|r| is_covered(r, frame)).collect();
+        let mut order: Vec<&super::resident::Resident> = blocks
+            .values()
+            .filter(|r| is_covered(r, frame))
+            .filter(|r| only.is_none_or(|ids| ids.contains(&r.block.id)))
+            .collect();
         order.sort_by(|a, b| a.tie_order(b));
         let mut total = 0u32;
         for r in order {
@@ -508,9 +589,7 @@ impl CloudShadows {
             // Beyond `full_detail_m` across the rays, every `far_sprite_stride`th sprite of a
             // cloud stands for that many (its optical depth times the stride): far shadows lie
             // under the haze, and the far field holds most of the sprites.
-            let (x, y) = frame.across(r.centre_m());
-            let near = x.abs().max(y.abs()) - r.radius_m <= self.settings.full_detail_m;
-            let stride = if near {
+            let stride = if is_near(frame, r.centre_m() - back_m, r.radius_m, &self.settings) {
                 1
             } else {
                 self.settings.far_sprite_stride
@@ -526,7 +605,7 @@ impl CloudShadows {
             }
             let (fade_kind, fade_progress) = fade_code(r.motion.fade);
             self.draws.push(GpuDrawBlock {
-                origin_rel: (r.centre_m() - frame.eye_m).as_vec3().to_array(),
+                origin_rel: (r.centre_m() - back_m - frame.eye_m).as_vec3().to_array(),
                 first: total,
                 list_base,
                 list_len: self.lists.len() as u32 - list_base,
@@ -564,7 +643,7 @@ impl CloudShadows {
             if let (Some(view), Some((c, _, n))) = (view, part) {
                 build.record(encoder, view, resident, (c, n));
             }
-            let load = if k == 0 {
+            let load = if k == 0 && !self.adding {
                 wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
             } else {
                 wgpu::LoadOp::Load
@@ -673,16 +752,42 @@ fn is_covered(r: &super::resident::Resident, frame: &ShadowFrame) -> bool {
     x.abs() <= reach && y.abs() <= reach
 }
 
-/// The blocks a drawing at `frame` covers: how many, their ids summed (a block arriving or
-/// going changes it), and whether any of them forms or dissipates.
-fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (usize, u64, bool) {
-    blocks.values().filter(|r| is_covered(r, frame)).fold(
-        (0, 0u64, false),
-        |(n, ids, changing), r| {
-            let fading = r.motion.fade != super::Fade::Steady;
-            (n + 1, ids.wrapping_add(r.block.id), changing || fading)
-        },
-    )
+/// Whether a block's shadow (centre and radius, placed) lies within `full_detail_m` of the
+/// map's centre across the rays.
+fn is_near(frame: &ShadowFrame, centre_m: DVec3, radius_m: f64, s: &ShadowSettings) -> bool {
+    let (x, y) = frame.across(centre_m);
+    x.abs().max(y.abs()) - radius_m <= s.full_detail_m
+}
+
+/// Whether a block (its centre and radius, placed) may shadow the ground within
+/// `full_detail_m` of the camera: its centre that close to the camera's sun ray across the
+/// rays, and not down-sun of the camera (its shadow then falls farther from the sun).
+fn shadow_is_near(
+    frame: &ShadowFrame,
+    centre_m: DVec3,
+    radius_m: f64,
+    camera_m: DVec3,
+    s: &ShadowSettings,
+) -> bool {
+    let to = centre_m - camera_m;
+    let sunward = to.dot(frame.sun);
+    let across = (to - frame.sun * sunward).length();
+    sunward >= -radius_m && across - radius_m <= s.full_detail_m
+}
+
+/// The blocks a drawing at `frame` covers (their ids), and whether any of them forms or
+/// dissipates.
+fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (HashSet<u64>, bool) {
+    let mut changing = false;
+    let ids = blocks
+        .values()
+        .filter(|r| is_covered(r, frame))
+        .map(|r| {
+            changing |= r.motion.fade != super::Fade::Steady;
+            r.block.id
+        })
+        .collect();
+    (ids, changing)
 }
 
 fn smoothstep(a: f64, b: f64, x: f64) -> f64 {
