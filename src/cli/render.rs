@@ -289,7 +289,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if !(-2_000.0..=100_000.0).contains(&args.alt_ft) {
         anyhow::bail!("--alt-ft {} is outside -2000..=100000 feet", args.alt_ft);
     }
-    let (settings, table) = args.look.load()?;
+    let (mut settings, table) = args.look.load()?;
+    // One offline frame: every block of it uploaded in that frame, not the nearest few of a
+    // simulator frame's budget (the blocks right under the camera, out of view, took it since
+    // the buffers grow in place).
+    settings.vertex_cache.max_uploaded_sprites_per_frame = u32::MAX;
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let unix_s = time_or_default(args.time)?;
     let field = loaded
