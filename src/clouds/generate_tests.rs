@@ -522,3 +522,66 @@ fn a_broken_high_layer_covers_its_oktas_at_a_real_time_cost() {
         );
     }
 }
+
+/// The strongest periodicity of an overcast deck's sprite centres over 3 x 3 blocks: the
+/// largest `|sum exp(2 pi i k.x)|^2 / N` over the wave vectors `k` with a whole number of cycles
+/// across the 12 km (periods down to 150 m, along and across the lattice and every angle
+/// between), against 1 for points strewn at random; and the wave vector's period, metres.
+fn strongest_period(t: CloudType) -> (f64, f64) {
+    let w = weather(t, 8.0, 1200.0, 800.0);
+    let mut points = Vec::new();
+    for j in 0..3 {
+        for i in 0..3 {
+            let block = generate_block(BlockIndex::new(i, j), &w, 7, types());
+            for c in &block.clouds {
+                for s in &c.sprites {
+                    points.push(DVec2::new(
+                        c.centre_m.x + s.offset_m[0] as f64,
+                        c.centre_m.y + s.offset_m[1] as f64,
+                    ));
+                }
+            }
+        }
+    }
+    let side = 3.0 * BLOCK_SIZE_M;
+    let most = (side / 150.0) as i32;
+    let mut strongest = (0.0, 0.0);
+    for ny in 0..=most {
+        for nx in -most..=most {
+            // Half the plane (k and -k give the same power), and not the two longest waves
+            // (the window's own shape).
+            if (ny == 0 && nx <= 0) || nx * nx + ny * ny <= 4 || (nx * nx + ny * ny) > most * most {
+                continue;
+            }
+            let k = DVec2::new(nx as f64, ny as f64) * (std::f64::consts::TAU / side);
+            let (mut re, mut im) = (0.0, 0.0);
+            for p in &points {
+                let phase = k.dot(*p);
+                re += phase.cos();
+                im += phase.sin();
+            }
+            let power = (re * re + im * im) / points.len() as f64;
+            if power > strongest.0 {
+                strongest = (power, std::f64::consts::TAU / k.length());
+            }
+        }
+    }
+    strongest
+}
+
+#[test]
+fn an_overcast_deck_has_no_lattice() {
+    // Seen from above, a deck whose sprites stood on a regular grid read as a grid of squares.
+    // Points strewn at random have a power of about 1 at each wave vector, the largest of the
+    // ~3,600 looked at about ln(3,600) = 8; the old layout (a fifth of a grid square of jitter,
+    // cells overlapping by a tenth) had 67 at the stratus grid's period (226 m); the sprites
+    // spread over their whole squares, 8 and 11 (measured).
+    for t in [CloudType::Stratus, CloudType::Stratocumulus] {
+        let (power, period) = strongest_period(t);
+        eprintln!("{t:?}: strongest period {period:.0} m, power {power:.1}");
+        assert!(
+            power < 20.0,
+            "{t:?}: the sprites stand on a lattice of period {period:.0} m (power {power:.1})"
+        );
+    }
+}
