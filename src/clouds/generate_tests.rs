@@ -576,7 +576,7 @@ fn an_overcast_deck_has_no_lattice() {
     // Points strewn at random have a power of about 1 at each wave vector, the largest of the
     // ~3,600 looked at about ln(3,600) = 8; the old layout (a fifth of a grid square of jitter,
     // cells overlapping by a tenth) had 67 at the stratus grid's period (226 m); the sprites
-    // spread over their whole squares, 8 and 11 (measured).
+    // spread over their whole squares, 9.1 and 9.3 (measured).
     for t in [CloudType::Stratus, CloudType::Stratocumulus] {
         let (power, period) = strongest_period(t);
         eprintln!("{t:?}: strongest period {period:.0} m, power {power:.1}");
@@ -609,7 +609,7 @@ fn a_deck_cell_does_not_list_its_sprites_row_by_row() {
         }
     }
     eprintln!("largest correlation of a cell's list with its sprites' positions: {worst:.2}");
-    // A cell's 25 sprites shuffled: the largest of 32 correlations measured 0.43 (row by
+    // A cell's 25 sprites shuffled: the largest of 32 correlations measured 0.42 (row by
     // row: 0.98).
     assert!(
         worst < 0.8,
