@@ -146,23 +146,40 @@ fn value_noise(p: vec2<f32>, period: i32) -> f32 {
     return mix(mix(a, b, u.x), mix(c, d, u.x), u.y);
 }
 
-// Three octaves at `scale_m`, over the world point `world` (metres in the noise's period); the
-// finest (cells of a quarter of the scale) fades to its mean where a pixel's footprint on the
-// layer, `footprint_m`, no longer resolves it (far out and at a slant: beyond about 200 km
-// from FL350 at full resolution), which saves its four hashes there and keeps it from
-// shimmering.
-fn cloud_noise(world: vec2<f32>, scale_m: f32, footprint_m: f32) -> f32 {
-    let period = ff.heights.w;
-    let cells = i32(round(period / scale_m));
-    var n = 0.5 * value_noise(world / scale_m, cells);
-    n += 0.3 * value_noise(world / scale_m * 2.0 + vec2<f32>(17.3, 5.1), cells * 2);
-    let fine = 1.0 - smoothstep(0.5, 1.0, footprint_m * 4.0 / scale_m);
-    var finest = 0.5;
-    if (fine > 0.0) {
-        finest = mix(0.5, value_noise(world / scale_m * 4.0 + vec2<f32>(3.7, 41.9), cells * 4), fine);
+// One octave of value noise, cells of `cell_m` (a power of two times the noise's period over
+// it), faded to its mean where a pixel's footprint on the layer, `footprint_m`, no longer
+// resolves it (far out and at a slant), which saves its four hashes there and keeps it from
+// shimmering. (A branch on the pixel's own footprint, not on a uniform.)
+// `lo`, `hi`: the footprints, in cells, over which it fades (0.5 and 1 for the cover's noise).
+fn octave(
+    world: vec2<f32>,
+    cell_m: f32,
+    shift: vec2<f32>,
+    footprint_m: f32,
+    lo: f32,
+    hi: f32,
+) -> f32 {
+    let keep = 1.0 - smoothstep(lo, hi, footprint_m / cell_m);
+    var v = 0.5;
+    if (keep > 0.0) {
+        let cells = i32(round(ff.heights.w / cell_m));
+        v = mix(0.5, value_noise(world / cell_m + shift, cells), keep);
     }
-    return n + 0.2 * finest;
+    return v;
 }
+
+// Three octaves at `scale_m`, over the world point `world` (metres in the noise's period), each
+// faded where the pixel does not resolve it (`octave`: the finest beyond about 200 km from
+// FL350 at full resolution for the heaped layers' lumps).
+fn cloud_noise(world: vec2<f32>, scale_m: f32, footprint_m: f32) -> f32 {
+    var n = 0.5 * octave(world, scale_m, vec2<f32>(0.0), footprint_m, 0.5, 1.0);
+    n += 0.3 * octave(world, scale_m * 0.5, vec2<f32>(17.3, 5.1), footprint_m, 0.5, 1.0);
+    return n + 0.2 * octave(world, scale_m * 0.25, vec2<f32>(3.7, 41.9), footprint_m, 0.5, 1.0);
+}
+
+// How much the grain (`far_layer`) lights and shades a sheet's and a heaped layer's tops.
+const GRAIN_SHEET: f32 = 0.12;
+const GRAIN_HEAPED: f32 = 0.5;
 
 // One layer along the ray: premultiplied colour and the distance of its clouds.
 struct FarHit {
@@ -222,23 +239,39 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
     let world = ff.noise_fade.xy + (ground_xy - ff.centre_rel_size.xy);
     let sin_e = max(abs(dir.z), 0.01);
     // A pixel's footprint on the layer: the mean of its widths across and along the ray.
-    let n = cloud_noise(world, scale, pixel * t / sqrt(sin_e));
+    let footprint = pixel * t / sqrt(sin_e);
+    let n = cloud_noise(world, scale, footprint);
+    // The grain of the near clouds' sprites in the light, not in the cover: a kilometre, the
+    // finest the far field resolves at the hand-over band from FL350 in the half-resolution
+    // cloud target, so that a sheet is not smooth where the deck's sprites were granular, nor a
+    // heaped layer's lumps flat where the cumulus were cauliflowers.
+    // (The footprint is `fwidth`'s, wider than a pixel: the grain, in the light only, fades a
+    // little later than the cover's noise.)
+    let grain_m = ff.shade_rgb.w * 0.5;
+    let grain = octave(world, grain_m, vec2<f32>(29.1, 7.7), footprint, 1.0, 2.0) - 0.5;
     // Seen at a slant, heaped clouds' sides fill the gaps between them (a cumulus field runs
     // together towards the horizon): the cover of a slab `top - base` thick seen at the ray's
     // elevation, as if the sides hid the gaps at random (`1 - (1 - c)^k`).
     let sides = select(0.0, 0.5 * (cell.z - cell.y) / (ff.shade_rgb.w * sin_e), heaped);
     let cover = 1.0 - pow(1.0 - clamp(cell.x, 0.0, 1.0), 1.0 + min(sides, 8.0));
-    let soft = select(0.12, 0.06, heaped);
+    // Heaped clouds' edges crisp (the near cumulus' are), sheets' soft.
+    let soft = select(0.12, 0.03, heaped);
     let threshold = mix(0.78, 0.22, cover);
     let density = select(smoothstep(threshold - soft, threshold + soft, n), 1.0, cover > 0.97);
     var alpha = density * weight;
     // Seen from above its top the sunlit side, from below its base the shade, in between mixed;
-    // the lumps of a heaped layer lit on their tops.
+    // the lumps of a heaped layer lit on their tops and shaded at their edges, also where
+    // their sides close the gaps at a slant (the threshold low: lit by the noise about its
+    // middle, not white all over), with the grain's cauliflowers on them.
     let camera = ff.lit_rgb.w;
     // The far side of a layer below is seen from under it.
     let from_above = select(smoothstep(cell.y, cell.z, camera), 0.0, far_side);
-    let relief = select(0.6 + 0.08 * n, 0.7 + 0.5 * (n - threshold), heaped);
-    var rgb = mix(ff.shade_rgb.rgb, ff.lit_rgb.rgb * clamp(relief, 0.6, 1.1), from_above);
+    let relief = select(
+        0.6 + 0.08 * n + GRAIN_SHEET * grain,
+        0.66 + 0.8 * (n - max(threshold, 0.4)) + GRAIN_HEAPED * grain,
+        heaped,
+    );
+    var rgb = mix(ff.shade_rgb.rgb, ff.lit_rgb.rgb * clamp(relief, 0.5, 1.1), from_above);
     // The altitude haze between the camera and the clouds (the flat frame's height: the true).
     let haze = haze_transmittance(t, height - camera);
     rgb = mix(frame.sky_horizon_rgb.rgb, rgb, haze);

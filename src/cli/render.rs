@@ -289,7 +289,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if !(-2_000.0..=100_000.0).contains(&args.alt_ft) {
         anyhow::bail!("--alt-ft {} is outside -2000..=100000 feet", args.alt_ft);
     }
-    let (settings, table) = args.look.load()?;
+    let (mut settings, table) = args.look.load()?;
+    // One offline frame: every block of it uploaded and every cloud sorted in that frame, not
+    // the nearest few of a simulator frame's budgets. (The blocks right under the camera, out
+    // of view, took the upload budget since the buffers grow in place; past the sorting budget
+    // a deck's clouds were drawn in their sprites' own order, row by row, which showed each
+    // lattice cell as a square from FL350 and the sorted blocks' edge as a staircase.)
+    settings.vertex_cache.max_uploaded_sprites_per_frame = u32::MAX;
+    settings.vertex_cache.max_sorted_sprites_per_frame = u32::MAX;
     let loaded = load(&args.weather, &args.stations, None, None)?;
     let unix_s = time_or_default(args.time)?;
     let field = loaded

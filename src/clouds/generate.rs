@@ -340,10 +340,13 @@ fn lattice_layer(index: BlockIndex, ctx: &LayerCtx, seed: u64, out: &mut Vec<Clo
     let mut boxes = 0;
     for &(key, ci, cj) in cells.iter().filter(|c| chosen.contains(c)) {
         let mut rng = SplitMix64::new(key);
-        let jitter = DVec2::new(rng.range_f64(-0.1, 0.1), rng.range_f64(-0.1, 0.1)) * s;
+        // Off the lattice's own points by up to a twentieth of a cell, so that the cells' sides
+        // (where one cloud's sprites, sorted as a whole, overlap its neighbour's) do not lie on
+        // a regular grid: on it, straight down, every cell side showed alike (1 km rows).
+        let jitter = DVec2::new(rng.range_f64(-0.05, 0.05), rng.range_f64(-0.05, 0.05)) * s;
         let centre = DVec2::new((ci as f64 + 0.5) * s, (cj as f64 + 0.5) * s) + jitter;
         let [dmin, dmax] = config.cloud_size_m.map(f64::from);
-        // Wide enough to cover the cell's corners: diagonal plus the jitter.
+        // Wide enough to cover the cell's corners.
         let d = rng.range_f64(dmin, dmax).max(s * 1.5);
         let (cloud, n) = build_cloud(ctx, centre, d, Some(s), rng.next_u64());
         boxes += n;
@@ -420,8 +423,9 @@ fn build_cloud(
     // (flat cirrus, a continuous type off the lattice) spread theirs around the centre.
     for _ in 0..n_boxes {
         let (half_w, offset) = if let Some(cell) = lattice_cell_m {
-            // A lattice cell: every box spans the cell and a little of its neighbours.
-            (cell * 0.55, DVec2::ZERO)
+            // A lattice cell: every box spans the cell and no more, so that cells do not overlap
+            // in strips of double density on a grid (the sprites overhang it).
+            (cell * 0.5, DVec2::ZERO)
         } else {
             let off = DVec2::new(rng.range_f64(-0.15, 0.15), rng.range_f64(-0.15, 0.15)) * d;
             (d / 2.0 * if n_boxes > 1 { 0.75 } else { 1.0 }, lay(off))
@@ -429,8 +433,9 @@ fn build_cloud(
         let n = rng.range_u32(config.sprites_per_box[0], config.sprites_per_box[1]);
         let mut n = ((n as f64 * density).round() as u32).clamp(1, 100);
         // On the lattice, enough sprites that the jittered grid leaves no hole (at most 100).
-        let grid_side = lattice_cell_m.map(|_| {
-            let cover = (2.0 * half_w / (0.5 * (wmin + wmax) / 2.0)).ceil();
+        // (As many as when each box spanned 1.1 cells: the same sprites, closer together.)
+        let grid_side = lattice_cell_m.map(|cell| {
+            let cover = (1.1 * cell / (0.5 * (wmin + wmax) / 2.0)).ceil();
             (n as f64).sqrt().ceil().max(cover).clamp(1.0, 10.0) as u32
         });
         if let Some(m) = grid_side {
@@ -444,12 +449,15 @@ fn build_cloud(
             let width = rng.range_f64(wmin, wmax);
             let height = width * rng.range_f64(rmin, rmax);
             let (x, y) = if let Some(m) = grid_side {
-                // Continuous decks: a jittered grid over the square cell, so no holes.
+                // Continuous decks: one sprite anywhere in each square of an m x m grid over
+                // the cell (stratified sampling), so no holes and no lattice: a sprite spread
+                // over its whole square has no component at the grid's period, where a
+                // jitter of a fifth of it left a regular grid that read as squares from above.
                 let (gx, gy) = ((s % m) as f64, ((s / m) % m) as f64);
                 let cell = 2.0 / m as f64;
                 (
-                    -1.0 + cell * (gx + 0.5 + rng.range_f64(-0.2, 0.2)),
-                    -1.0 + cell * (gy + 0.5 + rng.range_f64(-0.2, 0.2)),
+                    -1.0 + cell * (gx + rng.range_f64(0.0, 1.0)),
+                    -1.0 + cell * (gy + rng.range_f64(0.0, 1.0)),
                 )
             } else {
                 // A random point in the box's elliptic footprint (rejection, no trigonometry).
@@ -488,7 +496,22 @@ fn build_cloud(
             });
         }
     }
-    let kept = cull(raws, config.cull_radius_fraction as f64);
+    let mut kept = cull(raws, config.cull_radius_fraction as f64);
+    // A deck's sprites in a shuffled order (after the cull, which keeps the same ones): until
+    // its first sort a cloud is drawn in its sprites' own order, and row by row that lit every
+    // lattice cell alike (a grid of squares from above, for the frames a block waits for the
+    // sorting budget). Its shading groups follow the new order (a deck is lit as one slab).
+    if lattice_cell_m.is_some() {
+        for i in (1..kept.len()).rev() {
+            let j = rng.range_u32(0, i as u32) as usize;
+            kept.swap(i, j);
+        }
+        let [lo, hi] = config.shading_group_size;
+        let size = ((lo + hi) / 2).max(1);
+        for (k, r) in kept.iter_mut().enumerate() {
+            r.group = k as u32 / size;
+        }
+    }
     let mut cloud = finish_cloud(ctx, centre, kept, &mut rng);
     // A deck on the lattice is lit from above only.
     if lattice_cell_m.is_some() {
@@ -650,7 +673,7 @@ mod golden {
             hashes,
             [
                 "6ea2ffa12cd8ec62",
-                "2610fe870de059b1",
+                "6151e0ce533d2c21",
                 "601c50867b47c891",
                 "f6cfc024a1869c4d"
             ]

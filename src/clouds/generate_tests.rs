@@ -253,13 +253,14 @@ fn sprites_follow_the_paper_and_the_config() {
                     );
                 }
             }
-            // The cull pass: no two sprites closer than the cull radius of the later one.
+            // The cull pass: no two sprites closer than the cull radius of the later one (of
+            // the smaller one: a deck's sprites are shuffled after the cull).
             for (k, s) in c.sprites.iter().enumerate() {
                 for o in &c.sprites[..k] {
                     let d2: f32 = (0..3)
                         .map(|a| (s.offset_m[a] - o.offset_m[a]).powi(2))
                         .sum();
-                    let r = config.cull_radius_fraction * s.height_m;
+                    let r = config.cull_radius_fraction * s.height_m.min(o.height_m);
                     assert!(d2 >= r * r * 0.999, "{t}: sprites {d2} apart");
                 }
             }
@@ -521,4 +522,97 @@ fn a_broken_high_layer_covers_its_oktas_at_a_real_time_cost() {
             "{oktas} oktas: {per_block} sprites a block, at most {most_sprites}"
         );
     }
+}
+
+/// The strongest periodicity of an overcast deck's sprite centres over 3 x 3 blocks: the
+/// largest `|sum exp(2 pi i k.x)|^2 / N` over the wave vectors `k` with a whole number of cycles
+/// across the 12 km (periods down to 150 m, along and across the lattice and every angle
+/// between), against 1 for points strewn at random; and the wave vector's period, metres.
+fn strongest_period(t: CloudType) -> (f64, f64) {
+    let w = weather(t, 8.0, 1200.0, 800.0);
+    let mut points = Vec::new();
+    for j in 0..3 {
+        for i in 0..3 {
+            let block = generate_block(BlockIndex::new(i, j), &w, 7, types());
+            for c in &block.clouds {
+                for s in &c.sprites {
+                    points.push(DVec2::new(
+                        c.centre_m.x + s.offset_m[0] as f64,
+                        c.centre_m.y + s.offset_m[1] as f64,
+                    ));
+                }
+            }
+        }
+    }
+    let side = 3.0 * BLOCK_SIZE_M;
+    let most = (side / 150.0) as i32;
+    let mut strongest = (0.0, 0.0);
+    for ny in 0..=most {
+        for nx in -most..=most {
+            // Half the plane (k and -k give the same power), and not the two longest waves
+            // (the window's own shape).
+            if (ny == 0 && nx <= 0) || nx * nx + ny * ny <= 4 || (nx * nx + ny * ny) > most * most {
+                continue;
+            }
+            let k = DVec2::new(nx as f64, ny as f64) * (std::f64::consts::TAU / side);
+            let (mut re, mut im) = (0.0, 0.0);
+            for p in &points {
+                let phase = k.dot(*p);
+                re += phase.cos();
+                im += phase.sin();
+            }
+            let power = (re * re + im * im) / points.len() as f64;
+            if power > strongest.0 {
+                strongest = (power, std::f64::consts::TAU / k.length());
+            }
+        }
+    }
+    strongest
+}
+
+#[test]
+fn an_overcast_deck_has_no_lattice() {
+    // Seen from above, a deck whose sprites stood on a regular grid read as a grid of squares.
+    // Points strewn at random have a power of about 1 at each wave vector, the largest of the
+    // ~3,600 looked at about ln(3,600) = 8; the old layout (a fifth of a grid square of jitter,
+    // cells overlapping by a tenth) had 67 at the stratus grid's period (226 m); the sprites
+    // spread over their whole squares, 9.1 and 9.3 (measured).
+    for t in [CloudType::Stratus, CloudType::Stratocumulus] {
+        let (power, period) = strongest_period(t);
+        eprintln!("{t:?}: strongest period {period:.0} m, power {power:.1}");
+        assert!(
+            power < 20.0,
+            "{t:?}: the sprites stand on a lattice of period {period:.0} m (power {power:.1})"
+        );
+    }
+}
+
+#[test]
+fn a_deck_cell_does_not_list_its_sprites_row_by_row() {
+    // Until its first sort a cloud is drawn in its sprites' own order: row by row, every
+    // lattice cell was lit alike (squares from above). The correlation of a sprite's place in
+    // the list with its position across the cell.
+    let w = weather(CloudType::Stratus, 8.0, 1200.0, 800.0);
+    let block = generate_block(BlockIndex::new(0, 0), &w, 3, types());
+    let mut worst = 0.0f64;
+    for c in &block.clouds {
+        let n = c.sprites.len() as f64;
+        for axis in 0..2 {
+            let (mut si, mut sp, mut sii, mut spp, mut sip) = (0.0, 0.0, 0.0, 0.0, 0.0);
+            for (i, s) in c.sprites.iter().enumerate() {
+                let (i, p) = (i as f64, s.offset_m[axis] as f64);
+                (si, sp, sii, spp, sip) = (si + i, sp + p, sii + i * i, spp + p * p, sip + i * p);
+            }
+            let cov = sip / n - si * sp / (n * n);
+            let var = (sii / n - (si / n).powi(2)) * (spp / n - (sp / n).powi(2));
+            worst = worst.max((cov / var.sqrt()).abs());
+        }
+    }
+    eprintln!("largest correlation of a cell's list with its sprites' positions: {worst:.2}");
+    // A cell's 25 sprites shuffled: the largest of 32 correlations measured 0.42 (row by
+    // row: 0.98).
+    assert!(
+        worst < 0.8,
+        "a deck cell lists its sprites in rows: correlation {worst:.2}"
+    );
 }

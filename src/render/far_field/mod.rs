@@ -96,7 +96,7 @@ pub struct FarFieldSettings {
     pub fade_start_m: f32,
     /// See `fade_start_m`.
     pub fade_end_m: f32,
-    /// Size of the lumps of heaped (cumuliform) layers, metres; sheets' patches are 4 times it.
+    /// Size of the lumps of heaped (cumuliform) layers, metres; sheets' patches are 8 times it.
     pub heaped_scale_m: f32,
 }
 
@@ -110,7 +110,7 @@ impl Default for FarFieldSettings {
             rows_per_frame: 1,
             fade_start_m: 42_000.0,
             fade_end_m: 60_000.0,
-            heaped_scale_m: 4_000.0,
+            heaped_scale_m: 2_000.0,
         }
     }
 }
@@ -501,7 +501,7 @@ impl FarField {
             heights: [
                 map.heights[0],
                 map.heights[1],
-                s.heaped_scale_m * 4.0,
+                s.heaped_scale_m * 8.0,
                 period as f32,
             ],
             fade: [
