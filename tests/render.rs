@@ -1806,30 +1806,34 @@ fn from_fl350_near_cumulus_stand_out_from_the_ground_below() {
     assert!(hazy[0] >= 0.25, "exactly 10 km: {hazy:?}");
 }
 
+/// A far map of 960 km a side around the origin, every cell a heaped layer from 1,500 to 2,500 m
+/// at `cover`.
+fn uniform_far_map(cover: f32) -> skycast::clouds::far_map::FarMap {
+    skycast::clouds::far_map::FarMap {
+        texels: 96,
+        texel_m: 10_000.0,
+        centre_m: DVec2::ZERO,
+        cells: vec![[cover, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
+    }
+}
+
 /// Issue 31, the far field: from FL350 over a heaped layer the weather has everywhere (half
 /// cover, 1,500 to 2,500 m), the rows of the frame whose rays meet the layer 150 to 400 km out
 /// (on the round Earth) show clouds: they differ from the same rows of a sky whose weather has
 /// none. The negative control is today's plate edge: with the far field off, nothing out there.
 #[test]
 fn from_fl350_the_clouds_reach_the_horizon() {
-    use skycast::clouds::far_map::FarMap;
     let mut settings = RenderSettings::default();
     // A narrow view (12 degrees) on the band below the horizon: 15 rows a degree.
     settings.camera.fov_y_deg = 12.0;
     let ground = HeightField::from_fn(DVec2::ZERO, 120_000.0, 16, |_| 0.0);
     let mut rig = Rig::with_settings(ground, settings);
-    let map = |cover: f32| FarMap {
-        texels: 96,
-        texel_m: 10_000.0,
-        centre_m: DVec2::ZERO,
-        cells: vec![[cover, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
-    };
     let cam_at = DVec3::new(0.0, 0.0, 10_668.0);
     let cam = rig.camera(cam_at, 0.0, -3.5);
     let mut frame = |name: &str, cover: f32, on: bool| {
         rig.host
             .sky
-            .set_far_map(&rig.host.gpu.queue, &map(cover), None);
+            .set_far_map(&rig.host.gpu.queue, &uniform_far_map(cover), None);
         rig.host.sky.set_far_field_enabled(on);
         rig.frame(name, &cam).0
     };
@@ -1889,7 +1893,6 @@ fn from_fl350_the_clouds_reach_the_horizon() {
 /// over the median change of the frames around it (three either side): above 1 where a frame
 /// changes more than the plain motion around it.
 fn hand_over_run(band_m: f32, ring: Option<f64>) -> Vec<f32> {
-    use skycast::clouds::far_map::FarMap;
     let mut settings = RenderSettings::default();
     settings.impostors.enabled = ring.is_some();
     settings.impostors.rebuild_move_fraction = 0.02;
@@ -1904,16 +1907,9 @@ fn hand_over_run(band_m: f32, ring: Option<f64>) -> Vec<f32> {
     };
     let ground = HeightField::from_fn(DVec2::ZERO, 400_000.0, 16, |_| 0.0);
     let mut rig = Rig::with_settings(ground, settings);
-    rig.host.sky.set_far_map(
-        &rig.host.gpu.queue,
-        &FarMap {
-            texels: 96,
-            texel_m: 10_000.0,
-            centre_m: DVec2::ZERO,
-            cells: vec![[0.15, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
-        },
-        None,
-    );
+    rig.host
+        .sky
+        .set_far_map(&rig.host.gpu.queue, &uniform_far_map(0.15), None);
     let mut blocks = Vec::new();
     // Sixteen along a diagonal 58 to 61.75 km ahead: as the camera flies 1 km, the end of the
     // band passes four of them, each on a frame of its own.
@@ -2031,22 +2027,14 @@ fn the_ring_to_far_field_hand_over_does_not_pop() {
 /// its view radius (100 km) as before.
 #[test]
 fn with_the_far_field_on_the_ring_stops_at_the_hand_over() {
-    use skycast::clouds::far_map::FarMap;
     let ring_blocks = |far_field: bool| {
         let mut settings = RenderSettings::default();
         settings.far_field.enabled = far_field;
         let ground = HeightField::from_fn(DVec2::ZERO, 400_000.0, 16, |_| 0.0);
         let mut rig = Rig::with_settings(ground, settings);
-        rig.host.sky.set_far_map(
-            &rig.host.gpu.queue,
-            &FarMap {
-                texels: 96,
-                texel_m: 10_000.0,
-                centre_m: DVec2::ZERO,
-                cells: vec![[0.15, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
-            },
-            None,
-        );
+        rig.host
+            .sky
+            .set_far_map(&rig.host.gpu.queue, &uniform_far_map(0.15), None);
         let blocks = [(1, 30_000.0), (2, 80_000.0)]
             .into_iter()
             .map(|(id, y)| {
