@@ -396,8 +396,10 @@ fn build_sprite(k: u32, at: u32) {
         let lock = view.forward_lock;
         alpha *= clamp((cos_angle - lock.w) / max(lock.z - lock.w, 1e-4), 0.0, 1.0);
     }
-    let morph = morph_radius.x * lifecycle_alpha(b.fade_kind, b.fade_progress, morph_radius.y);
-    alpha *= far_fade(to_cam);
+    // Bit 4 of `fade_kind`: a distant block (a storm cell beyond the cloud field,
+    // `DISTANT_BLOCK` in src/render/draw_list.rs), drawn whole however far.
+    let morph = morph_radius.x * lifecycle_alpha(b.fade_kind & 3u, b.fade_progress, morph_radius.y);
+    alpha *= select(far_fade(to_cam), 1.0, (b.fade_kind & 4u) != 0u);
     if (!(alpha > 0.0 && morph > 0.0)) {
         // Faded out: the draw puts its corners outside the clip volume.
         for (var c = 0u; c < 4u; c++) {

@@ -48,6 +48,15 @@ fn vs_sprite(v: VertexIn) -> VertexOut {
     // On the round Earth (`earth_curved`): at 100 km a sprite sits 0.8 km below the flat frame.
     let rel = earth_curved(v.position_visible.xyz);
     o.position = frame.view_proj * vec4<f32>(rel, 1.0);
+    // Beyond the host's far plane (a storm cell 100-450 km off): held just inside it rather
+    // than clipped; the view depth (1 / w) stays true. `params.x`: 1 standard Z (far at w),
+    // 0 reversed (far at 0).
+    let w = o.position.w;
+    o.position.z = select(
+        max(o.position.z, 0.0),
+        min(o.position.z, w * 0.999999),
+        frame.params.x > 0.5,
+    );
     // Aerial perspective: distant clouds fade into the horizon haze, thinner with height.
     let haze = 1.0 - haze_transmittance(length(rel), v.position_visible.z);
     o.uv_haze = vec3<f32>(v.uv, haze);
@@ -69,7 +78,10 @@ fn fs_sprite_offscreen(i: VertexOut) -> CloudOut {
 // Premultiplied colour of a sprite fragment (also used by the impostor pass).
 fn sprite_colour(i: VertexOut) -> vec4<f32> {
     let texel = textureSample(sheet, sheet_sampler, i.uv_haze.xy);
-    let scene_m = scene_m_at(i.position.xy);
+    // Where the host drew nothing, nothing is in front however far the cloud (a storm cell
+    // beyond the host's far plane); the cloud target's depth says so already (1e9 metres).
+    let background = !SCENE_IN_METRES && is_background(scene_depth_at(i.position.xy));
+    let scene_m = select(scene_m_at(i.position.xy), 1.0e9, background);
     let soft = clamp((scene_m - view_depth_m(i)) * frame.params.y, 0.0, 1.0);
     let alpha = texel.a * i.colour.a * soft;
     let rgb = mix(i.colour.rgb * texel.rgb, frame.sky_horizon_rgb.rgb, i.uv_haze.z);

@@ -9,6 +9,7 @@ use skycast::clouds::CloudTypes;
 use skycast::clouds::storm::cell_cloud;
 use skycast::demo::terrain::HeightField;
 use skycast::demo::{DemoHost, Frame, headless};
+use skycast::render::scene::BlockMotion;
 use skycast::render::{Camera, SkyBlock, SkyCloud, SkyConfig, SkyFlash};
 use skycast::shading::{FogSettings, SunPosition};
 use skycast::weather::storms::{StormCell, StormSettings};
@@ -227,4 +228,73 @@ fn a_10_km_cell_from_20_km_spans_25_degrees_on_a_dark_base_and_a_flash_lights_it
     assert!((outside(&lit) - outside(&storm)).abs() < 0.01);
     let after = frame(&mut host, "cell_after_flash", &camera);
     assert!((inside(&after) - dark).abs() < 0.005, "the flash is over");
+}
+
+/// A storm cell beyond the cloud field, 200 km off (past the host's 160 km far plane): drawn as
+/// a distant block ([`skycast::render::Sky::insert_distant_block`], what `flight::far_cells`
+/// hands the sky) it stands over the horizon from 10,000 ft; the same block inserted as a near
+/// block is left out at the draw distance (60 km), as every cell beyond the field was before.
+#[test]
+fn a_cell_200_km_off_stands_over_the_horizon_as_a_distant_block() {
+    let types = CloudTypes::builtin();
+    let far = StormSettings::default().far;
+    let c = StormCell {
+        centre_m: [0.0, 200_000.0],
+        anvil_offset_m: [0.0, 0.0],
+        ..cell()
+    };
+    let weather = BlockWeather::default();
+    let cloud = skycast::clouds::storm::far_cell_cloud(
+        &c,
+        types.get(CloudType::Cumulonimbus),
+        &weather,
+        (far.sprites, far.sprite_over_base),
+    );
+    let block = SkyBlock {
+        id: 9,
+        centre_m: cloud.centre_m,
+        clouds: vec![SkyCloud::from(&cloud)],
+    };
+    let mut host = host();
+    host.sky.set_cloud_shadows(false);
+    host.sky.set_weather_overhead(&BlockWeather {
+        visibility_m: 9_999.0,
+        ..weather.clone()
+    });
+    // In clear air of 100 km (the other test's): in the shipped 40 km only its top shows.
+    host.sky.set_fog_settings(FogSettings {
+        clear_visibility_m: 100_000.0,
+        ..FogSettings::default()
+    });
+    // From 10,000 ft through a 20 degree lens: the cell spans a few degrees.
+    let camera = Camera {
+        fov_y_deg: 20.0,
+        ..host.camera(DVec3::new(0.0, 0.0, 3_048.0), 0.0, 0.0)
+    };
+    let clear = frame(&mut host, "far_clear", &camera);
+    host.sky.insert_block(block.clone(), BlockMotion::default());
+    let near = frame(&mut host, "far_cell_as_near_block", &camera);
+    host.sky.remove_block(block.id);
+    host.sky.insert_distant_block(block, BlockMotion::default());
+    let distant = frame(&mut host, "far_cell_200_km", &camera);
+    let changed = |f: &Frame| cell_mask(f, &clear).iter().filter(|&&m| m).count();
+    let (near_px, distant_px) = (changed(&near), changed(&distant));
+    eprintln!("pixels changed: {near_px} as a near block, {distant_px} as a distant one");
+    assert_eq!(
+        near_px, 0,
+        "a near block 200 km off is past the draw distance"
+    );
+    // A 10 km cell with its 12 km top 200 km off, 3.1 km below the camera's tangent plane
+    // there, its lowest 0.1 km under the horizon: 2.9 degrees wide, 3.3 tall from 1.8 below
+    // the horizon (about 26 x 30 pixels at 9 a degree), its 30 km anvil 8.6 degrees wide.
+    assert!(distant_px >= 400, "{distant_px} pixels");
+    // Over the horizon: its pixels show the sky behind them, and it stands in it.
+    let mask = cell_mask(&distant, &clear);
+    let above = (0..W * H)
+        .filter(|&i| mask[i as usize] && clear.depth[i as usize] >= 1.0)
+        .count();
+    assert!(
+        above * 2 >= distant_px,
+        "{above} of {distant_px} over the sky"
+    );
 }

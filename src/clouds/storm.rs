@@ -114,6 +114,23 @@ pub fn cell_cloud(cell: &StormCell, config: &CloudTypeConfig, weather: &BlockWea
     cloud
 }
 
+/// A cell beyond the cloud field, drawn whole with `sprites` sprites `sprite_over_base` of its
+/// base wide (`config/storms.toml` `[far]`): the same cell as the near one, in coarser sprites.
+pub fn far_cell_cloud(
+    cell: &StormCell,
+    config: &CloudTypeConfig,
+    weather: &BlockWeather,
+    (sprites, sprite_over_base): (u32, [f32; 2]),
+) -> Cloud {
+    let mut far = config.clone();
+    far.cell = Some(StormCellConfig {
+        sprites,
+        sprite_over_base,
+        ..config.cell.unwrap_or(FALLBACK)
+    });
+    cell_cloud(cell, &far, weather)
+}
+
 /// Whole cells already drawn, shared by the blocks that each draw a part of one (a cell spans
 /// tens of blocks): keyed by the cell's key, kept while the cell stays the same.
 #[derive(Debug, Default)]

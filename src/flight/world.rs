@@ -114,6 +114,8 @@ pub struct LivingClouds {
     /// Generations forming or dissipating this frame and the last.
     fading: Vec<u64>,
     was_fading: Vec<u64>,
+    /// Storm cells beyond the field, drawn whole.
+    far_cells: super::far_cells::FarCells,
 }
 
 /// Weather field and cloud blocks around a reference point.
@@ -358,8 +360,20 @@ impl World {
             arriving: HashMap::new(),
             fading: Vec::new(),
             was_fading: Vec::new(),
+            far_cells: super::far_cells::FarCells::new(
+                crate::weather::storms::StormSettings::default().far,
+            ),
         });
         Ok(true)
+    }
+
+    /// Whether storm cells beyond the cloud field are drawn as cells (`config/storms.toml`
+    /// `[far]`): the far field then leaves cumulonimbus out of its map.
+    pub fn draws_far_cells(&self) -> bool {
+        self.living.as_ref().map_or(
+            crate::weather::storms::StormSettings::default().far.enabled,
+            |l| l.far_cells.enabled(),
+        )
     }
 
     /// Generates the living clouds around `point_m` and waits for them, without a sky: for
@@ -430,6 +444,20 @@ impl World {
             return Ok(());
         };
         let drift = living.field.drift_m();
+        living.far_cells.update(
+            sky,
+            &super::far_cells::FarCellFrame {
+                weather: &self.field,
+                version: self.field_version,
+                storms: (living.field.storms(), living.field.seed()),
+                types: &self.types,
+                camera_air_m: camera_m.truncate() - drift,
+                drift_m: drift,
+                field_radius_m: self.clouds_config.field.radius_m,
+                now_s: living.field.time_s(),
+                whole: self.synchronous_clouds,
+            },
+        );
         let offset_m = DVec3::new(drift.x, drift.y, 0.0);
         let now = living.field.time_s();
         let lifecycle = *living.field.lifecycle();

@@ -208,6 +208,10 @@ fn fade_opacity(fade: Fade) -> f32 {
     }
 }
 
+/// Or'ed into a draw block's `fade_kind` for a distant block: its sprites keep their opacity
+/// beyond the draw distance (`far_fade` in `shaders/sprite_build.wgsl`, keep in sync).
+const DISTANT_BLOCK: u32 = 4;
+
 pub(super) fn fade_code(fade: Fade) -> (u32, f32) {
     match fade {
         Fade::Steady => (0, 1.0),
@@ -235,6 +239,15 @@ fn blocks_back_to_front(blocks: &Blocks, ids: &[u64], from_m: DVec3) -> Vec<(f64
 /// Back to front by squared distance, equally far blocks in [`Resident::tie_order`].
 fn farthest_first(a: (f64, &Resident), b: (f64, &Resident)) -> std::cmp::Ordering {
     b.0.total_cmp(&a.0).then_with(|| a.1.tie_order(b.1))
+}
+
+/// The sprites of a frame's distant blocks, which its draw list puts first: they are drawn
+/// behind the impostor ring, which holds nearer clouds.
+pub(super) fn distant_sprites(draws: &[GpuDrawBlock], total: u32) -> u32 {
+    draws
+        .iter()
+        .find(|d| d.fade_kind & DISTANT_BLOCK == 0)
+        .map_or(total, |d| d.first)
 }
 
 /// Where the sky camera's sprite orders and cloud lists go: CPU copies of the order and list
@@ -270,7 +283,12 @@ pub(super) fn main_view(
         .filter(|r| frustum.sees_sphere((r.centre_m() - camera_m).as_vec3(), r.radius_m as f32))
         .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
         .collect();
-    order.sort_by(|a, b| farthest_first((a.0, &*a.1), (b.0, &*b.1)));
+    // Distant blocks (storm cells beyond the field) first: drawn behind the ring.
+    order.sort_by(|a, b| {
+        b.1.distant
+            .cmp(&a.1.distant)
+            .then_with(|| farthest_first((a.0, &*a.1), (b.0, &*b.1)))
+    });
     let Copies {
         orders,
         dirty_orders,
@@ -322,10 +340,10 @@ pub(super) fn main_view(
         let (fade_kind, fade_progress) = fade_code(r.motion.fade);
         out.push(GpuDrawBlock {
             origin_rel: (-rel).as_vec3().to_array(),
+            fade_kind: fade_kind | if r.distant { DISTANT_BLOCK } else { 0 },
             first: total,
             list_base: r.place.as_ref().map_or(0, |p| p.1.start),
             list_len: r.list.len() as u32,
-            fade_kind,
             fade_progress,
         });
         total += r.list_sprites;
@@ -366,7 +384,12 @@ fn recheck(
     (scratch, keys): (&mut Vec<(usize, f64, f64)>, &mut SortKeys),
 ) {
     let cache = &settings.vertex_cache;
-    let draw_m = settings.clouds.draw_distance_m as f64;
+    // A distant block (a storm cell beyond the field) is drawn however far it is.
+    let draw_m = if r.distant {
+        f64::INFINITY
+    } else {
+        settings.clouds.draw_distance_m as f64
+    };
     let offset = r.motion.offset_m;
     let fading = r.motion.fade != Fade::Steady;
     let slope = cache.move_fraction as f64;

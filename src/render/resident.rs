@@ -76,6 +76,9 @@ pub(super) struct Resident {
     pub light: BlockLight,
     /// Drawn as sprites this frame (not in the impostor ring); set by the ring's split.
     pub near: bool,
+    /// Drawn as sprites at any distance and never in the ring: a storm cell beyond the cloud
+    /// field ([`super::Sky::insert_distant_block`]).
+    pub distant: bool,
     pub clouds: Vec<CloudState>,
     /// Lowest and highest heights of its clouds' sprites (their core boxes), metres relative
     /// to the block's centre: a storm cell's part spans from its base to its anvil.
@@ -125,6 +128,7 @@ impl Resident {
             uploaded: false,
             light: BlockLight::default(),
             near: true,
+            distant: false,
             clouds,
         }
     }

@@ -479,6 +479,21 @@ impl Sky {
         self.pending_us += start.elapsed().as_micros() as u64;
     }
 
+    /// Adds a block drawn as sprites however far it is, never into the impostor ring nor faded
+    /// at the draw distance: what the ring and the far field cannot draw beyond the cloud field,
+    /// a storm cell's tower seen from 100-450 km (`flight::far_cells`). Replaces the block with
+    /// its id; uploaded once, by the next [`Self::prepare`].
+    pub fn insert_distant_block(&mut self, block: SkyBlock, motion: BlockMotion) {
+        let start = Instant::now();
+        let id = block.id;
+        self.retire(id);
+        self.resident.insert(block, motion);
+        if let Some(r) = self.resident.blocks.get_mut(&id) {
+            r.distant = true;
+        }
+        self.pending_us += start.elapsed().as_micros() as u64;
+    }
+
     /// Retires a block; false if the sky did not hold it.
     pub fn remove_block(&mut self, id: u64) -> bool {
         let start = Instant::now();
@@ -1054,6 +1069,8 @@ impl Sky {
             },
         );
         self.views[i].sprites_to_draw = stats.sprites_drawn;
+        self.views[i].distant_sprites =
+            super::draw_list::distant_sprites(&self.views[i].draws, stats.sprites_drawn);
         let in_cloud = inside.cloud;
         self.views[i].in_cloud = in_cloud;
         self.views[i].in_rain = inside.rain;
@@ -1309,8 +1326,23 @@ impl Sky {
             Some(target) => (target.sprite_pipeline(), target.in_cloud_pipeline()),
             None => (&self.sprite_pipeline, &self.in_cloud_pipeline),
         };
-        // The far field behind the ring and the sprites (blended over, back to front).
+        // The far field behind the distant cells, they behind the ring, it behind the sprites
+        // (blended over, back to front). The distant cells' sprites come first in the draw
+        // list; split off when the frame's sprites are built in one part (with more, they are
+        // drawn with the others, over the ring).
         self.far_field.draw(&mut pass, offscreen.is_some());
+        let distant = if parts.len() == 1 {
+            v.distant_sprites.min(v.sprites_to_draw)
+        } else {
+            0
+        };
+        if distant > 0 {
+            pass.set_pipeline(sprite_pipeline);
+            pass.set_bind_group(1, &self.sheet_group, &[]);
+            pass.set_vertex_buffer(0, self.build.vertices().slice(..));
+            pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..distant * 6, 0, 0..1);
+        }
         v.ring.draw(&mut pass, offscreen.is_some());
         if timer.is_some() {
             drop(pass);
@@ -1336,7 +1368,7 @@ impl Sky {
             pass.set_bind_group(1, &self.sheet_group, &[]);
             pass.set_vertex_buffer(0, self.build.vertices().slice(..));
             pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..n * 6, 0, 0..1);
+            pass.draw_indexed(distant.min(n) * 6..n * 6, 0, 0..1);
         }
         if v.in_cloud > 0.0 {
             pass.set_pipeline(in_cloud_pipeline);

@@ -44,6 +44,8 @@ pub(super) struct View {
     pub draws: Vec<GpuDrawBlock>,
     pub locks: Locks,
     pub sprites_to_draw: u32,
+    /// The first of them: the distant blocks' (drawn behind the impostor ring).
+    pub distant_sprites: u32,
     pub in_cloud: f32,
     /// How opaque the rain or snow shaft the camera is in is there (0: none): the fog thickens.
     pub in_rain: f32,
@@ -98,6 +100,7 @@ impl View {
             draws: Vec::new(),
             locks: Locks::default(),
             sprites_to_draw: 0,
+            distant_sprites: 0,
             in_cloud: 0.0,
             in_rain: 0.0,
             record_us: Cell::new(0),

@@ -42,6 +42,33 @@ pub struct StormSettings {
     pub cells: CellSettings,
     /// How often they flash.
     pub lightning: LightningSettings,
+    /// Cells beyond the cloud field, out to the horizon.
+    pub far: FarCellSettings,
+}
+
+/// Cells drawn beyond the cloud field's blocks (`[far]`): each whole, with few large sprites,
+/// so a storm reads from 100 km and more (docs/src/storms.md, "Far cells").
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FarCellSettings {
+    /// Whether cells beyond the cloud field are drawn.
+    pub enabled: bool,
+    /// How far from the camera they are looked for, metres.
+    pub reach_m: f64,
+    /// At most this many, the nearest.
+    pub most: usize,
+    /// Sprites of one far cell (the near cells' `[cumulonimbus.cell] sprites` budget).
+    pub sprites: u32,
+    /// Sprite width over the cell's base width, range (wider than a near cell's: fewer sprites
+    /// cover the same cell).
+    pub sprite_over_base: [f32; 2],
+    /// Grid rows of the placement grid looked at a frame while a new set is found.
+    pub rows_per_frame: u32,
+    /// A new set is found after the camera moved this far from where the last was, metres.
+    pub move_m: f64,
+    /// A far cell forms or dissipates over this long as it comes into or leaves the set,
+    /// seconds.
+    pub fade_s: f64,
 }
 
 /// Placement and size of the cells (`[cells]`).
@@ -166,6 +193,32 @@ impl StormSettings {
         }
         if !(l.reach_m >= 10.0 && l.reach_m <= 50_000.0) {
             return Err(bad("lightning.reach_m", "must be within 10..=50000"));
+        }
+        let f = &s.far;
+        if !(f.reach_m >= 0.0 && f.reach_m <= 2_000_000.0) {
+            return Err(bad("far.reach_m", "must be within 0..=2000000"));
+        }
+        if f.most > 4096 {
+            return Err(bad("far.most", "must be at most 4096"));
+        }
+        if !(8..=4000).contains(&f.sprites) {
+            return Err(bad("far.sprites", "must be within 8..=4000"));
+        }
+        let widths = f.sprite_over_base;
+        if !(widths[0] > 0.0 && widths[0] <= widths[1] && widths[1] <= 2.0) {
+            return Err(bad(
+                "far.sprite_over_base",
+                "must be [low, high] with 0 < low <= high <= 2",
+            ));
+        }
+        if f.rows_per_frame == 0 {
+            return Err(bad("far.rows_per_frame", "must be at least 1"));
+        }
+        if !(f.move_m >= 0.0 && f.move_m.is_finite()) {
+            return Err(bad("far.move_m", "must be at least 0"));
+        }
+        if !(0.0..=600.0).contains(&f.fade_s) {
+            return Err(bad("far.fade_s", "must be within 0..=600"));
         }
         Ok(s)
     }

@@ -549,6 +549,7 @@ impl ImpostorRing {
                 r.near = !in_far;
                 far_count += in_far as u32;
                 if steady_shown
+                    && !r.distant
                     && let Some(st) = shown
                     && is_far(r.nearest_height_m(camera_m.z), st.centre_m, camera_m, &s)
                 {
@@ -579,7 +580,9 @@ impl ImpostorRing {
         self.pending.retain(|p| p.0 != ring);
         let far: Vec<(u64, f64)> = blocks
             .values()
-            .filter(|r| is_far(r.nearest_height_m(camera_m.z), camera_m, camera_m, &s))
+            .filter(|r| {
+                !r.distant && is_far(r.nearest_height_m(camera_m.z), camera_m, camera_m, &s)
+            })
             .map(|r| (r.block.id, (r.centre_m() - camera_m).length()))
             .collect();
         let far_mean_m = if far.is_empty() {

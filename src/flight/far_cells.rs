@@ -1,0 +1,406 @@
+//! Storm cells beyond the cloud field: the cells of the weather field between the field's rim
+//! (`config/clouds.toml` `radius_m`) and `[far] reach_m` of `config/storms.toml`, each drawn
+//! whole as one cloud of few large sprites ([`crate::clouds::storm::far_cell_cloud`]) that the
+//! sky draws however far it is ([`Sky::insert_distant_block`]). The ring and the far field stop
+//! a storm at the field's rim: the far field would draw its area as a grey layer from base to
+//! top (it leaves cumulonimbus out for this), and pilots see storms 50-160 km off.
+//!
+//! The cells are placed as the near ones are ([`cell_of_square`], the same grid, seed and block
+//! weather, in the moving air's frame), looked for a few grid rows a frame around where the
+//! camera was, again after it moved `move_m` or the weather changed. Each frame the nearest
+//! `most` found beyond the rim are shown: one that joins forms, one that leaves (the camera came
+//! near: its blocks draw it now) dissipates, over `fade_s`.
+
+use std::collections::HashMap;
+
+use glam::{DVec2, DVec3};
+
+use crate::clouds::CloudTypes;
+use crate::clouds::storm::far_cell_cloud;
+use crate::render::Sky;
+use crate::render::scene::{BlockMotion, Fade, SkyBlock, SkyCloud};
+use crate::weather::field::WeatherField;
+use crate::weather::storms::{FarCellSettings, StormCell, StormContext, cell_of_square};
+use crate::weather::{BlockIndex, CloudType};
+
+/// Sky ids of far cells: apart from the field's generation serials, which count up from 0.
+const FAR_CELL_IDS: u64 = 1 << 62;
+
+/// What a frame's far cells are decided from.
+pub(super) struct FarCellFrame<'a> {
+    /// The weather field (its block weather places the cells, as the near blocks').
+    pub weather: &'a WeatherField,
+    /// The weather's version: a new one looks for the cells again.
+    pub version: u64,
+    /// The storm settings, wind profile and latitude, and the field's seed.
+    pub storms: (&'a StormContext, u64),
+    /// The cloud types (the cumulonimbus' drawing).
+    pub types: &'a CloudTypes,
+    /// The camera in the moving air's frame (ground position less the drift), metres.
+    pub camera_air_m: DVec2,
+    /// The drift: added to every cell's position, as to the field's blocks.
+    pub drift_m: DVec2,
+    /// The cloud field's radius: cells nearer than it are the field's.
+    pub field_radius_m: f64,
+    /// The clouds' clock, seconds.
+    pub now_s: f64,
+    /// Find and show everything in this call, with no fades (offline frames).
+    pub whole: bool,
+}
+
+/// A search of the placement grid around a point, a few rows a frame.
+struct Search {
+    centre_m: DVec2,
+    version: u64,
+    rows: std::ops::Range<i64>,
+    cols: std::ops::Range<i64>,
+    next_row: i64,
+    cells: Vec<StormCell>,
+}
+
+/// A far cell the sky holds.
+struct Shown {
+    id: u64,
+    cell: StormCell,
+    /// When it started forming (`Some(false)`) or dissipating (`Some(true)`); `None`: steady.
+    fade: Option<(bool, f64)>,
+}
+
+/// The far cells of a living world (module docs).
+pub(super) struct FarCells {
+    settings: FarCellSettings,
+    search: Option<Search>,
+    /// The last finished search: where, with which weather, and what it found.
+    found: Option<(DVec2, u64, Vec<StormCell>)>,
+    shown: HashMap<u64, Shown>,
+    next_id: u64,
+    /// Searches finished so far, and the search and camera place the shown set was last
+    /// decided for: it is decided again only when either changed.
+    searches: u64,
+    decided: Option<(u64, DVec2)>,
+    /// Shown cells forming or dissipating.
+    fading: usize,
+}
+
+/// The camera moves this far, metres, before the shown set is decided again (cells join and
+/// leave at the field's rim, where a kilometre is a fraction of a degree).
+const DECIDE_MOVE_M: f64 = 1000.0;
+
+impl FarCells {
+    /// No cells yet; `settings` from `config/storms.toml` `[far]`.
+    pub(super) fn new(settings: FarCellSettings) -> Self {
+        Self {
+            settings,
+            search: None,
+            found: None,
+            shown: HashMap::new(),
+            next_id: FAR_CELL_IDS,
+            searches: 0,
+            decided: None,
+            fading: 0,
+        }
+    }
+
+    /// Whether far cells are drawn.
+    pub(super) fn enabled(&self) -> bool {
+        self.settings.enabled
+    }
+
+    /// One frame: looks further for cells, and hands `sky` the ones that join or leave.
+    pub(super) fn update(&mut self, sky: &mut Sky, f: &FarCellFrame) {
+        if !self.settings.enabled {
+            for (_, s) in self.shown.drain() {
+                sky.remove_block(s.id);
+            }
+            return;
+        }
+        self.search_on(f);
+        let decide = self.decided.is_none_or(|(searches, at)| {
+            searches != self.searches || at.distance(f.camera_air_m) > DECIDE_MOVE_M
+        });
+        if decide {
+            self.decided = Some((self.searches, f.camera_air_m));
+            self.decide(sky, f);
+        }
+        if self.fading > 0 {
+            self.fade_on(sky, f);
+        }
+    }
+
+    /// Hands `sky` the cells that join the shown set (forming) and marks those that leave it.
+    fn decide(&mut self, sky: &mut Sky, f: &FarCellFrame) {
+        let wanted = self.wanted(f);
+        let offset_m = DVec3::new(f.drift_m.x, f.drift_m.y, 0.0);
+        // Leaving: dissipate (a cell whose weather changed leaves too, its new self joins).
+        for s in self.shown.values_mut() {
+            let keep = wanted.get(&s.cell.key).is_some_and(|c| *c == s.cell);
+            match s.fade {
+                _ if keep => {}
+                Some((true, _)) => {}
+                _ => s.fade = Some((true, f.now_s)),
+            }
+        }
+        // Joining: drawn now, forming.
+        for (key, cell) in &wanted {
+            if self.shown.get(key).is_some_and(|s| s.cell == *cell) {
+                continue;
+            }
+            if let Some(old) = self.shown.remove(key) {
+                sky.remove_block(old.id);
+            }
+            let id = self.next_id;
+            self.next_id += 1;
+            sky.insert_distant_block(
+                far_block(id, cell, f, &self.settings),
+                BlockMotion {
+                    offset_m,
+                    fade: Fade::Forming(0.0),
+                },
+            );
+            self.shown.insert(
+                *key,
+                Shown {
+                    id,
+                    cell: *cell,
+                    fade: Some((false, f.now_s)),
+                },
+            );
+        }
+        self.fading = self.shown.values().filter(|s| s.fade.is_some()).count();
+    }
+
+    /// The fades go on; those done are steady, or gone.
+    fn fade_on(&mut self, sky: &mut Sky, f: &FarCellFrame) {
+        let fade_s = if f.whole { 0.0 } else { self.settings.fade_s };
+        self.shown.retain(|_, s| {
+            let Some((leaving, since)) = s.fade else {
+                return true;
+            };
+            let p = if fade_s > 0.0 {
+                ((f.now_s - since) / fade_s) as f32
+            } else {
+                1.0
+            };
+            match (leaving, p >= 1.0) {
+                (true, true) => {
+                    sky.remove_block(s.id);
+                    return false;
+                }
+                (false, true) => {
+                    s.fade = None;
+                    sky.set_block_fade(s.id, Fade::Steady);
+                }
+                (true, false) => {
+                    sky.set_block_fade(s.id, Fade::Dissipating(p));
+                }
+                (false, false) => {
+                    sky.set_block_fade(s.id, Fade::Forming(p));
+                }
+            }
+            true
+        });
+        self.fading = self.shown.values().filter(|s| s.fade.is_some()).count();
+    }
+
+    /// Starts a search where the camera left the last one or the weather changed, and looks
+    /// through this frame's rows (all of them for offline frames).
+    fn search_on(&mut self, f: &FarCellFrame) {
+        let s = &self.settings;
+        let grid = f.storms.0.settings.cells.grid_m;
+        let stale = self.found.as_ref().is_none_or(|(at, version, _)| {
+            *version != f.version || at.distance(f.camera_air_m) > s.move_m
+        });
+        let searching_stale = self
+            .search
+            .as_ref()
+            .is_some_and(|search| search.version != f.version);
+        if (self.search.is_none() && stale) || searching_stale {
+            let reach = s.reach_m + f.storms.0.settings.reach_m();
+            let lo = ((f.camera_air_m - DVec2::splat(reach)) / grid).floor();
+            let hi = ((f.camera_air_m + DVec2::splat(reach)) / grid).ceil();
+            self.search = Some(Search {
+                centre_m: f.camera_air_m,
+                version: f.version,
+                rows: lo.y as i64..hi.y as i64,
+                cols: lo.x as i64..hi.x as i64,
+                next_row: lo.y as i64,
+                cells: Vec::new(),
+            });
+        }
+        // An offline frame's search goes through at once.
+        let Some(search) = self.search.as_mut() else {
+            return;
+        };
+        let rows = if f.whole {
+            search.rows.end - search.next_row
+        } else {
+            i64::from(s.rows_per_frame)
+        };
+        let end = (search.next_row + rows).min(search.rows.end);
+        let drift = f.drift_m;
+        let mut weather = |p: DVec2| f.weather.block_weather(BlockIndex::containing(p + drift));
+        let reach = s.reach_m + f.storms.0.settings.reach_m();
+        for cj in search.next_row..end {
+            for ci in search.cols.clone() {
+                let square = DVec2::new(ci as f64 + 0.5, cj as f64 + 0.5) * grid;
+                if square.distance(search.centre_m) > reach {
+                    continue;
+                }
+                if let Some(cell) = cell_of_square(ci, cj, &mut weather, f.storms.0, f.storms.1) {
+                    search.cells.push(cell);
+                }
+            }
+        }
+        search.next_row = end;
+        if end >= search.rows.end
+            && let Some(done) = self.search.take()
+        {
+            self.found = Some((done.centre_m, done.version, done.cells));
+            self.searches += 1;
+        }
+    }
+
+    /// The nearest `most` cells found whose centre lies beyond the field's radius and within
+    /// the reach, by key.
+    fn wanted(&self, f: &FarCellFrame) -> HashMap<u64, StormCell> {
+        let Some((_, _, cells)) = &self.found else {
+            return HashMap::new();
+        };
+        let mut by_distance: Vec<(f64, &StormCell)> = cells
+            .iter()
+            .map(|c| (c.centre().distance(f.camera_air_m), c))
+            .filter(|(d, _)| *d > f.field_radius_m && *d <= self.settings.reach_m)
+            .collect();
+        by_distance.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.key.cmp(&b.1.key)));
+        by_distance
+            .into_iter()
+            .take(self.settings.most)
+            .map(|(_, c)| (c.key, *c))
+            .collect()
+    }
+}
+
+/// A far cell as the sky's block: one cloud, the whole cell, where the field places it (the
+/// drift is its motion).
+fn far_block(id: u64, cell: &StormCell, f: &FarCellFrame, s: &FarCellSettings) -> SkyBlock {
+    let weather = f
+        .weather
+        .block_weather(BlockIndex::containing(cell.centre() + f.drift_m));
+    let cloud = far_cell_cloud(
+        cell,
+        f.types.get(CloudType::Cumulonimbus),
+        &weather,
+        (s.sprites, s.sprite_over_base),
+    );
+    let sky_cloud = SkyCloud::from(&cloud);
+    SkyBlock {
+        id,
+        centre_m: sky_cloud.centre_m,
+        clouds: vec![sky_cloud],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::weather::field::{CloudTypeRule, FieldSettings};
+    use crate::weather::frame::LocalFrame;
+    use crate::weather::storms::{StormSettings, cells_over};
+    use crate::weather::{files, stations::StationTable};
+
+    const SEED: u64 = 2003;
+
+    /// The 2025 file around a point 125 km east-north-east of Belo Horizonte (SBBH, TSRA
+    /// BKN045CB; SBCF FEW045CB), which reports CAVOK itself.
+    fn field() -> WeatherField {
+        let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/weather"));
+        let stations = StationTable::load(&dir.join("nsd_cccc.txt")).unwrap();
+        let file = files::load(
+            &dir.join("awc-metars-2025-01-27T22Z.cache.csv"),
+            Some(&stations),
+        )
+        .unwrap();
+        WeatherField::build(
+            LocalFrame::new(-19.55, -42.80),
+            &file.reports,
+            &FieldSettings::default(),
+            &CloudTypeRule::default(),
+        )
+    }
+
+    fn frame<'a>(
+        weather: &'a WeatherField,
+        ctx: &'a StormContext,
+        types: &'a CloudTypes,
+        whole: bool,
+    ) -> FarCellFrame<'a> {
+        FarCellFrame {
+            weather,
+            version: 1,
+            storms: (ctx, SEED),
+            types,
+            camera_air_m: DVec2::ZERO,
+            drift_m: DVec2::ZERO,
+            field_radius_m: 100_000.0,
+            now_s: 0.0,
+            whole,
+        }
+    }
+
+    #[test]
+    fn far_cells_are_the_fields_own_cells_beyond_its_rim() {
+        let weather = field();
+        let ctx = StormContext {
+            lat_deg: -19.55,
+            ..StormContext::default()
+        };
+        let types = CloudTypes::builtin();
+        let settings = StormSettings::default().far;
+        let mut far = FarCells::new(settings);
+        let f = frame(&weather, &ctx, &types, true);
+        far.search_on(&f);
+        let wanted = far.wanted(&f);
+        let near_sbbh = wanted
+            .values()
+            .filter(|c| c.centre().distance(DVec2::new(-120_000.0, -34_000.0)) < 60_000.0)
+            .count();
+        eprintln!(
+            "{} far cells, {near_sbbh} within 60 km of SBBH",
+            wanted.len()
+        );
+        assert!(near_sbbh >= 5, "{near_sbbh} cells by SBBH");
+        assert!(wanted.len() <= settings.most);
+        for c in wanted.values() {
+            let d = c.centre().length();
+            assert!(d > 100_000.0 && d <= settings.reach_m, "a cell {d} m off");
+            // The very cell the field's blocks draw once the camera is near.
+            let square = DVec2::splat(1.0);
+            let near = cells_over(
+                c.centre() - square,
+                c.centre() + square,
+                &mut |p| weather.block_weather(BlockIndex::containing(p)),
+                &ctx,
+                SEED,
+            );
+            assert!(near.contains(c), "{c:?}");
+        }
+        // A few rows a frame find the same.
+        let mut slow = FarCells::new(settings);
+        let f = frame(&weather, &ctx, &types, false);
+        let mut frames = 0;
+        while slow.found.is_none() {
+            slow.search_on(&f);
+            frames += 1;
+            assert!(frames < 1000);
+        }
+        let rows = (2.0 * (settings.reach_m + ctx.settings.reach_m()) / ctx.settings.cells.grid_m)
+            .ceil() as u32;
+        assert!(
+            frames + 2 >= rows / settings.rows_per_frame,
+            "{frames} frames"
+        );
+        assert_eq!(slow.wanted(&f), wanted);
+    }
+}
