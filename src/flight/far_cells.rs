@@ -130,21 +130,34 @@ impl FarCells {
     /// Hands `sky` the cells that join the shown set (forming) and marks those that leave it.
     fn decide(&mut self, sky: &mut Sky, f: &FarCellFrame) {
         let wanted = self.wanted(f);
+        let by_key: HashMap<u64, &StormCell> = wanted.iter().map(|c| (c.key, c)).collect();
         let offset_m = DVec3::new(f.drift_m.x, f.drift_m.y, 0.0);
         // Leaving: dissipate (a cell whose weather changed leaves too, its new self joins).
         for s in self.shown.values_mut() {
-            let keep = wanted.get(&s.cell.key).is_some_and(|c| *c == s.cell);
+            let keep = by_key.get(&s.cell.key).is_some_and(|c| **c == s.cell);
             match s.fade {
                 _ if keep => {}
                 Some((true, _)) => {}
                 _ => s.fade = Some((true, f.now_s)),
             }
         }
-        // Joining: drawn now, forming.
-        for (key, cell) in &wanted {
+        // Joining: drawn now, forming; a few a frame (all at once offline), the rest decided
+        // again the next frames.
+        let mut joins = if f.whole {
+            u32::MAX
+        } else {
+            self.settings.joins_per_frame
+        };
+        for cell in &wanted {
+            let key = &cell.key;
             if self.shown.get(key).is_some_and(|s| s.cell == *cell) {
                 continue;
             }
+            if joins == 0 {
+                self.decided = None;
+                break;
+            }
+            joins -= 1;
             if let Some(old) = self.shown.remove(key) {
                 sky.remove_block(old.id);
             }
@@ -261,10 +274,10 @@ impl FarCells {
     }
 
     /// The nearest `most` cells found whose centre lies beyond the field's radius and within
-    /// the reach, by key.
-    fn wanted(&self, f: &FarCellFrame) -> HashMap<u64, StormCell> {
+    /// the reach, nearest first.
+    fn wanted(&self, f: &FarCellFrame) -> Vec<StormCell> {
         let Some((_, _, cells)) = &self.found else {
-            return HashMap::new();
+            return Vec::new();
         };
         let mut by_distance: Vec<(f64, &StormCell)> = cells
             .iter()
@@ -275,7 +288,7 @@ impl FarCells {
         by_distance
             .into_iter()
             .take(self.settings.most)
-            .map(|(_, c)| (c.key, *c))
+            .map(|(_, c)| *c)
             .collect()
     }
 }
@@ -363,7 +376,7 @@ mod tests {
         far.search_on(&f);
         let wanted = far.wanted(&f);
         let near_sbbh = wanted
-            .values()
+            .iter()
             .filter(|c| c.centre().distance(DVec2::new(-120_000.0, -34_000.0)) < 60_000.0)
             .count();
         eprintln!(
@@ -372,7 +385,7 @@ mod tests {
         );
         assert!(near_sbbh >= 5, "{near_sbbh} cells by SBBH");
         assert!(wanted.len() <= settings.most);
-        for c in wanted.values() {
+        for c in &wanted {
             let d = c.centre().length();
             assert!(d > 100_000.0 && d <= settings.reach_m, "a cell {d} m off");
             // The very cell the field's blocks draw once the camera is near.

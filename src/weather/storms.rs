@@ -64,6 +64,8 @@ pub struct FarCellSettings {
     pub sprite_over_base: [f32; 2],
     /// Grid rows of the placement grid looked at a frame while a new set is found.
     pub rows_per_frame: u32,
+    /// Cells that join the shown set in one frame at most (each is drawn then).
+    pub joins_per_frame: u32,
     /// A new set is found after the camera moved this far from where the last was, metres.
     pub move_m: f64,
     /// A far cell forms or dissipates over this long as it comes into or leaves the set,
@@ -213,6 +215,9 @@ impl StormSettings {
         }
         if f.rows_per_frame == 0 {
             return Err(bad("far.rows_per_frame", "must be at least 1"));
+        }
+        if f.joins_per_frame == 0 {
+            return Err(bad("far.joins_per_frame", "must be at least 1"));
         }
         if !(f.move_m >= 0.0 && f.move_m.is_finite()) {
             return Err(bad("far.move_m", "must be at least 0"));
