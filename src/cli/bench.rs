@@ -36,7 +36,8 @@ use glam::{DVec2, DVec3};
 use skycast::clouds::{CloudTypes, generate_block};
 use skycast::demo::{DemoHost, GroundSettings, demo_ground};
 use skycast::flight::world::{World, WorldSettings};
-use skycast::render::{RenderSettings, SkyConfig};
+
+use skycast::render::{BlockMotion, RenderSettings, SkyConfig};
 use skycast::shading::{TimeOfDayTable, sun_position};
 use skycast::weather::{
     BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, METRES_PER_FOOT, StationTable,
@@ -267,14 +268,25 @@ fn fly(
     (impostors, scales): (bool, &[f32]),
 ) -> anyhow::Result<Vec<Flown>> {
     let ground = demo_ground(world.field(), &GroundSettings::default());
-    // The far field's map around the path (12 km: one map holds it), made once.
+    // The storm cells beyond the blocks (the world's radius is the view radius), drawn whole
+    // as a flight draws them, and the far field's map around the path (12 km: one map holds
+    // both), made once; the map leaves cumulonimbus to the cells.
+    let distant = world.far_cell_blocks(DVec3::ZERO, setup.settings.impostors.view_radius_m);
+    let cells_apart = world.draws_far_cells();
     let far_map = setup.settings.far_field.enabled.then(|| {
         let f = setup.settings.far_field;
         let field = world.field();
         skycast::clouds::far_map::FarMapFeed::new(f.texels, f.texel_m, f.move_texels, 1).update(
             DVec2::ZERO,
             true,
-            |p| field.weather_at(p),
+            |p| {
+                let mut w = field.weather_at(p);
+                if cells_apart {
+                    w.layers
+                        .retain(|l| l.cloud_type != skycast::weather::CloudType::Cumulonimbus);
+                }
+                w
+            },
         )
     });
     let mut hosts = Vec::new();
@@ -348,6 +360,10 @@ fn fly(
             }
             for host in &mut hosts {
                 host.sky.set_clouds(blocks.clone());
+                for block in &distant {
+                    host.sky
+                        .insert_distant_block(block.clone(), BlockMotion::default());
+                }
             }
             indices = now;
         }

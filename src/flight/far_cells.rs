@@ -27,6 +27,7 @@ use crate::weather::{BlockIndex, CloudType};
 const FAR_CELL_IDS: u64 = 1 << 62;
 
 /// What a frame's far cells are decided from.
+#[derive(Clone, Copy)]
 pub(super) struct FarCellFrame<'a> {
     /// The weather field (its block weather places the cells, as the near blocks').
     pub weather: &'a WeatherField,
@@ -213,6 +214,18 @@ impl FarCells {
             true
         });
         self.fading = self.shown.values().filter(|s| s.fade.is_some()).count();
+    }
+
+    /// The blocks of the far cells around `f`'s camera, found at once (a still world: the bench,
+    /// tests), ids from [`FAR_CELL_IDS`] up, nearest first.
+    pub(super) fn blocks_now(settings: FarCellSettings, f: &FarCellFrame) -> Vec<SkyBlock> {
+        let mut far = Self::new(settings);
+        far.search_on(&FarCellFrame { whole: true, ..*f });
+        far.wanted(f)
+            .iter()
+            .enumerate()
+            .map(|(i, cell)| far_block(FAR_CELL_IDS + i as u64, cell, f, &settings))
+            .collect()
     }
 
     /// Starts a search where the camera left the last one or the weather changed, and looks

@@ -367,6 +367,33 @@ impl World {
         Ok(true)
     }
 
+    /// The storm cells beyond `radius_m` of `camera_m` as the living world draws them (each a
+    /// block for [`Sky::insert_distant_block`]), found at once, without drift: for a still
+    /// world (the bench). None when `config/storms.toml` `[far]` is off.
+    pub fn far_cell_blocks(&self, camera_m: DVec3, radius_m: f64) -> Vec<SkyBlock> {
+        let settings = crate::weather::storms::StormSettings::default();
+        if !settings.far.enabled {
+            return Vec::new();
+        }
+        let ctx = crate::weather::storms::StormContext {
+            settings,
+            wind: self.air_settings().wind,
+            lat_deg: self.field.frame().to_lat_lon_deg(DVec2::ZERO).0,
+        };
+        let f = super::far_cells::FarCellFrame {
+            weather: &self.field,
+            version: self.field_version,
+            storms: (&ctx, self.settings.seed),
+            types: &self.types,
+            camera_air_m: camera_m.truncate(),
+            drift_m: DVec2::ZERO,
+            field_radius_m: radius_m,
+            now_s: 0.0,
+            whole: true,
+        };
+        super::far_cells::FarCells::blocks_now(settings.far, &f)
+    }
+
     /// Whether storm cells beyond the cloud field are drawn as cells (`config/storms.toml`
     /// `[far]`): the far field then leaves cumulonimbus out of its map.
     pub fn draws_far_cells(&self) -> bool {
