@@ -49,8 +49,17 @@ fn sun() -> SunPosition {
 }
 
 fn host() -> DemoHost {
+    host_at(None)
+}
+
+/// A host drawing the clouds at `scale` of the frame's resolution (the shipped one: `None`).
+fn host_at(scale: Option<f32>) -> DemoHost {
     let ground = HeightField::from_fn(DVec2::ZERO, 120_000.0, 64, |_| 0.0);
-    DemoHost::new(W, H, &ground, SkyConfig::new(headless::TARGETS))
+    let mut config = SkyConfig::new(headless::TARGETS);
+    if let Some(scale) = scale {
+        config.settings.clouds.resolution_scale = scale;
+    }
+    DemoHost::new(W, H, &ground, config)
         .unwrap_or_else(|e| panic!("render tests need an adapter: {e}"))
 }
 
@@ -255,7 +264,16 @@ fn a_cell_200_km_off_stands_over_the_horizon_as_a_distant_block() {
         centre_m: cloud.centre_m,
         clouds: vec![SkyCloud::from(&cloud)],
     };
-    let mut host = host();
+    // At the shipped cloud scale (1/2: the cloud target's depth is in metres) and at full
+    // resolution (the host's own depth, whose background is its far plane).
+    for scale in [None, Some(1.0)] {
+        far_cell_frames(scale, &block);
+    }
+}
+
+fn far_cell_frames(scale: Option<f32>, block: &SkyBlock) {
+    let weather = BlockWeather::default();
+    let mut host = host_at(scale);
     host.sky.set_cloud_shadows(false);
     host.sky.set_weather_overhead(&BlockWeather {
         visibility_m: 9_999.0,
@@ -275,11 +293,15 @@ fn a_cell_200_km_off_stands_over_the_horizon_as_a_distant_block() {
     host.sky.insert_block(block.clone(), BlockMotion::default());
     let near = frame(&mut host, "far_cell_as_near_block", &camera);
     host.sky.remove_block(block.id);
-    host.sky.insert_distant_block(block, BlockMotion::default());
+    host.sky
+        .insert_distant_block(block.clone(), BlockMotion::default());
     let distant = frame(&mut host, "far_cell_200_km", &camera);
     let changed = |f: &Frame| cell_mask(f, &clear).iter().filter(|&&m| m).count();
     let (near_px, distant_px) = (changed(&near), changed(&distant));
-    eprintln!("pixels changed: {near_px} as a near block, {distant_px} as a distant one");
+    eprintln!(
+        "cloud scale {scale:?}: pixels changed: {near_px} as a near block, {distant_px} as a \
+         distant one"
+    );
     assert_eq!(
         near_px, 0,
         "a near block 200 km off is past the draw distance"
