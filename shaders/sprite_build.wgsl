@@ -397,9 +397,11 @@ fn build_sprite(k: u32, at: u32) {
         alpha *= clamp((cos_angle - lock.w) / max(lock.z - lock.w, 1e-4), 0.0, 1.0);
     }
     // Bit 4 of `fade_kind`: a distant block (a storm cell beyond the cloud field,
-    // `DISTANT_BLOCK` in src/render/draw_list.rs), drawn whole however far.
+    // `DISTANT_BLOCK` in src/render/draw_list.rs), drawn however far; while the far field is
+    // drawn (`hl_deck.z`) it fades in over the hand-over band as the near sprites fade out.
     let morph = morph_radius.x * lifecycle_alpha(b.fade_kind & 3u, b.fade_progress, morph_radius.y);
-    alpha *= select(far_fade(to_cam), 1.0, (b.fade_kind & 4u) != 0u);
+    let faded = far_fade(to_cam);
+    alpha *= select(faded, 1.0 - view.hl_deck.z * faded, (b.fade_kind & 4u) != 0u);
     if (!(alpha > 0.0 && morph > 0.0)) {
         // Faded out: the draw puts its corners outside the clip volume.
         for (var c = 0u; c < 4u; c++) {

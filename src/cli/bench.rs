@@ -271,7 +271,14 @@ fn fly(
     // The storm cells beyond the blocks (the world's radius is the view radius), drawn whole
     // as a flight draws them, and the far field's map around the path (12 km: one map holds
     // both), made once; the map leaves cumulonimbus to the cells.
-    let distant = world.far_cell_blocks(DVec3::ZERO, setup.settings.impostors.view_radius_m);
+    let far_field = setup.settings.far_field;
+    let distant = world.far_cell_blocks(
+        DVec3::ZERO,
+        setup.settings.impostors.view_radius_m,
+        far_field
+            .enabled
+            .then_some(f64::from(far_field.fade_start_m)),
+    );
     let cells_apart = world.draws_far_cells();
     let far_map = setup.settings.far_field.enabled.then(|| {
         let f = setup.settings.far_field;

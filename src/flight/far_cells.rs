@@ -41,8 +41,12 @@ pub(super) struct FarCellFrame<'a> {
     pub camera_air_m: DVec2,
     /// The drift: added to every cell's position, as to the field's blocks.
     pub drift_m: DVec2,
-    /// The cloud field's radius: cells nearer than it are the field's.
+    /// The cloud field's radius: cells whose centre is nearer are the field's ...
     pub field_radius_m: f64,
+    /// ... unless the far field is drawn: from where its hand-over band starts, the near
+    /// sprites fade out and the far cells' sprites fade in (every cell that reaches past it is
+    /// a far cell too).
+    pub band_start_m: Option<f64>,
     /// The clouds' clock, seconds.
     pub now_s: f64,
     /// Find and show everything in this call, with no fades (offline frames).
@@ -75,10 +79,10 @@ pub(super) struct FarCells {
     found: Option<(DVec2, u64, Vec<StormCell>)>,
     shown: HashMap<u64, Shown>,
     next_id: u64,
-    /// Searches finished so far, and the search and camera place the shown set was last
-    /// decided for: it is decided again only when either changed.
+    /// Searches finished so far, and the search, camera place and hand-over the shown set was
+    /// last decided for: it is decided again only when one changed.
     searches: u64,
-    decided: Option<(u64, DVec2)>,
+    decided: Option<(u64, DVec2, Option<f64>)>,
     /// Shown cells forming or dissipating.
     fading: usize,
 }
@@ -116,11 +120,13 @@ impl FarCells {
             return;
         }
         self.search_on(f);
-        let decide = self.decided.is_none_or(|(searches, at)| {
-            searches != self.searches || at.distance(f.camera_air_m) > DECIDE_MOVE_M
+        let decide = self.decided.is_none_or(|(searches, at, band)| {
+            searches != self.searches
+                || at.distance(f.camera_air_m) > DECIDE_MOVE_M
+                || band != f.band_start_m
         });
         if decide {
-            self.decided = Some((self.searches, f.camera_air_m));
+            self.decided = Some((self.searches, f.camera_air_m, f.band_start_m));
             self.decide(sky, f);
         }
         if self.fading > 0 {
@@ -286,8 +292,9 @@ impl FarCells {
         }
     }
 
-    /// The nearest `most` cells found whose centre lies beyond the field's radius and within
-    /// the reach, nearest first.
+    /// The nearest `most` cells found that the field's blocks do not draw whole (beyond its
+    /// radius, or reaching past the hand-over band's start), their centre within the reach,
+    /// nearest first.
     fn wanted(&self, f: &FarCellFrame) -> Vec<StormCell> {
         let Some((_, _, cells)) = &self.found else {
             return Vec::new();
@@ -295,7 +302,13 @@ impl FarCells {
         let mut by_distance: Vec<(f64, &StormCell)> = cells
             .iter()
             .map(|c| (c.centre().distance(f.camera_air_m), c))
-            .filter(|(d, _)| *d > f.field_radius_m && *d <= self.settings.reach_m)
+            .filter(|(d, c)| {
+                let far = match f.band_start_m {
+                    Some(start) => d + c.radius_m() > start,
+                    None => *d > f.field_radius_m,
+                };
+                far && *d <= self.settings.reach_m
+            })
             .collect();
         by_distance.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.key.cmp(&b.1.key)));
         by_distance
@@ -370,6 +383,7 @@ mod tests {
             camera_air_m: DVec2::ZERO,
             drift_m: DVec2::ZERO,
             field_radius_m: 100_000.0,
+            band_start_m: None,
             now_s: 0.0,
             whole,
         }
@@ -428,5 +442,21 @@ mod tests {
             "{frames} frames"
         );
         assert_eq!(slow.wanted(&f), wanted);
+        // With the far field drawn, every cell reaching past its hand-over band's start is
+        // drawn whole too (the near sprites fade out there): cells centred within the field.
+        let band = FarCellFrame {
+            band_start_m: Some(42_000.0),
+            ..frame(&weather, &ctx, &types, true)
+        };
+        let banded = far.wanted(&band);
+        assert!(
+            banded.iter().any(|c| c.centre().length() < 100_000.0),
+            "none within the field"
+        );
+        assert!(
+            banded
+                .iter()
+                .all(|c| c.centre().length() + c.radius_m() > 42_000.0)
+        );
     }
 }

@@ -367,10 +367,16 @@ impl World {
         Ok(true)
     }
 
-    /// The storm cells beyond `radius_m` of `camera_m` as the living world draws them (each a
-    /// block for [`Sky::insert_distant_block`]), found at once, without drift: for a still
-    /// world (the bench). None when `config/storms.toml` `[far]` is off.
-    pub fn far_cell_blocks(&self, camera_m: DVec3, radius_m: f64) -> Vec<SkyBlock> {
+    /// The storm cells beyond `radius_m` of `camera_m` (or reaching past `band_start_m`, where
+    /// a drawn far field's hand-over starts) as the living world draws them (each a block for
+    /// [`Sky::insert_distant_block`]), found at once, without drift: for a still world (the
+    /// bench). None when `config/storms.toml` `[far]` is off.
+    pub fn far_cell_blocks(
+        &self,
+        camera_m: DVec3,
+        radius_m: f64,
+        band_start_m: Option<f64>,
+    ) -> Vec<SkyBlock> {
         let settings = crate::weather::storms::StormSettings::default();
         if !settings.far.enabled {
             return Vec::new();
@@ -388,6 +394,7 @@ impl World {
             camera_air_m: camera_m.truncate(),
             drift_m: DVec2::ZERO,
             field_radius_m: radius_m,
+            band_start_m,
             now_s: 0.0,
             whole: true,
         };
@@ -481,6 +488,9 @@ impl World {
                 camera_air_m: camera_m.truncate() - drift,
                 drift_m: drift,
                 field_radius_m: self.clouds_config.field.radius_m,
+                band_start_m: sky
+                    .far_field_hand_over_m()
+                    .map(|(start, _)| f64::from(start)),
                 now_s: living.field.time_s(),
                 whole: self.synchronous_clouds,
             },

@@ -479,9 +479,11 @@ impl Sky {
         self.pending_us += start.elapsed().as_micros() as u64;
     }
 
-    /// Adds a block drawn as sprites however far it is, never into the impostor ring nor faded
-    /// at the draw distance: what the ring and the far field cannot draw beyond the cloud field,
-    /// a storm cell's tower seen from 100-450 km (`flight::far_cells`). Replaces the block with
+    /// Adds a block drawn as sprites however far it is, never into the impostor ring nor cut at
+    /// the draw distance: what the ring and the far field cannot draw beyond the cloud field,
+    /// a storm cell's tower seen from 100-450 km (`flight::far_cells`). While the far field is
+    /// drawn, its sprites fade in over the hand-over band as the near sprites and the ring fade
+    /// out there ([`Self::far_field_hand_over_m`]). Replaces the block with
     /// its id; uploaded once, by the next [`Self::prepare`].
     pub fn insert_distant_block(&mut self, block: SkyBlock, motion: BlockMotion) {
         let start = Instant::now();
@@ -737,6 +739,13 @@ impl Sky {
     ) {
         self.far_field
             .set_map(&self.device, queue, map, (self.elapsed_s, fade_in_s));
+    }
+
+    /// Where the far field takes over from the sprites and the ring while it is drawn: the band
+    /// over which they fade out and it fades in (metres from the camera), and the distant
+    /// blocks fade in ([`Self::insert_distant_block`]). `None` while it is not drawn.
+    pub fn far_field_hand_over_m(&self) -> Option<(f32, f32)> {
+        self.far_field.hand_over_m()
     }
 
     /// Switches the far field on or off at run time (for comparisons; the sprites and the ring
