@@ -49,7 +49,9 @@ pub(super) struct FarCellFrame<'a> {
     pub band_start_m: Option<f64>,
     /// The clouds' clock, seconds.
     pub now_s: f64,
-    /// Find and show everything in this call, with no fades (offline frames).
+    /// Offline frames (synchronous clouds): the first set is found and shown in this call,
+    /// steady at once; later ones come a few rows and cells a frame, fading, as in a live
+    /// flight (a whole search is 80 x 80 grid squares of block weather).
     pub whole: bool,
 }
 
@@ -148,9 +150,10 @@ impl FarCells {
                 _ => s.fade = Some((true, f.now_s)),
             }
         }
-        // Joining: drawn now, forming; a few a frame (all at once offline), the rest decided
-        // again the next frames.
-        let mut joins = if f.whole {
+        // Joining: drawn now, forming; a few a frame (the first set of offline frames all at
+        // once, steady), the rest decided again the next frames.
+        let at_once = f.whole && self.shown.is_empty();
+        let mut joins = if at_once {
             u32::MAX
         } else {
             self.settings.joins_per_frame
@@ -174,7 +177,11 @@ impl FarCells {
                 far_block(id, cell, f, &self.settings),
                 BlockMotion {
                     offset_m,
-                    fade: Fade::Forming(0.0),
+                    fade: if at_once {
+                        Fade::Steady
+                    } else {
+                        Fade::Forming(0.0)
+                    },
                 },
             );
             self.shown.insert(
@@ -182,7 +189,7 @@ impl FarCells {
                 Shown {
                     id,
                     cell: *cell,
-                    fade: Some((false, f.now_s)),
+                    fade: (!at_once).then_some((false, f.now_s)),
                 },
             );
         }
@@ -191,7 +198,7 @@ impl FarCells {
 
     /// The fades go on; those done are steady, or gone.
     fn fade_on(&mut self, sky: &mut Sky, f: &FarCellFrame) {
-        let fade_s = if f.whole { 0.0 } else { self.settings.fade_s };
+        let fade_s = self.settings.fade_s;
         self.shown.retain(|_, s| {
             let Some((leaving, since)) = s.fade else {
                 return true;
@@ -259,11 +266,11 @@ impl FarCells {
                 cells: Vec::new(),
             });
         }
-        // An offline frame's search goes through at once.
+        // An offline flight's first search goes through at once.
         let Some(search) = self.search.as_mut() else {
             return;
         };
-        let rows = if f.whole {
+        let rows = if f.whole && self.found.is_none() {
             search.rows.end - search.next_row
         } else {
             i64::from(s.rows_per_frame)
