@@ -192,14 +192,16 @@ fn hash_u32(c: vec2<i32>, salt: u32) -> u32 {
 // hand-over band; beyond, where the slab is crossed at a shallower slant, the puffs are faded
 // out before the walk would need more).
 const PUFF_STEPS: i32 = 8;
+// The share of a puff's height below its widest.
+const PUFF_WAIST: f32 = 0.3;
 
 // The heaped layer's clouds one by one where a pixel resolves them, as the near cumulus' sprites
 // show them: a lattice of cells of `cell_m` (`heaped_scale_m`) over the world, each cell with
 // one puff or none, there with the chance that the cover `cover` asks, its diameter between the
 // cumulus' smallest and largest (`ff.puffs`, from config/cloud_types.toml), larger with the
 // cover where they cannot cover it at their own size, its centre anywhere in its cell (no row
-// of the lattice shows: one point strewn a cell); each a half-ellipsoid standing on the layer's
-// base, as tall as its diameter allows up to the layer's top. The ray `d` (unit, in the local
+// of the lattice shows: one point strewn a cell); each an ellipsoid cut flat below its middle
+// on the layer's base, as tall as its diameter allows up to the layer's top. The ray `d` (unit, in the local
 // frame at the point `o`: world metres in the noise's period, and metres above sea level)
 // crosses the slab `base..top`; it is walked through the cells of the lattice offset by half a
 // cell, whose corners are the primary cells' centres: a puff reaches no farther than half a
@@ -265,9 +267,12 @@ fn heaped_puffs(
             let centre = (vec2<f32>(cell) + u.zw) * cell_m;
             // The ray in the puff's frame, its height scaled so the puff is a sphere of `r`,
             // the outline lumpy.
-            let squash = r / height;
+            // Widest a third of the way up (an ellipsoid cut below its middle: a cumulus'
+            // steep sides over its flat base, not a dome's), `cut` the base in the scaled frame.
+            let squash = r / ((1.0 - PUFF_WAIST) * height);
+            let cut = -r * PUFF_WAIST / (1.0 - PUFF_WAIST);
             let rb = min(r * (1.0 + 0.4 * bumps), 0.5 * cell_m);
-            let p = vec3<f32>(start.xy - centre, (start.z - base) * squash);
+            let p = vec3<f32>(start.xy - centre, (start.z - base - PUFF_WAIST * height) * squash);
             let v = vec3<f32>(d.xy, d.z * squash);
             let vv = dot(v, v);
             let tc = -dot(p, v) / vv;
@@ -280,8 +285,8 @@ fn heaped_puffs(
             let half_chord = sqrt(max(inside, 0.0) / vv);
             let enter = p + v * (tc - half_chord);
             let leave = p + v * (tc + half_chord);
-            // Above the base somewhere along the chord (a half-ellipsoid), softly.
-            let highest = select(closest.z, max(enter.z, leave.z), inside > 0.0) / squash;
+            // Above the base somewhere along the chord, softly.
+            let highest = (select(closest.z, max(enter.z, leave.z), inside > 0.0) - cut) / squash;
             let a = smoothstep(rb + 0.5 * edge_m, rb - 0.5 * edge_m, miss)
                 * smoothstep(-0.5 * edge_m, 0.5 * edge_m, highest)
                 * select(0.0, 1.0, here);
@@ -289,9 +294,9 @@ fn heaped_puffs(
             // brighter), through the flat base from below shaded.
             let at = select(closest, enter, inside > 0.0);
             let n = normalize(vec3<f32>(at.xy, at.z * squash) + vec3<f32>(0.0, 0.0, 1.0e-3));
-            let up = clamp(at.z / rb, 0.0, 1.0);
-            let lit = clamp(0.5 * up + 0.6 * max(dot(n, sun), 0.0) + bumps - 0.1, 0.0, 1.0);
-            let light = select(lit, 0.0, at.z < 0.0 && d.z > 0.0);
+            let up = clamp((at.z - cut) / (rb - cut), 0.0, 1.0);
+            let lit = clamp(0.5 * up + 0.6 * max(dot(n, sun), 0.0) + 0.5 * bumps - 0.2, 0.0, 1.0);
+            let light = select(lit, 0.0, at.z < cut && d.z > 0.0);
             let rgb = mix(ff.shade_rgb.rgb, ff.lit_rgb.rgb, light);
             acc += vec4<f32>(rgb, 1.0) * (a * (1.0 - acc.a));
         }

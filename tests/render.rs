@@ -2113,3 +2113,129 @@ fn a_block_arriving_adds_its_shadow_to_the_map() {
         "the added map differs from a whole drawing by {worst}"
     );
 }
+
+/// Mean luminance step from one pixel to the next along the rows `rows` of a frame: the fine
+/// grain of what those rows show.
+fn row_step(frame: &Frame, rows: &[u32]) -> f32 {
+    let mut sum = 0.0;
+    for &y in rows {
+        for x in 1..W {
+            let i = (y * W + x) as usize;
+            sum += (luminance(frame.rgba[i]) - luminance(frame.rgba[i - 1])).abs();
+        }
+    }
+    sum / (rows.len() as u32 * (W - 1)) as f32
+}
+
+/// Issue 31, the far field's heaped layer reads as the cumulus the sprites draw: from FL350,
+/// the rows whose rays meet a scattered cumulus mediocris layer 60 to 75 km out (where the
+/// far field takes over from the sprites) are drawn once by the clouds stage's own sprites
+/// (the far field off, the sprites drawn to 150 km) and once by the far field alone (its
+/// map made from the same weather, its hand-over pulled in to 20-25 km). The far field's
+/// pixel-to-pixel luminance step is at least 0.6 of the sprites': discrete clouds with lit
+/// tops, shaded bases and the ground between them, not a soft texture (the noise texture of
+/// before drew a third to a half of it).
+#[test]
+fn the_far_fields_cumulus_have_the_sprites_grain() {
+    let weather = BlockWeather {
+        layers: vec![BlockLayer {
+            cloud_type: CloudType::CumulusMediocris,
+            type_source: TypeSource::Reported,
+            coverage_oktas: 4.0,
+            base_ft_agl: 5000.0,
+            thickness_ft: 3000.0,
+        }],
+        visibility_m: 9999.0,
+        ground_elevation_m: 0.0,
+        ..BlockWeather::default()
+    };
+    let types = CloudTypes::builtin();
+    // Blocks of 4 km over the view 52 to 84 km ahead.
+    let blocks: Vec<SkyBlock> = (13..21)
+        .flat_map(|j| (-5..5).map(move |i| BlockIndex::new(i, j)))
+        .map(|index| {
+            let block = generate_block(index, &weather, 7, &types);
+            let c = index.centre_m();
+            SkyBlock {
+                id: block_id(index),
+                centre_m: DVec3::new(c.x, c.y, 2000.0),
+                clouds: block.clouds.iter().map(SkyCloud::from).collect(),
+            }
+        })
+        .collect();
+    let cell = skycast::clouds::far_map::far_cell(&weather);
+    let map = skycast::clouds::far_map::FarMap {
+        texels: 96,
+        texel_m: 10_000.0,
+        centre_m: DVec2::ZERO,
+        cells: vec![cell; 96 * 96],
+    };
+    let (pitch, fov) = (-8.0f64, 12.0f64);
+    let frame = |far: bool| {
+        let mut settings = RenderSettings::default();
+        settings.camera.fov_y_deg = fov as f32;
+        settings.clouds.draw_distance_m = 150_000.0;
+        settings.far_field.enabled = far;
+        settings.far_field.fade_start_m = 20_000.0;
+        settings.far_field.fade_end_m = 25_000.0;
+        let ground = HeightField::from_fn(DVec2::ZERO, 200_000.0, 16, |_| 0.0);
+        let mut rig = Rig::with_settings(ground, settings);
+        rig.host.sky.set_far_map(&rig.host.gpu.queue, &map, None);
+        if !far {
+            rig.set_clouds(blocks.clone());
+        }
+        let cam = rig.camera(DVec3::new(0.0, 0.0, 10_668.0), 0.0, pitch);
+        rig.frame(
+            if far {
+                "grain-far-field"
+            } else {
+                "grain-sprites"
+            },
+            &cam,
+        )
+        .0
+    };
+    // The rows whose middle column's ray meets the layer's middle (the sphere's geometry).
+    let middle = f64::from(0.5 * (cell[1] + cell[2]));
+    let r = 6_371_000.0f64;
+    let layer_km = |row: u32| -> Option<f64> {
+        let ndc = 1.0 - 2.0 * (row as f64 + 0.5) / H as f64;
+        let elevation = pitch.to_radians() + (ndc * (0.5 * fov).to_radians().tan()).atan();
+        let (rc, rl) = (r + 10_668.0, r + middle);
+        let b = rc * elevation.sin();
+        let disc = b * b - (rc * rc - rl * rl);
+        (disc >= 0.0 && b < 0.0).then(|| (-b - disc.sqrt()) / 1000.0)
+    };
+    let rows: Vec<u32> = (0..H)
+        .filter(|&y| layer_km(y).is_some_and(|d| (60.0..=75.0).contains(&d)))
+        .collect();
+    assert!(rows.len() >= 8, "rows {rows:?}");
+    let mean = |f: &Frame| {
+        let sum: f32 = rows
+            .iter()
+            .flat_map(|&y| (0..W).map(move |x| (y * W + x) as usize))
+            .map(|i| luminance(f.rgba[i]))
+            .sum();
+        255.0 * sum / (rows.len() as u32 * W) as f32
+    };
+    let (sprite_frame, far_frame) = (frame(false), frame(true));
+    let sprites = row_step(&sprite_frame, &rows);
+    let far = row_step(&far_frame, &rows);
+    eprintln!(
+        "60-75 km out, rows {rows:?}: pixel step of the sprites {:.2}/255, of the far field \
+         {:.2}/255 ({:.2} of it); mean luminance {:.1} and {:.1}",
+        sprites * 255.0,
+        far * 255.0,
+        far / sprites,
+        mean(&sprite_frame),
+        mean(&far_frame)
+    );
+    assert!(
+        sprites > 1.0 / 255.0,
+        "the sprites show no grain: {sprites}"
+    );
+    assert!(
+        far >= 0.6 * sprites,
+        "the far field's step {far} against the sprites' {sprites}"
+    );
+}
