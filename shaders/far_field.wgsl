@@ -189,9 +189,12 @@ fn hash_u32(c: vec2<i32>, salt: u32) -> u32 {
 }
 
 // Cells of the walk along a pixel's ray in the heaped layer, at most (from FL350 about 4 at the
-// hand-over band; beyond, where the slab is crossed at a shallower slant, the puffs are faded
-// out before the walk would need more).
-const PUFF_STEPS: i32 = 8;
+// hand-over band; where the slab is crossed at a shallower slant, the puffs are faded out
+// before the walk would need more: `PUFF_PATH_CELLS`).
+const PUFF_STEPS: i32 = 12;
+// The longest path through the layer, in cells, on which the puffs are drawn whole: the walk
+// crosses at most `sqrt(2)` times as many cells and two more.
+const PUFF_PATH_CELLS: f32 = 6.0;
 // The share of a puff's height below its widest.
 const PUFF_WAIST: f32 = 0.3;
 
@@ -409,16 +412,22 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
     let size_m = 0.5 * (ff.puffs.x + ff.puffs.y);
     let tall_m = min(cell.z - cell.y, size_m * ff.puffs.z);
     let seen_m = min(size_m, size_m * sin_e + tall_m * sqrt(1.0 - sin_e * sin_e));
+    // The ray in the layer's local frame at the point met (the round Earth's up there), and the
+    // cells of the puffs' lattice it crosses in the layer: where that is more than the walk
+    // takes (`PUFF_STEPS`, at a shallow slant), the noise again, so that no puff comes and goes
+    // where the walk ends.
+    let rc = frame.sky_horizon_rgb.w;
+    let up = select(normalize(dir * t + vec3<f32>(0.0, 0.0, rc)), vec3<f32>(0.0, 0.0, 1.0), rc <= 0.0);
+    let sin_l = clamp(dot(dir, up), -1.0, 1.0);
+    let cos_l = sqrt(1.0 - sin_l * sin_l);
+    let path_cells = (cell.z - cell.y) * cos_l / (max(abs(sin_l), 1.0e-3) * ff.shade_rgb.w);
     let resolve = select(0.0, 1.0, heaped)
-        * (1.0 - smoothstep(0.4, 0.8, pixel * t / seen_m));
+        * (1.0 - smoothstep(0.4, 0.8, pixel * t / seen_m))
+        * (1.0 - smoothstep(PUFF_PATH_CELLS - 2.0, PUFF_PATH_CELLS, path_cells));
     var body = vec4<f32>(rgb * density, density);
     if (resolve > 0.0) {
-        // The ray in the layer's local frame at the point met (the round Earth's up there).
-        let rc = frame.sky_horizon_rgb.w;
-        let up = select(normalize(dir * t + vec3<f32>(0.0, 0.0, rc)), vec3<f32>(0.0, 0.0, 1.0), rc <= 0.0);
-        let sin_l = clamp(dot(dir, up), -1.0, 1.0);
         let along = dir.xy / max(length(dir.xy), 1.0e-6);
-        let local = vec3<f32>(along * sqrt(1.0 - sin_l * sin_l), sin_l);
+        let local = vec3<f32>(along * cos_l, sin_l);
         let puffs = heaped_puffs(
             vec3<f32>(world, height),
             local,

@@ -596,6 +596,27 @@ mod tests {
         z.atan2(x)
     }
 
+    /// The shipped far field's heaped clouds are the near cumulus' size and shape: their
+    /// diameters and height over diameter are cumulus mediocris' in config/cloud_types.toml.
+    #[test]
+    fn the_shipped_puffs_are_the_cumulus_of_the_cloud_types() {
+        let shipped = crate::render::RenderSettings::default().far_field;
+        let types = crate::clouds::CloudTypes::builtin();
+        let cumulus = types.get(crate::weather::CloudType::CumulusMediocris);
+        assert_eq!(shipped.heaped_cloud_size_m, cumulus.cloud_size_m);
+        assert_eq!(
+            shipped.heaped_height_over_size,
+            cumulus.max_height_over_size
+        );
+        assert!(shipped.invalid_field().is_none());
+        let mut too_big = shipped;
+        too_big.heaped_cloud_size_m[1] = shipped.heaped_scale_m;
+        assert_eq!(
+            too_big.invalid_field().map(|f| f.0),
+            Some("far_field.heaped_cloud_size_m")
+        );
+    }
+
     /// From FL350 over a layer from 1,000 to 3,000 m, out to 700 km: every point of the layer
     /// the pass may draw lies inside the band (its highest near the layer's own horizon, 330 km
     /// out), and the band is a narrow strip below the horizon, not the screen.
