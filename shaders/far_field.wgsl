@@ -181,6 +181,7 @@ fn cloud_noise(world: vec2<f32>, scale_m: f32, footprint_m: f32) -> f32 {
     return n + 0.2 * octave(world, scale_m * 0.25, vec2<f32>(3.7, 41.9), footprint_m, 0.5, 1.0);
 }
 
+// 32 random bits of a lattice cell (and a salt), for four 8-bit values of one puff.
 fn hash_u32(c: vec2<i32>, salt: u32) -> u32 {
     var h = (u32(c.x) * 747796405u) ^ (u32(c.y) * 2891336453u) ^ (salt * 2246822519u);
     h = (h ^ (h >> 16u)) * 73244475u;
@@ -199,21 +200,20 @@ const PUFF_PATH_CELLS: f32 = 6.0;
 const PUFF_WAIST: f32 = 0.3;
 
 // The heaped layer's clouds one by one where a pixel resolves them, as the near cumulus' sprites
-// show them: a lattice of cells of `cell_m` (`heaped_scale_m`) over the world, each cell with
-// one puff or none, there with the chance that the cover `cover` asks, its diameter between the
-// cumulus' smallest and largest (`ff.puffs`, from config/cloud_types.toml), larger with the
-// cover where they cannot cover it at their own size, its centre anywhere in its cell (no row
-// of the lattice shows: one point strewn a cell); each an ellipsoid cut flat below its middle
-// on the layer's base, as tall as its diameter allows up to the layer's top. The ray `d` (unit, in the local
-// frame at the point `o`: world metres in the noise's period, and metres above sea level)
+// show them: a lattice of cells of `cell_m` (`heaped_scale_m`) over the world, each cell with one
+// puff or none, there with the chance that the cover `cover` asks, its diameter between the
+// cumulus' smallest and largest (`ff.puffs`, from config/cloud_types.toml), larger with the cover
+// where they cannot cover it at their own size, its centre anywhere in its cell (no row of the
+// lattice shows: one point strewn a cell); each an ellipsoid cut flat below its middle on the
+// layer's base, as tall as its diameter allows up to the layer's top. The ray `d` (unit, in the
+// local frame at the point `o`: world metres in the noise's period, and metres above sea level)
 // crosses the slab `base..top`; it is walked through the cells of the lattice offset by half a
-// cell, whose corners are the primary cells' centres: a puff reaches no farther than half a
-// cell from its centre, so the four primary cells about a walked cell hold every puff the ray
-// can meet there, and each puff is taken in the one step where the ray passes nearest it (front
-// to back, near enough). Each puff met is lit on its sunward side and on top, shaded on its
-// flat underside, its outline and light lumpy with `bumps` (the pixel's cauliflowers, -0.5 to
-// 0.5), its outline softened over `edge_m` (a pixel's width there). Premultiplied colour
-// (before the haze) and alpha.
+// cell, whose corners are the primary cells' centres: a puff reaches no farther than half a cell
+// from its centre, so the four primary cells about a walked cell hold every puff the ray can meet
+// there, and each puff is taken in the one step where the ray passes nearest it (front to back,
+// near enough). Each puff met is lit on its sunward side and on top, shaded on its flat underside,
+// its outline and light lumpy with `bumps` (the pixel's cauliflowers, -0.5 to 0.5), its outline
+// softened over `edge_m` (a pixel's width there). Premultiplied colour (before the haze) and alpha.
 fn heaped_puffs(
     o: vec3<f32>,
     d: vec3<f32>,
@@ -268,10 +268,10 @@ fn heaped_puffs(
             let r = 0.5 * size;
             let height = max(min(top - base, size * ff.puffs.z), 0.2 * size);
             let centre = (vec2<f32>(cell) + u.zw) * cell_m;
-            // The ray in the puff's frame, its height scaled so the puff is a sphere of `r`,
-            // the outline lumpy.
-            // Widest a third of the way up (an ellipsoid cut below its middle: a cumulus'
-            // steep sides over its flat base, not a dome's), `cut` the base in the scaled frame.
+            // The ray in the puff's frame, its height scaled so the puff is a sphere of `r`
+            // (its outline `rb`, lumpy), widest a third of the way up (an ellipsoid cut below
+            // its middle: a cumulus' steep sides over its flat base, not a dome's); `cut`: the
+            // base in the scaled frame.
             let squash = r / ((1.0 - PUFF_WAIST) * height);
             let cut = -r * PUFF_WAIST / (1.0 - PUFF_WAIST);
             let rb = min(r * (1.0 + 0.4 * bumps), 0.5 * cell_m);
@@ -293,7 +293,7 @@ fn heaped_puffs(
             let a = smoothstep(rb + 0.5 * edge_m, rb - 0.5 * edge_m, miss)
                 * smoothstep(-0.5 * edge_m, 0.5 * edge_m, highest)
                 * select(0.0, 1.0, here);
-            // Lit where the ray meets it: on the dome by its normal (sunward and upward
+            // Lit where the ray meets it: on its body by the normal (sunward and upward
             // brighter), through the flat base from below shaded.
             let at = select(closest, enter, inside > 0.0);
             let n = normalize(vec3<f32>(at.xy, at.z * squash) + vec3<f32>(0.0, 0.0, 1.0e-3));
@@ -417,7 +417,11 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
     // takes (`PUFF_STEPS`, at a shallow slant), the noise again, so that no puff comes and goes
     // where the walk ends.
     let rc = frame.sky_horizon_rgb.w;
-    let up = select(normalize(dir * t + vec3<f32>(0.0, 0.0, rc)), vec3<f32>(0.0, 0.0, 1.0), rc <= 0.0);
+    let up = select(
+        normalize(dir * t + vec3<f32>(0.0, 0.0, rc)),
+        vec3<f32>(0.0, 0.0, 1.0),
+        rc <= 0.0,
+    );
     let sin_l = clamp(dot(dir, up), -1.0, 1.0);
     let cos_l = sqrt(1.0 - sin_l * sin_l);
     let path_cells = (cell.z - cell.y) * cos_l / (max(abs(sin_l), 1.0e-3) * ff.shade_rgb.w);

@@ -1881,14 +1881,14 @@ fn from_fl350_the_clouds_reach_the_horizon() {
     assert!(today < 0.01, "the far field off still shows {today}");
 }
 
-/// Mean luminance change per pixel between successive frames of a flight north towards cumulus
-/// 58 to 62 km ahead over a far field of heaped cloud (cover 0.05, 0.15 with the ring): the
-/// clouds cross the end of the hand-over band at 60 km, where the clouds drawn nearer fade out and the far field fades in, over
-/// `band_m`. `ring`: `None` flies at 10 km looking 8 degrees down, the ring off and the sprites
-/// drawn to 100 km (the sprite / far-field boundary); `Some(crossfade_s)` flies at 4.4 km,
-/// within the ring's height limit of the clouds, looking 3 degrees down, the ring on (its blocks
-/// beyond 20 km from its centre, rebuilt every 400 m and crossfaded over `crossfade_s`: the
-/// ring / far-field boundary, which moves with the ring's centre at each rebuild). A frame's
+/// Mean luminance change per pixel between successive frames of a flight north towards cumulus 58
+/// to 62 km ahead over a far field of heaped cloud (cover 0.05, 0.15 with the ring): the clouds
+/// cross the end of the hand-over band at 60 km, where the clouds drawn nearer fade out and the far
+/// field fades in, over `band_m`. `ring`: `None` flies at 10 km looking 8 degrees down, the ring
+/// off and the sprites drawn to 100 km (the sprite / far-field boundary); `Some(crossfade_s)` flies
+/// at 4.4 km, within the ring's height limit of the clouds, looking 3 degrees down, the ring on
+/// (its blocks beyond 20 km from its centre, rebuilt every 400 m and crossfaded over `crossfade_s`:
+/// the ring / far-field boundary, which moves with the ring's centre at each rebuild). A frame's
 /// change is the sum over the pixels of their luminance's change; returned, each frame's change
 /// over the median change of the frames around it (three either side): above 1 where a frame
 /// changes more than the plain motion around it.
