@@ -29,6 +29,10 @@ struct FarField {
     heights: vec4<f32>,
     // x: how far the map has faded in, 0..1 (a first map, new weather).
     fade: vec4<f32>,
+    // The heaped layers' clouds one by one (`heaped_puffs`): x, y: their smallest and largest
+    // diameter, metres; z: their greatest height over their diameter; w: the share of the
+    // layer they cover when every cell holds one.
+    puffs: vec4<f32>,
 };
 
 struct FarOut {
@@ -177,6 +181,137 @@ fn cloud_noise(world: vec2<f32>, scale_m: f32, footprint_m: f32) -> f32 {
     return n + 0.2 * octave(world, scale_m * 0.25, vec2<f32>(3.7, 41.9), footprint_m, 0.5, 1.0);
 }
 
+// 32 random bits of a lattice cell (and a salt), for four 8-bit values of one puff.
+fn hash_u32(c: vec2<i32>, salt: u32) -> u32 {
+    var h = (u32(c.x) * 747796405u) ^ (u32(c.y) * 2891336453u) ^ (salt * 2246822519u);
+    h = (h ^ (h >> 16u)) * 73244475u;
+    h = (h ^ (h >> 16u)) * 73244475u;
+    return h ^ (h >> 16u);
+}
+
+// Cells of the walk along a pixel's ray in the heaped layer, at most (from FL350 about 4 at the
+// hand-over band; where the slab is crossed at a shallower slant, the puffs are faded out
+// before the walk would need more: `PUFF_PATH_CELLS`).
+const PUFF_STEPS: i32 = 12;
+// The longest path through the layer, in cells, on which the puffs are drawn whole: the walk
+// crosses at most `sqrt(2)` times as many cells and two more.
+const PUFF_PATH_CELLS: f32 = 6.0;
+// The share of a puff's height below its widest.
+const PUFF_WAIST: f32 = 0.3;
+
+// The heaped layer's clouds one by one where a pixel resolves them, as the near cumulus' sprites
+// show them: a lattice of cells of `cell_m` (`heaped_scale_m`) over the world, each cell with one
+// puff or none, there with the chance that the cover `cover` asks, its diameter between the
+// cumulus' smallest and largest (`ff.puffs`, from config/cloud_types.toml), larger with the cover
+// where they cannot cover it at their own size, its centre anywhere in its cell (no row of the
+// lattice shows: one point strewn a cell); each an ellipsoid cut flat below its middle on the
+// layer's base, as tall as its diameter allows up to the layer's top. The ray `d` (unit, in the
+// local frame at the point `o`: world metres in the noise's period, and metres above sea level)
+// crosses the slab `base..top`; it is walked through the cells of the lattice offset by half a
+// cell, whose corners are the primary cells' centres: a puff reaches no farther than half a cell
+// from its centre, so the four primary cells about a walked cell hold every puff the ray can meet
+// there, and each puff is taken in the one step where the ray passes nearest it (front to back,
+// near enough). Each puff met is lit on its sunward side and on top, shaded on its flat underside,
+// its outline and light lumpy with `bumps` (the pixel's cauliflowers, -0.5 to 0.5), its outline
+// softened over `edge_m` (a pixel's width there). Premultiplied colour (before the haze) and alpha.
+fn heaped_puffs(
+    o: vec3<f32>,
+    d: vec3<f32>,
+    base: f32,
+    top: f32,
+    cover: f32,
+    cell_m: f32,
+    edge_m: f32,
+    bumps: f32,
+) -> vec4<f32> {
+    // Where the ray is in the slab: from its entry to its exit, both relative to `o`.
+    let dz = select(min(d.z, -1.0e-4), max(d.z, 1.0e-4), d.z >= 0.0);
+    let ta = (top - o.z) / dz;
+    let tb = (base - o.z) / dz;
+    let t0 = min(ta, tb);
+    let length_m = max(ta, tb) - t0;
+    let start = o + d * t0;
+    // The walk (Amanatides and Woo) over the offset lattice, in cells.
+    let q = start.xy / cell_m - vec2<f32>(0.5);
+    let dq = d.xy / cell_m;
+    var walked = vec2<i32>(floor(q));
+    let step_c = vec2<i32>(select(vec2<f32>(-1.0), vec2<f32>(1.0), dq >= vec2<f32>(0.0)));
+    let inv = 1.0 / max(abs(dq), vec2<f32>(1.0e-9));
+    var next = (select(floor(q), floor(q) + vec2<f32>(1.0), dq >= vec2<f32>(0.0)) - q)
+        * sign(dq) * inv;
+    next = select(next, vec2<f32>(1.0e30), dq == vec2<f32>(0.0));
+    let m = vec2<i32>(i32(round(ff.heights.w / cell_m)) - 1);
+    // The chance a cell holds a puff, and the puffs' size, for this cover: the cumulus' own
+    // sizes until every cell holds one, larger beyond, up to a cell (about 0.6 of the layer's
+    // area; at a slant their sides close the rest).
+    let share = ff.puffs.w;
+    let chance = min(cover / share, 1.0);
+    let grow = sqrt(max(cover / share, 1.0));
+    let sun = frame.sun_dir.xyz;
+    var acc = vec4<f32>(0.0);
+    var t = 0.0;
+    for (var k = 0; k < PUFF_STEPS; k++) {
+        if (t > length_m || acc.a > 0.98) {
+            break;
+        }
+        let t_out = min(next.x, next.y);
+        for (var corner = 0; corner < 4; corner++) {
+            let cell = walked + vec2<i32>(corner & 1, corner >> 1u);
+            let h = hash_u32(cell & m, 1u);
+            let u = vec4<f32>(
+                f32(h & 255u),
+                f32((h >> 8u) & 255u),
+                f32((h >> 16u) & 255u),
+                f32(h >> 24u),
+            ) / 255.0;
+            let size = min(mix(ff.puffs.x, ff.puffs.y, u.y) * grow, cell_m);
+            let r = 0.5 * size;
+            let height = max(min(top - base, size * ff.puffs.z), 0.2 * size);
+            let centre = (vec2<f32>(cell) + u.zw) * cell_m;
+            // The ray in the puff's frame, its height scaled so the puff is a sphere of `r`
+            // (its outline `rb`, lumpy), widest a third of the way up (an ellipsoid cut below
+            // its middle: a cumulus' steep sides over its flat base, not a dome's); `cut`: the
+            // base in the scaled frame.
+            let squash = r / ((1.0 - PUFF_WAIST) * height);
+            let cut = -r * PUFF_WAIST / (1.0 - PUFF_WAIST);
+            let rb = min(r * (1.0 + 0.4 * bumps), 0.5 * cell_m);
+            let p = vec3<f32>(start.xy - centre, (start.z - base - PUFF_WAIST * height) * squash);
+            let v = vec3<f32>(d.xy, d.z * squash);
+            let vv = dot(v, v);
+            let tc = -dot(p, v) / vv;
+            // Taken in the step the ray passes nearest it.
+            let mine = clamp(tc, 0.0, length_m);
+            let here = mine >= t && mine < t_out && u.x < chance;
+            let closest = p + v * tc;
+            let miss = length(closest);
+            let inside = rb * rb - miss * miss;
+            let half_chord = sqrt(max(inside, 0.0) / vv);
+            let enter = p + v * (tc - half_chord);
+            let leave = p + v * (tc + half_chord);
+            // Above the base somewhere along the chord, softly.
+            let highest = (select(closest.z, max(enter.z, leave.z), inside > 0.0) - cut) / squash;
+            let a = smoothstep(rb + 0.5 * edge_m, rb - 0.5 * edge_m, miss)
+                * smoothstep(-0.5 * edge_m, 0.5 * edge_m, highest)
+                * select(0.0, 1.0, here);
+            // Lit where the ray meets it: on its body by the normal (sunward and upward
+            // brighter), through the flat base from below shaded.
+            let at = select(closest, enter, inside > 0.0);
+            let n = normalize(vec3<f32>(at.xy, at.z * squash) + vec3<f32>(0.0, 0.0, 1.0e-3));
+            let up = clamp((at.z - cut) / (rb - cut), 0.0, 1.0);
+            let lit = clamp(0.5 * up + 0.6 * max(dot(n, sun), 0.0) + 0.5 * bumps - 0.2, 0.0, 1.0);
+            let light = select(lit, 0.0, at.z < cut && d.z > 0.0);
+            let rgb = mix(ff.shade_rgb.rgb, ff.lit_rgb.rgb, light);
+            acc += vec4<f32>(rgb, 1.0) * (a * (1.0 - acc.a));
+        }
+        // On to the next cell of the walk.
+        let x_next = next.x < next.y;
+        t = t_out;
+        walked += select(vec2<i32>(0, step_c.y), vec2<i32>(step_c.x, 0), x_next);
+        next += select(vec2<f32>(0.0, inv.y), vec2<f32>(inv.x, 0.0), x_next);
+    }
+    return acc;
+}
+
 // How much the grain (`far_layer`) lights and shades a sheet's and a heaped layer's tops.
 const GRAIN_SHEET: f32 = 0.12;
 const GRAIN_HEAPED: f32 = 0.5;
@@ -258,7 +393,6 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
     let soft = select(0.12, 0.03, heaped);
     let threshold = mix(0.78, 0.22, cover);
     let density = select(smoothstep(threshold - soft, threshold + soft, n), 1.0, cover > 0.97);
-    var alpha = density * weight;
     // Seen from above its top the sunlit side, from below its base the shade, in between mixed;
     // the lumps of a heaped layer lit on their tops and shaded at their edges, also where
     // their sides close the gaps at a slant (the threshold low: lit by the noise about its
@@ -272,6 +406,46 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
         heaped,
     );
     var rgb = mix(ff.shade_rgb.rgb, ff.lit_rgb.rgb * clamp(relief, 0.5, 1.1), from_above);
+    // Where a pixel resolves them, a heaped layer's clouds one by one (`heaped_puffs`), as the
+    // sprites draw them nearer: they take over from the noise as the puffs grow to a few
+    // pixels (their width, or their height seen at the ray's slant, whichever is less).
+    let size_m = 0.5 * (ff.puffs.x + ff.puffs.y);
+    let tall_m = min(cell.z - cell.y, size_m * ff.puffs.z);
+    let seen_m = min(size_m, size_m * sin_e + tall_m * sqrt(1.0 - sin_e * sin_e));
+    // The ray in the layer's local frame at the point met (the round Earth's up there), and the
+    // cells of the puffs' lattice it crosses in the layer: where that is more than the walk
+    // takes (`PUFF_STEPS`, at a shallow slant), the noise again, so that no puff comes and goes
+    // where the walk ends.
+    let rc = frame.sky_horizon_rgb.w;
+    let up = select(
+        normalize(dir * t + vec3<f32>(0.0, 0.0, rc)),
+        vec3<f32>(0.0, 0.0, 1.0),
+        rc <= 0.0,
+    );
+    let sin_l = clamp(dot(dir, up), -1.0, 1.0);
+    let cos_l = sqrt(1.0 - sin_l * sin_l);
+    let path_cells = (cell.z - cell.y) * cos_l / (max(abs(sin_l), 1.0e-3) * ff.shade_rgb.w);
+    let resolve = select(0.0, 1.0, heaped)
+        * (1.0 - smoothstep(0.4, 0.8, pixel * t / seen_m))
+        * (1.0 - smoothstep(PUFF_PATH_CELLS - 2.0, PUFF_PATH_CELLS, path_cells));
+    var body = vec4<f32>(rgb * density, density);
+    if (resolve > 0.0) {
+        let along = dir.xy / max(length(dir.xy), 1.0e-6);
+        let local = vec3<f32>(along * cos_l, sin_l);
+        let puffs = heaped_puffs(
+            vec3<f32>(world, height),
+            local,
+            cell.y,
+            cell.z,
+            clamp(cell.x, 0.0, 1.0),
+            ff.shade_rgb.w,
+            0.6 * pixel * t,
+            octave(world, 0.2 * ff.shade_rgb.w, vec2<f32>(11.3, 2.9), pixel * t, 0.8, 1.6) - 0.5,
+        );
+        body = mix(body, puffs, resolve);
+    }
+    var alpha = body.a * weight;
+    rgb = body.rgb / max(body.a, 1.0e-6);
     // The altitude haze between the camera and the clouds (the flat frame's height: the true).
     let haze = haze_transmittance(t, height - camera);
     rgb = mix(frame.sky_horizon_rgb.rgb, rgb, haze);

@@ -1881,14 +1881,14 @@ fn from_fl350_the_clouds_reach_the_horizon() {
     assert!(today < 0.01, "the far field off still shows {today}");
 }
 
-/// Mean luminance change per pixel between successive frames of a flight north towards cumulus
-/// 58 to 62 km ahead over a far field of heaped cloud: the clouds cross the end of the hand-over
-/// band at 60 km, where the clouds drawn nearer fade out and the far field fades in, over
-/// `band_m`. `ring`: `None` flies at 10 km looking 8 degrees down, the ring off and the sprites
-/// drawn to 100 km (the sprite / far-field boundary); `Some(crossfade_s)` flies at 4.4 km,
-/// within the ring's height limit of the clouds, looking 3 degrees down, the ring on (its blocks
-/// beyond 20 km from its centre, rebuilt every 400 m and crossfaded over `crossfade_s`: the
-/// ring / far-field boundary, which moves with the ring's centre at each rebuild). A frame's
+/// Mean luminance change per pixel between successive frames of a flight north towards cumulus 58
+/// to 62 km ahead over a far field of heaped cloud (cover 0.05, 0.15 with the ring): the clouds
+/// cross the end of the hand-over band at 60 km, where the clouds drawn nearer fade out and the far
+/// field fades in, over `band_m`. `ring`: `None` flies at 10 km looking 8 degrees down, the ring
+/// off and the sprites drawn to 100 km (the sprite / far-field boundary); `Some(crossfade_s)` flies
+/// at 4.4 km, within the ring's height limit of the clouds, looking 3 degrees down, the ring on
+/// (its blocks beyond 20 km from its centre, rebuilt every 400 m and crossfaded over `crossfade_s`:
+/// the ring / far-field boundary, which moves with the ring's centre at each rebuild). A frame's
 /// change is the sum over the pixels of their luminance's change; returned, each frame's change
 /// over the median change of the frames around it (three either side): above 1 where a frame
 /// changes more than the plain motion around it.
@@ -1907,9 +1907,14 @@ fn hand_over_run(band_m: f32, ring: Option<f64>) -> Vec<f32> {
     };
     let ground = HeightField::from_fn(DVec2::ZERO, 400_000.0, 16, |_| 0.0);
     let mut rig = Rig::with_settings(ground, settings);
+    // The far field's own layer: sparser seen from 10 km, where the far field draws its heaped
+    // clouds one by one (from 4.4 km it crosses them at too shallow a slant and draws the
+    // noise): their texture moves with the flight as the sprites' does, and a sparser layer
+    // keeps the cumulus crossing the band the larger share of a frame's change.
+    let cover = if ring.is_some() { 0.15 } else { 0.05 };
     rig.host
         .sky
-        .set_far_map(&rig.host.gpu.queue, &uniform_far_map(0.15), None);
+        .set_far_map(&rig.host.gpu.queue, &uniform_far_map(cover), None);
     let mut blocks = Vec::new();
     // Sixteen along a diagonal 58 to 61.75 km ahead: as the camera flies 1 km, the end of the
     // band passes four of them, each on a frame of its own.
@@ -2111,5 +2116,131 @@ fn a_block_arriving_adds_its_shadow_to_the_map() {
     assert!(
         worst < 2e-3,
         "the added map differs from a whole drawing by {worst}"
+    );
+}
+
+/// Mean luminance step from one pixel to the next along the rows `rows` of a frame: the fine
+/// grain of what those rows show.
+fn row_step(frame: &Frame, rows: &[u32]) -> f32 {
+    let mut sum = 0.0;
+    for &y in rows {
+        for x in 1..W {
+            let i = (y * W + x) as usize;
+            sum += (luminance(frame.rgba[i]) - luminance(frame.rgba[i - 1])).abs();
+        }
+    }
+    sum / (rows.len() as u32 * (W - 1)) as f32
+}
+
+/// Issue 31, the far field's heaped layer reads as the cumulus the sprites draw: from FL350,
+/// the rows whose rays meet a scattered cumulus mediocris layer 60 to 75 km out (where the
+/// far field takes over from the sprites) are drawn once by the clouds stage's own sprites
+/// (the far field off, the sprites drawn to 150 km) and once by the far field alone (its
+/// map made from the same weather, its hand-over pulled in to 20-25 km). The far field's
+/// pixel-to-pixel luminance step is at least 0.9 of the sprites': discrete clouds with lit
+/// tops, shaded bases and the ground between them, not a soft texture (the noise texture of
+/// before, the puffs off, drew 0.62 of it).
+#[test]
+fn the_far_fields_cumulus_have_the_sprites_grain() {
+    let weather = BlockWeather {
+        layers: vec![BlockLayer {
+            cloud_type: CloudType::CumulusMediocris,
+            type_source: TypeSource::Reported,
+            coverage_oktas: 4.0,
+            base_ft_agl: 5000.0,
+            thickness_ft: 3000.0,
+        }],
+        visibility_m: 9999.0,
+        ground_elevation_m: 0.0,
+        ..BlockWeather::default()
+    };
+    let types = CloudTypes::builtin();
+    // Blocks of 4 km over the view 52 to 84 km ahead.
+    let blocks: Vec<SkyBlock> = (13..21)
+        .flat_map(|j| (-5..5).map(move |i| BlockIndex::new(i, j)))
+        .map(|index| {
+            let block = generate_block(index, &weather, 7, &types);
+            let c = index.centre_m();
+            SkyBlock {
+                id: block_id(index),
+                centre_m: DVec3::new(c.x, c.y, 2000.0),
+                clouds: block.clouds.iter().map(SkyCloud::from).collect(),
+            }
+        })
+        .collect();
+    let cell = skycast::clouds::far_map::far_cell(&weather);
+    let map = skycast::clouds::far_map::FarMap {
+        texels: 96,
+        texel_m: 10_000.0,
+        centre_m: DVec2::ZERO,
+        cells: vec![cell; 96 * 96],
+    };
+    let (pitch, fov) = (-8.0f64, 12.0f64);
+    let frame = |far: bool| {
+        let mut settings = RenderSettings::default();
+        settings.camera.fov_y_deg = fov as f32;
+        settings.clouds.draw_distance_m = 150_000.0;
+        settings.far_field.enabled = far;
+        settings.far_field.fade_start_m = 20_000.0;
+        settings.far_field.fade_end_m = 25_000.0;
+        let ground = HeightField::from_fn(DVec2::ZERO, 200_000.0, 16, |_| 0.0);
+        let mut rig = Rig::with_settings(ground, settings);
+        rig.host.sky.set_far_map(&rig.host.gpu.queue, &map, None);
+        if !far {
+            rig.set_clouds(blocks.clone());
+        }
+        let cam = rig.camera(DVec3::new(0.0, 0.0, 10_668.0), 0.0, pitch);
+        rig.frame(
+            if far {
+                "grain-far-field"
+            } else {
+                "grain-sprites"
+            },
+            &cam,
+        )
+        .0
+    };
+    // The rows whose middle column's ray meets the layer's middle (the sphere's geometry).
+    let middle = f64::from(0.5 * (cell[1] + cell[2]));
+    let r = 6_371_000.0f64;
+    let layer_km = |row: u32| -> Option<f64> {
+        let ndc = 1.0 - 2.0 * (row as f64 + 0.5) / H as f64;
+        let elevation = pitch.to_radians() + (ndc * (0.5 * fov).to_radians().tan()).atan();
+        let (rc, rl) = (r + 10_668.0, r + middle);
+        let b = rc * elevation.sin();
+        let disc = b * b - (rc * rc - rl * rl);
+        (disc >= 0.0 && b < 0.0).then(|| (-b - disc.sqrt()) / 1000.0)
+    };
+    let rows: Vec<u32> = (0..H)
+        .filter(|&y| layer_km(y).is_some_and(|d| (60.0..=75.0).contains(&d)))
+        .collect();
+    assert!(rows.len() >= 8, "rows {rows:?}");
+    let mean = |f: &Frame| {
+        let sum: f32 = rows
+            .iter()
+            .flat_map(|&y| (0..W).map(move |x| (y * W + x) as usize))
+            .map(|i| luminance(f.rgba[i]))
+            .sum();
+        255.0 * sum / (rows.len() as u32 * W) as f32
+    };
+    let (sprite_frame, far_frame) = (frame(false), frame(true));
+    let sprites = row_step(&sprite_frame, &rows);
+    let far = row_step(&far_frame, &rows);
+    eprintln!(
+        "60-75 km out, rows {rows:?}: pixel step of the sprites {:.2}/255, of the far field \
+         {:.2}/255 ({:.2} of it); mean luminance {:.1} and {:.1}",
+        sprites * 255.0,
+        far * 255.0,
+        far / sprites,
+        mean(&sprite_frame),
+        mean(&far_frame)
+    );
+    assert!(
+        sprites > 1.0 / 255.0,
+        "the sprites show no grain: {sprites}"
+    );
+    assert!(
+        far >= 0.9 * sprites,
+        "the far field's step {far} against the sprites' {sprites}"
     );
 }

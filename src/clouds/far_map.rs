@@ -76,8 +76,10 @@ fn is_high(t: CloudType) -> bool {
     )
 }
 
-/// Whether a type's far texture is heaped (cumuliform) rather than a sheet.
-fn is_heaped(t: CloudType) -> bool {
+/// Whether a layer's far texture is heaped (separate clouds) rather than a sheet: the
+/// cumuliform types, and stratocumulus short of overcast (the clouds stage draws it as separate
+/// flat clouds then, config/cloud_types.toml; an overcast one as a deck on the lattice).
+fn is_heaped(t: CloudType, oktas: f32) -> bool {
     matches!(
         t,
         CloudType::CumulusHumilis
@@ -86,7 +88,7 @@ fn is_heaped(t: CloudType) -> bool {
             | CloudType::Cumulonimbus
             | CloudType::Altocumulus
             | CloudType::Cirrocumulus
-    )
+    ) || (t == CloudType::Stratocumulus && oktas < 8.0)
 }
 
 /// The cell of a weather (module docs).
@@ -113,7 +115,7 @@ pub fn far_cell(weather: &BlockWeather) -> FarCell {
             let base = ground + l.base_ft_agl * METRES_PER_FOOT as f32;
             let top = base + l.thickness_ft.max(0.0) * METRES_PER_FOOT as f32;
             if best.is_none_or(|b| cover > b.0) {
-                best = Some((cover, base, top, is_heaped(l.cloud_type)));
+                best = Some((cover, base, top, is_heaped(l.cloud_type, l.coverage_oktas)));
             }
         }
         if let Some((_, base, top, heaped)) = best {
@@ -250,6 +252,13 @@ mod tests {
         assert_eq!(c[3], 1.0);
         assert!((c[4] - 0.75).abs() < 1e-6 && c[7] == 0.0, "{c:?}");
         assert_eq!(far_cell(&BlockWeather::default())[0], 0.0);
+        // Broken stratocumulus is separate clouds, an overcast one a sheet.
+        let sc = |oktas| BlockWeather {
+            layers: vec![layer(CloudType::Stratocumulus, oktas, 4000.0, 1000.0)],
+            ..BlockWeather::default()
+        };
+        assert_eq!(far_cell(&sc(6.0))[3], 1.0);
+        assert_eq!(far_cell(&sc(8.0))[3], 0.0);
     }
 
     #[test]

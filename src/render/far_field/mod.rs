@@ -97,7 +97,15 @@ pub struct FarFieldSettings {
     /// See `fade_start_m`.
     pub fade_end_m: f32,
     /// Size of the lumps of heaped (cumuliform) layers, metres; sheets' patches are 8 times it.
+    /// Also the cell of the lattice the heaped layers' puffs stand on, where a pixel resolves
+    /// them (a puff or none a cell, anywhere in it).
     pub heaped_scale_m: f32,
+    /// The heaped layers' puffs' smallest and largest diameter, metres, at a cover they fill
+    /// without growing (the near cumulus' `cloud_size_m`, config/cloud_types.toml).
+    pub heaped_cloud_size_m: [f32; 2],
+    /// A puff's greatest height over its diameter (the cumulus' `max_height_over_size`); the
+    /// layer's top caps it.
+    pub heaped_height_over_size: f32,
 }
 
 impl Default for FarFieldSettings {
@@ -111,6 +119,8 @@ impl Default for FarFieldSettings {
             fade_start_m: 42_000.0,
             fade_end_m: 60_000.0,
             heaped_scale_m: 2_000.0,
+            heaped_cloud_size_m: [800.0, 1600.0],
+            heaped_height_over_size: 1.0,
         }
     }
 }
@@ -142,7 +152,30 @@ impl FarFieldSettings {
                 "must be at least 10 metres".into(),
             ));
         }
+        let [small, large] = self.heaped_cloud_size_m;
+        if !(small >= 10.0 && large >= small && large <= 0.9 * self.heaped_scale_m) {
+            return Some((
+                "far_field.heaped_cloud_size_m",
+                "must be [smallest, largest], at least 10 metres and at most 0.9 heaped_scale_m"
+                    .into(),
+            ));
+        }
+        if !(self.heaped_height_over_size > 0.0 && self.heaped_height_over_size <= 20.0) {
+            return Some((
+                "far_field.heaped_height_over_size",
+                "must be above 0 and at most 20".into(),
+            ));
+        }
         None
+    }
+
+    /// The share of a heaped layer its puffs cover on average when every cell holds one (their
+    /// overlaps counted twice): a disc's mean area over the cell's, the diameters spread evenly
+    /// between the smallest and the largest.
+    pub fn puff_share(&self) -> f32 {
+        let [a, b] = self.heaped_cloud_size_m;
+        let mean_square = (a * a + a * b + b * b) / 3.0;
+        std::f32::consts::FRAC_PI_4 * mean_square / (self.heaped_scale_m * self.heaped_scale_m)
     }
 
     /// The noise's period, metres: a power of two of the heaped and the sheet cells (1024 and
@@ -171,8 +204,11 @@ pub struct GpuFarField {
     /// x: how far the map has faded in, 0..=1; y, z: the band of elevations the pass is drawn
     /// over, radians (lowest first; equal: nothing to draw); w unused.
     pub fade: [f32; 4],
+    /// The heaped layers' puffs: x, y: their smallest and largest diameter, metres; z: their
+    /// greatest height over their diameter; w: [`FarFieldSettings::puff_share`].
+    pub puffs: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuFarField>() == 96);
+const _: () = assert!(std::mem::size_of::<GpuFarField>() == 112);
 
 /// What the far field needs of the sky's layouts and targets.
 pub(super) struct FarFieldShared<'a> {
@@ -512,6 +548,12 @@ impl FarField {
                 band.1,
                 0.0,
             ],
+            puffs: [
+                s.heaped_cloud_size_m[0],
+                s.heaped_cloud_size_m[1],
+                s.heaped_height_over_size,
+                s.puff_share(),
+            ],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&gpu));
     }
@@ -552,6 +594,27 @@ mod tests {
         let theta = s / (r + c);
         let (x, z) = ((r + h) * theta.sin(), (r + h) * theta.cos() - (r + c));
         z.atan2(x)
+    }
+
+    /// The shipped far field's heaped clouds are the near cumulus' size and shape: their
+    /// diameters and height over diameter are cumulus mediocris' in config/cloud_types.toml.
+    #[test]
+    fn the_shipped_puffs_are_the_cumulus_of_the_cloud_types() {
+        let shipped = crate::render::RenderSettings::default().far_field;
+        let types = crate::clouds::CloudTypes::builtin();
+        let cumulus = types.get(crate::weather::CloudType::CumulusMediocris);
+        assert_eq!(shipped.heaped_cloud_size_m, cumulus.cloud_size_m);
+        assert_eq!(
+            shipped.heaped_height_over_size,
+            cumulus.max_height_over_size
+        );
+        assert!(shipped.invalid_field().is_none());
+        let mut too_big = shipped;
+        too_big.heaped_cloud_size_m[1] = shipped.heaped_scale_m;
+        assert_eq!(
+            too_big.invalid_field().map(|f| f.0),
+            Some("far_field.heaped_cloud_size_m")
+        );
     }
 
     /// From FL350 over a layer from 1,000 to 3,000 m, out to 700 km: every point of the layer
