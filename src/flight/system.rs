@@ -442,7 +442,8 @@ impl SkySystem {
         let weather_us = start.elapsed().as_micros() as u64;
         self.sky.add_field_cpu_us(weather_us);
         let position_m = self.local_m(camera.position);
-        self.world.update_sky(&mut self.sky, position_m, dt_s)?;
+        // The far field's map first: the far storm cells hand over in its band once it is
+        // drawn (`flight::far_cells`).
         if self.sky.far_field_settings().enabled {
             let field = self.world.field();
             // Cumulonimbus beyond the cloud field is drawn cell by cell (`flight::far_cells`),
@@ -464,6 +465,7 @@ impl SkySystem {
                 self.sky.set_far_map(queue, &map, fade_s);
             }
         }
+        self.world.update_sky(&mut self.sky, position_m, dt_s)?;
         self.sky.set_flash(self.world.flash_now());
         self.sky
             .set_weather_overhead(&self.world.weather_over(position_m));
