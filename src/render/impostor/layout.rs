@@ -109,20 +109,6 @@ pub fn is_far(block_m: DVec3, centre_m: DVec3, camera_m: DVec3, s: &ImpostorSett
         && dz <= s.max_height_difference_ft * METRES_PER_FOOT
 }
 
-/// Whether a block centred at `block_m`, its clouds spanning `z_span_m` (metres below and
-/// above that centre), lies within an impostor's view from a ring centred at `centre_m`: 22.5
-/// degrees above and below the horizontal, from the nearest point of the block's square, with a
-/// tenth to spare for the sprites' size. A storm cell's part near the ring radius reaches its
-/// anvil 30 degrees up, and the impostor cut it along its top edge (a straight line and a
-/// staircase across the sky); such a block stays a sprite.
-pub fn fits_impostor(block_m: DVec3, z_span_m: (f64, f64), centre_m: DVec3) -> bool {
-    let near_m = (block_m - centre_m).truncate().length()
-        - crate::weather::BLOCK_SIZE_M * std::f64::consts::FRAC_1_SQRT_2;
-    let reach_m = (block_m.z + z_span_m.1 - centre_m.z).max(centre_m.z - (block_m.z + z_span_m.0));
-    let tan_half = (0.5 * IMPOSTOR_FOV_DEG).to_radians().tan();
-    near_m > 0.0 && reach_m <= 0.9 * tan_half * near_m
-}
-
 /// Whether the camera (or sun) left a ring built at `built_m` with sun `built_sun`.
 pub fn needs_rebuild(
     built_m: DVec3,
@@ -203,36 +189,6 @@ mod tests {
         // 10,000 ft is 3,048 m.
         assert!(is_far(block(4, 0.0, 30_000.0, 4000.0), cam, cam, &s));
         assert!(!is_far(block(5, 0.0, 30_000.0, 4100.0), cam, cam, &s));
-    }
-
-    #[test]
-    fn a_block_reaching_past_an_impostors_view_stays_a_sprite() {
-        let centre = DVec3::new(0.0, 0.0, 1_000.0);
-        // A storm cell's part 22 km off, from its base at 1 km to its anvil at 12 km (the
-        // block's centre at 6.5 km): the anvil 29 degrees up from the block's near side.
-        let cell = DVec3::new(0.0, 22_000.0, 6_500.0);
-        assert!(!fits_impostor(cell, (-5_500.0, 5_500.0), centre));
-        // The same 40 km off: 17 degrees up.
-        assert!(fits_impostor(
-            cell + DVec3::Y * 18_000.0,
-            (-5_500.0, 5_500.0),
-            centre
-        ));
-        // A cumulus block 22 km off, 1-3 km: 6 degrees.
-        let cumulus = DVec3::new(0.0, 22_000.0, 2_000.0);
-        assert!(fits_impostor(cumulus, (-1_000.0, 1_000.0), centre));
-        // A deck 5 km below the camera, 22 km off: 15 degrees down.
-        assert!(fits_impostor(
-            cumulus - DVec3::Z * 6_000.0,
-            (-100.0, 100.0),
-            centre
-        ));
-        // Nothing within the block's own square.
-        assert!(!fits_impostor(
-            DVec3::new(1_000.0, 0.0, 1_000.0),
-            (0.0, 0.0),
-            centre
-        ));
     }
 
     #[test]

@@ -552,7 +552,6 @@ impl ImpostorRing {
                     && !r.distant
                     && let Some(st) = shown
                     && is_far(r.nearest_height_m(camera_m.z), st.centre_m, camera_m, &s)
-                    && fits_impostor(r, st.centre_m)
                 {
                     far_now += 1;
                     same &= in_far;
@@ -582,9 +581,7 @@ impl ImpostorRing {
         let far: Vec<(u64, f64)> = blocks
             .values()
             .filter(|r| {
-                !r.distant
-                    && is_far(r.nearest_height_m(camera_m.z), camera_m, camera_m, &s)
-                    && fits_impostor(r, camera_m)
+                !r.distant && is_far(r.nearest_height_m(camera_m.z), camera_m, camera_m, &s)
             })
             .map(|r| (r.block.id, (r.centre_m() - camera_m).length()))
             .collect();
@@ -873,9 +870,4 @@ impl ImpostorRing {
         pass.set_bind_group(1, &self.quad_groups[old][new], &[]);
         pass.draw(0..3, 0..1);
     }
-}
-
-/// [`layout::fits_impostor`] of a resident block.
-fn fits_impostor(r: &super::resident::Resident, centre_m: DVec3) -> bool {
-    layout::fits_impostor(r.centre_m(), r.z_span_m, centre_m)
 }
