@@ -141,10 +141,16 @@ impl FarCells {
         let wanted = self.wanted(f);
         let by_key: HashMap<u64, &StormCell> = wanted.iter().map(|c| (c.key, c)).collect();
         let offset_m = DVec3::new(f.drift_m.x, f.drift_m.y, 0.0);
-        // Leaving: dissipate (a cell whose weather changed leaves too, its new self joins).
+        // Leaving: dissipate. Wanted again while dissipating: form back from as far as it
+        // had gone. (A cell whose weather changed is replaced by its new self below.)
+        let fade_s = self.settings.fade_s;
         for s in self.shown.values_mut() {
             let keep = by_key.get(&s.cell.key).is_some_and(|c| **c == s.cell);
             match s.fade {
+                Some((true, since)) if keep => {
+                    let gone = ((f.now_s - since) / fade_s.max(1e-9)).clamp(0.0, 1.0);
+                    s.fade = Some((false, f.now_s - (1.0 - gone) * fade_s));
+                }
                 _ if keep => {}
                 Some((true, _)) => {}
                 _ => s.fade = Some((true, f.now_s)),
@@ -242,7 +248,7 @@ impl FarCells {
     }
 
     /// Starts a search where the camera left the last one or the weather changed, and looks
-    /// through this frame's rows (all of them for offline frames).
+    /// through this frame's rows (all of them for an offline flight's first search).
     fn search_on(&mut self, f: &FarCellFrame) {
         let s = &self.settings;
         let grid = f.storms.0.settings.cells.grid_m;
