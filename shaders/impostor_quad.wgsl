@@ -46,6 +46,10 @@ fn on_sphere(centre: vec3<f32>, dir: vec3<f32>, dist_m: f32) -> vec3<f32> {
     return dir * t;
 }
 
+// An impostor's half height over its half width: tan(35 deg) / tan(22.5 deg)
+// (`IMPOSTOR_FOV_Y_DEG` and `IMPOSTOR_FOV_DEG` in src/render/impostor/layout.rs).
+const IMPOSTOR_TALL: f32 = 1.6904;
+
 // The impostor (xyz: texture coordinates and layer) that sees `from_centre` (a direction from
 // the ring centre), and how far along its axis a unit step in that direction goes (w);
 // layer 8 when the direction leaves every impostor (above or below them).
@@ -58,7 +62,7 @@ fn impostor_at(from_centre: vec3<f32>) -> vec4<f32> {
     let facing = dot(from_centre, n);
     let q = from_centre * (ring.size.x / max(facing, 1e-6));
     let x = dot(q, right) / ring.size.y;
-    let y = q.z / ring.size.y;
+    let y = q.z / (ring.size.y * IMPOSTOR_TALL);
     var layer = f32(j);
     if (abs(x) > 1.0 || abs(y) > 1.0 || facing <= 1e-6) {
         layer = 8.0;

@@ -6,14 +6,14 @@ use std::path::PathBuf;
 
 use glam::{DVec2, DVec3};
 use skycast::clouds::CloudTypes;
-use skycast::clouds::storm::cell_cloud;
+use skycast::clouds::storm::{cell_cloud, part_in_block};
 use skycast::demo::terrain::HeightField;
 use skycast::demo::{DemoHost, Frame, headless};
 use skycast::render::scene::BlockMotion;
 use skycast::render::{Camera, SkyBlock, SkyCloud, SkyConfig, SkyFlash};
 use skycast::shading::{FogSettings, SunPosition};
 use skycast::weather::storms::{StormCell, StormSettings};
-use skycast::weather::{BlockWeather, CloudType, Wind};
+use skycast::weather::{BlockIndex, BlockWeather, CloudType, Wind};
 
 const W: u32 = 320;
 const H: u32 = 180;
@@ -318,5 +318,79 @@ fn far_cell_frames(scale: Option<f32>, block: &SkyBlock) {
     assert!(
         above * 2 >= distant_px,
         "{above} of {distant_px} over the sky"
+    );
+}
+
+/// A cell 25 km off, cut into its blocks' parts as the field draws it: the parts past the ring
+/// radius (20 km) that span the camera's height go into the impostor ring, anvil and all, and
+/// the anvil reaches 24-40 degrees up. The impostors hold it (35 degrees up and down): its
+/// pixels more than 24 degrees up are those the sprites draw. At 45 degrees of impostor height
+/// (22.5 up) the ring cut the anvil along the impostors' top edge.
+#[test]
+fn the_impostor_ring_holds_a_cells_anvil_high_above_the_horizon() {
+    let types = CloudTypes::builtin();
+    let c = StormCell {
+        centre_m: [0.0, 25_000.0],
+        ..cell()
+    };
+    let cloud = cell_cloud(
+        &c,
+        types.get(CloudType::Cumulonimbus),
+        &BlockWeather::default(),
+    );
+    // Cut into its 4 km blocks' parts, as the field draws it.
+    let mut blocks = Vec::new();
+    let reach = c.radius_m() + 4_000.0;
+    let (lo, hi) = (
+        BlockIndex::containing(c.centre() - DVec2::splat(reach)),
+        BlockIndex::containing(c.centre() + DVec2::splat(reach)),
+    );
+    for j in lo.j..=hi.j {
+        for i in lo.i..=hi.i {
+            let index = BlockIndex::new(i, j);
+            if let Some(part) = part_in_block(&cloud, index, 0) {
+                let centre = index.centre_m();
+                blocks.push(SkyBlock {
+                    id: blocks.len() as u64 + 100,
+                    centre_m: DVec3::new(centre.x, centre.y, part.centre_m.z),
+                    clouds: vec![SkyCloud::from(&part)],
+                });
+            }
+        }
+    }
+    let mut host = host();
+    host.sky.set_cloud_shadows(false);
+    // Looking up at 30 degrees: the rows of the frame from 0 (60 degrees up) down.
+    let camera = host.camera(DVec3::new(0.0, 0.0, EYE_M), 0.0, 30.0);
+    // The first ring is built at once, with the cell in it.
+    let parts = blocks.len() as u32;
+    host.sky.set_clouds(blocks);
+    let (ring, stats) = host.frame(&camera, &sun(), 0.0, 60_000.0).unwrap();
+    eprintln!(
+        "{parts} parts: {} near, {} in the ring",
+        stats.blocks_near, stats.blocks_far
+    );
+    assert!(stats.blocks_far > 0, "{stats:?}");
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("storm-tests");
+    ring.write_png(&dir.join("anvil_in_the_ring.png")).unwrap();
+    host.sky.set_impostors(false);
+    let sprites = frame(&mut host, "anvil_as_sprites", &camera);
+    host.sky.set_clouds(Vec::new());
+    let clear = frame(&mut host, "anvil_clear", &camera);
+    // The rows more than 24 degrees up: the top 36 of the frame's 60 degrees (rows 0..108).
+    let high = |f: &Frame| {
+        let mask = cell_mask(f, &clear);
+        (0..W * 108).filter(|&i| mask[i as usize]).count()
+    };
+    let (in_ring, as_sprites) = (high(&ring), high(&sprites));
+    eprintln!(
+        "anvil pixels more than 24 degrees up: {in_ring} in the ring, {as_sprites} as sprites"
+    );
+    assert!(as_sprites > 2_000, "{as_sprites}");
+    // At 45 degrees of impostor height the ring held 6,824 of the sprites' 7,308 (0.93): the
+    // cut along the impostors' top edge; at 70, 7,293.
+    assert!(
+        in_ring as f64 > 0.97 * as_sprites as f64,
+        "the ring holds {in_ring} of the anvil's {as_sprites} pixels"
     );
 }

@@ -12,8 +12,13 @@ use crate::weather::METRES_PER_FOOT;
 
 /// Number of impostors in a ring.
 pub const IMPOSTORS: usize = 8;
-/// Horizontal (and vertical) field of view of one impostor, degrees.
+/// Horizontal field of view of one impostor (its share of the ring's bearings), degrees.
 pub const IMPOSTOR_FOV_DEG: f64 = 45.0;
+/// Vertical field of view of one impostor, degrees: 35 up and down, so a storm cell's anvil
+/// 25-30 degrees above a ring block near the ring radius is held whole (at 45 the impostor cut
+/// anvils along its top edge: a straight line and a staircase across the sky). Keep
+/// `IMPOSTOR_TALL` in `shaders/impostor_quad.wgsl` in sync (its half height over half width).
+pub const IMPOSTOR_FOV_Y_DEG: f64 = 70.0;
 
 /// The `[impostors]` table of `config/render.toml`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -137,8 +142,10 @@ pub(super) fn impostor_camera(i: usize, centre_m: DVec3, s: &ImpostorSettings) -
         position_m: centre_m,
         heading_deg: heading_deg(i),
         pitch_deg: 0.0,
-        fov_y_deg: IMPOSTOR_FOV_DEG as f32,
-        aspect: 1.0,
+        fov_y_deg: IMPOSTOR_FOV_Y_DEG as f32,
+        // The width of IMPOSTOR_FOV_DEG.
+        aspect: ((0.5 * IMPOSTOR_FOV_DEG).to_radians().tan()
+            / (0.5 * IMPOSTOR_FOV_Y_DEG).to_radians().tan()) as f32,
         near_m: 50.0,
         far_m: (s.view_radius_m * 1.5) as f32,
     }
