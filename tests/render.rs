@@ -242,18 +242,7 @@ fn clear_overcast_and_in_cloud_frames() {
         ..BlockWeather::default()
     };
     let types = CloudTypes::builtin();
-    let blocks: Vec<SkyBlock> = (-2..2)
-        .flat_map(|j| (-2..2).map(move |i| BlockIndex::new(i, j)))
-        .map(|index| {
-            let block = generate_block(index, &weather, 7, &types);
-            let c = index.centre_m();
-            SkyBlock {
-                id: block_id(index),
-                centre_m: DVec3::new(c.x, c.y, 700.0),
-                clouds: block.clouds.iter().map(SkyCloud::from).collect(),
-            }
-        })
-        .collect();
+    let blocks = generated_blocks(&weather, &types, (-2..2, -2..2), 700.0);
     rig.set_clouds(blocks);
     let (stratus, stats) = rig.frame("stratus_overhead", &up);
     let covered = fraction(&stratus, |i| {
@@ -850,6 +839,26 @@ fn big_cumulus(centre: DVec3, scale: f32) -> SkyCloud {
     }
     cloud.colour_levels = levels(centre.z as f32, centre.z as f32 + 500.0 * scale);
     cloud
+}
+
+/// The blocks `columns` x `rows` generated from `weather` (seed 7), each centred at `z_m`.
+fn generated_blocks(
+    weather: &BlockWeather,
+    types: &CloudTypes,
+    (columns, rows): (std::ops::Range<i32>, std::ops::Range<i32>),
+    z_m: f64,
+) -> Vec<SkyBlock> {
+    rows.flat_map(|j| columns.clone().map(move |i| BlockIndex::new(i, j)))
+        .map(|index| {
+            let block = generate_block(index, weather, 7, types);
+            let c = index.centre_m();
+            SkyBlock {
+                id: block_id(index),
+                centre_m: DVec3::new(c.x, c.y, z_m),
+                clouds: block.clouds.iter().map(SkyCloud::from).collect(),
+            }
+        })
+        .collect()
 }
 
 /// The ring scene: a cumulus 6 km north (near), a big one 30 km north at the camera's height
@@ -2156,18 +2165,7 @@ fn the_far_fields_cumulus_have_the_sprites_grain() {
     };
     let types = CloudTypes::builtin();
     // Blocks of 4 km over the view 52 to 84 km ahead.
-    let blocks: Vec<SkyBlock> = (13..21)
-        .flat_map(|j| (-5..5).map(move |i| BlockIndex::new(i, j)))
-        .map(|index| {
-            let block = generate_block(index, &weather, 7, &types);
-            let c = index.centre_m();
-            SkyBlock {
-                id: block_id(index),
-                centre_m: DVec3::new(c.x, c.y, 2000.0),
-                clouds: block.clouds.iter().map(SkyCloud::from).collect(),
-            }
-        })
-        .collect();
+    let blocks = generated_blocks(&weather, &types, (-5..5, 13..21), 2000.0);
     let cell = skycast::clouds::far_map::far_cell(&weather);
     let map = skycast::clouds::far_map::FarMap {
         texels: 96,

@@ -279,21 +279,12 @@ fn fly(
             .enabled
             .then_some(f64::from(far_field.fade_start_m)),
     );
-    let cells_apart = world.draws_far_cells();
     let far_map = setup.settings.far_field.enabled.then(|| {
         let f = setup.settings.far_field;
-        let field = world.field();
         skycast::clouds::far_map::FarMapFeed::new(f.texels, f.texel_m, f.move_texels, 1).update(
             DVec2::ZERO,
             true,
-            |p| {
-                let mut w = field.weather_at(p);
-                if cells_apart {
-                    w.layers
-                        .retain(|l| l.cloud_type != skycast::weather::CloudType::Cumulonimbus);
-                }
-                w
-            },
+            world.far_map_weather(),
         )
     });
     let mut hosts = Vec::new();

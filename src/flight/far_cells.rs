@@ -354,32 +354,15 @@ fn far_block(id: u64, cell: &StormCell, f: &FarCellFrame, s: &FarCellSettings) -
 
 #[cfg(test)]
 mod tests {
-    use std::path::Path;
-
     use super::*;
-    use crate::weather::field::{CloudTypeRule, FieldSettings};
-    use crate::weather::frame::LocalFrame;
     use crate::weather::storms::{StormSettings, cells_over};
-    use crate::weather::{files, stations::StationTable};
 
     const SEED: u64 = 2003;
 
     /// The 2025 file around a point 125 km east-north-east of Belo Horizonte (SBBH, TSRA
     /// BKN045CB; SBCF FEW045CB), which reports CAVOK itself.
     fn field() -> WeatherField {
-        let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/weather"));
-        let stations = StationTable::load(&dir.join("nsd_cccc.txt")).unwrap();
-        let file = files::load(
-            &dir.join("awc-metars-2025-01-27T22Z.cache.csv"),
-            Some(&stations),
-        )
-        .unwrap();
-        WeatherField::build(
-            LocalFrame::new(-19.55, -42.80),
-            &file.reports,
-            &FieldSettings::default(),
-            &CloudTypeRule::default(),
-        )
+        crate::weather::storms::tests::real_field(-19.55, -42.80)
     }
 
     fn frame<'a>(

@@ -444,26 +444,15 @@ impl SkySystem {
         let position_m = self.local_m(camera.position);
         // The far field's map first: the far storm cells hand over in its band once it is
         // drawn (`flight::far_cells`).
-        if self.sky.far_field_settings().enabled {
-            let field = self.world.field();
-            // Cumulonimbus beyond the cloud field is drawn cell by cell (`flight::far_cells`),
-            // not as a layer from its base to its top.
-            let cells_apart = self.world.draws_far_cells();
-            if let Some(map) = self.far_map.update(
+        if self.sky.far_field_settings().enabled
+            && let Some(map) = self.far_map.update(
                 position_m.truncate(),
                 self.world.synchronous_clouds(),
-                |p| {
-                    let mut w = field.weather_at(p);
-                    if cells_apart {
-                        w.layers
-                            .retain(|l| l.cloud_type != crate::weather::CloudType::Cumulonimbus);
-                    }
-                    w
-                },
-            ) {
-                let fade_s = self.world.arrival_fade_s();
-                self.sky.set_far_map(queue, &map, fade_s);
-            }
+                self.world.far_map_weather(),
+            )
+        {
+            let fade_s = self.world.arrival_fade_s();
+            self.sky.set_far_map(queue, &map, fade_s);
         }
         self.world.update_sky(&mut self.sky, position_m, dt_s)?;
         self.sky.set_flash(self.world.flash_now());

@@ -342,12 +342,7 @@ impl World {
         };
         let mut field = CloudField::new(config, Arc::new(self.types.clone()), threads)
             .map_err(|e| RenderError::Clouds(e.to_string()))?;
-        // Storm anvils spread along the wind aloft of the air data's own profile.
-        field.set_storms(crate::weather::storms::StormContext {
-            wind: self.air_settings().wind,
-            lat_deg: self.field.frame().to_lat_lon_deg(DVec2::ZERO).0,
-            ..Default::default()
-        });
+        field.set_storms(self.storm_context(Default::default()));
         self.clouds_config = config;
         self.living = Some(LivingClouds {
             field,
@@ -381,11 +376,7 @@ impl World {
         if !settings.far.enabled {
             return Vec::new();
         }
-        let ctx = crate::weather::storms::StormContext {
-            settings,
-            wind: self.air_settings().wind,
-            lat_deg: self.field.frame().to_lat_lon_deg(DVec2::ZERO).0,
-        };
+        let ctx = self.storm_context(settings);
         let f = super::far_cells::FarCellFrame {
             weather: &self.field,
             version: self.field_version,
@@ -399,6 +390,35 @@ impl World {
             whole: true,
         };
         super::far_cells::FarCells::blocks_now(settings.far, &f)
+    }
+
+    /// What the storm cells are decided with: `settings`, the air data's own wind profile
+    /// (storm anvils spread along its wind aloft) and the frame's latitude.
+    fn storm_context(
+        &self,
+        settings: crate::weather::storms::StormSettings,
+    ) -> crate::weather::storms::StormContext {
+        crate::weather::storms::StormContext {
+            settings,
+            wind: self.air_settings().wind,
+            lat_deg: self.field.frame().to_lat_lon_deg(DVec2::ZERO).0,
+        }
+    }
+
+    /// The weather the far field's map is made of at a point: the field's, without its
+    /// cumulonimbus while storm cells beyond the cloud field are drawn as cells
+    /// ([`Self::draws_far_cells`]), not as a layer from base to top. Decided once, for the
+    /// thousands of points of a map.
+    pub fn far_map_weather(&self) -> impl Fn(DVec2) -> BlockWeather + '_ {
+        let cells_apart = self.draws_far_cells();
+        move |p| {
+            let mut w = self.field.weather_at(p);
+            if cells_apart {
+                w.layers
+                    .retain(|l| l.cloud_type != crate::weather::CloudType::Cumulonimbus);
+            }
+            w
+        }
     }
 
     /// Whether storm cells beyond the cloud field are drawn as cells (`config/storms.toml`

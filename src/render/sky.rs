@@ -1346,11 +1346,7 @@ impl Sky {
             0
         };
         if distant > 0 {
-            pass.set_pipeline(sprite_pipeline);
-            pass.set_bind_group(1, &self.sheet_group, &[]);
-            pass.set_vertex_buffer(0, self.build.vertices().slice(..));
-            pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..distant * 6, 0, 0..1);
+            self.draw_sprites(&mut pass, sprite_pipeline, 0..distant);
         }
         v.ring.draw(&mut pass, offscreen.is_some());
         if timer.is_some() {
@@ -1373,11 +1369,7 @@ impl Sky {
                     None => self.sky_pass(encoder, colour_view, &frame_group, None),
                 };
             }
-            pass.set_pipeline(sprite_pipeline);
-            pass.set_bind_group(1, &self.sheet_group, &[]);
-            pass.set_vertex_buffer(0, self.build.vertices().slice(..));
-            pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(distant.min(n) * 6..n * 6, 0, 0..1);
+            self.draw_sprites(&mut pass, sprite_pipeline, distant.min(n)..n);
         }
         if v.in_cloud > 0.0 {
             pass.set_pipeline(in_cloud_pipeline);
@@ -1395,6 +1387,21 @@ impl Sky {
         v.recorded.set(true);
         v.record_us.set(start.elapsed().as_micros() as u64);
         Ok(())
+    }
+
+    /// Draws `sprites` of the quads the build pass made this frame with `pipeline` (the host's
+    /// colour or the cloud target's).
+    fn draw_sprites(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        pipeline: &wgpu::RenderPipeline,
+        sprites: std::ops::Range<u32>,
+    ) {
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(1, &self.sheet_group, &[]);
+        pass.set_vertex_buffer(0, self.build.vertices().slice(..));
+        pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(sprites.start * 6..sprites.end * 6, 0, 0..1);
     }
 
     /// A pass over the host's colour (kept), with the frame's group 0 bound, and the host's

@@ -566,4 +566,4 @@ pub fn flashes_between(
 
 #[cfg(test)]
 #[path = "storms_tests.rs"]
-mod tests;
+pub(crate) mod tests;

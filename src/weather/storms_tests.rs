@@ -8,7 +8,9 @@ use crate::weather::{BlockIndex, files, stations::StationTable, theme};
 
 const SEED: u64 = 0x5eed;
 
-fn real_field(lat: f64, lon: f64) -> WeatherField {
+/// The shipped 2025 bulk file as a weather field framed at `lat`, `lon` (also the far cells'
+/// tests, `flight::far_cells`).
+pub(crate) fn real_field(lat: f64, lon: f64) -> WeatherField {
     let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/weather"));
     let stations = StationTable::load(&dir.join("nsd_cccc.txt")).unwrap();
     let file = files::load(
