@@ -424,8 +424,10 @@ impl World {
     /// Whether storm cells beyond the cloud field are drawn as cells (`config/storms.toml`
     /// `[far]`): the far field then leaves cumulonimbus out of its map.
     pub fn draws_far_cells(&self) -> bool {
-        self.living.as_ref().map_or(
-            crate::weather::storms::StormSettings::default().far.enabled,
+        // `_else`: the shipped settings are parsed only without living clouds (this is
+        // asked every frame).
+        self.living.as_ref().map_or_else(
+            || crate::weather::storms::StormSettings::default().far.enabled,
             |l| l.far_cells.enabled(),
         )
     }
