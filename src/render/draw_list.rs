@@ -18,6 +18,7 @@ use glam::{DVec3, Vec3};
 
 use super::camera::Frustum;
 use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, MAX_LOCKS};
+use super::id_hash::IdMap;
 use super::resident::{BlockCheck, CloudState, Resident};
 use super::scene::{Fade, SkyCloud};
 use super::settings::{RenderSettings, VertexCacheSettings};
@@ -221,7 +222,7 @@ pub(super) fn fade_code(fade: Fade) -> (u32, f32) {
 }
 
 /// The blocks the sky holds, by id.
-pub(super) type Blocks = HashMap<u64, Resident>;
+pub(super) type Blocks = IdMap<Resident>;
 
 /// Blocks' ids, farthest centre (with its drift) from `from_m` first (the impostor views; the
 /// sky camera's sorts the near blocks themselves).
@@ -525,8 +526,10 @@ fn inside_clouds(
 /// far blocks changed at the rim, the sun turned) takes most orders from here.
 #[derive(Debug, Default)]
 pub(super) struct RingOrders {
-    /// By block id and cloud index.
-    kept: HashMap<(u64, usize), RingOrder>,
+    /// By block id, then cloud index: one lookup a block, its clouds' orders side by side
+    /// (a lookup by block and cloud, with tens of thousands of far clouds, was most of a
+    /// gathering frame's time).
+    kept: IdMap<Vec<Option<RingOrder>>>,
     keys: SortKeys,
     /// The gather under way ([`RingSort::gather`]) and its clouds still to sort (block id,
     /// cloud index): found once, when it starts, so that its later frames look at nothing else.
@@ -565,7 +568,7 @@ pub(super) struct RingSort<'a> {
 impl RingOrders {
     /// Forgets the orders of blocks the sky no longer holds.
     pub fn retain(&mut self, blocks: &Blocks) {
-        self.kept.retain(|(id, _), _| blocks.contains_key(id));
+        self.kept.retain(|id, _| blocks.contains_key(id));
     }
 
     /// Sorts, from `from_m`, the clouds of blocks `ids` within `draw_m` whose order is missing
@@ -588,13 +591,14 @@ impl RingOrders {
                     continue;
                 };
                 let fading = r.motion.fade != Fade::Steady;
+                let kept = self.kept.get(id).map_or(&[][..], Vec::as_slice);
                 for (ci, (state, cloud)) in r.clouds.iter().zip(&r.block.clouds).enumerate() {
                     let rel = from_m - (state.centre_m + r.motion.offset_m);
                     let near_edge = (rel.length() - state.radius_m as f64).max(0.0);
                     if near_edge > draw_m || state.sprites == 0 || state.sprites > when.largest {
                         continue;
                     }
-                    let good = self.kept.get(&(*id, ci)).is_some_and(|o| {
+                    let good = kept.get(ci).and_then(Option::as_ref).is_some_and(|o| {
                         o.order.len() == cloud.sprites.len()
                             && (o.at_s >= when.since_s
                                 || (when.cache.enabled
@@ -636,7 +640,11 @@ impl RingOrders {
             sorted += state.sprites;
             let rel = from_m - (state.centre_m + r.motion.offset_m);
             // A kept order's buffer is sorted into again.
-            let kept = self.kept.entry((id, ci)).or_insert_with(|| RingOrder {
+            let block = self.kept.entry(id).or_default();
+            if block.len() < r.clouds.len() {
+                block.resize_with(r.clouds.len(), || None);
+            }
+            let kept = block[ci].get_or_insert_with(|| RingOrder {
                 from_rel_m: rel,
                 at_s: when.time_s,
                 order: Vec::new(),
@@ -683,6 +691,7 @@ impl RingOrders {
             cloud_order.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
             let list_base = lists.len() as u32;
             let mut first = 0u32;
+            let kept = self.kept.get(&id).map_or(&[][..], Vec::as_slice);
             for &(ci, _) in &cloud_order {
                 let state = &r.clouds[ci];
                 lists.push(GpuListCloud {
@@ -692,7 +701,7 @@ impl RingOrders {
                     stride: 0,
                 });
                 let base = state.sprite_base;
-                match self.kept.get(&(id, ci)) {
+                match kept.get(ci).and_then(Option::as_ref) {
                     Some(o) if o.order.len() == state.sprites as usize => {
                         orders.extend(o.order.iter().map(|&i| base + i));
                     }

@@ -41,6 +41,7 @@ pub mod draw_list;
 pub mod earth;
 pub mod far_field;
 pub mod gpu_types;
+mod id_hash;
 pub mod impostor;
 mod overhead_ease;
 mod pass_timing;

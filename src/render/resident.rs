@@ -10,12 +10,12 @@
 //!
 //! Units: metres; sprite and cloud data relative to the cloud centre, cloud centres f64.
 
-use std::collections::HashMap;
 use std::ops::Range;
 
 use glam::{DVec3, Vec3};
 
 use super::cloud_light::{BlockLight, CloudLight};
+use super::id_hash::IdMap;
 use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT};
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
@@ -229,7 +229,7 @@ pub fn gpu_cloud(cloud: &SkyCloud, block_m: DVec3) -> GpuCloud {
 /// The blocks the sky holds and their GPU buffers.
 pub(super) struct ResidentSet {
     device: wgpu::Device,
-    pub blocks: HashMap<u64, Resident>,
+    pub blocks: IdMap<Resident>,
     sprite_slots: SlotRanges,
     cloud_slots: SlotRanges,
     /// Most sprite slots the device (or the budget) allows.
@@ -317,7 +317,7 @@ impl ResidentSet {
         let b = buffers(device, &layout, sprites, FIRST_CLOUDS);
         Self {
             device: device.clone(),
-            blocks: HashMap::new(),
+            blocks: IdMap::default(),
             sprite_slots: SlotRanges::new(sprites),
             cloud_slots: SlotRanges::new(FIRST_CLOUDS),
             limit_sprites,

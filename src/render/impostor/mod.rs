@@ -27,8 +27,6 @@
 mod layout;
 
 use std::cell::Cell;
-use std::collections::HashSet;
-use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::{DVec3, Vec3};
 use wgpu::util::DeviceExt;
@@ -40,6 +38,7 @@ use layout::{impostor_camera, sectors_of};
 
 use super::build::{SpriteBuild, chunks};
 use super::draw_list::{RingOrders, RingSort};
+use super::id_hash::IdSet;
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuRing, GpuSpriteVertex};
 use super::pipeline::{PassDesc, SceneDepth, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
@@ -56,32 +55,10 @@ struct RingState {
     centre_m: DVec3,
     sun: Vec3,
     /// Ids of the blocks drawn into this ring (looked up for every block every frame).
-    far_ids: HashSet<u64, BuildHasherDefault<IdHasher>>,
+    far_ids: IdSet,
     /// Mean distance of those blocks from the centre (the ring radius if none), metres: the
     /// first guess of the ring pass's depth reprojection.
     far_mean_m: f64,
-}
-
-/// A hasher for block ids, which are looked up for every block every frame: one multiply
-/// (Fibonacci hashing) instead of SipHash, whose protection against chosen keys the sky's own
-/// ids do not need.
-#[derive(Default)]
-struct IdHasher(u64);
-
-impl Hasher for IdHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 = (self.0.rotate_left(8) ^ b as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-        }
-    }
-
-    fn write_u64(&mut self, id: u64) {
-        self.0 = (self.0 ^ id).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    }
 }
 
 struct Build {
@@ -590,7 +567,7 @@ impl ImpostorRing {
         } else {
             far.iter().map(|f| f.1).sum::<f64>() / far.len() as f64
         };
-        let far_ids: HashSet<u64, _> = far.iter().map(|f| f.0).collect();
+        let far_ids: IdSet = far.iter().map(|f| f.0).collect();
         let mut sectors: [Vec<u64>; IMPOSTORS] = Default::default();
         for r in blocks.values().filter(|r| far_ids.contains(&r.block.id)) {
             let bits = sectors_of(camera_m, r.centre_m());

@@ -28,7 +28,6 @@
 mod layout;
 
 use std::cell::Cell;
-use std::collections::{HashMap, HashSet};
 
 use glam::{DVec3, Mat4, Vec3};
 
@@ -38,6 +37,7 @@ use super::RenderError;
 use super::build::{SpriteBuild, chunks};
 use super::draw_list::{Blocks, fade_code};
 use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuSpriteVertex};
+use super::id_hash::{IdMap, IdSet};
 use super::resident::{ResidentSet, storage_buffer};
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
@@ -133,7 +133,7 @@ pub struct CloudShadows {
     /// The blocks whose shadows the map holds (by id): their centre and radius when drawn.
     /// Blocks that arrive later are added to the map; one that leaves is kept there until the
     /// next whole drawing unless its shadow lies within `full_detail_m`.
-    in_map: HashMap<u64, (DVec3, f64)>,
+    in_map: IdMap<(DVec3, f64)>,
     /// Whether this frame's draw adds to the map (blocks that arrived) rather than clearing it.
     adding: bool,
     /// Draw the map at the next prepare whatever changed ([`Self::redraw`]).
@@ -299,7 +299,7 @@ impl CloudShadows {
             list_buffer: storage_buffer(device, "sky.cloud_shadow_lists", 4096 * 16),
             list_buffers_made: 0,
             drawn: None,
-            in_map: HashMap::new(),
+            in_map: IdMap::default(),
             adding: false,
             force: false,
             drift_m: DVec3::ZERO,
@@ -403,7 +403,7 @@ impl CloudShadows {
         // shadow lies near was taken away; else only the blocks that arrived since are drawn,
         // added to the map (the sums are additive): a block arriving at the edge of the sprites'
         // reach no longer costs a drawing of every cloud (most frames of the storm bench did).
-        let mut added: Option<HashSet<u64>> = None;
+        let mut added: Option<IdSet> = None;
         // The shadows fade out as the sun nears the horizon (they would reach for ever); with
         // it below 1 degree nothing shows, and the map is drawn with no sprite.
         let sun_up = smoothstep(1.0f64.to_radians().sin(), 5.0f64.to_radians().sin(), sun.z);
@@ -421,7 +421,7 @@ impl CloudShadows {
                 // Nothing to add or take away while the sun is too low for shadows (the map
                 // is drawn empty then).
                 let near_gone = near_gone && !dark;
-                let arrived: HashSet<u64> = now
+                let arrived: IdSet = now
                     .iter()
                     .filter(|id| !self.in_map.contains_key(id))
                     .copied()
@@ -566,7 +566,7 @@ impl CloudShadows {
         &mut self,
         blocks: &Blocks,
         frame: &ShadowFrame,
-        only: Option<&HashSet<u64>>,
+        only: Option<&IdSet>,
         back_m: DVec3,
         none: bool,
     ) -> u32 {
@@ -777,7 +777,7 @@ fn shadow_is_near(
 
 /// The blocks a drawing at `frame` covers (their ids), and whether any of them forms or
 /// dissipates.
-fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (HashSet<u64>, bool) {
+fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (IdSet, bool) {
     let mut changing = false;
     let ids = blocks
         .values()
