@@ -1137,8 +1137,44 @@ fn ring_rebuilds_over_eight_frames_then_crossfades() {
 /// sector on the frame that renders it (the ring's `fresh_view` before) sorts 360 at once.
 #[test]
 fn ring_rebuild_frames_sort_within_the_frames_budget() {
+    let rebuild = ring_rebuild_run(None);
+    assert_eq!(rebuild.rendered, 8, "every impostor rendered");
+    assert!(rebuild.faded, "the new ring faded in");
+    assert_eq!(rebuild.sorted, 360, "the far clouds sorted once each");
+    assert!(
+        rebuild.sorting_frames >= 4,
+        "{} frames sorted them",
+        rebuild.sorting_frames
+    );
+}
+
+/// `[impostors] order_move_fraction`: the far clouds' orders from the ring centre are kept
+/// while the centre moved less than that fraction of their distance. At 0.2 the 3,100 m move of
+/// [`ring_rebuild_run`] is within the far block's 5.4 km: the rebuild renders every impostor and
+/// sorts nothing (at `[vertex_cache]`'s 0.02, 545 m, it sorts all 360 sprites, above).
+#[test]
+fn ring_keeps_far_orders_within_its_move_fraction() {
+    let rebuild = ring_rebuild_run(Some(0.2));
+    assert_eq!(rebuild.rendered, 8, "every impostor rendered");
+    assert!(rebuild.faded, "the new ring faded in");
+    assert_eq!(rebuild.sorted, 0, "the far clouds' orders kept");
+}
+
+/// What a ring rebuild did over its frames.
+struct RingRebuild {
+    rendered: u32,
+    sorting_frames: u32,
+    sorted: u32,
+    faded: bool,
+}
+
+/// A first ring with a far block 30 km north (6 clouds of 60 sprites), then the camera 3,100 m
+/// on: the rebuild's frames until its crossfade ends, with a sorting budget of 100 sprites a
+/// frame (asserted on every frame) and the ring's `order_move_fraction`.
+fn ring_rebuild_run(order_move_fraction: Option<f64>) -> RingRebuild {
     let mut settings = RenderSettings::default();
     settings.vertex_cache.max_sorted_sprites_per_frame = 100;
+    settings.impostors.order_move_fraction = order_move_fraction;
     let mut rig = Rig::with_settings(flat_ground(0.0), settings);
     let far = DVec3::new(0.0, 30_000.0, 1500.0);
     let mut blocks = ring_blocks(false);
@@ -1158,7 +1194,12 @@ fn ring_rebuild_frames_sort_within_the_frames_budget() {
     let first = step(0.0);
     assert_eq!(first.impostors_rebuilt, 8, "{first:?}");
     // 3,100 m on: a rebuild, its orders sorted a budget at a time.
-    let (mut rendered, mut sorting_frames, mut sorted, mut faded) = (0, 0, 0, false);
+    let mut run = RingRebuild {
+        rendered: 0,
+        sorting_frames: 0,
+        sorted: 0,
+        faded: false,
+    };
     for frame in 0..60 {
         let s = step(3100.0);
         assert!(
@@ -1167,18 +1208,15 @@ fn ring_rebuild_frames_sort_within_the_frames_budget() {
             s.sprites_recomputed,
             s.ring_sprites_sorted
         );
-        rendered += s.impostors_rebuilt;
-        sorting_frames += (s.ring_sprites_sorted > 0) as u32;
-        sorted += s.ring_sprites_sorted;
-        faded |= s.crossfade_weight > 0.0;
-        if faded && s.crossfade_weight == 0.0 {
+        run.rendered += s.impostors_rebuilt;
+        run.sorting_frames += (s.ring_sprites_sorted > 0) as u32;
+        run.sorted += s.ring_sprites_sorted;
+        run.faded |= s.crossfade_weight > 0.0;
+        if run.faded && s.crossfade_weight == 0.0 {
             break;
         }
     }
-    assert_eq!(rendered, 8, "every impostor rendered");
-    assert!(faded, "the new ring faded in");
-    assert_eq!(sorted, 360, "the far clouds sorted once each");
-    assert!(sorting_frames >= 4, "{sorting_frames} frames sorted them");
+    run
 }
 
 /// Beyond Wang: the impostors keep each texel's cloud depth. A 3,000 m ridge 45 km north stands

@@ -15,8 +15,8 @@ use std::ops::Range;
 use glam::{DVec3, Vec3};
 
 use super::cloud_light::{BlockLight, CloudLight};
-use super::id_hash::IdMap;
 use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT};
+use super::id_hash::IdMap;
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
 

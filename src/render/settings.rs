@@ -344,6 +344,9 @@ mod tests {
         let err = error_with("resolution_scale = 0.5", "resolution_scale = 0.3");
         names(&err, "clouds.resolution_scale");
         assert!(err.contains("must be 1, 0.5 or 0.25"), "{err}");
+        let err = error_with("order_move_fraction = 0.06", "order_move_fraction = 0.0");
+        names(&err, "impostors.order_move_fraction");
+        assert!(err.contains("greater than 0"), "{err}");
         let err = error_with("size_px = 1024", "size_px = 2048");
         names(&err, "cloud_shadows.size_px");
         assert!(err.contains("4 MiB"), "{err}");

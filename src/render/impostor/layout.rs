@@ -42,6 +42,11 @@ pub struct ImpostorSettings {
     pub crossfade_s: f64,
     /// Blocks more than this above or below the camera are never put in impostors, feet.
     pub max_height_difference_ft: f64,
+    /// Wang 6.1's `move_fraction` for the far clouds' orders seen from the ring centre: an
+    /// order is kept until the centre moved this fraction of the cloud's distance (the other
+    /// thresholds are `[vertex_cache]`'s). Absent: `[vertex_cache] move_fraction`.
+    #[serde(default)]
+    pub order_move_fraction: Option<f64>,
 }
 
 impl Default for ImpostorSettings {
@@ -56,6 +61,7 @@ impl Default for ImpostorSettings {
             rebuild_sun_deg: 2.0,
             crossfade_s: 1.0,
             max_height_difference_ft: 10_000.0,
+            order_move_fraction: None,
         }
     }
 }
@@ -92,6 +98,15 @@ impl ImpostorSettings {
         }
         if self.crossfade_s.is_nan() || self.crossfade_s < 0.0 {
             return Some(("impostors.crossfade_s", "must be 0 or more".into()));
+        }
+        if let Some(f) = self.order_move_fraction
+            && !(f > 0.0 && f <= 1.0)
+        {
+            let field = "impostors.order_move_fraction";
+            return Some((
+                field,
+                format!("must be greater than 0 and at most 1, is {f}"),
+            ));
         }
         if self.max_height_difference_ft.is_nan() || self.max_height_difference_ft < 0.0 {
             return Some((

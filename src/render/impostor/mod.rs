@@ -38,8 +38,8 @@ use layout::{impostor_camera, sectors_of};
 
 use super::build::{SpriteBuild, chunks};
 use super::draw_list::{RingOrders, RingSort};
-use super::id_hash::IdSet;
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuRing, GpuSpriteVertex};
+use super::id_hash::IdSet;
 use super::pipeline::{PassDesc, SceneDepth, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
 use super::settings::VertexCacheSettings;
@@ -638,11 +638,19 @@ impl ImpostorRing {
                 let whole = cache.max_sorted_sprites_per_frame;
                 (1, whole.saturating_sub(stats.sprites_recomputed), whole)
             };
+            // The far clouds' own move threshold (`order_move_fraction`).
+            let ring_cache = VertexCacheSettings {
+                move_fraction: self
+                    .settings
+                    .order_move_fraction
+                    .map_or(cache.move_fraction, |f| f as f32),
+                ..*cache
+            };
             let mut when = RingSort {
                 gather: 0,
                 since_s: build.since_s,
                 time_s: self.clock_s,
-                cache,
+                cache: &ring_cache,
                 largest,
             };
             let view_radius_m = self.reach_settings().view_radius_m;
