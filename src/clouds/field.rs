@@ -14,7 +14,7 @@
 //!
 //! Units: metres east/north in the local frame, seconds of field time.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender, channel};
 
@@ -236,6 +236,9 @@ pub struct CloudField {
     membership: u64,
     /// Generations forming or dissipating: while none are, advancing time touches no block.
     unsettled: usize,
+    /// The blocks that have (or had, if gone since) such generations: advancing time touches
+    /// only them, not the field's thousands (building cumulus fade for ten minutes).
+    unsettled_at: BTreeSet<BlockIndex>,
     /// What the weather field's storm cells are decided with.
     storms: StormContext,
     /// The storm cells over the field, as last decided (in the moving air's frame).
@@ -267,6 +270,7 @@ impl CloudField {
             next_serial: 0,
             membership: 0,
             unsettled: 0,
+            unsettled_at: BTreeSet::new(),
             storms: StormContext::default(),
             cells: Vec::new(),
         }
@@ -443,6 +447,7 @@ impl CloudField {
                 g.phase = match g.phase {
                     Phase::Steady => {
                         self.unsettled += 1;
+                        self.unsettled_at.insert(done.index);
                         Phase::Dissipating { since_s: now }
                     }
                     // Still forming: back the way it came, from as far as it had formed.
@@ -455,6 +460,7 @@ impl CloudField {
             }
             if phase != Phase::Steady {
                 self.unsettled += 1;
+                self.unsettled_at.insert(done.index);
             }
             self.next_serial += 1;
             self.membership += 1;
@@ -475,7 +481,12 @@ impl CloudField {
         let now = self.time_s;
         let lifecycle = self.config.lifecycle;
         if self.unsettled > 0 {
-            for slot in self.slots.values_mut() {
+            let slots = &mut self.slots;
+            let (mut unsettled, mut membership) = (self.unsettled, self.membership);
+            self.unsettled_at.retain(|index| {
+                let Some(slot) = slots.get_mut(index) else {
+                    return false;
+                };
                 let before = slot.unsettled();
                 for g in &mut slot.generations {
                     g.phase = phase_at(g.phase, now, &lifecycle);
@@ -483,10 +494,13 @@ impl CloudField {
                 let len = slot.generations.len();
                 slot.generations.retain(|g| g.phase != Phase::Gone);
                 if slot.generations.len() != len {
-                    self.membership += 1;
+                    membership += 1;
                 }
-                self.unsettled -= before - slot.unsettled();
-            }
+                let after = slot.unsettled();
+                unsettled -= before - after;
+                after > 0
+            });
+            (self.unsettled, self.membership) = (unsettled, membership);
         }
         self.take_finished();
     }

@@ -12,6 +12,7 @@ use std::time::Instant;
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
+use crate::clouds::config::LifecycleConfig;
 use crate::clouds::lifecycle::{Phase, progress};
 use crate::clouds::{
     Cloud, CloudField, CloudTypes, CloudsConfig, field::FieldBlock, field::weather_changed,
@@ -111,9 +112,10 @@ pub struct LivingClouds {
     /// Generations fading in as they arrive (see [`WorldSettings::arrival_fade_s`]), with the
     /// field time they arrived at.
     arriving: HashMap<u64, f64>,
-    /// Generations forming or dissipating this frame and the last.
-    fading: Vec<u64>,
-    was_fading: Vec<u64>,
+    /// Generations forming or dissipating this frame and the last (serial and block), by
+    /// serial.
+    fading: Vec<(u64, BlockIndex)>,
+    was_fading: Vec<(u64, BlockIndex)>,
     /// Storm cells beyond the field, drawn whole.
     far_cells: super::far_cells::FarCells,
 }
@@ -521,13 +523,37 @@ impl World {
         let now = living.field.time_s();
         let lifecycle = *living.field.lifecycle();
         let sky_before_us = sky.pending_cpu_us();
+        let same_members = living.membership == Some(living.field.membership());
         // Nothing came, went, forms, dissipates or arrives: only the drift changed.
-        if living.membership == Some(living.field.membership())
-            && living.was_fading.is_empty()
-            && living.arriving.is_empty()
-        {
+        if same_members && living.was_fading.is_empty() && living.arriving.is_empty() {
             sky.set_drift(offset_m);
             sky.add_field_cpu_us(start.elapsed().as_micros() as u64);
+            return Ok(());
+        }
+        // Nothing came or went: only the generations that were fading can be fading now (a
+        // steady one starts to dissipate only beside a new one), so only they are looked at,
+        // not the field's thousands (the Cb circle's building cumulus fade for minutes).
+        if same_members && living.arriving.is_empty() {
+            living.fading.clear();
+            for &(serial, index) in &living.was_fading {
+                let Some(fb) = living
+                    .field
+                    .generations(index)
+                    .iter()
+                    .find(|g| g.serial == serial)
+                else {
+                    continue;
+                };
+                let fade = fade_of(fb.phase, None, now, &lifecycle);
+                sky.set_block_fade(serial, fade);
+                if fade != Fade::Steady {
+                    living.fading.push((serial, index));
+                }
+            }
+            std::mem::swap(&mut living.was_fading, &mut living.fading);
+            sky.set_drift(offset_m);
+            let sky_us = sky.pending_cpu_us() - sky_before_us;
+            sky.add_field_cpu_us((start.elapsed().as_micros() as u64).saturating_sub(sky_us));
             return Ok(());
         }
         living.membership = Some(living.field.membership());
@@ -565,14 +591,7 @@ impl World {
             if arrival.is_none() && !living.arriving.is_empty() {
                 living.arriving.remove(&fb.serial);
             }
-            let fade = match fb.phase {
-                Phase::Steady => arrival.map_or(Fade::Steady, Fade::Forming),
-                Phase::Forming { .. } | Phase::Unforming { .. } => {
-                    Fade::Forming(progress(fb.phase, now, &lifecycle))
-                }
-                Phase::Dissipating { .. } => Fade::Dissipating(progress(fb.phase, now, &lifecycle)),
-                Phase::Gone => Fade::Dissipating(1.0),
-            };
+            let fade = fade_of(fb.phase, arrival, now, &lifecycle);
             if fb.serial > newest {
                 living.newest_serial = living.newest_serial.max(fb.serial);
                 living.in_sky.insert(fb.serial);
@@ -581,13 +600,13 @@ impl World {
                 sky.set_block_fade(fb.serial, fade);
             }
             if fade != Fade::Steady {
-                living.fading.push(fb.serial);
+                living.fading.push((fb.serial, index));
             }
         }
         // The ones that finished forming since the last frame.
-        living.fading.sort_unstable();
-        for &id in &living.was_fading {
-            if living.fading.binary_search(&id).is_err() {
+        living.fading.sort_unstable_by_key(|f| f.0);
+        for &(id, _) in &living.was_fading {
+            if living.fading.binary_search_by_key(&id, |f| f.0).is_err() {
                 sky.set_block_fade(id, Fade::Steady);
             }
         }
@@ -629,4 +648,17 @@ fn living_block(index: BlockIndex, fb: &FieldBlock) -> SkyBlock {
 /// A block's id for the vertex cache: its index packed into 64 bits.
 pub fn block_id(index: BlockIndex) -> u64 {
     ((index.i as u32 as u64) << 32) | index.j as u32 as u64
+}
+
+/// How a generation in `phase` is drawn at field time `now_s`: forming, dissipating or steady,
+/// or fading in by `arrival` (0..1) as it arrives.
+fn fade_of(phase: Phase, arrival: Option<f32>, now_s: f64, lifecycle: &LifecycleConfig) -> Fade {
+    match phase {
+        Phase::Steady => arrival.map_or(Fade::Steady, Fade::Forming),
+        Phase::Forming { .. } | Phase::Unforming { .. } => {
+            Fade::Forming(progress(phase, now_s, lifecycle))
+        }
+        Phase::Dissipating { .. } => Fade::Dissipating(progress(phase, now_s, lifecycle)),
+        Phase::Gone => Fade::Dissipating(1.0),
+    }
 }

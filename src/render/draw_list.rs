@@ -119,13 +119,12 @@ impl Locks {
 
 /// Wang 6.1's thresholds for a cloud `near_edge_m` away: how far the camera may move relative
 /// to it and how long it may wait, metres and seconds; they grow with the distance, and fading
-/// clouds age out sooner.
+/// clouds age out sooner only with `fading_max_age_s` set.
 fn thresholds(fading: bool, near_edge_m: f64, cache: &VertexCacheSettings) -> (f64, f64) {
     let move_limit_m = cache.min_move_m as f64 + cache.move_fraction as f64 * near_edge_m;
-    let max_age_s = if fading {
-        cache.fading_max_age_s as f64
-    } else {
-        cache.max_age_s as f64 * (1.0 + near_edge_m / cache.time_distance_m as f64)
+    let max_age_s = match cache.fading_max_age_s {
+        Some(age_s) if fading => age_s as f64,
+        _ => cache.max_age_s as f64 * (1.0 + near_edge_m / cache.time_distance_m as f64),
     };
     (move_limit_m, max_age_s)
 }

@@ -9,7 +9,7 @@ fn cache() -> VertexCacheSettings {
 }
 
 #[test]
-fn the_order_ages_and_moves_out_by_distance_and_sooner_while_fading() {
+fn the_order_ages_and_moves_out_by_distance_and_sooner_while_fading_if_set() {
     let c = cache();
     let at = (DVec3::new(0.0, -1000.0, 0.0), 10.0);
     // 1 km from its edge: 5 m + 2% = 25 m of movement, 2 s x 1.5 = 3 s of age.
@@ -20,7 +20,14 @@ fn the_order_ages_and_moves_out_by_distance_and_sooner_while_fading() {
     assert!(used_up((at, false), moved(0.0), 13.1, 1000.0, &c, 1.0));
     // 10 km out the same 26 m keeps the order (limit 205 m).
     assert!(!used_up((at, false), moved(26.0), 10.0, 10_000.0, &c, 1.0));
-    // Fading: every 0.25 s whatever the distance.
+    // Fading, as shipped: as a steady cloud (the fade is the GPU's), 2 s x 6 = 12 s at 10 km.
+    assert!(!used_up((at, true), moved(0.0), 21.9, 10_000.0, &c, 1.0));
+    assert!(used_up((at, true), moved(0.0), 22.1, 10_000.0, &c, 1.0));
+    // With `fading_max_age_s` 0.25: every 0.25 s whatever the distance.
+    let c = VertexCacheSettings {
+        fading_max_age_s: Some(0.25),
+        ..c
+    };
     assert!(used_up((at, true), moved(0.0), 10.3, 10_000.0, &c, 1.0));
     assert!(!used_up((at, true), moved(0.0), 10.2, 10_000.0, &c, 1.0));
     // Time running backwards (a new flight in the same sky) recomputes.

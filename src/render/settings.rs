@@ -125,8 +125,12 @@ pub struct VertexCacheSettings {
     pub max_age_s: f32,
     /// Distance scale of the age threshold, metres.
     pub time_distance_m: f32,
-    /// Age threshold while a cloud forms or dissipates, seconds.
-    pub fading_max_age_s: f32,
+    /// Age threshold while a cloud forms or dissipates, seconds. Absent (the shipped setting):
+    /// the steady threshold, since a cloud's order is geometric and its fade is applied on the
+    /// GPU every frame (Wang re-sorted fading clouds sooner because his CPU wrote their faded
+    /// vertex colours with the order).
+    #[serde(default)]
+    pub fading_max_age_s: Option<f32>,
     /// Most sprites re-sorted in one frame; past it stale clouds keep their order until a later
     /// frame (nearest clouds first), so a frame where many clouds come near at once (the ring
     /// handing blocks back) does not stall.
@@ -195,6 +199,11 @@ impl RenderSettings {
             (
                 "vertex_cache.time_distance_m",
                 s.vertex_cache.time_distance_m,
+            ),
+            // Not set is valid (fading clouds age as steady ones).
+            (
+                "vertex_cache.fading_max_age_s",
+                s.vertex_cache.fading_max_age_s.unwrap_or(1.0),
             ),
         ];
         for (field, value) in positive {
