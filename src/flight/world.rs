@@ -13,7 +13,7 @@ use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::clouds::config::LifecycleConfig;
-use crate::clouds::lifecycle::{Phase, progress};
+use crate::clouds::lifecycle::{Phase, phase_at, progress};
 use crate::clouds::{
     Cloud, CloudField, CloudTypes, CloudsConfig, field::FieldBlock, field::weather_changed,
     generate_block,
@@ -112,10 +112,10 @@ pub struct LivingClouds {
     /// Generations fading in as they arrive (see [`WorldSettings::arrival_fade_s`]), with the
     /// field time they arrived at.
     arriving: HashMap<u64, f64>,
-    /// Generations forming or dissipating this frame and the last (serial and block), by
+    /// Generations forming or dissipating this frame and the last (serial and phase), by
     /// serial.
-    fading: Vec<(u64, BlockIndex)>,
-    was_fading: Vec<(u64, BlockIndex)>,
+    fading: Vec<(u64, Phase)>,
+    was_fading: Vec<(u64, Phase)>,
     /// Storm cells beyond the field, drawn whole.
     far_cells: super::far_cells::FarCells,
 }
@@ -532,22 +532,18 @@ impl World {
         }
         // Nothing came or went: only the generations that were fading can be fading now (a
         // steady one starts to dissipate only beside a new one), so only they are looked at,
-        // not the field's thousands (the Cb circle's building cumulus fade for minutes).
+        // from their phases kept here, not the field's thousands of generations (the Cb
+        // circle's building cumulus fade for minutes).
         if same_members && living.arriving.is_empty() {
             living.fading.clear();
-            for &(serial, index) in &living.was_fading {
-                let Some(fb) = living
-                    .field
-                    .generations(index)
-                    .iter()
-                    .find(|g| g.serial == serial)
-                else {
-                    continue;
-                };
-                let fade = fade_of(fb.phase, None, now, &lifecycle);
+            for &(serial, phase) in &living.was_fading {
+                // The phase moves on with time alone (as `CloudField::advance` moves it); one
+                // that ended (gone) would have changed the membership.
+                let phase = phase_at(phase, now, &lifecycle);
+                let fade = fade_of(phase, None, now, &lifecycle);
                 sky.set_block_fade(serial, fade);
                 if fade != Fade::Steady {
-                    living.fading.push((serial, index));
+                    living.fading.push((serial, phase));
                 }
             }
             std::mem::swap(&mut living.was_fading, &mut living.fading);
@@ -600,7 +596,7 @@ impl World {
                 sky.set_block_fade(fb.serial, fade);
             }
             if fade != Fade::Steady {
-                living.fading.push((fb.serial, index));
+                living.fading.push((fb.serial, fb.phase));
             }
         }
         // The ones that finished forming since the last frame.
