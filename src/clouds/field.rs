@@ -23,9 +23,9 @@ use rayon::prelude::*;
 
 use super::CloudsError;
 use super::block::CloudBlock;
-use super::config::{CloudTypes, CloudsConfig};
+use super::config::{CloudTypes, CloudsConfig, LifecycleConfig};
 use super::generate::{generate_block, generate_block_in_field};
-use super::lifecycle::{Phase, phase_at};
+use super::lifecycle::{Phase, ends_at, phase_at};
 use super::storm::CellCache;
 use crate::weather::storms::{StormCell, StormContext, cells_over};
 use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockWeather, CloudType};
@@ -190,13 +190,42 @@ pub fn weather_changed(a: &BlockWeather, b: &BlockWeather) -> bool {
         })
 }
 
+/// A field time as a key of the queue of phase ends (times are finite).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct FieldTime(f64);
+
+impl Eq for FieldTime {}
+
+impl PartialOrd for FieldTime {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for FieldTime {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+/// When each block's next generation stops forming or dissipating by itself, soonest first.
+type PhaseEnds = BTreeSet<(FieldTime, BlockIndex)>;
+
 impl Slot {
-    /// Its generations forming or dissipating.
-    fn unsettled(&self) -> usize {
-        self.generations
+    /// Puts the slot at `index` into `ends` at its generations' first phase end (out of it while
+    /// every generation is steady), in place of where it was.
+    fn schedule(&mut self, index: BlockIndex, ends: &mut PhaseEnds, lifecycle: &LifecycleConfig) {
+        if let Some(t) = self.ends_s.take() {
+            ends.remove(&(FieldTime(t), index));
+        }
+        self.ends_s = self
+            .generations
             .iter()
-            .filter(|g| g.phase != Phase::Steady)
-            .count()
+            .filter_map(|g| ends_at(g.phase, lifecycle))
+            .reduce(f64::min);
+        if let Some(t) = self.ends_s {
+            ends.insert((FieldTime(t), index));
+        }
     }
 }
 
@@ -220,6 +249,8 @@ struct Slot {
     generations: Vec<FieldBlock>,
     /// The phase its first generation starts in (`CloudField::joining_phase` when it joined).
     joins: Phase,
+    /// Where it is in the field's queue of phase ends (`CloudField::phase_ends`).
+    ends_s: Option<f64>,
 }
 
 /// The blocks around a point, advancing in time. See the module docs.
@@ -234,11 +265,12 @@ pub struct CloudField {
     next_serial: u64,
     /// Counts changes to which generations exist (added, gone).
     membership: u64,
-    /// Generations forming or dissipating: while none are, advancing time touches no block.
-    unsettled: usize,
-    /// The blocks that have (or had, if gone since) such generations: advancing time touches
-    /// only them, not the field's thousands (building cumulus fade for ten minutes).
-    unsettled_at: BTreeSet<BlockIndex>,
+    /// The blocks with generations forming or dissipating, by when the first of them ends:
+    /// advancing time touches only the blocks whose phases end then, not the thousands that
+    /// fade at once across a weather change (building cumulus fade for ten minutes).
+    phase_ends: PhaseEnds,
+    /// The blocks taken off `phase_ends` in a frame (kept for its allocation).
+    ending: Vec<BlockIndex>,
     /// What the weather field's storm cells are decided with.
     storms: StormContext,
     /// The storm cells over the field, as last decided (in the moving air's frame).
@@ -269,8 +301,8 @@ impl CloudField {
             slots: BTreeMap::new(),
             next_serial: 0,
             membership: 0,
-            unsettled: 0,
-            unsettled_at: BTreeSet::new(),
+            phase_ends: PhaseEnds::new(),
+            ending: Vec::new(),
             storms: StormContext::default(),
             cells: Vec::new(),
         }
@@ -371,6 +403,7 @@ impl CloudField {
                             weather: w,
                             generations: Vec::new(),
                             joins,
+                            ends_s: None,
                         },
                     );
                 }
@@ -392,15 +425,14 @@ impl CloudField {
         // Blocks a block beyond the rim leave the field.
         let keep = radius + BLOCK_SIZE_M;
         let before = self.slots.len();
-        let mut unsettled_gone = 0;
+        let phase_ends = &mut self.phase_ends;
         self.slots.retain(|index, slot| {
             let kept = index.centre_m().distance_squared(air_centre) <= keep * keep;
-            if !kept {
-                unsettled_gone += slot.unsettled();
+            if let Some(t) = slot.ends_s.filter(|_| !kept) {
+                phase_ends.remove(&(FieldTime(t), *index));
             }
             kept
         });
-        self.unsettled -= unsettled_gone;
         if self.slots.len() != before {
             self.membership += 1;
         }
@@ -445,11 +477,7 @@ impl CloudField {
             };
             for g in &mut slot.generations {
                 g.phase = match g.phase {
-                    Phase::Steady => {
-                        self.unsettled += 1;
-                        self.unsettled_at.insert(done.index);
-                        Phase::Dissipating { since_s: now }
-                    }
+                    Phase::Steady => Phase::Dissipating { since_s: now },
                     // Still forming: back the way it came, from as far as it had formed.
                     Phase::Forming { .. } => Phase::Unforming {
                         since_s: now,
@@ -458,10 +486,6 @@ impl CloudField {
                     going => going,
                 };
             }
-            if phase != Phase::Steady {
-                self.unsettled += 1;
-                self.unsettled_at.insert(done.index);
-            }
             self.next_serial += 1;
             self.membership += 1;
             slot.generations.push(FieldBlock {
@@ -469,6 +493,7 @@ impl CloudField {
                 phase,
                 serial: self.next_serial,
             });
+            slot.schedule(done.index, &mut self.phase_ends, &lifecycle);
         }
     }
 
@@ -480,27 +505,30 @@ impl CloudField {
         self.drift_m += self.wind_m_s * dt_s;
         let now = self.time_s;
         let lifecycle = self.config.lifecycle;
-        if self.unsettled > 0 {
-            let slots = &mut self.slots;
-            let (mut unsettled, mut membership) = (self.unsettled, self.membership);
-            self.unsettled_at.retain(|index| {
-                let Some(slot) = slots.get_mut(index) else {
-                    return false;
-                };
-                let before = slot.unsettled();
-                for g in &mut slot.generations {
-                    g.phase = phase_at(g.phase, now, &lifecycle);
-                }
-                let len = slot.generations.len();
-                slot.generations.retain(|g| g.phase != Phase::Gone);
-                if slot.generations.len() != len {
-                    membership += 1;
-                }
-                let after = slot.unsettled();
-                unsettled -= before - after;
-                after > 0
-            });
-            (self.unsettled, self.membership) = (unsettled, membership);
+        // Only the blocks a phase of which ends by now; each goes back in at its next end.
+        self.ending.clear();
+        while let Some(&(FieldTime(t), index)) = self.phase_ends.first() {
+            if t > now {
+                break;
+            }
+            self.phase_ends.pop_first();
+            self.ending.push(index);
+        }
+        for &index in &self.ending {
+            let Some(slot) = self.slots.get_mut(&index) else {
+                continue;
+            };
+            slot.ends_s = None;
+            for g in &mut slot.generations {
+                g.phase = phase_at(g.phase, now, &lifecycle);
+            }
+            let len = slot.generations.len();
+            slot.generations.retain(|g| g.phase != Phase::Gone);
+            if slot.generations.len() != len {
+                self.membership += 1;
+            }
+            // A phase that ends a rounding after `now` is back in the queue for the next call.
+            slot.schedule(index, &mut self.phase_ends, &lifecycle);
         }
         self.take_finished();
     }

@@ -77,6 +77,20 @@ pub fn phase_at(phase: Phase, now_s: f64, config: &LifecycleConfig) -> Phase {
     }
 }
 
+/// The field time at which `phase` ends by itself (where [`phase_at`] moves it on: forming
+/// becomes steady, dissipating or unforming becomes gone); `None` for Steady and Gone, which
+/// last until something else changes them.
+pub fn ends_at(phase: Phase, config: &LifecycleConfig) -> Option<f64> {
+    match phase {
+        Phase::Forming { since_s } => Some(since_s + f64::from(config.formation_s)),
+        Phase::Dissipating { since_s } => Some(since_s + f64::from(config.dissipation_s)),
+        Phase::Unforming { since_s, from } => {
+            Some(since_s + f64::from(from) * f64::from(config.formation_s))
+        }
+        Phase::Steady | Phase::Gone => None,
+    }
+}
+
 /// Progress of a formation or dissipation at field time `now_s`, 0..=1 (1 for Steady and Gone);
 /// of an unforming generation, the formation progress it is back at.
 pub fn progress(phase: Phase, now_s: f64, config: &LifecycleConfig) -> f32 {
@@ -261,6 +275,26 @@ mod tests {
 
     /// What the renderer fades by (`Fade::Forming(progress)`): from the phase's own start to its
     /// end, 1 once settled or gone.
+    #[test]
+    fn a_phase_ends_where_phase_at_moves_it_on() {
+        let c = config();
+        for phase in [
+            Phase::Forming { since_s: 100.0 },
+            Phase::Dissipating { since_s: 100.0 },
+            Phase::Unforming {
+                since_s: 100.0,
+                from: 0.4,
+            },
+        ] {
+            let end = ends_at(phase, &c).expect("a fading phase ends");
+            assert!(end > 100.0, "{phase:?} ends at {end}");
+            assert_eq!(phase_at(phase, end - 0.01, &c), phase, "{phase:?}");
+            assert_ne!(phase_at(phase, end + 1e-6, &c), phase, "{phase:?}");
+        }
+        assert_eq!(ends_at(Phase::Steady, &c), None);
+        assert_eq!(ends_at(Phase::Gone, &c), None);
+    }
+
     #[test]
     fn progress_runs_from_the_phase_start_to_its_end() {
         let c = config();
