@@ -942,6 +942,23 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     let (_, stats) = rig.frame("ring_switched_on", &cam);
     assert_eq!(stats.impostors_rebuilt, 8, "{stats:?}");
     assert_eq!((stats.blocks_near, stats.blocks_far), (2, 1), "{stats:?}");
+    // A far block arriving while the ring stands (the camera still) goes into it: a rebuild
+    // starts (the ring keeps its look over the blocks between frames only while none comes).
+    let (_, steady) = rig.frame("ring_steady", &cam);
+    assert_eq!(steady.impostors_rebuilt, 0, "{steady:?}");
+    let mut more = ring_blocks(true);
+    let south = DVec3::new(0.0, -30_000.0, 1500.0);
+    more.push(SkyBlock {
+        id: 4,
+        centre_m: south,
+        clouds: vec![big_cumulus(south, 6.0)],
+    });
+    rig.set_clouds(more);
+    let rebuilt: u32 = (0..3)
+        .map(|k| rig.frame(&format!("ring_far_block_arrives_{k}"), &cam).1)
+        .map(|stats| stats.impostors_rebuilt)
+        .sum();
+    assert!(rebuilt > 0, "the arriving far block started no rebuild");
     // A sky made without the ring has no textures to turn it on with.
     assert!(!plain.host.sky.set_impostors(true));
 }
@@ -2133,6 +2150,9 @@ fn a_block_arriving_adds_its_shadow_to_the_map() {
         whole.shadow_redrawn && whole.shadow_sprites == 180,
         "{whole:?}"
     );
+    // The same sky again: nothing drawn (the map keeps what it looked at over the blocks).
+    let (_, steady) = rig.frame("shadow_add_steady", &camera);
+    assert!(!steady.shadow_redrawn, "{steady:?}");
     let queue = rig.host.gpu.queue.clone();
     let before = rig.host.sky.read_back_cloud_shadows(&queue).unwrap();
     rig.set_clouds(vec![first, block(2, 2000.0, 1)]);

@@ -16,7 +16,7 @@ use glam::{DVec3, Vec3};
 
 use super::cloud_light::{BlockLight, CloudLight};
 use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT};
-use super::id_hash::IdMap;
+use super::id_hash::{IdMap, IdSet};
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
 
@@ -263,6 +263,16 @@ pub(super) struct ResidentSet {
     pub grow_wait_us: u64,
     /// Whether this frame placed every block again (packed): they are all written again.
     repacked: bool,
+    /// The blocks not placed or not written yet: what placing and writing look at each frame,
+    /// not the thousands held.
+    waiting: IdSet,
+    /// Counts changes to which blocks are on the GPU (one came, went, was written or lost its
+    /// place): while it stays the same, so do they.
+    pub changes: u64,
+    /// Counts changes of a block's fade ([`super::Sky::set_block_fade`] and its kin).
+    pub fades: u64,
+    /// The drift [`super::Sky::set_drift`] last moved every block to.
+    pub drift_m: DVec3,
 }
 
 const FIRST_SPRITES: u32 = 4096;
@@ -338,6 +348,10 @@ impl ResidentSet {
             generation: 0,
             grow_wait_us: 0,
             repacked: false,
+            waiting: IdSet::default(),
+            changes: 0,
+            fades: 0,
+            drift_m: DVec3::ZERO,
         }
     }
 
@@ -369,12 +383,16 @@ impl ResidentSet {
     /// Adds or replaces a block (uploaded by the next [`Self::place_and_upload`]).
     pub fn insert(&mut self, block: SkyBlock, motion: BlockMotion) {
         self.remove(block.id);
+        self.waiting.insert(block.id);
+        self.changes += 1;
         self.blocks.insert(block.id, Resident::new(block, motion));
     }
 
     /// Retires a block and frees its slots; returns the sprite slots it had, if it was held.
     pub fn remove(&mut self, id: u64) -> Option<Range<u32>> {
         let old = self.blocks.remove(&id)?;
+        self.waiting.remove(&id);
+        self.changes += 1;
         match old.place {
             Some((sprites, clouds)) => {
                 self.sprite_slots.release(sprites.clone());
@@ -397,9 +415,11 @@ impl ResidentSet {
     ) -> (u64, u32) {
         self.repacked = false;
         self.grow_wait_us = 0;
+        let blocks = &self.blocks;
         let mut waiting: Vec<(f64, &Resident)> = self
-            .blocks
-            .values()
+            .waiting
+            .iter()
+            .filter_map(|id| blocks.get(id))
             .filter(|r| r.place.is_none())
             .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
             .collect();
@@ -412,7 +432,13 @@ impl ResidentSet {
             }
         }
         // Blocks that did not fit, and any a nearer one took the place of.
-        let left_out = self.blocks.values().filter(|r| r.place.is_none()).count() as u32;
+        let blocks = &self.blocks;
+        let left_out = self
+            .waiting
+            .iter()
+            .filter_map(|id| blocks.get(id))
+            .filter(|r| r.place.is_none())
+            .count() as u32;
         let budget = if self.repacked {
             u32::MAX
         } else {
@@ -444,6 +470,8 @@ impl ResidentSet {
                         && let Some((s, c)) = r.place.take()
                     {
                         r.uploaded = false;
+                        self.waiting.insert(far_id);
+                        self.changes += 1;
                         self.sprite_slots.release(s);
                         self.cloud_slots.release(c);
                     }
@@ -558,6 +586,8 @@ impl ResidentSet {
         for r in self.blocks.values_mut() {
             r.place = None;
         }
+        self.waiting.extend(self.blocks.keys().copied());
+        self.changes += 1;
         for id in placed {
             self.try_place(id);
         }
@@ -624,18 +654,24 @@ impl ResidentSet {
         } else {
             self.light.budget().saturating_sub(self.lit_sprites)
         };
-        let mut todo: Vec<(f64, &mut Resident)> = self
-            .blocks
-            .values_mut()
+        let blocks = &self.blocks;
+        let mut todo: Vec<(f64, &Resident)> = self
+            .waiting
+            .iter()
+            .filter_map(|id| blocks.get(id))
             .filter(|r| r.place.is_some() && !r.uploaded)
             .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
             .collect();
         todo.sort_by(|a, b| a.0.total_cmp(&b.0).then_with(|| a.1.tie_order(b.1)));
+        let todo: Vec<u64> = todo.iter().map(|(_, r)| r.block.id).collect();
         let mut written = 0u32;
-        for (_, r) in todo {
+        for id in todo {
             if written > 0 && written >= budget {
                 break;
             }
+            let Some(r) = self.blocks.get_mut(&id) else {
+                continue;
+            };
             let Some((s, c)) = r.place.clone() else {
                 continue;
             };
@@ -664,6 +700,8 @@ impl ResidentSet {
             }
             bytes += sprites.len() as u64 * sprite_bytes + clouds.len() as u64 * cloud_bytes;
             r.uploaded = true;
+            self.waiting.remove(&id);
+            self.changes += 1;
             if self.light.enabled() {
                 let light_start = std::time::Instant::now();
                 let to = (queue, &self.light_buffer, s.start);

@@ -463,7 +463,13 @@ impl Sky {
         }
         for block in blocks {
             match self.resident.blocks.get_mut(&block.id) {
-                Some(r) if r.block == block => r.motion = BlockMotion::default(),
+                Some(r) if r.block == block => {
+                    if r.motion != BlockMotion::default() {
+                        r.motion = BlockMotion::default();
+                        self.resident.changes += 1;
+                        self.resident.fades += 1;
+                    }
+                }
                 _ => self.resident.insert(block, BlockMotion::default()),
             }
         }
@@ -521,6 +527,9 @@ impl Sky {
     pub fn set_block_motion(&mut self, id: u64, motion: BlockMotion) -> bool {
         match self.resident.blocks.get_mut(&id) {
             Some(r) => {
+                // What the shadow map watches for (a block moved by other means than the drift).
+                self.resident.changes += (r.motion.offset_m != motion.offset_m) as u64;
+                self.resident.fades += (r.motion.fade != motion.fade) as u64;
                 r.motion = motion;
                 true
             }
@@ -534,6 +543,7 @@ impl Sky {
         for r in self.resident.blocks.values_mut() {
             r.motion.offset_m = offset_m;
         }
+        self.resident.drift_m = offset_m;
         self.shadows.set_drift(offset_m);
     }
 
@@ -541,6 +551,7 @@ impl Sky {
     pub fn set_block_fade(&mut self, id: u64, fade: super::Fade) -> bool {
         match self.resident.blocks.get_mut(&id) {
             Some(r) => {
+                self.resident.fades += (r.motion.fade != fade) as u64;
                 r.motion.fade = fade;
                 true
             }

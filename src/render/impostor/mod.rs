@@ -121,6 +121,25 @@ pub struct ImpostorRing {
     clock_s: f64,
     /// Builds started.
     builds: u64,
+    /// The last pass over every block while the ring was steady.
+    last_split: Option<SplitCheck>,
+}
+
+/// What a pass over every block found while the ring was steady (shown, no build, no fade),
+/// and what with: while no block came, went or was written, the same ring is shown and the
+/// camera and the drift moved less than a tenth of the ring's own rebuild distances, the
+/// blocks' near marks and the crossings stand, and the thousands of blocks are not walked
+/// again (a block that crossed the ring radius starts a rebuild that little later).
+#[derive(Debug, Clone, Copy)]
+struct SplitCheck {
+    changes: u64,
+    builds: u64,
+    view_radius_m: f64,
+    camera_m: DVec3,
+    drift_m: DVec3,
+    far_now: usize,
+    same: bool,
+    far_count: u32,
 }
 
 const SPRITES_WGSL: &str = include_str!("../../../shaders/sprites.wgsl");
@@ -422,6 +441,7 @@ impl ImpostorRing {
             sorts: RingOrders::default(),
             clock_s: 0.0,
             builds: 0,
+            last_split: None,
         }
     }
 
@@ -488,6 +508,7 @@ impl ImpostorRing {
         if self.recorded.replace(false) {
             self.pending.clear();
         }
+        let (changes, drift_m) = (resident.changes, resident.drift_m);
         let blocks = &mut resident.blocks;
         self.blocks_far = 0;
         if !s.enabled {
@@ -513,7 +534,17 @@ impl ImpostorRing {
         let mut far_now = 0;
         let mut same = true;
         let mut far_count = 0;
-        {
+        let slack_m = 0.1 * s.rebuild_move_fraction.min(s.rebuild_climb_fraction) * s.ring_radius_m;
+        let kept = self.last_split.filter(|c| {
+            steady_shown
+                && c.changes == changes
+                && c.builds == self.builds
+                && c.view_radius_m == s.view_radius_m
+                && (c.camera_m - camera_m).length() + (c.drift_m - drift_m).length() <= slack_m
+        });
+        if let Some(c) = kept {
+            (far_now, same, far_count) = (c.far_now, c.same, c.far_count);
+        } else {
             let shown = self.shown.as_ref().map(|(_, st)| st);
             let far = self
                 .fade
@@ -534,6 +565,16 @@ impl ImpostorRing {
                     same &= in_far;
                 }
             }
+            self.last_split = steady_shown.then_some(SplitCheck {
+                changes,
+                builds: self.builds,
+                view_radius_m: s.view_radius_m,
+                camera_m,
+                drift_m,
+                far_now,
+                same,
+                far_count,
+            });
         }
         self.blocks_far = far_count;
         if self.build.is_some() {

@@ -136,6 +136,10 @@ pub struct CloudShadows {
     in_map: IdMap<(DVec3, f64)>,
     /// Whether this frame's draw adds to the map (blocks that arrived) rather than clearing it.
     adding: bool,
+    /// Counts whole drawings.
+    drawings: u64,
+    /// The last look over every block the sky holds, while it still holds.
+    cover: Option<CoverCheck>,
     /// Draw the map at the next prepare whatever changed ([`Self::redraw`]).
     force: bool,
     /// The clouds' drift now ([`super::Sky::set_drift`]).
@@ -147,6 +151,23 @@ pub struct CloudShadows {
     /// whether the last prepared frame drew it.
     timer: Option<super::Timestamps>,
     timed: Cell<bool>,
+}
+
+/// What a look over every block the sky holds found for the map's drawing: the blocks the map
+/// holds that are no longer covered, and whether a covered block forms or dissipates. Looked
+/// at again only when a block came, went, was written, moved or changed its fade, or the drift
+/// moved a texel, or the map was drawn anew: a frame of a steady sky walks none of its
+/// thousands of blocks for the map.
+#[derive(Debug)]
+struct CoverCheck {
+    /// `ResidentSet::changes` and `fades`, the whole drawing, and the drift it was made at.
+    changes: u64,
+    fades: u64,
+    drawing: u64,
+    drift_m: DVec3,
+    /// The blocks of `in_map` left out of the cover then: their centre and radius when drawn.
+    gone: Vec<(DVec3, f64)>,
+    changing: bool,
 }
 
 /// The built corners as the shadow pass reads them: `GpuSpriteVertex`'s position, uv, how many
@@ -301,6 +322,8 @@ impl CloudShadows {
             drawn: None,
             in_map: IdMap::default(),
             adding: false,
+            drawings: 0,
+            cover: None,
             force: false,
             drift_m: DVec3::ZERO,
             pending: None,
@@ -411,23 +434,53 @@ impl CloudShadows {
         let stale = match &self.drawn {
             None => true,
             Some((frame, at_s, _)) => {
-                let (now, changing) = covered(blocks, frame);
+                let same = self.cover.as_ref().is_some_and(|c| {
+                    c.changes == resident.changes
+                        && c.fades == resident.fades
+                        && c.drawing == self.drawings
+                        && (c.drift_m - self.drift_m).length() <= s.texel_m()
+                });
+                let mut arrived = IdSet::default();
+                if !same {
+                    let (now, changing) = covered(blocks, frame);
+                    let gone = self
+                        .in_map
+                        .iter()
+                        .filter(|(id, _)| !now.contains(id))
+                        .map(|(_, &place)| place)
+                        .collect();
+                    arrived = now
+                        .iter()
+                        .filter(|id| !self.in_map.contains_key(id))
+                        .copied()
+                        .collect();
+                    self.cover = Some(CoverCheck {
+                        changes: resident.changes,
+                        fades: resident.fades,
+                        drawing: self.drawings,
+                        drift_m: self.drift_m,
+                        gone,
+                        changing,
+                    });
+                }
+                let (gone, changing) = self
+                    .cover
+                    .as_ref()
+                    .map_or((&[][..], false), |c| (&c.gone[..], c.changing));
                 let times = (*at_s, now_s);
                 let due = std::mem::take(&mut self.force)
                     || needs_redraw(frame, times, camera_m, sun, changing, &s);
-                let near_gone = self.in_map.iter().any(|(id, &(centre, radius))| {
-                    !now.contains(id) && shadow_is_near(frame, centre, radius, camera_m, &s)
-                });
+                let near_gone = gone
+                    .iter()
+                    .any(|&(centre, radius)| shadow_is_near(frame, centre, radius, camera_m, &s));
                 // Nothing to add or take away while the sun is too low for shadows (the map
                 // is drawn empty then).
                 let near_gone = near_gone && !dark;
-                let arrived: IdSet = now
-                    .iter()
-                    .filter(|id| !self.in_map.contains_key(id))
-                    .copied()
-                    .collect();
                 if !(due || near_gone || dark || arrived.is_empty()) {
                     added = Some(arrived);
+                } else if !arrived.is_empty() {
+                    // Not added now: looked for again next frame.
+                    self.cover = None;
                 }
                 due || near_gone
             }
@@ -476,6 +529,7 @@ impl CloudShadows {
             queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
             bytes += std::mem::size_of::<GpuCloudShadow>() as u64;
             self.drawn = Some((frame, now_s, self.drift_m));
+            self.drawings += 1;
             self.adding = false;
             self.pending = Some(sprites);
             self.timed.set(self.timer.is_some());
@@ -576,11 +630,12 @@ impl CloudShadows {
             return 0;
         }
         // A fixed order (by place, then id): the half-float sums come out the same every run.
-        let mut order: Vec<&super::resident::Resident> = blocks
-            .values()
-            .filter(|r| is_covered(r, frame))
-            .filter(|r| only.is_none_or(|ids| ids.contains(&r.block.id)))
-            .collect();
+        // Blocks added to a map are a few of the thousands held: looked up, not searched for.
+        let mut order: Vec<&super::resident::Resident> = match only {
+            Some(ids) => ids.iter().filter_map(|id| blocks.get(id)).collect(),
+            None => blocks.values().collect(),
+        };
+        order.retain(|r| is_covered(r, frame));
         order.sort_by(|a, b| a.tie_order(b));
         let mut total = 0u32;
         for r in order {
