@@ -324,11 +324,9 @@ pub(super) fn main_view(
         }
     }
     let mut inside = Inside::default();
-    let mut total = 0u32;
     out.clear();
     locks.begin();
-    for (d2, r) in order {
-        let rel = camera_m - r.centre_m();
+    for (d2, r) in order.iter() {
         if d2.sqrt() < r.radius_m {
             let here = inside_clouds(r, camera_m, settings, locks);
             // A forming or dissipating block's inside is as thick as it has formed: a new
@@ -337,19 +335,14 @@ pub(super) fn main_view(
             inside.cloud = inside.cloud.max(here.cloud * shown);
             inside.rain = inside.rain.max(here.rain * shown);
         }
-        let (fade_kind, fade_progress) = fade_code(r.motion.fade);
-        out.push(GpuDrawBlock {
-            origin_rel: (-rel).as_vec3().to_array(),
-            fade_kind: fade_kind | if r.distant { DISTANT_BLOCK } else { 0 },
-            first: total,
-            list_base: r.place.as_ref().map_or(0, |p| p.1.start),
-            list_len: r.list.len() as u32,
-            fade_progress,
-        });
-        total += r.list_sprites;
         stats.clouds_drawn += r.list.len() as u32;
     }
     locks.end();
+    let order: Vec<Listed> = order
+        .into_iter()
+        .map(|(d2, r)| Listed::resident(d2, r))
+        .collect();
+    let total = draw_entries(&order, camera_m, out);
     stats.sprites_drawn = total;
     stats.cache_hit_rate = if stats.clouds_drawn == 0 {
         1.0
@@ -357,6 +350,193 @@ pub(super) fn main_view(
         1.0 - stats.clouds_recomputed as f32 / stats.clouds_drawn as f32
     };
     inside
+}
+
+/// At most this many blocks have their clouds interleaved together: a camera on the corner of
+/// four blocks, each in two generations during a weather change. A block that would make a
+/// group larger stays whole (a host's own layout of blocks could chain them without end).
+const MAX_INTERLEAVED: usize = 8;
+
+/// A block of a draw list: its squared distance from the view's eye, the block, and its drawn
+/// clouds' list back to front (`list`, at `list_base` of the bound list buffer) with their
+/// sprites.
+#[derive(Clone, Copy)]
+struct Listed<'a> {
+    d2: f64,
+    r: &'a Resident,
+    list: &'a [GpuListCloud],
+    list_base: u32,
+    sprites: u32,
+}
+
+impl<'a> Listed<'a> {
+    /// The sky camera's view of a block: its list as last sorted.
+    fn resident(d2: f64, r: &'a Resident) -> Self {
+        Self {
+            d2,
+            r,
+            list: &r.list,
+            list_base: r.place.as_ref().map_or(0, |p| p.1.start),
+            sprites: r.list_sprites,
+        }
+    }
+
+    /// Squared distance from `eye_m` of the `k`th cloud of its list (none past its end).
+    fn cloud_d2(&self, k: usize, eye_m: DVec3) -> f64 {
+        let start = self.r.place.as_ref().map_or(0, |p| p.1.start);
+        self.list
+            .get(k)
+            .and_then(|e| self.r.clouds.get(e.cloud.wrapping_sub(start) as usize))
+            .map_or(f64::NEG_INFINITY, |c| {
+                (c.centre_m + self.r.motion.offset_m - eye_m).length_squared()
+            })
+    }
+
+    /// Sprites before the `k`th cloud of its list.
+    fn sprites_before(&self, k: usize) -> u32 {
+        self.list.get(k).map_or(self.sprites, |e| e.first)
+    }
+
+    /// The entry of clouds `part` of its list, its first sprite `first`.
+    fn entry(&self, part: std::ops::Range<usize>, eye_m: DVec3, first: u32) -> GpuDrawBlock {
+        let (fade_kind, fade_progress) = fade_code(self.r.motion.fade);
+        GpuDrawBlock {
+            origin_rel: (self.r.centre_m() - eye_m).as_vec3().to_array(),
+            fade_kind: fade_kind | if self.r.distant { DISTANT_BLOCK } else { 0 },
+            first,
+            list_base: self.list_base + part.start as u32,
+            list_len: part.len() as u32,
+            fade_progress,
+        }
+    }
+}
+
+/// The draw list of `order` (back to front, distant blocks first, seen from `eye_m`): one
+/// entry for each block, except where the eye is close to the plane that decides the order of
+/// two neighbouring blocks. Drawn whole, one after the other, their overlapping sprites along
+/// that plane blend out of their distance order: with the eye on a block boundary every sprite
+/// of one side is drawn over the other's, and a straight seam runs along the boundary from the
+/// eye to the horizon. So their clouds are drawn interleaved, farthest first, as the clouds of
+/// one block are: each run of one block's clouds is an entry of its own (a part of its cloud
+/// list). Returns the sprites.
+fn draw_entries(order: &[Listed], eye_m: DVec3, out: &mut Vec<GpuDrawBlock>) -> u32 {
+    let groups = seam_groups(order);
+    let mut sizes = vec![0u8; order.len()];
+    for &g in &groups {
+        sizes[g as usize] += 1;
+    }
+    let mut total = 0u32;
+    let mut members: Vec<Listed> = Vec::with_capacity(MAX_INTERLEAVED);
+    for (i, b) in order.iter().enumerate() {
+        let group = groups[i] as usize;
+        if sizes[group] == 1 {
+            out.push(b.entry(0..b.list.len(), eye_m, total));
+            total += b.sprites;
+        } else if group == i {
+            // A group is drawn where its farthest block (its first) is, and skipped after.
+            members.clear();
+            let mut left = sizes[group] as usize;
+            for (j, &g) in groups.iter().enumerate().skip(i) {
+                if g as usize == group {
+                    members.push(order[j]);
+                    left -= 1;
+                    if left == 0 {
+                        break;
+                    }
+                }
+            }
+            total = interleave(&members, eye_m, total, out);
+        }
+    }
+    total
+}
+
+/// For each block of `order` (back to front) the index of the first block of its group, its
+/// own where it has none. Two neighbouring blocks (their spheres overlap) are grouped when the
+/// eye is within their largest cloud's radius of the plane half way between their centres:
+/// nearer, some of the farther block's sprites that overlap the nearer one's on screen are
+/// nearer the eye than they are. Squared distances differ by `2 |c_a - c_b|` times the eye's
+/// distance from that plane, so only blocks a few places apart in `order` are looked at (about
+/// three on a grid of equal blocks, however far out).
+fn seam_groups(order: &[Listed]) -> Vec<u32> {
+    fn root(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            parent[i as usize] = parent[parent[i as usize] as usize];
+            i = parent[i as usize];
+        }
+        i
+    }
+    let n = order.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut size = vec![1u8; n];
+    let (mut radius, mut reach) = (0.0f64, 0.0f64);
+    for b in order.iter().filter(|b| !b.r.distant) {
+        radius = radius.max(b.r.radius_m);
+        reach = reach.max(b.r.largest_cloud_m);
+    }
+    let window = 4.0 * reach * radius;
+    for (i, a) in order.iter().enumerate() {
+        if a.r.distant {
+            continue;
+        }
+        for (j, b) in order.iter().enumerate().skip(i + 1) {
+            let dd2 = a.d2 - b.d2;
+            if dd2 > window {
+                break;
+            }
+            let apart = (a.r.centre_m() - b.r.centre_m()).length();
+            let reach = a.r.largest_cloud_m.max(b.r.largest_cloud_m);
+            if b.r.distant || apart >= a.r.radius_m + b.r.radius_m || dd2 > 2.0 * reach * apart {
+                continue;
+            }
+            let (ri, rj) = (root(&mut parent, i as u32), root(&mut parent, j as u32));
+            let joined = size[ri as usize] as usize + size[rj as usize] as usize;
+            if ri != rj && joined <= MAX_INTERLEAVED {
+                // The root is the group's farthest block (its lowest index).
+                let (lo, hi) = (ri.min(rj), ri.max(rj));
+                parent[hi as usize] = lo;
+                size[lo as usize] = joined as u8;
+            }
+        }
+    }
+    (0..n as u32).map(|i| root(&mut parent, i)).collect()
+}
+
+/// Draw entries for the clouds of `members` (a group of [`seam_groups`], farthest block first)
+/// merged farthest first by their distance from `eye_m` now; each block's list keeps its own
+/// order, so each run of one block's clouds is a part of its list. Returns `total` (the
+/// sprites before them) plus theirs.
+fn interleave(
+    members: &[Listed],
+    eye_m: DVec3,
+    mut total: u32,
+    out: &mut Vec<GpuDrawBlock>,
+) -> u32 {
+    let mut heads = [0usize; MAX_INTERLEAVED];
+    let mut far = [f64::NEG_INFINITY; MAX_INTERLEAVED];
+    for (m, b) in members.iter().enumerate() {
+        far[m] = b.cloud_d2(0, eye_m);
+    }
+    // The run under way: which member, from which cloud of its list.
+    let mut run: Option<(usize, usize)> = None;
+    loop {
+        // Equally far: the farther block's first.
+        let next = (0..members.len())
+            .filter(|&m| heads[m] < members[m].list.len())
+            .max_by(|&a, &b| far[a].total_cmp(&far[b]).then(b.cmp(&a)));
+        if let Some((m, start)) = run.filter(|&(m, _)| Some(m) != next) {
+            let b = &members[m];
+            out.push(b.entry(start..heads[m], eye_m, total));
+            total += b.sprites_before(heads[m]) - b.sprites_before(start);
+            run = None;
+        }
+        let Some(m) = next else {
+            return total;
+        };
+        run.get_or_insert((m, heads[m]));
+        heads[m] += 1;
+        far[m] = members[m].cloud_d2(heads[m], eye_m);
+    }
 }
 
 /// Where the camera is among the clouds of a frame.
