@@ -421,7 +421,7 @@ fn the_clouds_of_two_blocks_the_camera_stands_between_are_drawn_interleaved() {
             .map(|&(d2, r)| Listed::resident(d2, r))
             .collect();
         let mut out = Vec::new();
-        let total = draw_entries(&listed, eye, &mut out);
+        let total = draw_entries(&listed, eye, &mut Seams::default(), &mut out);
         assert_eq!(total, 32 * 40, "camera {eye}");
         assert_eq!(out.len() == 2, whole, "camera {eye}: {} entries", out.len());
         // Each entry's sprites follow the last's.

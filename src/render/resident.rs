@@ -70,6 +70,9 @@ pub(super) struct Resident {
     /// Its drawn clouds, back to front, as last sorted (the GPU's copy is at its cloud slots of
     /// the list buffer), and their sprites.
     pub list: Vec<GpuListCloud>,
+    /// Which writing of `list` it holds (0: none yet): what the draw list worked out from a
+    /// list (the clouds of neighbouring blocks interleaved) holds while this stays.
+    pub list_serial: u64,
     pub list_sprites: u32,
     pub check: Option<BlockCheck>,
     /// Its slots, while it is on the GPU.
@@ -128,6 +131,7 @@ impl Resident {
             largest_cloud_m,
             z_span_m,
             list: Vec::new(),
+            list_serial: 0,
             list_sprites: 0,
             check: None,
             place: None,
