@@ -451,3 +451,39 @@ fn the_clouds_of_two_blocks_the_camera_stands_between_are_drawn_interleaved() {
         }
     }
 }
+
+/// A group's merge is kept while its blocks' lists are: from a camera 300 m east of where the
+/// lists were sorted, a frame that keeps them draws the merge it made there (the draw list a
+/// block's kept list would give, not one merged anew); once one of the lists is sorted again
+/// (its serial changes), the merge is made anew, from where the camera is now.
+#[test]
+fn a_merge_is_kept_while_the_blocks_lists_are_and_made_anew_when_one_is_sorted_again() {
+    let (here, there) = (DVec3::new(0.0, 0.0, 3000.0), DVec3::new(300.0, 0.0, 3000.0));
+    let mut blocks = two_blocks(here);
+    let entries = |blocks: &Blocks, eye: DVec3, seams: &mut Seams| {
+        let mut order: Vec<(f64, &Resident)> = blocks
+            .values()
+            .map(|r| ((r.centre_m() - eye).length_squared(), r))
+            .collect();
+        order.sort_by(|a, b| farthest_first(*a, *b));
+        let listed: Vec<Listed> = order
+            .iter()
+            .map(|&(d2, r)| Listed::resident(d2, r))
+            .collect();
+        let mut out = Vec::new();
+        let total = draw_entries(&listed, eye, seams, &mut out);
+        assert_eq!(total, 32 * 40, "camera {eye}");
+        // What the shader reads: which clouds, in which order, from which sprite.
+        out.iter()
+            .map(|d| (d.list_base, d.list_len, d.first))
+            .collect::<Vec<_>>()
+    };
+    let made_here = entries(&blocks, here, &mut Seams::default());
+    let made_there = entries(&blocks, there, &mut Seams::default());
+    assert_ne!(made_here, made_there, "the camera's move changes the merge");
+    let mut seams = Seams::default();
+    assert_eq!(entries(&blocks, here, &mut seams), made_here);
+    assert_eq!(entries(&blocks, there, &mut seams), made_here);
+    blocks.values_mut().next().unwrap().list_serial = 7;
+    assert_eq!(entries(&blocks, there, &mut seams), made_there);
+}
