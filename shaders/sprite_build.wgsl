@@ -352,7 +352,10 @@ fn locked_facing(slot: u32, fallback: Facing) -> Facing {
 // what the corners share (finding the sprite, its facing, lock and fades) is done once.
 fn build_sprite(k: u32, at: u32) {
     let b = draws.blocks[block_of(k)];
-    let in_block = k - b.first;
+    // An entry may be a part of its block's cloud list (the clouds of two blocks the camera
+    // stands between are drawn interleaved, `draw_entries` in src/render/draw_list.rs): its
+    // list's sprite counts run on from the part's first cloud's.
+    let in_block = k - b.first + lists[b.list_base].first;
     let entry = lists[cloud_of(b, in_block)];
     // In the cloud's order, or (the shadow map, `hl_deck.y`) in its slots' own: sums that do not
     // change with the camera's sort. A `select`, not an `if` on the uniform (see below).

@@ -306,3 +306,184 @@ fn ring_orders_are_sorted_within_the_frames_budget_and_kept_between_builds() {
         (base..base + 40).collect::<Vec<_>>()[..]
     );
 }
+
+/// Two blocks of a row of 4 km blocks, west and east of x = 0, 6 km north, each of 4 x 4
+/// clouds (500 m in radius) on a 1 km lattice, placed, with their lists back to front from `eye_m` as
+/// [`recheck`] writes them.
+fn two_blocks(eye_m: DVec3) -> Blocks {
+    let mut base = 0u32;
+    let mut slot = 0u32;
+    [(1u64, -2000.0), (2, 2000.0)]
+        .into_iter()
+        .map(|(id, x)| {
+            let centre = DVec3::new(x, 6000.0, 1000.0);
+            let clouds = (0..16)
+                .map(|k| SkyCloud {
+                    // A deck's cell: sprites 400 m wide up to 300 m from its centre.
+                    sprites: small_cloud()
+                        .sprites
+                        .into_iter()
+                        .map(|s| SkySprite {
+                            offset_m: s.offset_m * 25.0,
+                            width_m: 400.0,
+                            height_m: 400.0,
+                            ..s
+                        })
+                        .collect(),
+                    centre_m: centre
+                        + DVec3::new(
+                            (k % 4) as f64 * 1000.0 - 1500.0,
+                            (k / 4) as f64 * 1000.0 - 1500.0,
+                            0.0,
+                        ),
+                    ..small_cloud()
+                })
+                .collect();
+            let block = crate::render::scene::SkyBlock {
+                id,
+                centre_m: centre,
+                clouds,
+            };
+            let mut r = Resident::new(block, Default::default());
+            let (sprites, clouds) = (base, slot);
+            for state in r.clouds.iter_mut() {
+                state.sprite_base = base;
+                state.cloud_slot = slot;
+                base += state.sprites;
+                slot += 1;
+            }
+            r.place = Some((sprites..base, clouds..slot));
+            let mut order: Vec<(usize, f64)> = r
+                .clouds
+                .iter()
+                .enumerate()
+                .map(|(ci, c)| (ci, (c.centre_m - eye_m).length()))
+                .collect();
+            order.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+            let mut first = 0;
+            for (ci, _) in order {
+                let c = &r.clouds[ci];
+                r.list.push(GpuListCloud {
+                    cloud: c.cloud_slot,
+                    first,
+                    order_base: c.sprite_base,
+                    stride: 0,
+                });
+                first += c.sprites;
+            }
+            r.list_sprites = first;
+            (id, r)
+        })
+        .collect()
+}
+
+/// The clouds of the frame's draw list in drawing order, with their squared distances from
+/// `eye_m`, read back as the shader reads it (an entry's sprites run on from its first
+/// cloud's `first`).
+fn drawn_clouds(blocks: &Blocks, out: &[GpuDrawBlock], eye_m: DVec3) -> Vec<(u32, f64)> {
+    let lists: HashMap<u32, (GpuListCloud, DVec3)> = blocks
+        .values()
+        .flat_map(|r| {
+            let start = r.place.as_ref().unwrap().1.start;
+            r.list.iter().enumerate().map(move |(k, e)| {
+                let c = &r.clouds[(e.cloud - start) as usize];
+                (start + k as u32, (*e, c.centre_m))
+            })
+        })
+        .collect();
+    out.iter()
+        .flat_map(|d| (d.list_base..d.list_base + d.list_len).map(|at| lists[&at]))
+        .map(|(e, c)| (e.cloud, (c - eye_m).length_squared()))
+        .collect()
+}
+
+/// With the camera on the boundary between two blocks (equally far), their clouds are drawn
+/// interleaved farthest first, not one block's all over the other's (the seam along the
+/// boundary, `a_deck_shows_no_seam_along_the_block_boundary_through_the_camera` in
+/// tests/render.rs); each cloud once, the entries' sprites following on. From the middle of a
+/// block (farther from the boundary than their clouds' radius) the blocks are drawn whole, one
+/// entry each.
+#[test]
+fn the_clouds_of_two_blocks_the_camera_stands_between_are_drawn_interleaved() {
+    for (eye, whole) in [
+        (DVec3::new(0.0, 0.0, 3000.0), false),
+        (DVec3::new(300.0, 0.0, 3000.0), false),
+        (DVec3::new(-2000.0, 0.0, 3000.0), true),
+    ] {
+        let blocks = two_blocks(eye);
+        let mut order: Vec<(f64, &Resident)> = blocks
+            .values()
+            .map(|r| ((r.centre_m() - eye).length_squared(), r))
+            .collect();
+        order.sort_by(|a, b| farthest_first(*a, *b));
+        let listed: Vec<Listed> = order
+            .iter()
+            .map(|&(d2, r)| Listed::resident(d2, r))
+            .collect();
+        let mut out = Vec::new();
+        let total = draw_entries(&listed, eye, &mut Seams::default(), &mut out);
+        assert_eq!(total, 32 * 40, "camera {eye}");
+        assert_eq!(out.len() == 2, whole, "camera {eye}: {} entries", out.len());
+        // Each entry's sprites follow the last's.
+        for w in out.windows(2) {
+            let lists = |d: &GpuDrawBlock| {
+                let r = blocks
+                    .values()
+                    .find(|r| r.place.as_ref().unwrap().1.contains(&d.list_base))
+                    .unwrap();
+                let k = (d.list_base - r.place.as_ref().unwrap().1.start) as usize;
+                let end = r
+                    .list
+                    .get(k + d.list_len as usize)
+                    .map_or(r.list_sprites, |e| e.first);
+                end - r.list[k].first
+            };
+            assert_eq!(w[1].first, w[0].first + lists(&w[0]), "camera {eye}");
+        }
+        let clouds = drawn_clouds(&blocks, &out, eye);
+        let mut seen: Vec<u32> = clouds.iter().map(|c| c.0).collect();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..32).collect::<Vec<_>>(), "camera {eye}");
+        if !whole {
+            for w in clouds.windows(2) {
+                assert!(w[0].1 >= w[1].1, "camera {eye}: {clouds:?}");
+            }
+        }
+    }
+}
+
+/// A group's merge is kept while its blocks' lists are: from a camera 300 m east of where the
+/// lists were sorted, a frame that keeps them draws the merge it made there (the draw list a
+/// block's kept list would give, not one merged anew); once one of the lists is sorted again
+/// (its serial changes), the merge is made anew, from where the camera is now.
+#[test]
+fn a_merge_is_kept_while_the_blocks_lists_are_and_made_anew_when_one_is_sorted_again() {
+    let (here, there) = (DVec3::new(0.0, 0.0, 3000.0), DVec3::new(300.0, 0.0, 3000.0));
+    let mut blocks = two_blocks(here);
+    let entries = |blocks: &Blocks, eye: DVec3, seams: &mut Seams| {
+        let mut order: Vec<(f64, &Resident)> = blocks
+            .values()
+            .map(|r| ((r.centre_m() - eye).length_squared(), r))
+            .collect();
+        order.sort_by(|a, b| farthest_first(*a, *b));
+        let listed: Vec<Listed> = order
+            .iter()
+            .map(|&(d2, r)| Listed::resident(d2, r))
+            .collect();
+        let mut out = Vec::new();
+        let total = draw_entries(&listed, eye, seams, &mut out);
+        assert_eq!(total, 32 * 40, "camera {eye}");
+        // What the shader reads: which clouds, in which order, from which sprite.
+        out.iter()
+            .map(|d| (d.list_base, d.list_len, d.first))
+            .collect::<Vec<_>>()
+    };
+    let made_here = entries(&blocks, here, &mut Seams::default());
+    let made_there = entries(&blocks, there, &mut Seams::default());
+    assert_ne!(made_here, made_there, "the camera's move changes the merge");
+    let mut seams = Seams::default();
+    assert_eq!(entries(&blocks, here, &mut seams), made_here);
+    assert_eq!(entries(&blocks, there, &mut seams), made_here);
+    blocks.values_mut().next().unwrap().list_serial = 7;
+    assert_eq!(entries(&blocks, there, &mut seams), made_there);
+}

@@ -143,7 +143,9 @@ pub struct GpuDrawBlock {
     pub origin_rel: [f32; 3],
     /// Index of its first sprite in the frame's sequence of drawn sprites.
     pub first: u32,
-    /// Where its clouds' list starts in the bound list buffer.
+    /// Where its clouds' list starts in the bound list buffer. A part of a block's list (its
+    /// clouds interleaved with a neighbour's) starts within it: the sprites of its first cloud
+    /// are the entry's `first`, whatever that cloud's `first` in the list.
     pub list_base: u32,
     /// Clouds in the list.
     pub list_len: u32,

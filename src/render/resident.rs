@@ -63,9 +63,16 @@ pub(super) struct Resident {
     pub motion: BlockMotion,
     /// Radius of a sphere around the block's centre holding all its clouds, metres.
     pub radius_m: f64,
+    /// Its largest cloud's radius, metres: how far its sprites reach past the plane between
+    /// it and a neighbour (the draw list interleaves the clouds of two blocks whose order the
+    /// camera is that close to deciding).
+    pub largest_cloud_m: f64,
     /// Its drawn clouds, back to front, as last sorted (the GPU's copy is at its cloud slots of
     /// the list buffer), and their sprites.
     pub list: Vec<GpuListCloud>,
+    /// Which writing of `list` it holds (0: none yet): what the draw list worked out from a
+    /// list (the clouds of neighbouring blocks interleaved) holds while this stays.
+    pub list_serial: u64,
     pub list_sprites: u32,
     pub check: Option<BlockCheck>,
     /// Its slots, while it is on the GPU.
@@ -108,6 +115,7 @@ impl Resident {
             .iter()
             .map(|c| (c.centre_m - block.centre_m).length() + c.radius_m as f64)
             .fold(0.0, f64::max);
+        let largest_cloud_m = clouds.iter().map(|c| c.radius_m as f64).fold(0.0, f64::max);
         let z_span_m = clouds
             .iter()
             .map(|c| {
@@ -120,8 +128,10 @@ impl Resident {
             block,
             motion,
             radius_m,
+            largest_cloud_m,
             z_span_m,
             list: Vec::new(),
+            list_serial: 0,
             list_sprites: 0,
             check: None,
             place: None,

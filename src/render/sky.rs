@@ -1044,7 +1044,7 @@ impl Sky {
             (camera.position_m, &camera.frustum()),
             self.elapsed_s,
             (&drawn, sort_budget),
-            &mut v.locks,
+            (&mut v.locks, &mut v.seams),
             &mut v.draws,
             &mut stats,
         );

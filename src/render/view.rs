@@ -9,7 +9,7 @@ use std::cell::Cell;
 use glam::Mat4;
 
 use super::cloud_target::{CloudShared, CloudTarget, cloud_targets, divisor_of};
-use super::draw_list::Locks;
+use super::draw_list::{Locks, Seams};
 use super::gpu_types::{GpuDrawBlock, GpuFrame};
 use super::impostor::{ImpostorRing, RingShared};
 use super::settings::RenderSettings;
@@ -43,6 +43,7 @@ pub(super) struct View {
     pub view: ViewBuffers,
     pub draws: Vec<GpuDrawBlock>,
     pub locks: Locks,
+    pub seams: Seams,
     pub sprites_to_draw: u32,
     /// The first of them: the distant blocks' (drawn behind the impostor ring).
     pub distant_sprites: u32,
@@ -99,6 +100,7 @@ impl View {
             view: ViewBuffers::new(device, false),
             draws: Vec::new(),
             locks: Locks::default(),
+            seams: Seams::default(),
             sprites_to_draw: 0,
             distant_sprites: 0,
             in_cloud: 0.0,
