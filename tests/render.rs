@@ -963,6 +963,55 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     assert!(!plain.host.sky.set_impostors(true));
 }
 
+/// Each view draws its own near blocks, also while its ring stands and its split no longer
+/// passes over the blocks. A second view 26 km north, looking north, prepared after the main
+/// one each frame: two cumulus in the main view's ring are 2 and 4 km ahead of it, near; the
+/// main view's near ones are behind it or out of its view. (When the views shared the blocks'
+/// near marks, a view whose ring stood drew the other view's split: here the main view drew
+/// the second's near blocks, 180 sprites.)
+#[test]
+fn each_view_draws_its_own_near_blocks() {
+    let mut rig = Rig::new(flat_ground(0.0));
+    let mut blocks = ring_blocks(true);
+    // A cumulus 2 km ahead of the second view, in the main view's ring.
+    let ahead = DVec3::new(1000.0, 28_000.0, 1300.0);
+    blocks.push(SkyBlock {
+        id: 5,
+        centre_m: ahead,
+        clouds: vec![cumulus(ahead)],
+    });
+    rig.set_clouds(blocks);
+    let main = rig.camera(DVec3::new(0.0, 0.0, 1000.0), 0.0, 3.0);
+    let north = rig.camera(DVec3::new(0.0, 26_000.0, 1000.0), 0.0, 3.0);
+    let second = rig.host.sky.add_view();
+    let queue = rig.host.gpu.queue.clone();
+    // Half-second frames: any crossfade is over within the first few.
+    let frames: Vec<_> = (0..8)
+        .map(|_| {
+            let a = rig.host.sky.prepare(&queue, main, &sun(), 0.5);
+            let b = rig
+                .host
+                .sky
+                .prepare_view(second, &queue, north, &sun(), 0.5);
+            (a.sprites_drawn, b.sprites_drawn, b.impostors_rebuilt)
+        })
+        .collect();
+    eprintln!("sprites drawn (main, second, second's impostors rebuilt): {frames:?}");
+    // The main view: the near cumulus and the high one (2 x 60); the second: the two ahead.
+    assert_eq!(frames[0].0, 120, "{frames:?}");
+    assert_eq!(frames[0].1, 120, "{frames:?}");
+    assert_eq!(
+        frames[7].2, 0,
+        "the second view's ring still builds: {frames:?}"
+    );
+    assert!(
+        frames
+            .iter()
+            .all(|f| (f.0, f.1) == (frames[0].0, frames[0].1)),
+        "{frames:?}"
+    );
+}
+
 /// Blocks that arrive when the resident buffers are full grow them, and the clouds already on
 /// the GPU stay as they were: the frame after the growth is the frame of a sky that got every
 /// block at once. (Placing everything again made the frames that grew take 42 to 144 ms; the

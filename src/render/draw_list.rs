@@ -260,15 +260,15 @@ pub(super) struct Copies<'a> {
     pub dirty_lists: &'a mut Vec<std::ops::Range<u32>>,
 }
 
-/// The sky camera's frame: fills `out` with the draw list of the blocks marked near, placed and
-/// in view (`frustum`: nothing of a block wholly outside it is built or drawn), looks again at
+/// The sky camera's frame: fills `out` with the draw list of the view's `near` blocks (the ids
+/// its impostor ring leaves to the sprites) that are placed and in view (`frustum`: nothing of a block wholly outside it is built or drawn), looks again at
 /// the blocks whose slack is used up (re-sorting their clouds, recomputing the orders the cache
 /// says are stale, into `copies`, marked dirty, at most `budget` sprites), updates `locks` and
 /// `seams`, and counts into `stats`. Returns how far inside a cloud, and how deep in rain, the
 /// camera is.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn main_view(
-    blocks: &mut Blocks,
+    (blocks, near): (&mut Blocks, &[u64]),
     copies: Copies,
     (camera_m, frustum): (DVec3, &Frustum),
     time_s: f64,
@@ -278,10 +278,12 @@ pub(super) fn main_view(
     stats: &mut FrameStats,
 ) -> Inside {
     // A block out of view is not looked at again either: its slack check catches up with the
-    // camera the frame it comes into view.
-    let mut order: Vec<(f64, &mut Resident)> = blocks
-        .values_mut()
-        .filter(|r| r.near && r.uploaded)
+    // camera the frame it comes into view. Only the view's near blocks are looked up, not the
+    // thousands held (most of them in the ring).
+    let mut order: Vec<(f64, &Resident)> = near
+        .iter()
+        .filter_map(|id| blocks.get(id))
+        .filter(|r| r.uploaded)
         .filter(|r| frustum.sees_sphere((r.centre_m() - camera_m).as_vec3(), r.radius_m as f32))
         .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
         .collect();
@@ -289,8 +291,9 @@ pub(super) fn main_view(
     order.sort_by(|a, b| {
         b.1.distant
             .cmp(&a.1.distant)
-            .then_with(|| farthest_first((a.0, &*a.1), (b.0, &*b.1)))
+            .then_with(|| farthest_first(*a, *b))
     });
+    let order: Vec<(f64, u64)> = order.into_iter().map(|(d2, r)| (d2, r.block.id)).collect();
     let Copies {
         orders,
         dirty_orders,
@@ -300,7 +303,10 @@ pub(super) fn main_view(
     let (mut scratch, mut keys) = (Vec::new(), Vec::new());
     // Looked at again nearest first, so that the frame's sorting budget goes to what is near.
     let mut budget = budget;
-    for (_, r) in order.iter_mut().rev() {
+    for (_, id) in order.iter().rev() {
+        let Some(r) = blocks.get_mut(id) else {
+            continue;
+        };
         let rel = camera_m - r.centre_m();
         let fresh = settings.vertex_cache.enabled
             && r.check.is_some_and(|c| {
@@ -325,10 +331,14 @@ pub(super) fn main_view(
             }
         }
     }
+    let order: Vec<Listed> = order
+        .iter()
+        .filter_map(|&(d2, id)| Some(Listed::resident(d2, blocks.get(&id)?)))
+        .collect();
     let mut inside = Inside::default();
     out.clear();
     locks.begin();
-    for (d2, r) in order.iter() {
+    for &Listed { d2, r, .. } in &order {
         if d2.sqrt() < r.radius_m {
             let here = inside_clouds(r, camera_m, settings, locks);
             // A forming or dissipating block's inside is as thick as it has formed: a new
@@ -340,10 +350,6 @@ pub(super) fn main_view(
         stats.clouds_drawn += r.list.len() as u32;
     }
     locks.end();
-    let order: Vec<Listed> = order
-        .into_iter()
-        .map(|(d2, r)| Listed::resident(d2, r))
-        .collect();
     let total = draw_entries(&order, camera_m, seams, out);
     stats.sprites_drawn = total;
     stats.cache_hit_rate = if stats.clouds_drawn == 0 {

@@ -81,8 +81,6 @@ pub(super) struct Resident {
     pub uploaded: bool,
     /// Its Harris and Lastra light (empty under Wang's model).
     pub light: BlockLight,
-    /// Drawn as sprites this frame (not in the impostor ring); set by the ring's split.
-    pub near: bool,
     /// Drawn as sprites at any distance and never in the ring: a storm cell beyond the cloud
     /// field ([`super::Sky::insert_distant_block`]).
     pub distant: bool,
@@ -137,7 +135,6 @@ impl Resident {
             place: None,
             uploaded: false,
             light: BlockLight::default(),
-            near: true,
             distant: false,
             clouds,
         }

@@ -1034,7 +1034,7 @@ impl Sky {
         let resident = &mut self.resident;
         let v = &mut self.views[i];
         let inside = main_view(
-            &mut resident.blocks,
+            (&mut resident.blocks, v.ring.near()),
             Copies {
                 orders: &mut resident.orders_cpu,
                 dirty_orders: &mut resident.dirty_orders,

@@ -123,6 +123,9 @@ pub struct ImpostorRing {
     builds: u64,
     /// The last pass over every block while the ring was steady.
     last_split: Option<SplitCheck>,
+    /// The ids of the blocks this view draws as sprites (held, not in the ring), as of the last
+    /// pass over every block: what the view's draw list looks at, not the thousands held.
+    near: Vec<u64>,
 }
 
 /// What a pass over every block found while the ring was steady (shown, no build, no fade),
@@ -442,6 +445,7 @@ impl ImpostorRing {
             clock_s: 0.0,
             builds: 0,
             last_split: None,
+            near: Vec::new(),
         }
     }
 
@@ -493,7 +497,12 @@ impl ImpostorRing {
         s
     }
 
-    /// Decides this frame's near blocks (marks `resident`'s blocks `near`: drawn as sprites) and
+    /// The ids of the blocks this view draws as sprites this frame (decided by [`Self::split`]).
+    pub(super) fn near(&self) -> &[u64] {
+        &self.near
+    }
+
+    /// Decides this frame's near blocks ([`Self::near`]: drawn as sprites) and
     /// starts or advances a rebuild. Call [`Self::prepare_builds`] after, with the frame's
     /// uniform. One pass over the blocks.
     pub(super) fn split(
@@ -512,7 +521,8 @@ impl ImpostorRing {
         let blocks = &mut resident.blocks;
         self.blocks_far = 0;
         if !s.enabled {
-            blocks.values_mut().for_each(|r| r.near = true);
+            self.near.clear();
+            self.near.extend(blocks.keys());
             return;
         }
         // Advance the crossfade; a finished fade makes the new ring the shown one.
@@ -552,9 +562,12 @@ impl ImpostorRing {
                 .map(|(_, st, _)| &st.far_ids)
                 .or(shown.map(|st| &st.far_ids))
                 .or(self.build.as_ref().map(|b| &b.state.far_ids));
-            for r in blocks.values_mut() {
+            self.near.clear();
+            for r in blocks.values() {
                 let in_far = far.is_some_and(|f| f.contains(&r.block.id));
-                r.near = !in_far;
+                if !in_far {
+                    self.near.push(r.block.id);
+                }
                 far_count += in_far as u32;
                 if steady_shown
                     && !r.distant
@@ -622,11 +635,8 @@ impl ImpostorRing {
         if first {
             // Before the first ring exists it is built this frame, so its blocks are far
             // already.
-            self.blocks_far = 0;
-            for r in blocks.values_mut() {
-                r.near = !far_ids.contains(&r.block.id);
-                self.blocks_far += !r.near as u32;
-            }
+            self.near.retain(|id| !far_ids.contains(id));
+            self.blocks_far = far_ids.len() as u32;
         }
         self.sorts.retain(blocks);
         self.builds += 1;
