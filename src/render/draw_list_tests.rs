@@ -308,9 +308,9 @@ fn ring_orders_are_sorted_within_the_frames_budget_and_kept_between_builds() {
 }
 
 /// Two blocks of a row of 4 km blocks, west and east of x = 0, 6 km north, each of 4 x 4
-/// clouds (500 m in radius) on a 1 km lattice, placed, with their lists back to front from `eye_m` as
-/// [`recheck`] writes them.
-fn two_blocks(eye_m: DVec3) -> Blocks {
+/// clouds (500 m in radius) on a 1 km lattice, placed, with their lists back to front from
+/// `eye_m` as [`recheck`] writes them; a deck's cells (`sunlit_depth_m` set) when `deck`.
+fn two_blocks(eye_m: DVec3, deck: bool) -> Blocks {
     let mut base = 0u32;
     let mut slot = 0u32;
     [(1u64, -2000.0), (2, 2000.0)]
@@ -336,6 +336,7 @@ fn two_blocks(eye_m: DVec3) -> Blocks {
                             (k / 4) as f64 * 1000.0 - 1500.0,
                             0.0,
                         ),
+                    sunlit_depth_m: if deck { 60.0 } else { 0.0 },
                     ..small_cloud()
                 })
                 .collect();
@@ -402,15 +403,16 @@ fn drawn_clouds(blocks: &Blocks, out: &[GpuDrawBlock], eye_m: DVec3) -> Vec<(u32
 /// boundary, `a_deck_shows_no_seam_along_the_block_boundary_through_the_camera` in
 /// tests/render.rs); each cloud once, the entries' sprites following on. From the middle of a
 /// block (farther from the boundary than their clouds' radius) the blocks are drawn whole, one
-/// entry each.
+/// entry each; and so are two blocks of heaped clouds (not decks) wherever the camera is.
 #[test]
 fn the_clouds_of_two_blocks_the_camera_stands_between_are_drawn_interleaved() {
-    for (eye, whole) in [
-        (DVec3::new(0.0, 0.0, 3000.0), false),
-        (DVec3::new(300.0, 0.0, 3000.0), false),
-        (DVec3::new(-2000.0, 0.0, 3000.0), true),
+    for (eye, deck, whole) in [
+        (DVec3::new(0.0, 0.0, 3000.0), true, false),
+        (DVec3::new(300.0, 0.0, 3000.0), true, false),
+        (DVec3::new(-2000.0, 0.0, 3000.0), true, true),
+        (DVec3::new(0.0, 0.0, 3000.0), false, true),
     ] {
-        let blocks = two_blocks(eye);
+        let blocks = two_blocks(eye, deck);
         let mut order: Vec<(f64, &Resident)> = blocks
             .values()
             .map(|r| ((r.centre_m() - eye).length_squared(), r))
@@ -459,7 +461,7 @@ fn the_clouds_of_two_blocks_the_camera_stands_between_are_drawn_interleaved() {
 #[test]
 fn a_merge_is_kept_while_the_blocks_lists_are_and_made_anew_when_one_is_sorted_again() {
     let (here, there) = (DVec3::new(0.0, 0.0, 3000.0), DVec3::new(300.0, 0.0, 3000.0));
-    let mut blocks = two_blocks(here);
+    let mut blocks = two_blocks(here, true);
     let entries = |blocks: &Blocks, eye: DVec3, seams: &mut Seams| {
         let mut order: Vec<(f64, &Resident)> = blocks
             .values()

@@ -64,9 +64,12 @@ pub(super) struct Resident {
     /// Radius of a sphere around the block's centre holding all its clouds, metres.
     pub radius_m: f64,
     /// Its largest cloud's radius, metres: how far its sprites reach past the plane between
-    /// it and a neighbour (the draw list interleaves the clouds of two blocks whose order the
-    /// camera is that close to deciding).
+    /// it and a neighbour (the draw list interleaves the clouds of two deck blocks whose order
+    /// the camera is that close to deciding).
     pub largest_cloud_m: f64,
+    /// Whether it holds a deck (a layer's cells on the lattice, `sunlit_depth_m` set): clouds
+    /// side by side up to its sides, which overlap a neighbouring deck's all along the boundary.
+    pub deck: bool,
     /// Its drawn clouds, back to front, as last sorted (the GPU's copy is at its cloud slots of
     /// the list buffer), and their sprites.
     pub list: Vec<GpuListCloud>,
@@ -114,6 +117,7 @@ impl Resident {
             .map(|c| (c.centre_m - block.centre_m).length() + c.radius_m as f64)
             .fold(0.0, f64::max);
         let largest_cloud_m = clouds.iter().map(|c| c.radius_m as f64).fold(0.0, f64::max);
+        let deck = block.clouds.iter().any(|c| c.sunlit_depth_m > 0.0);
         let z_span_m = clouds
             .iter()
             .map(|c| {
@@ -127,6 +131,7 @@ impl Resident {
             motion,
             radius_m,
             largest_cloud_m,
+            deck,
             z_span_m,
             list: Vec::new(),
             list_serial: 0,
