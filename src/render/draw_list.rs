@@ -261,11 +261,11 @@ pub(super) struct Copies<'a> {
 }
 
 /// The sky camera's frame: fills `out` with the draw list of the view's `near` blocks (the ids
-/// its impostor ring leaves to the sprites) that are placed and in view (`frustum`: nothing of a block wholly outside it is built or drawn), looks again at
-/// the blocks whose slack is used up (re-sorting their clouds, recomputing the orders the cache
-/// says are stale, into `copies`, marked dirty, at most `budget` sprites), updates `locks` and
-/// `seams`, and counts into `stats`. Returns how far inside a cloud, and how deep in rain, the
-/// camera is.
+/// its impostor ring leaves to the sprites) that are placed and in view (`frustum`: nothing of
+/// a block wholly outside it is built or drawn), looks again at the blocks whose slack is used
+/// up (re-sorting their clouds, recomputing the orders the cache says are stale, into `copies`,
+/// marked dirty, at most `budget` sprites), updates `locks` and `seams`, and counts into
+/// `stats`. Returns how far inside a cloud, and how deep in rain, the camera is.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn main_view(
     (blocks, near): (&mut Blocks, &[u64]),
