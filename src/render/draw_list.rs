@@ -570,7 +570,7 @@ fn seam_groups(order: &[Listed]) -> Option<Vec<u32>> {
     // Only decks: their cells stand side by side up to the blocks' sides, so two decks'
     // sprites overlap all along the boundary and the blend out of order is a line. Heaped
     // clouds have gaps between them; where two overlap across a boundary the error is one
-    // cloud's, and grouping them made the cumulus cruise's frames dearer by a sixth.
+    // cloud's, and grouping them made the cumulus cruise's update dearer by a third.
     let interleaved = |b: &Listed| b.r.deck && !b.r.distant;
     let (mut radius, mut reach) = (0.0f64, 0.0f64);
     for b in order.iter().filter(|b| interleaved(b)) {

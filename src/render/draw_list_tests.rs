@@ -398,6 +398,23 @@ fn drawn_clouds(blocks: &Blocks, out: &[GpuDrawBlock], eye_m: DVec3) -> Vec<(u32
         .collect()
 }
 
+/// The draw list of every block of `blocks` seen from `eye_m`, back to front as the sky camera
+/// orders them: its sprites and entries.
+fn entries_of(blocks: &Blocks, eye_m: DVec3, seams: &mut Seams) -> (u32, Vec<GpuDrawBlock>) {
+    let mut order: Vec<(f64, &Resident)> = blocks
+        .values()
+        .map(|r| ((r.centre_m() - eye_m).length_squared(), r))
+        .collect();
+    order.sort_by(|a, b| farthest_first(*a, *b));
+    let listed: Vec<Listed> = order
+        .iter()
+        .map(|&(d2, r)| Listed::resident(d2, r))
+        .collect();
+    let mut out = Vec::new();
+    let total = draw_entries(&listed, eye_m, seams, &mut out);
+    (total, out)
+}
+
 /// With the camera on the boundary between two blocks (equally far), their clouds are drawn
 /// interleaved farthest first, not one block's all over the other's (the seam along the
 /// boundary, `a_deck_shows_no_seam_along_the_block_boundary_through_the_camera` in
@@ -413,17 +430,7 @@ fn the_clouds_of_two_blocks_the_camera_stands_between_are_drawn_interleaved() {
         (DVec3::new(0.0, 0.0, 3000.0), false, true),
     ] {
         let blocks = two_blocks(eye, deck);
-        let mut order: Vec<(f64, &Resident)> = blocks
-            .values()
-            .map(|r| ((r.centre_m() - eye).length_squared(), r))
-            .collect();
-        order.sort_by(|a, b| farthest_first(*a, *b));
-        let listed: Vec<Listed> = order
-            .iter()
-            .map(|&(d2, r)| Listed::resident(d2, r))
-            .collect();
-        let mut out = Vec::new();
-        let total = draw_entries(&listed, eye, &mut Seams::default(), &mut out);
+        let (total, out) = entries_of(&blocks, eye, &mut Seams::default());
         assert_eq!(total, 32 * 40, "camera {eye}");
         assert_eq!(out.len() == 2, whole, "camera {eye}: {} entries", out.len());
         // Each entry's sprites follow the last's.
@@ -463,17 +470,7 @@ fn a_merge_is_kept_while_the_blocks_lists_are_and_made_anew_when_one_is_sorted_a
     let (here, there) = (DVec3::new(0.0, 0.0, 3000.0), DVec3::new(300.0, 0.0, 3000.0));
     let mut blocks = two_blocks(here, true);
     let entries = |blocks: &Blocks, eye: DVec3, seams: &mut Seams| {
-        let mut order: Vec<(f64, &Resident)> = blocks
-            .values()
-            .map(|r| ((r.centre_m() - eye).length_squared(), r))
-            .collect();
-        order.sort_by(|a, b| farthest_first(*a, *b));
-        let listed: Vec<Listed> = order
-            .iter()
-            .map(|&(d2, r)| Listed::resident(d2, r))
-            .collect();
-        let mut out = Vec::new();
-        let total = draw_entries(&listed, eye, seams, &mut out);
+        let (total, out) = entries_of(blocks, eye, seams);
         assert_eq!(total, 32 * 40, "camera {eye}");
         // What the shader reads: which clouds, in which order, from which sprite.
         out.iter()
