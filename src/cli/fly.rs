@@ -193,6 +193,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "flashes",
         "sprites_recomputed",
         "ring_sprites_sorted",
+        "ring_orders_rewritten",
         "gpu_wait_us",
         "preempted",
     ])?;
@@ -307,6 +308,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             host.sky.drain_flashes().len().to_string(),
             stats.sprites_recomputed.to_string(),
             stats.ring_sprites_sorted.to_string(),
+            stats.ring_orders_rewritten.to_string(),
             stats.gpu_wait_us.to_string(),
             preempted,
         ])?;
@@ -413,7 +415,6 @@ impl Summary {
     }
 }
 
-/// The process's peak resident memory (Linux: `VmHWM` of /proc/self/status).
 /// Involuntary context switches of the calling thread so far (Linux: the thread's
 /// `nonvoluntary_ctxt_switches`), `None` elsewhere: a frame with more at its end than at its
 /// start was preempted (the system ran something else on its core meanwhile).
@@ -425,6 +426,7 @@ fn involuntary_switches() -> Option<u64> {
     line.split_whitespace().nth(1)?.parse().ok()
 }
 
+/// The process's peak resident memory (Linux: `VmHWM` of /proc/self/status).
 fn peak_rss_bytes() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;

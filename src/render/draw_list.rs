@@ -132,7 +132,7 @@ fn thresholds(fading: bool, near_edge_m: f64, cache: &VertexCacheSettings) -> (f
 
 /// Whether more than `share` of a cloud's movement or age threshold is used up since its order
 /// was computed (or time ran backwards): with `share` 1 Wang's rule that the order is stale.
-fn used_up(
+pub(super) fn used_up(
     (ordered_at, fading): ((DVec3, f64), bool),
     camera_rel_m: DVec3,
     time_s: f64,
@@ -175,14 +175,14 @@ pub fn sprites_back_to_front(cloud: &SkyCloud, cam_local_m: Vec3) -> Vec<(usize,
 /// Sort keys of a cloud's sprites: the complement of the squared distance's bits above the
 /// sprite's index, so that one ascending sort of plain integers puts the farthest first and
 /// equally far sprites by index.
-type SortKeys = Vec<u64>;
+pub(super) type SortKeys = Vec<u64>;
 
 /// Writes the cloud's sprite slots (`base` + index), farthest from the camera first, into
 /// `slots` (`cam_local_m`: the camera relative to the cloud centre). The same order as
 /// [`sprites_back_to_front`], on integer keys (squared distances are positive floats, whose bits
 /// sort as integers; packed with the index into one `u64`, which sorts about twice as fast as a
 /// pair with a comparator) and a reused buffer: this runs for a hundred clouds a frame.
-fn order_into(
+pub(super) fn order_into(
     cloud: &SkyCloud,
     cam_local_m: Vec3,
     base: u32,
@@ -226,7 +226,7 @@ pub(super) type Blocks = IdMap<Resident>;
 
 /// Blocks' ids, farthest centre (with its drift) from `from_m` first (the impostor views; the
 /// sky camera's sorts the near blocks themselves).
-fn blocks_back_to_front(blocks: &Blocks, ids: &[u64], from_m: DVec3) -> Vec<(f64, u64)> {
+pub(super) fn blocks_back_to_front(blocks: &Blocks, ids: &[u64], from_m: DVec3) -> Vec<(f64, u64)> {
     let mut order: Vec<(f64, &Resident)> = ids
         .iter()
         .filter_map(|id| blocks.get(id))
@@ -826,214 +826,6 @@ fn inside_clouds(
     }
 }
 
-/// The far clouds' sprite orders as the impostor ring sees them (from its centre), kept from
-/// one ring build to the next and sorted a budget at a time: Wang's vertex cache for the ring's
-/// views. An impostor is rendered only once every cloud of its sector has an order that is good
-/// for its centre; until then each frame sorts what the frame's sorting budget has left after
-/// the sky camera's clouds (`[vertex_cache] max_sorted_sprites_per_frame` holds on the frames
-/// that rebuild the ring too). A rebuild that finds the camera near where the last one was (the
-/// far blocks changed at the rim, the sun turned) takes most orders from here.
-#[derive(Debug, Default)]
-pub(super) struct RingOrders {
-    /// By block id, then cloud index: one lookup a block, its clouds' orders side by side
-    /// (a lookup by block and cloud, with tens of thousands of far clouds, was most of a
-    /// gathering frame's time).
-    kept: IdMap<Vec<Option<RingOrder>>>,
-    keys: SortKeys,
-    /// The gather under way ([`RingSort::gather`]) and its clouds still to sort (block id,
-    /// cloud index): found once, when it starts, so that its later frames look at nothing else.
-    gather: Option<u64>,
-    todo: Vec<(u64, usize)>,
-    /// Scratch for the clouds a frame leaves to the next.
-    left: Vec<(u64, usize)>,
-}
-
-/// One cloud's order seen from a ring centre.
-#[derive(Debug)]
-struct RingOrder {
-    /// The centre relative to the cloud, and the sky time, when it was computed.
-    from_rel_m: DVec3,
-    at_s: f64,
-    /// Its sprites' indices within the cloud, farthest from the centre first.
-    order: Vec<u32>,
-}
-
-/// When a ring build started and what it may sort this frame.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct RingSort<'a> {
-    /// Which impostor of which build is being gathered (a new value starts a new gather).
-    pub gather: u64,
-    /// Sky time when the build started: orders computed since are good for it, older ones as
-    /// long as Wang's thresholds (judged then) hold.
-    pub since_s: f64,
-    /// Sky time now.
-    pub time_s: f64,
-    pub cache: &'a VertexCacheSettings,
-    /// A cloud with more sprites than this is never sorted for the ring (no frame could afford
-    /// it): it goes in in its sprites' own order, as the sky camera draws it until its first sort.
-    pub largest: u32,
-}
-
-impl RingOrders {
-    /// Forgets the orders of blocks the sky no longer holds.
-    pub fn retain(&mut self, blocks: &Blocks) {
-        self.kept.retain(|id, _| blocks.contains_key(id));
-    }
-
-    /// Sorts, from `from_m`, the clouds of blocks `ids` within `draw_m` whose order is missing
-    /// or stale, while `budget` (sprites) lasts, taking what it sorts from it. Which clouds
-    /// those are is found on the first call of a gather; later calls of it sort what is left.
-    /// Returns whether every such cloud now has a good order, and the sprites sorted.
-    pub fn sort(
-        &mut self,
-        blocks: &Blocks,
-        ids: &[u64],
-        (from_m, draw_m): (DVec3, f64),
-        when: &RingSort,
-        budget: &mut u32,
-    ) -> (bool, u32) {
-        if self.gather != Some(when.gather) {
-            self.gather = Some(when.gather);
-            self.todo.clear();
-            for id in ids {
-                let Some(r) = blocks.get(id).filter(|r| r.place.is_some()) else {
-                    continue;
-                };
-                let fading = r.motion.fade != Fade::Steady;
-                let kept = self.kept.get(id).map_or(&[][..], Vec::as_slice);
-                for (ci, (state, cloud)) in r.clouds.iter().zip(&r.block.clouds).enumerate() {
-                    let rel = from_m - (state.centre_m + r.motion.offset_m);
-                    let near_edge = (rel.length() - state.radius_m as f64).max(0.0);
-                    if near_edge > draw_m || state.sprites == 0 || state.sprites > when.largest {
-                        continue;
-                    }
-                    let good = kept.get(ci).and_then(Option::as_ref).is_some_and(|o| {
-                        o.order.len() == cloud.sprites.len()
-                            && (o.at_s >= when.since_s
-                                || (when.cache.enabled
-                                    && !used_up(
-                                        ((o.from_rel_m, o.at_s), fading),
-                                        rel,
-                                        when.since_s,
-                                        near_edge,
-                                        when.cache,
-                                        1.0,
-                                    )))
-                    });
-                    if !good {
-                        self.todo.push((*id, ci));
-                    }
-                }
-            }
-        }
-        let mut sorted = 0u32;
-        let mut left = std::mem::take(&mut self.left);
-        left.clear();
-        for (id, ci) in self.todo.drain(..) {
-            if *budget == 0 {
-                left.push((id, ci));
-                continue;
-            }
-            // A block gone since (or off the GPU) is not in the view either.
-            let Some(r) = blocks.get(&id).filter(|r| r.place.is_some()) else {
-                continue;
-            };
-            let (Some(state), Some(cloud)) = (r.clouds.get(ci), r.block.clouds.get(ci)) else {
-                continue;
-            };
-            if state.sprites > *budget {
-                left.push((id, ci));
-                continue;
-            }
-            *budget -= state.sprites;
-            sorted += state.sprites;
-            let rel = from_m - (state.centre_m + r.motion.offset_m);
-            // A kept order's buffer is sorted into again.
-            let block = self.kept.entry(id).or_default();
-            if block.len() < r.clouds.len() {
-                block.resize_with(r.clouds.len(), || None);
-            }
-            let kept = block[ci].get_or_insert_with(|| RingOrder {
-                from_rel_m: rel,
-                at_s: when.time_s,
-                order: Vec::new(),
-            });
-            kept.order.resize(cloud.sprites.len(), 0);
-            order_into(cloud, rel.as_vec3(), 0, &mut kept.order, &mut self.keys);
-            (kept.from_rel_m, kept.at_s) = (rel, when.time_s);
-        }
-        // What is left, kept in `left`'s place for the next frame (no allocation a frame).
-        self.left = std::mem::replace(&mut self.todo, left);
-        (self.todo.is_empty(), sorted)
-    }
-
-    /// An impostor's view from `from_m` (no locks), once [`Self::sort`] is done for it: the
-    /// draw list of the blocks `ids` within `draw_m`, back to front, with each block's cloud
-    /// list and the clouds' kept orders (as sprite slots) into `lists` and `orders`. Returns the
-    /// sprites.
-    pub fn view(
-        &self,
-        blocks: &Blocks,
-        ids: &[u64],
-        (from_m, draw_m): (DVec3, f64),
-        out: &mut Vec<GpuDrawBlock>,
-        lists: &mut Vec<GpuListCloud>,
-        orders: &mut Vec<u32>,
-    ) -> u32 {
-        out.clear();
-        lists.clear();
-        orders.clear();
-        let mut total = 0u32;
-        let mut cloud_order: Vec<(usize, f64)> = Vec::new();
-        for (_, id) in blocks_back_to_front(blocks, ids, from_m) {
-            let Some(r) = blocks.get(&id) else {
-                continue;
-            };
-            let offset = r.motion.offset_m;
-            cloud_order.clear();
-            for (ci, state) in r.clouds.iter().enumerate() {
-                let d = (state.centre_m + offset - from_m).length();
-                if (d - state.radius_m as f64).max(0.0) <= draw_m && state.sprites > 0 {
-                    cloud_order.push((ci, d));
-                }
-            }
-            cloud_order.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-            let list_base = lists.len() as u32;
-            let mut first = 0u32;
-            let kept = self.kept.get(&id).map_or(&[][..], Vec::as_slice);
-            for &(ci, _) in &cloud_order {
-                let state = &r.clouds[ci];
-                lists.push(GpuListCloud {
-                    cloud: state.cloud_slot,
-                    first,
-                    order_base: orders.len() as u32,
-                    stride: 0,
-                });
-                let base = state.sprite_base;
-                match kept.get(ci).and_then(Option::as_ref) {
-                    Some(o) if o.order.len() == state.sprites as usize => {
-                        orders.extend(o.order.iter().map(|&i| base + i));
-                    }
-                    // Too large to sort: its sprites' own order.
-                    _ => orders.extend(base..base + state.sprites),
-                }
-                first += state.sprites;
-            }
-            let (fade_kind, fade_progress) = fade_code(r.motion.fade);
-            out.push(GpuDrawBlock {
-                origin_rel: (r.centre_m() - from_m).as_vec3().to_array(),
-                first: total,
-                list_base,
-                list_len: cloud_order.len() as u32,
-                fade_kind,
-                fade_progress,
-            });
-            total += first;
-        }
-        total
-    }
-}
-
 #[cfg(test)]
 #[path = "draw_list_tests.rs"]
-mod tests;
+pub(super) mod tests;

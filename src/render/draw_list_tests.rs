@@ -4,7 +4,7 @@ use super::*;
 use crate::render::scene::SkySprite;
 use crate::shading::ColourLevels;
 
-fn cache() -> VertexCacheSettings {
+pub(in crate::render) fn cache() -> VertexCacheSettings {
     RenderSettings::default().vertex_cache
 }
 
@@ -78,7 +78,7 @@ fn facings_keep_up_up_and_upright_ones_level() {
 }
 
 /// A cloud of 40 sprites on a 12 m spiral (smaller than any tolerance of a whole-cloud order).
-fn small_cloud() -> SkyCloud {
+pub(in crate::render) fn small_cloud() -> SkyCloud {
     let sprites = (0..40)
         .map(|k| {
             let a = k as f32 * 2.4;
@@ -171,140 +171,6 @@ fn equally_far_blocks_are_ordered_by_place_not_by_id() {
     };
     assert_eq!(order_with([1, 2, 3, 4]), order_with([4, 3, 2, 1]));
     assert_eq!(order_with([1, 2, 3, 4]), order_with([3, 1, 4, 2]));
-}
-
-/// `blocks` blocks of `clouds` small clouds each, 30 km north of the origin in a row, placed
-/// (slots given as the sky would) so that the ring's views can be read.
-fn far_row(blocks: u64, clouds: usize) -> Blocks {
-    let mut base = 0u32;
-    (0..blocks)
-        .map(|id| {
-            let centre = DVec3::new(id as f64 * 4000.0, 30_000.0, 1500.0);
-            let block = crate::render::scene::SkyBlock {
-                id,
-                centre_m: centre,
-                clouds: (0..clouds)
-                    .map(|k| SkyCloud {
-                        centre_m: centre + DVec3::new(k as f64 * 500.0, 0.0, 0.0),
-                        ..small_cloud()
-                    })
-                    .collect(),
-            };
-            let mut r = Resident::new(block, Default::default());
-            let start = base;
-            for (k, state) in r.clouds.iter_mut().enumerate() {
-                state.sprite_base = base;
-                state.cloud_slot = id as u32 * clouds as u32 + k as u32;
-                base += state.sprites;
-            }
-            r.place = Some((start..base, 0..clouds as u32));
-            (id, r)
-        })
-        .collect()
-}
-
-/// The ring's sprite orders are sorted a budget at a time: no call sorts more sprites than it is
-/// given (the frame's budget left after the sky camera's clouds), the impostor's view is made
-/// only once every cloud has its order, and that view is the back-to-front order from the ring
-/// centre. A later build from nearly the same centre (the far blocks changed, the sun turned)
-/// sorts nothing; one 3 km away sorts every cloud again. Sorting the whole sector in one call,
-/// as the ring did before, fails the budget here.
-#[test]
-fn ring_orders_are_sorted_within_the_frames_budget_and_kept_between_builds() {
-    let blocks = far_row(4, 3);
-    let ids: Vec<u64> = (0..4).collect();
-    let cache = cache();
-    let centre = DVec3::new(0.0, 0.0, 1000.0);
-    let reach = (centre, 100_000.0);
-    let mut ring = RingOrders::default();
-    let when = |since_s: f64, time_s: f64| RingSort {
-        gather: since_s as u64,
-        since_s,
-        time_s,
-        cache: &cache,
-        largest: 100,
-    };
-    // 12 clouds of 40 sprites, 100 sprites a frame: two clouds a frame, six frames.
-    let mut frames = 0;
-    let mut total = 0;
-    loop {
-        let mut budget = 100;
-        let (done, sorted) = ring.sort(
-            &blocks,
-            &ids,
-            reach,
-            &when(0.0, frames as f64 * 0.1),
-            &mut budget,
-        );
-        assert!(sorted <= 100, "frame {frames}: {sorted} sprites sorted");
-        assert_eq!(budget, 100 - sorted);
-        total += sorted;
-        frames += 1;
-        if done {
-            break;
-        }
-        assert!(frames < 20, "never done");
-    }
-    assert_eq!((frames, total), (6, 480));
-    let (mut out, mut lists, mut orders) = (Vec::new(), Vec::new(), Vec::new());
-    let sprites = ring.view(&blocks, &ids, reach, &mut out, &mut lists, &mut orders);
-    assert_eq!(sprites, 480);
-    assert_eq!(orders.len(), 480);
-    // Farthest block first; within each cloud the slots in the reference order from the centre.
-    assert_eq!(out.len(), 4);
-    assert!(out[0].origin_rel[0] > out[3].origin_rel[0], "{out:?}");
-    for list in &lists {
-        let r = blocks
-            .values()
-            .find(|r| r.clouds.iter().any(|c| c.cloud_slot == list.cloud))
-            .unwrap();
-        let ci = r
-            .clouds
-            .iter()
-            .position(|c| c.cloud_slot == list.cloud)
-            .unwrap();
-        let state = &r.clouds[ci];
-        let rel = (centre - (state.centre_m + r.motion.offset_m)).as_vec3();
-        let reference: Vec<u32> = sprites_back_to_front(&r.block.clouds[ci], rel)
-            .iter()
-            .map(|s| state.sprite_base + s.0 as u32)
-            .collect();
-        let at = list.order_base as usize;
-        assert_eq!(orders[at..at + 40], reference[..], "cloud {}", list.cloud);
-    }
-    // A rebuild 20 s later from 50 m away: every order still good (Wang's thresholds 30 km out
-    // allow 605 m and 32 s). From 3 km away: all sorted again, within the budget.
-    let near = (centre + DVec3::new(50.0, 0.0, 0.0), 100_000.0);
-    let mut budget = 100;
-    assert_eq!(
-        ring.sort(&blocks, &ids, near, &when(20.0, 20.0), &mut budget),
-        (true, 0)
-    );
-    let moved = (centre + DVec3::new(3000.0, 0.0, 0.0), 100_000.0);
-    let mut budget = 100;
-    assert_eq!(
-        ring.sort(&blocks, &ids, moved, &when(21.0, 21.0), &mut budget),
-        (false, 80)
-    );
-    // A cloud larger than any frame's budget is never sorted (nor waited for): it goes in in
-    // its sprites' own order.
-    let mut ring = RingOrders::default();
-    let mut budget = 30;
-    let big = RingSort {
-        largest: 30,
-        ..when(0.0, 0.0)
-    };
-    assert_eq!(
-        ring.sort(&blocks, &ids, reach, &big, &mut budget),
-        (true, 0)
-    );
-    ring.view(&blocks, &ids, reach, &mut out, &mut lists, &mut orders);
-    let at = lists[0].order_base as usize;
-    let base = orders[at];
-    assert_eq!(
-        orders[at..at + 40],
-        (base..base + 40).collect::<Vec<_>>()[..]
-    );
 }
 
 /// Two blocks of a row of 4 km blocks, west and east of x = 0, 6 km north, each of 4 x 4

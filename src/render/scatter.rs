@@ -15,6 +15,9 @@ const WGSL: &str = include_str!("../../shaders/scatter.wgsl");
 /// Workgroups per dispatch row.
 const ROW: u32 = 65_535;
 
+/// What a patch writes into: the CPU copy, the buffer, the spans of the copy changed.
+type Target<'a, T> = (&'a [T], &'a wgpu::Buffer, &'a mut Vec<Range<u32>>);
+
 /// The patch being gathered and its GPU side.
 pub(super) struct Scatter {
     pipeline: wgpu::ComputePipeline,
@@ -24,6 +27,8 @@ pub(super) struct Scatter {
     spans: Vec<[u32; 4]>,
     patch: wgpu::Buffer,
     span_buffer: wgpu::Buffer,
+    /// Bound as the list target by a patch of orders only (the impostor ring's).
+    no_lists: wgpu::Buffer,
     /// The bind group of the patch written.
     group: Option<wgpu::BindGroup>,
     /// Whether that patch went into a recorded frame (then the next one starts afresh).
@@ -52,6 +57,7 @@ impl Scatter {
             spans: Vec::new(),
             patch: storage_buffer(device, "sky.scatter_patch", 16 << 10),
             span_buffer: storage_buffer(device, "sky.scatter_spans", 4 << 10),
+            no_lists: storage_buffer(device, "sky.scatter_no_lists", 16),
             group: None,
             applied: Cell::new(true),
         }
@@ -59,12 +65,11 @@ impl Scatter {
 
     /// Bytes of its buffers.
     pub fn gpu_bytes(&self) -> u64 {
-        self.patch.size() + self.span_buffer.size()
+        self.patch.size() + self.span_buffer.size() + self.no_lists.size()
     }
 
     /// Gathers the changed spans of the orders and lists (their CPU copies) and writes the patch;
     /// a patch not yet applied is kept and added to. Returns the bytes written.
-    #[allow(clippy::too_many_arguments)]
     pub fn prepare(
         &mut self,
         device: &wgpu::Device,
@@ -74,6 +79,37 @@ impl Scatter {
         (lists, list_buffer): (&[GpuListCloud], &wgpu::Buffer),
         dirty_lists: &mut Vec<Range<u32>>,
     ) -> u64 {
+        self.prepare_any(
+            device,
+            queue,
+            (orders, order_buffer, dirty_orders),
+            Some((lists, list_buffer, dirty_lists)),
+        )
+    }
+
+    /// [`Self::prepare`] for a buffer of orders alone (the impostor ring's).
+    pub fn prepare_orders(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (orders, order_buffer): (&[u32], &wgpu::Buffer),
+        dirty_orders: &mut Vec<Range<u32>>,
+    ) -> u64 {
+        self.prepare_any(device, queue, (orders, order_buffer, dirty_orders), None)
+    }
+
+    fn prepare_any(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (orders, order_buffer, dirty_orders): Target<u32>,
+        lists: Option<Target<GpuListCloud>>,
+    ) -> u64 {
+        let (lists, list_buffer, mut dirty_lists) = match lists {
+            Some((l, b, d)) => (l, b, Some(d)),
+            None => (&[][..], &self.no_lists, None),
+        };
+        let list_buffer = list_buffer.clone();
         if self.applied.replace(false) {
             self.values.clear();
             self.spans.clear();
@@ -83,7 +119,7 @@ impl Scatter {
             self.push(0, r.start, &orders[r.start as usize..r.end as usize]);
         }
         let words = |l: &[GpuListCloud]| bytemuck::cast_slice::<GpuListCloud, u32>(l).to_vec();
-        for r in dirty_lists.drain(..) {
+        for r in dirty_lists.iter_mut().flat_map(|d| d.drain(..)) {
             let part = words(&lists[r.start as usize..r.end as usize]);
             self.push(1, r.start * 4, &part);
         }
@@ -96,7 +132,9 @@ impl Scatter {
             self.values.clear();
             self.spans.clear();
             queue.write_buffer(order_buffer, 0, bytemuck::cast_slice(orders));
-            queue.write_buffer(list_buffer, 0, bytemuck::cast_slice(lists));
+            if !lists.is_empty() {
+                queue.write_buffer(&list_buffer, 0, bytemuck::cast_slice(lists));
+            }
             return whole as u64 * 4;
         }
         let value_bytes = self.values.len() as u64 * 4;
@@ -128,7 +166,7 @@ impl Scatter {
                 binding(0, &self.patch, value_bytes),
                 binding(1, &self.span_buffer, span_bytes),
                 binding(2, order_buffer, order_buffer.size()),
-                binding(3, list_buffer, list_buffer.size()),
+                binding(3, &list_buffer, list_buffer.size()),
             ],
         }));
         value_bytes + span_bytes

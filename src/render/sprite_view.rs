@@ -123,10 +123,10 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
 pub(super) struct ViewBuffers {
     uniform: wgpu::Buffer,
     draws: Grown,
-    /// An impostor view's own cloud lists and orders (the sky's camera uses the resident ones).
-    own: Option<(Grown, Grown)>,
+    /// An impostor view's own cloud lists (the sky's camera uses the resident ones).
+    own: Option<Grown>,
     group: Option<wgpu::BindGroup>,
-    /// Which resident buffers the group was made with.
+    /// Which order (and, for the sky's camera, list) buffers the group was made with.
     external_generation: u64,
 }
 
@@ -168,14 +168,14 @@ impl Grown {
 }
 
 /// What a view writes besides its uniform: its draw list (after a header of its counts: blocks,
-/// locks, sprites), and an impostor's own cloud lists and orders or, for the sky's camera, the
-/// resident list and order buffers (with their generation).
+/// locks, sprites), and an impostor's own cloud lists with the ring's order buffer or, for the
+/// sky's camera, the resident list and order buffers (with their generation).
 pub(super) enum ViewData<'a> {
     Own {
         counts: [u32; 4],
         draws: &'a [GpuDrawBlock],
         lists: &'a [GpuListCloud],
-        orders: &'a [u32],
+        orders: (&'a wgpu::Buffer, u64),
     },
     Resident {
         counts: [u32; 4],
@@ -187,7 +187,7 @@ pub(super) enum ViewData<'a> {
 }
 
 impl ViewBuffers {
-    /// Buffers for a view; `own` for an impostor view (its own lists and orders).
+    /// Buffers for a view; `own` for an impostor view (its own cloud lists).
     pub fn new(device: &wgpu::Device, own: bool) -> Self {
         Self {
             uniform: device.create_buffer(&wgpu::BufferDescriptor {
@@ -197,12 +197,7 @@ impl ViewBuffers {
                 mapped_at_creation: false,
             }),
             draws: Grown::new(device, "sky.draws", 256 * 32),
-            own: own.then(|| {
-                (
-                    Grown::new(device, "sky.view_lists", 1024 * 16),
-                    Grown::new(device, "sky.view_orders", 4096 * 4),
-                )
-            }),
+            own: own.then(|| Grown::new(device, "sky.view_lists", 1024 * 16)),
             group: None,
             external_generation: u64::MAX,
         }
@@ -212,10 +207,7 @@ impl ViewBuffers {
     pub fn gpu_bytes(&self) -> u64 {
         self.uniform.size()
             + self.draws.buffer.size()
-            + self
-                .own
-                .as_ref()
-                .map_or(0, |(l, o)| l.buffer.size() + o.buffer.size())
+            + self.own.as_ref().map_or(0, |l| l.buffer.size())
     }
 
     /// Writes the uniform (`locks`: the whole lock table too, else only the header) and `data`;
@@ -242,21 +234,20 @@ impl ViewBuffers {
             queue.write_buffer(&self.draws.buffer, 16, bytemuck::cast_slice(draws));
             bytes += draws.len() as u64 * 32;
         }
-        match (&data, &mut self.own) {
-            (ViewData::Own { lists, orders, .. }, Some((own_lists, own_orders))) => {
+        let generation = match (&data, &mut self.own) {
+            (ViewData::Own { lists, orders, .. }, Some(own_lists)) => {
                 regroup |= own_lists.reserve(device, lists.len() as u64 * 16);
-                regroup |= own_orders.reserve(device, orders.len() as u64 * 4);
-                bytes += own_lists.write(queue, lists) + own_orders.write(queue, orders);
+                bytes += own_lists.write(queue, lists);
+                orders.1
             }
-            (ViewData::Resident { generation, .. }, None) => {
-                regroup |= *generation != self.external_generation;
-                self.external_generation = *generation;
-            }
-            _ => {}
-        }
+            (ViewData::Resident { generation, .. }, _) => *generation,
+            (ViewData::Own { .. }, None) => return bytes,
+        };
+        regroup |= generation != self.external_generation;
+        self.external_generation = generation;
         let (lists, orders) = match (&data, &self.own) {
             (ViewData::Resident { lists, orders, .. }, _) => (*lists, *orders),
-            (_, Some((l, o))) => (&l.buffer, &o.buffer),
+            (ViewData::Own { orders, .. }, Some(l)) => (&l.buffer, orders.0),
             (ViewData::Own { .. }, None) => return bytes,
         };
         if regroup {

@@ -32,6 +32,11 @@ pub struct FrameStats {
     /// max_sorted_sprites_per_frame`, except on the frame that builds a first ring (the sky's
     /// first, or the ring switched on), which sorts it whole.
     pub ring_sprites_sorted: u32,
+    /// Far sprites whose orders an impostor's view wrote again this frame into the ring's order
+    /// buffer without sorting them: clouds placed at other slots since their sort (the resident
+    /// buffers packed, another block in their slots), or too large to sort (their own order).
+    /// Mostly 0: a sorted order is written once, by its sort.
+    pub ring_orders_rewritten: u32,
     /// Fraction of drawn clouds served from the cache, 0..=1 (1 when nothing was drawn).
     pub cache_hit_rate: f32,
     /// CPU time of [`crate::render::Sky::prepare`] (less `gpu_wait_us`) plus the block changes

@@ -25,6 +25,8 @@
 //! and geometry: `layout`. Units: metres, degrees.
 
 mod layout;
+mod order_buffer;
+mod orders;
 
 use std::cell::Cell;
 
@@ -37,7 +39,6 @@ pub use layout::{
 use layout::{impostor_camera, sectors_of};
 
 use super::build::{SpriteBuild, chunks};
-use super::draw_list::{RingOrders, RingSort};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuRing, GpuSpriteVertex};
 use super::id_hash::IdSet;
 use super::pipeline::{PassDesc, SceneDepth, pipeline, premultiplied_over};
@@ -45,6 +46,8 @@ use super::resident::ResidentSet;
 use super::settings::VertexCacheSettings;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
+use order_buffer::OrderBuffer;
+use orders::{RingOrders, RingSort};
 
 const IMPOSTOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// Alpha-weighted cloud depth, kilometres times alpha (half floats: about 30 m at 60 km).
@@ -87,15 +90,14 @@ pub struct ImpostorRing {
     /// `[old ring][new ring]` bind groups of the ring pass (both rings' texture arrays).
     quad_groups: Vec<Vec<wgpu::BindGroup>>,
     /// Per impostor of each ring (`[ring * IMPOSTORS + impostor]`): frame uniform, its bind
-    /// group, and its view of the resident sprites (draw list and sprite orders from the ring
-    /// centre).
+    /// group, and its view of the resident sprites (draw list and cloud lists from the ring
+    /// centre; the sprite orders are the ring's `order_buffer`).
     slot_frames: Vec<wgpu::Buffer>,
     slot_groups: Vec<wgpu::BindGroup>,
     slot_views: Vec<ViewBuffers>,
     view_layout: wgpu::BindGroupLayout,
     draws: Vec<GpuDrawBlock>,
     lists: Vec<GpuListCloud>,
-    orders: Vec<u32>,
     /// The ring pass's uniform (`GpuRing`).
     ring_uniform: wgpu::Buffer,
     shown: Option<(usize, RingState)>,
@@ -115,8 +117,10 @@ pub struct ImpostorRing {
     /// ring's blocks would be built faded out to nothing.
     reach_limit_m: Option<f64>,
     bytes: u64,
-    /// The far clouds' orders from the ring centre, kept between builds.
+    /// The far clouds' orders from the ring centre, kept between builds, and their GPU copy.
     sorts: RingOrders,
+    /// `None` for a ring made without impostors.
+    order_buffer: Option<OrderBuffer>,
     /// Time the ring has seen pass (the sum of the frames' steps), seconds.
     clock_s: f64,
     /// Builds started.
@@ -430,7 +434,6 @@ impl ImpostorRing {
             view_layout: shared.view_layout.clone(),
             draws: Vec::new(),
             lists: Vec::new(),
-            orders: Vec::new(),
             ring_uniform,
             shown: None,
             build: None,
@@ -442,6 +445,7 @@ impl ImpostorRing {
             blocks_far: 0,
             bytes,
             sorts: RingOrders::default(),
+            order_buffer: (slots > 0).then(|| OrderBuffer::new(device)),
             clock_s: 0.0,
             builds: 0,
             last_split: None,
@@ -472,6 +476,7 @@ impl ImpostorRing {
                 .iter()
                 .map(ViewBuffers::gpu_bytes)
                 .sum::<u64>()
+            + self.order_buffer.as_ref().map_or(0, OrderBuffer::gpu_bytes)
             + if self.settings.enabled {
                 self.ring_uniform.size()
             } else {
@@ -682,7 +687,12 @@ impl ImpostorRing {
         }
         let mut bytes = 0;
         let first = self.shown.is_none() && self.fade.is_none();
-        if let Some(mut build) = self.build.take() {
+        let view_radius_m = self.reach_settings().view_radius_m;
+        if let Some(mut build) = self.build.take()
+            && let Some(order_buffer) = self.order_buffer.as_mut()
+        {
+            let slots = resident.orders_cpu.len() as u32;
+            bytes += order_buffer.fit(&self.device, queue, &mut self.sorts, slots);
             let (count, mut budget, largest) = if first {
                 (IMPOSTORS, u32::MAX, u32::MAX)
             } else {
@@ -704,7 +714,6 @@ impl ImpostorRing {
                 cache: &ring_cache,
                 largest,
             };
-            let view_radius_m = self.reach_settings().view_radius_m;
             let reach = (build.state.centre_m, view_radius_m);
             let mut rendered = 0;
             for _ in 0..count {
@@ -719,14 +728,8 @@ impl ImpostorRing {
                     // The rest next frame; the shown ring stays meanwhile.
                     break;
                 }
-                let sprites = self.sorts.view(
-                    blocks,
-                    sector,
-                    reach,
-                    &mut self.draws,
-                    &mut self.lists,
-                    &mut self.orders,
-                );
+                let sprites =
+                    (self.sorts).view(blocks, sector, reach, &mut self.draws, &mut self.lists);
                 let light = ViewLight {
                     camera_z_m: centre.z as f32,
                     farthest_m: view_radius_m as f32,
@@ -744,7 +747,7 @@ impl ImpostorRing {
                         counts: [self.draws.len() as u32, 0, sprites, 0],
                         draws: &self.draws,
                         lists: &self.lists,
-                        orders: &self.orders,
+                        orders: order_buffer.buffer(),
                     },
                 );
                 let cam = impostor_camera(i, centre, &self.settings);
@@ -770,6 +773,9 @@ impl ImpostorRing {
                 rendered += 1;
             }
             stats.impostors_rebuilt = rendered;
+            let (sent, rewritten) = order_buffer.send(&self.device, queue, &mut self.sorts);
+            bytes += sent;
+            stats.ring_orders_rewritten = rewritten;
             if build.next >= IMPOSTORS {
                 if first {
                     self.shown = Some((build.ring, build.state));
@@ -846,6 +852,9 @@ impl ImpostorRing {
         indices: &wgpu::Buffer,
     ) {
         self.recorded.set(true);
+        if let Some(order_buffer) = &self.order_buffer {
+            order_buffer.record(encoder);
+        }
         for &(r, i, sprites) in &self.pending {
             let slot = r * IMPOSTORS + i;
             let view = self.slot_views[slot].group().filter(|_| sprites > 0);
