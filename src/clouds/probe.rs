@@ -246,9 +246,9 @@ impl SightBoxes {
     }
 
     /// The boxes the segment `a..b` enters, each once, nearest cells first:
-    /// `hit(generation, box, t in, t out)` says whether it counts (a faded-out cloud does not).
-    /// With `whole` false it stops once no box left can be entered before the nearest counted
-    /// one. `seen` is scratch, one entry per box, and `stamp` a number it does not hold yet (a
+    /// `hit(generation, box, t in, t out)` says whether it counts (a faded-out cloud does not)
+    /// and whether the walk has met enough. With `whole` false it also stops once no box left
+    /// can be entered before the nearest counted one. `seen` is scratch, one entry per box, and `stamp` a number it does not hold yet (a
     /// box is tested the first time a cell lists it, and marked with the stamp: a big box is
     /// listed in many cells).
     fn crossed(
@@ -258,16 +258,20 @@ impl SightBoxes {
         whole: bool,
         seen: &mut [u32],
         stamp: u32,
-        mut hit: impl FnMut(usize, &CloudBox, f64, f64) -> bool,
+        mut hit: impl FnMut(usize, &CloudBox, f64, f64) -> Met,
     ) {
         let Some((from, to)) = slab(a, b, self.lo_m, self.hi_m) else {
             return;
         };
         let mut best = f64::INFINITY;
+        let mut enough = false;
         // The big boxes first, then the small ones with the nearest big one's entry to beat.
         // In each grid, once the nearest entry is before the cell is left, no box not yet met
         // can be entered earlier (its entry point lies in a later cell, which lists it).
         for grid in &self.grids {
+            if enough {
+                return;
+            }
             grid.walk(a, b, from, to, |list, _, cell_out| {
                 for &index in list {
                     let index = index as usize;
@@ -284,14 +288,30 @@ impl SightBoxes {
                     }
                     let (g, k) = self.owners[index];
                     let bx = &self.generations[g as usize].boxes[k as usize];
-                    if hit(g as usize, bx, t0, t1) {
-                        best = best.min(t0);
+                    match hit(g as usize, bx, t0, t1) {
+                        Met::Passed => {}
+                        Met::Counted => best = best.min(t0),
+                        Met::Enough => {
+                            enough = true;
+                            return false;
+                        }
                     }
                 }
                 whole || best >= cell_out
             });
         }
     }
+}
+
+/// What a box a line of sight enters is to the walk.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Met {
+    /// It does not count (a faded-out cloud).
+    Passed,
+    /// It counts.
+    Counted,
+    /// It counts, and the walk has what it wants: it stops.
+    Enough,
 }
 
 /// A uniform horizontal grid over boxes: each cell lists the boxes whose footprint (padded by a
@@ -749,17 +769,28 @@ impl<'a> CloudProbe<'a> {
     /// The first cloud met along the segment from ground point `a` to `b`, with the optical
     /// depth through it and through every cloud along it; `None` in clear air.
     pub fn line_of_sight(&self, a: DVec3, b: DVec3) -> Option<SightHit> {
-        self.sight(a, b, true)
+        self.sight(a, b, true, f64::INFINITY)
+    }
+
+    /// The optical depth through the clouds along the segment from ground point `a` to `b`,
+    /// walked only until it reaches `enough`: then at least that (the sun's occlusion, which
+    /// `1 - exp(-depth)` makes 1 to within `exp(-enough)`, needs no more, and a ray up through
+    /// a storm would cross hundreds of boxes beyond). 0 in clear air.
+    pub fn optical_depth_until(&self, a: DVec3, b: DVec3, enough: f64) -> f64 {
+        self.sight(a, b, true, enough)
+            .map_or(0.0, |hit| hit.total_optical_depth)
     }
 
     /// The first cloud met along the segment and the optical depth through it; its
     /// `total_optical_depth` counts only the clouds looked at before the first was certain (the
     /// cheap query a host casts many of).
     pub fn first_cloud(&self, a: DVec3, b: DVec3) -> Option<SightHit> {
-        self.sight(a, b, false)
+        self.sight(a, b, false, f64::INFINITY)
     }
 
-    fn sight(&self, a: DVec3, b: DVec3, whole: bool) -> Option<SightHit> {
+    /// The walk of [`Self::line_of_sight`] (`whole`) or [`Self::first_cloud`], stopped once the
+    /// optical depth counted reaches `enough`.
+    fn sight(&self, a: DVec3, b: DVec3, whole: bool, enough: f64) -> Option<SightHit> {
         let (qa, qb) = (self.air_point(a), self.air_point(b));
         let length = (qb - qa).length();
         let sigma = 3.0 / f64::from(self.settings.visibility_m);
@@ -805,19 +836,23 @@ impl<'a> CloudProbe<'a> {
                     }
                 };
                 let Some(block) = block else {
-                    return false;
+                    return Met::Passed;
                 };
                 let mid = qa.lerp(qb, 0.5 * (t0 + t1));
                 let fade = f64::from(self.fade(block, bx, mid));
                 if fade <= 0.0 {
-                    return false;
+                    return Met::Passed;
                 }
                 let depth = sigma * (t1 - t0) * length * fade;
                 total += depth;
                 if first.is_none_or(|f| t0 < f.0) {
                     first = Some((t0, depth, bx.cloud_type));
                 }
-                true
+                if total >= enough {
+                    Met::Enough
+                } else {
+                    Met::Counted
+                }
             },
         );
         first.map(|(t, depth, cloud_type)| SightHit {
@@ -1014,16 +1049,24 @@ mod tests {
                 stamp += 1;
                 sight.crossed(a, b, true, &mut seen, stamp, |g, bx, t0, _| {
                     met.push((t0, g, bx.cloud));
-                    true
+                    Met::Counted
                 });
                 met.sort_by_key(|x| (x.1, x.2));
                 assert_eq!(met, all, "cell {cell_m} m, segment {k}: {a} to {b}");
+                // A walk that has enough after its first box meets no other, in any grid.
+                let mut walked = 0;
+                stamp += 1;
+                sight.crossed(a, b, true, &mut seen, stamp, |_, _, _, _| {
+                    walked += 1;
+                    Met::Enough
+                });
+                assert_eq!(walked, all.len().min(1), "cell {cell_m} m, segment {k}");
                 let nearest = all.iter().map(|h| h.0).fold(f64::INFINITY, f64::min);
                 let mut first = f64::INFINITY;
                 stamp += 1;
                 sight.crossed(a, b, false, &mut seen, stamp, |_, _, t0, _| {
                     first = first.min(t0);
-                    true
+                    Met::Counted
                 });
                 assert_eq!(first, nearest, "cell {cell_m} m, segment {k}");
                 met_first += nearest.is_finite() as usize;

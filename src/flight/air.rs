@@ -128,6 +128,11 @@ pub struct AirData {
 /// Lengths of the line of sight towards the sun, metres.
 const SUN_SIGHT_M: f64 = 30_000.0;
 
+/// The optical depth towards the sun past which the walk along the sun line stops: the
+/// occlusion, `1 - exp(-depth)`, is then within `exp(-17)` (4e-8) of 1, less than an f32's step
+/// below 1 (6e-8).
+const SUN_OPAQUE_DEPTH: f64 = 17.0;
+
 /// How far above the weather's highest cloud top the air data's sun line goes, metres (the
 /// clouds' boxes reach a little above the layer tops).
 const SUN_TOP_MARGIN_M: f64 = 1_000.0;
@@ -180,10 +185,10 @@ impl World {
     /// 0..=1: `1 - exp(-optical depth)` through every cloud along 30 km towards it.
     pub fn sun_occlusion(&self, point_m: DVec3, sun_direction: DVec3) -> f32 {
         let to = point_m + sun_direction * SUN_SIGHT_M;
-        let Some(hit) = self.probe().and_then(|p| p.line_of_sight(point_m, to)) else {
-            return 0.0;
-        };
-        (1.0 - (-hit.total_optical_depth).exp()) as f32
+        self.probe().map_or(0.0, |p| {
+            let depth = p.optical_depth_until(point_m, to, SUN_OPAQUE_DEPTH);
+            (1.0 - (-depth).exp()) as f32
+        })
     }
 
     /// The air data at `point_m` (local metres east, north, and up above mean sea level), with
@@ -207,9 +212,10 @@ impl World {
         } else {
             let climb_m = ((ceiling_m - point_m.z) / sun_direction.z).min(SUN_SIGHT_M);
             let to = point_m + sun_direction * climb_m;
-            self.probe()
-                .and_then(|p| p.line_of_sight(point_m, to))
-                .map_or(0.0, |hit| (1.0 - (-hit.total_optical_depth).exp()) as f32)
+            self.probe().map_or(0.0, |p| {
+                let depth = p.optical_depth_until(point_m, to, SUN_OPAQUE_DEPTH);
+                (1.0 - (-depth).exp()) as f32
+            })
         };
         let lat_deg = self.field().frame().to_lat_lon_deg(point_m.truncate()).0;
         let s = &self.air.settings;

@@ -281,7 +281,9 @@ pub(super) struct ResidentSet {
     /// Counts changes to which blocks are on the GPU (one came, went, was written or lost its
     /// place): while it stays the same, so do they.
     pub changes: u64,
-    /// Counts changes of a block's fade ([`super::Sky::set_block_fade`] and its kin).
+    /// Counts changes of a block's kind of fade (steady, forming, dissipating;
+    /// [`super::Sky::set_block_fade`] and its kin), not of its progress: what the shadow map's
+    /// cover check watches, which a sky of forming clouds would otherwise trip every frame.
     pub fades: u64,
     /// The drift [`super::Sky::set_drift`] last moved every block to.
     pub drift_m: DVec3,

@@ -122,6 +122,14 @@ pub enum Fade {
     Dissipating(f32),
 }
 
+impl Fade {
+    /// Whether going to `to` changes the kind of fade (steady, forming, dissipating), not
+    /// only its progress.
+    pub fn kind_changes(self, to: Fade) -> bool {
+        std::mem::discriminant(&self) != std::mem::discriminant(&to)
+    }
+}
+
 /// What changes of a block from frame to frame without a new upload.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct BlockMotion {
@@ -144,5 +152,22 @@ pub fn square_sprite(offset_m: Vec3, size_m: f32, cell: u8, group: u16) -> SkySp
         radius_fraction: 0.0,
         upright: false,
         precipitation: false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Fade;
+
+    /// The shadow map's cover check watches the kind of a block's fade, never its progress: a
+    /// sky of forming clouds would trip it every frame.
+    #[test]
+    fn a_fade_changes_kind_only_between_steady_forming_and_dissipating() {
+        assert!(!Fade::Forming(0.2).kind_changes(Fade::Forming(0.3)));
+        assert!(!Fade::Dissipating(0.9).kind_changes(Fade::Dissipating(0.1)));
+        assert!(!Fade::Steady.kind_changes(Fade::Steady));
+        assert!(Fade::Forming(1.0).kind_changes(Fade::Steady));
+        assert!(Fade::Steady.kind_changes(Fade::Dissipating(0.0)));
+        assert!(Fade::Forming(0.5).kind_changes(Fade::Dissipating(0.5)));
     }
 }

@@ -465,9 +465,10 @@ impl Sky {
             match self.resident.blocks.get_mut(&block.id) {
                 Some(r) if r.block == block => {
                     if r.motion != BlockMotion::default() {
-                        r.motion = BlockMotion::default();
+                        let steady = BlockMotion::default();
+                        self.resident.fades += r.motion.fade.kind_changes(steady.fade) as u64;
+                        r.motion = steady;
                         self.resident.changes += 1;
-                        self.resident.fades += 1;
                     }
                 }
                 _ => self.resident.insert(block, BlockMotion::default()),
@@ -529,7 +530,7 @@ impl Sky {
             Some(r) => {
                 // What the shadow map watches for (a block moved by other means than the drift).
                 self.resident.changes += (r.motion.offset_m != motion.offset_m) as u64;
-                self.resident.fades += (r.motion.fade != motion.fade) as u64;
+                self.resident.fades += r.motion.fade.kind_changes(motion.fade) as u64;
                 r.motion = motion;
                 true
             }
@@ -551,7 +552,7 @@ impl Sky {
     pub fn set_block_fade(&mut self, id: u64, fade: super::Fade) -> bool {
         match self.resident.blocks.get_mut(&id) {
             Some(r) => {
-                self.resident.fades += (r.motion.fade != fade) as u64;
+                self.resident.fades += r.motion.fade.kind_changes(fade) as u64;
                 r.motion.fade = fade;
                 true
             }
