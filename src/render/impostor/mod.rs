@@ -773,9 +773,6 @@ impl ImpostorRing {
                 rendered += 1;
             }
             stats.impostors_rebuilt = rendered;
-            let (sent, rewritten) = order_buffer.send(&self.device, queue, &mut self.sorts);
-            bytes += sent;
-            stats.ring_orders_rewritten = rewritten;
             if build.next >= IMPOSTORS {
                 if first {
                     self.shown = Some((build.ring, build.state));
@@ -785,6 +782,13 @@ impl ImpostorRing {
             } else {
                 self.build = Some(build);
             }
+        }
+        // The orders this frame's sorts and views wrote, as a patch; sent on frames with none
+        // too, so that a patch already applied is not recorded again.
+        if let Some(order_buffer) = self.order_buffer.as_mut() {
+            let (sent, rewritten) = order_buffer.send(&self.device, queue, &mut self.sorts);
+            bytes += sent;
+            stats.ring_orders_rewritten = rewritten;
         }
         // The ring pass: the shown ring, mixed with the one fading in by the crossfade weight.
         let w = self.fade.as_ref().map_or(0.0, |f| f.2);

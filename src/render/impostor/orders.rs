@@ -245,14 +245,18 @@ impl RingOrders {
                 .for_each(|(slot, &i)| *slot = base + i),
             None => span.iter_mut().zip(base..).for_each(|(slot, i)| *slot = i),
         }
-        // Clouds whose spans this one overlaps no longer own them.
-        while let Some((&start, o)) = self.owners.range(..end).next_back() {
-            if o.end <= base {
-                break;
+        let owner = Owner { block, cloud, end };
+        // A cloud sorted again where it was written last time owns its span already; else the
+        // clouds whose spans this one overlaps no longer own them.
+        if self.owners.get(&base) != Some(&owner) {
+            while let Some((&start, o)) = self.owners.range(..end).next_back() {
+                if o.end <= base {
+                    break;
+                }
+                self.owners.remove(&start);
             }
-            self.owners.remove(&start);
+            self.owners.insert(base, owner);
         }
-        self.owners.insert(base, Owner { block, cloud, end });
         // Clouds are written in slot order by a sort and, back to front, in reverse by a view.
         match self.dirty.last_mut() {
             Some(last) if last.end == base => last.end = end,
