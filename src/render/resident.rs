@@ -80,6 +80,9 @@ pub(super) struct Resident {
     pub check: Option<BlockCheck>,
     /// Its slots, while it is on the GPU.
     pub place: Option<(Range<u32>, Range<u32>)>,
+    /// Which placing `place` is: a number no other placing of any block had, so that a copy
+    /// of what was written at its slots (the impostor ring's orders) knows it still is.
+    pub place_serial: u64,
     /// Written to its slots yet.
     pub uploaded: bool,
     /// Its Harris and Lastra light (empty under Wang's model).
@@ -138,6 +141,7 @@ impl Resident {
             list_sprites: 0,
             check: None,
             place: None,
+            place_serial: 0,
             uploaded: false,
             light: BlockLight::default(),
             distant: false,
@@ -287,6 +291,8 @@ pub(super) struct ResidentSet {
     pub fades: u64,
     /// The drift [`super::Sky::set_drift`] last moved every block to.
     pub drift_m: DVec3,
+    /// Placings of blocks so far ([`Resident::place_serial`]).
+    placings: u64,
 }
 
 const FIRST_SPRITES: u32 = 4096;
@@ -366,6 +372,7 @@ impl ResidentSet {
             changes: 0,
             fades: 0,
             drift_m: DVec3::ZERO,
+            placings: 0,
         }
     }
 
@@ -512,6 +519,8 @@ impl ResidentSet {
             self.orders_cpu[slot as usize] = slot;
         }
         self.dirty_orders.push(sprites.clone());
+        self.placings += 1;
+        let serial = self.placings;
         let Some(r) = self.blocks.get_mut(&id) else {
             return true;
         };
@@ -523,6 +532,7 @@ impl ResidentSet {
             base += cloud.sprites.len() as u32;
         }
         r.place = Some((sprites, clouds));
+        r.place_serial = serial;
         r.uploaded = false;
         r.check = None;
         true

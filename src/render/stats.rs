@@ -33,9 +33,9 @@ pub struct FrameStats {
     /// first, or the ring switched on), which sorts it whole.
     pub ring_sprites_sorted: u32,
     /// Far sprites whose orders an impostor's view wrote again this frame into the ring's order
-    /// buffer without sorting them: clouds placed at other slots since their sort (the resident
-    /// buffers packed, another block in their slots), or too large to sort (their own order).
-    /// Mostly 0: a sorted order is written once, by its sort.
+    /// buffer without sorting them: clouds whose blocks were placed again since their sort (the
+    /// resident buffers packed), or too large to sort (their own order). Mostly 0: a sorted
+    /// order is written once, by its sort.
     pub ring_orders_rewritten: u32,
     /// Fraction of drawn clouds served from the cache, 0..=1 (1 when nothing was drawn).
     pub cache_hit_rate: f32,

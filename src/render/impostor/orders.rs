@@ -6,14 +6,15 @@
 //! thousands of far sprites' orders, whatever the ring holds.
 //!
 //! The buffer is mirrored on the CPU (`slots`), for the whole writes a grown buffer and a pile
-//! of unrecorded patches need. Which cloud's order is written where is kept apart (`owners`):
-//! a block placed again at other slots (the resident buffers packed), or slots that another
-//! block's clouds took since, make the view write the cloud's order again, once.
+//! of unrecorded patches need. Each cloud's order remembers which placing of its block it was
+//! written at ([`Resident::place_serial`]): a block placed again since (the resident buffers
+//! packed, or taken off the GPU and put back) has its clouds' orders written again by the next
+//! view, once. Nothing else writes the ring's slots, and the resident set never gives two placed
+//! blocks the same slots, so an order written at its block's present placing is still there.
 //!
 //! In: the resident blocks, the ring centre, the sky time. Out: the orders (as the slots' CPU
 //! copy and the spans changed), draw lists and cloud lists. No wgpu calls.
 
-use std::collections::BTreeMap;
 use std::ops::Range;
 
 use glam::DVec3;
@@ -23,6 +24,8 @@ use crate::render::draw_list::{
 };
 use crate::render::gpu_types::{GpuDrawBlock, GpuListCloud};
 use crate::render::id_hash::IdMap;
+#[cfg(doc)]
+use crate::render::resident::Resident;
 use crate::render::scene::Fade;
 use crate::render::settings::VertexCacheSettings;
 
@@ -51,8 +54,6 @@ pub(crate) struct RingOrders {
     slots: Vec<u32>,
     /// The spans of `slots` written since the last [`Self::take_dirty`].
     dirty: Vec<Range<u32>>,
-    /// What `slots` holds: by first slot, the cloud whose order is written there.
-    owners: BTreeMap<u32, Owner>,
     /// Sprite orders written by views (clouds moved to other slots, or too large to sort)
     /// since the last [`Self::take_dirty`].
     rewritten: u32,
@@ -64,16 +65,11 @@ struct RingOrder {
     /// The centre relative to the cloud, and the sky time, when it was computed.
     from_rel_m: DVec3,
     at_s: f64,
-    /// Its sprites' indices within the cloud, farthest from the centre first.
+    /// Its sprites' indices within the cloud, farthest from the centre first (empty for a cloud
+    /// never sorted: too large, in its sprites' own order).
     order: Vec<u32>,
-}
-
-/// The cloud whose order a span of slots holds, and where the span ends.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Owner {
-    block: u64,
-    cloud: usize,
-    end: u32,
+    /// The placing of its block ([`Resident::place_serial`]) it was last written at.
+    written: Option<u64>,
 }
 
 /// When a ring build started and what it may sort this frame.
@@ -96,7 +92,6 @@ impl RingOrders {
     /// Forgets the orders of blocks the sky no longer holds.
     pub fn retain(&mut self, blocks: &Blocks) {
         self.kept.retain(|id, _| blocks.contains_key(id));
-        self.owners.retain(|_, o| blocks.contains_key(&o.block));
     }
 
     /// Makes the slots' copy as long as the resident sprite slots (`slots`), keeping what it
@@ -170,11 +165,13 @@ impl RingOrders {
                 from_rel_m: rel,
                 at_s: when.time_s,
                 order: Vec::new(),
+                written: None,
             });
             kept.order.resize(cloud.sprites.len(), 0);
             order_into(cloud, rel.as_vec3(), 0, &mut kept.order, &mut self.keys);
             (kept.from_rel_m, kept.at_s) = (rel, when.time_s);
-            self.write((id, ci), state.sprite_base, state.sprites);
+            let at = (state.sprite_base, state.sprites, r.place_serial);
+            self.write((id, ci, r.clouds.len()), at);
         }
         // What is left, kept in `left`'s place for the next frame (no allocation a frame).
         self.left = std::mem::replace(&mut todo, left);
@@ -224,39 +221,34 @@ impl RingOrders {
         }
     }
 
-    /// Writes cloud `(block, cloud)`'s kept order (its sprites' own order if none fits) at
-    /// slots `base..base + sprites`, and makes it their owner.
-    fn write(&mut self, (block, cloud): (u64, usize), base: u32, sprites: u32) {
+    /// Writes cloud `cloud` of block `block` (of `clouds`)'s kept order (its sprites' own
+    /// order if none fits) at slots `base..base + sprites`, and remembers that it did at
+    /// placing `place`.
+    fn write(&mut self, (block, cloud, clouds): (u64, usize, usize), at: (u32, u32, u64)) {
+        let (base, sprites, place) = at;
         let end = base + sprites;
         let Some(span) = self.slots.get_mut(base as usize..end as usize) else {
             // Slots beyond the copy: `fit` was not called for the resident buffers' size.
             return;
         };
-        let kept = self
-            .kept
-            .get(&block)
-            .and_then(|b| b.get(cloud))
-            .and_then(Option::as_ref)
-            .filter(|o| o.order.len() == sprites as usize);
-        match kept {
-            Some(o) => span
-                .iter_mut()
-                .zip(&o.order)
-                .for_each(|(slot, &i)| *slot = base + i),
-            None => span.iter_mut().zip(base..).for_each(|(slot, i)| *slot = i),
+        let kept = self.kept.entry(block).or_default();
+        if kept.len() < clouds {
+            kept.resize_with(clouds, || None);
         }
-        let owner = Owner { block, cloud, end };
-        // A cloud sorted again where it was written last time owns its span already; else the
-        // clouds whose spans this one overlaps no longer own them.
-        if self.owners.get(&base) != Some(&owner) {
-            while let Some((&start, o)) = self.owners.range(..end).next_back() {
-                if o.end <= base {
-                    break;
-                }
-                self.owners.remove(&start);
-            }
-            self.owners.insert(base, owner);
+        let kept = kept[cloud].get_or_insert_with(|| RingOrder {
+            from_rel_m: DVec3::ZERO,
+            at_s: f64::NEG_INFINITY,
+            order: Vec::new(),
+            written: None,
+        });
+        if kept.order.len() == sprites as usize {
+            span.iter_mut()
+                .zip(&kept.order)
+                .for_each(|(slot, &i)| *slot = base + i);
+        } else {
+            span.iter_mut().zip(base..).for_each(|(slot, i)| *slot = i);
         }
+        kept.written = Some(place);
         // Clouds are written in slot order by a sort and, back to front, in reverse by a view.
         match self.dirty.last_mut() {
             Some(last) if last.end == base => last.end = end,
@@ -282,6 +274,7 @@ impl RingOrders {
         lists.clear();
         let mut total = 0u32;
         let mut cloud_order: Vec<(usize, f64)> = Vec::new();
+        let mut stale: Vec<usize> = Vec::new();
         for (_, id) in blocks_back_to_front(blocks, ids, from_m) {
             let Some(r) = blocks.get(&id) else {
                 continue;
@@ -296,19 +289,25 @@ impl RingOrders {
             }
             cloud_order.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
             let list_base = lists.len() as u32;
+            // The clouds whose orders are not at their slots (one look-up a block).
+            let kept = self.kept.get(&id).map_or(&[][..], Vec::as_slice);
+            let written = |ci: usize| kept.get(ci)?.as_ref()?.written;
+            stale.clear();
+            stale.extend(
+                (cloud_order.iter())
+                    .map(|c| c.0)
+                    .filter(|&ci| written(ci) != Some(r.place_serial)),
+            );
+            for &ci in &stale {
+                let state = &r.clouds[ci];
+                let at = (state.sprite_base, state.sprites, r.place_serial);
+                self.write((id, ci, r.clouds.len()), at);
+                self.rewritten += state.sprites;
+            }
             let mut first = 0u32;
             for &(ci, _) in &cloud_order {
                 let state = &r.clouds[ci];
                 let (base, sprites) = (state.sprite_base, state.sprites);
-                let owner = Owner {
-                    block: id,
-                    cloud: ci,
-                    end: base + sprites,
-                };
-                if self.owners.get(&base) != Some(&owner) {
-                    self.write((id, ci), base, sprites);
-                    self.rewritten += sprites;
-                }
                 lists.push(GpuListCloud {
                     cloud: state.cloud_slot,
                     first,

@@ -34,6 +34,7 @@ fn far_row(blocks: u64, clouds: usize) -> Blocks {
                 base += state.sprites;
             }
             r.place = Some((start..base, 0..clouds as u32));
+            r.place_serial = id + 1;
             (id, r)
         })
         .collect()
@@ -131,10 +132,10 @@ fn ring_orders_are_sorted_within_the_frames_budget_and_kept_between_builds() {
     assert_eq!(ring.take_dirty(&mut spans), 0);
 }
 
-/// A block placed at other slots (the resident buffers packed) has its clouds' orders written
-/// at the new slots by the next view, without a sort, and a block that takes the slots another
-/// one's orders were written at has its own written over them: the order buffer never shows a
-/// cloud another cloud's order. Blocks that stayed are not written again.
+/// A block placed again (another placing: the resident buffers packed) has its clouds' orders
+/// written at its new slots by the next view, without a sort, and a block that takes the slots
+/// another one's orders were written at has its own written over them: the order buffer never
+/// shows a cloud another cloud's order. Blocks that stayed are not written again.
 #[test]
 fn orders_follow_their_clouds_to_other_slots() {
     let mut blocks = far_row(4, 3);
@@ -159,7 +160,7 @@ fn orders_follow_their_clouds_to_other_slots() {
     ring.view(&blocks, &ids, reach, &mut out, &mut lists);
     ring.take_dirty(&mut spans);
     // Blocks 0 and 1 swap slots; block 3 moves up to 480.. .
-    let mut place = |id: u64, start: u32| {
+    let place = |blocks: &mut Blocks, id: u64, start: u32| {
         let r = blocks.get_mut(&id).unwrap();
         let mut base = start;
         for state in &mut r.clouds {
@@ -167,10 +168,12 @@ fn orders_follow_their_clouds_to_other_slots() {
             base += state.sprites;
         }
         r.place = Some((start..base, r.place.clone().unwrap().1));
+        // Another placing, as the resident set numbers them.
+        r.place_serial += 100;
     };
-    place(0, 120);
-    place(1, 0);
-    place(3, 480);
+    place(&mut blocks, 0, 120);
+    place(&mut blocks, 1, 0);
+    place(&mut blocks, 3, 480);
     spans.clear();
     ring.view(&blocks, &ids, reach, &mut out, &mut lists);
     assert_eq!(ring.take_dirty(&mut spans), 360, "{spans:?}");
@@ -181,10 +184,16 @@ fn orders_follow_their_clouds_to_other_slots() {
         "block 2 was written again"
     );
     assert_slots_hold_orders(&ring, &blocks, &lists, centre, 100);
-    // Gone blocks' owners go with their orders.
+    // A block placed again at the slots it had is written again too (its slots may have held
+    // another block's orders meanwhile); gone blocks' orders are forgotten.
+    place(&mut blocks, 2, 240);
+    spans.clear();
+    ring.view(&blocks, &ids, reach, &mut out, &mut lists);
+    assert_eq!(ring.take_dirty(&mut spans), 120, "{spans:?}");
+    assert_eq!(spans, vec![240..360]);
     blocks.remove(&3);
     ring.retain(&blocks);
-    assert!(ring.owners.values().all(|o| o.block != 3));
+    assert!(!ring.kept.contains_key(&3));
 }
 
 /// Every listed cloud's orders in the ring's slots are its sprites' slots back to front from
