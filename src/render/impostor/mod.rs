@@ -688,8 +688,9 @@ impl ImpostorRing {
         let mut bytes = 0;
         let first = self.shown.is_none() && self.fade.is_none();
         let view_radius_m = self.reach_settings().view_radius_m;
-        if let Some(mut build) = self.build.take()
-            && let Some(order_buffer) = self.order_buffer.as_mut()
+        // (A ring with a build has impostors, and so an order buffer.)
+        if let Some(order_buffer) = self.order_buffer.as_mut()
+            && let Some(mut build) = self.build.take()
         {
             let slots = resident.orders_cpu.len() as u32;
             bytes += order_buffer.fit(&self.device, queue, &mut self.sorts, slots);

@@ -54,7 +54,7 @@ pub(crate) struct RingOrders {
     slots: Vec<u32>,
     /// The spans of `slots` written since the last [`Self::take_dirty`].
     dirty: Vec<Range<u32>>,
-    /// Sprite orders written by views (clouds moved to other slots, or too large to sort)
+    /// Sprite orders written by views (blocks placed again since, clouds too large to sort)
     /// since the last [`Self::take_dirty`].
     rewritten: u32,
 }
@@ -110,7 +110,7 @@ impl RingOrders {
     }
 
     /// The spans of [`Self::slots`] written since the last call, and the sprite orders views
-    /// wrote again since (clouds moved to other slots, or too large to sort).
+    /// wrote again since (blocks placed again, clouds too large to sort).
     pub fn take_dirty(&mut self, into: &mut Vec<Range<u32>>) -> u32 {
         into.append(&mut self.dirty);
         std::mem::take(&mut self.rewritten)
