@@ -2,8 +2,8 @@
 //! into place there (`shaders/scatter.wgsl`): a queue write costs a few microseconds whatever
 //! its size, and a frame changes a hundred scattered orders. The patch is applied by the next
 //! `Sky::record` (or corner read-back); a frame prepared and never recorded keeps its patch for
-//! the next one, and past the size of the buffers themselves the whole buffers are written
-//! instead, so nothing grows however the sky is driven.
+//! the next one, which writes only what it adds to it, and past the size of the buffers
+//! themselves the whole buffers are written instead, so nothing grows however the sky is driven.
 
 use std::cell::Cell;
 use std::ops::Range;
@@ -29,6 +29,9 @@ pub(super) struct Scatter {
     span_buffer: wgpu::Buffer,
     /// Bound as the list target by a patch of orders only (the impostor ring's).
     no_lists: wgpu::Buffer,
+    /// How many of `values` and `spans` the GPU buffers hold already: a patch kept over frames
+    /// prepared and never drawn is added to there, not written again whole each frame.
+    sent: (usize, usize),
     /// The bind group of the patch written.
     group: Option<wgpu::BindGroup>,
     /// Whether that patch went into a recorded frame (then the next one starts afresh).
@@ -58,6 +61,7 @@ impl Scatter {
             patch: storage_buffer(device, "sky.scatter_patch", 16 << 10),
             span_buffer: storage_buffer(device, "sky.scatter_spans", 4 << 10),
             no_lists: storage_buffer(device, "sky.scatter_no_lists", 16),
+            sent: (0, 0),
             group: None,
             applied: Cell::new(true),
         }
@@ -113,6 +117,7 @@ impl Scatter {
         if self.applied.replace(false) {
             self.values.clear();
             self.spans.clear();
+            self.sent = (0, 0);
         }
         self.group = None;
         for r in dirty_orders.drain(..) {
@@ -131,6 +136,7 @@ impl Scatter {
             // Frames prepared and never drawn piled up more than the buffers hold: write them.
             self.values.clear();
             self.spans.clear();
+            self.sent = (0, 0);
             queue.write_buffer(order_buffer, 0, bytemuck::cast_slice(orders));
             if !lists.is_empty() {
                 queue.write_buffer(&list_buffer, 0, bytemuck::cast_slice(lists));
@@ -142,13 +148,24 @@ impl Scatter {
         if value_bytes > self.patch.size() {
             self.patch =
                 storage_buffer(device, "sky.scatter_patch", value_bytes.next_power_of_two());
+            self.sent.0 = 0;
         }
         if span_bytes > self.span_buffer.size() {
             let bytes = span_bytes.next_power_of_two();
             self.span_buffer = storage_buffer(device, "sky.scatter_spans", bytes);
+            self.sent.1 = 0;
         }
-        queue.write_buffer(&self.patch, 0, bytemuck::cast_slice(&self.values));
-        queue.write_buffer(&self.span_buffer, 0, bytemuck::cast_slice(&self.spans));
+        // What the buffers do not hold yet (all of it, after a drawn frame or a new buffer).
+        let (values, spans) = (&self.values[self.sent.0..], &self.spans[self.sent.1..]);
+        let at = (self.sent.0 as u64 * 4, self.sent.1 as u64 * 16);
+        if !values.is_empty() {
+            queue.write_buffer(&self.patch, at.0, bytemuck::cast_slice(values));
+        }
+        if !spans.is_empty() {
+            queue.write_buffer(&self.span_buffer, at.1, bytemuck::cast_slice(spans));
+        }
+        let written = (values.len() * 4 + spans.len() * 16) as u64;
+        self.sent = (self.values.len(), self.spans.len());
         fn binding(binding: u32, buffer: &wgpu::Buffer, size: u64) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry {
                 binding,
@@ -169,7 +186,7 @@ impl Scatter {
                 binding(3, &list_buffer, list_buffer.size()),
             ],
         }));
-        value_bytes + span_bytes
+        written
     }
 
     fn push(&mut self, target: u32, dst: u32, data: &[u32]) {
