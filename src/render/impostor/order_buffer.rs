@@ -64,7 +64,7 @@ impl OrderBuffer {
 
     /// After a frame's sorts and views: sends the spans of `orders` written since the last
     /// call as one patch. Returns the bytes written and the sprite orders the views wrote again
-    /// (clouds moved to other slots, or too large to sort).
+    /// (blocks placed again since, or clouds too large to sort).
     pub fn send(
         &mut self,
         device: &wgpu::Device,
