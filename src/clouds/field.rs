@@ -23,6 +23,7 @@ use rayon::prelude::*;
 
 use super::CloudsError;
 use super::block::CloudBlock;
+use super::boxes::GenerationBoxes;
 use super::config::{CloudTypes, CloudsConfig, LifecycleConfig};
 use super::generate::{generate_block, generate_block_in_field};
 use super::lifecycle::{Phase, ends_at, phase_at};
@@ -39,6 +40,9 @@ pub struct Generated {
     pub weather: BlockWeather,
     /// The clouds.
     pub block: CloudBlock,
+    /// Their core boxes for the probe's queries, worked out here on the worker (not on the
+    /// frame thread that takes the block in).
+    pub boxes: Arc<GenerationBoxes>,
 }
 
 /// Generates blocks on a thread pool without blocking the caller.
@@ -91,11 +95,13 @@ impl BlockGenerator {
         self.pending += 1;
         self.pool.spawn(move || {
             let block = generate_block(index, &weather, seed, &types);
+            let boxes = Arc::new(GenerationBoxes::of(&block.clouds));
             // The receiver is gone only when the generator was dropped: nobody wants the block.
             let _ = tx.send(Generated {
                 index,
                 weather,
                 block,
+                boxes,
             });
         });
     }
@@ -115,10 +121,12 @@ impl BlockGenerator {
         self.pending += 1;
         self.pool.spawn(move || {
             let block = generate_block_in_field(index, &weather, &cells, &cache, seed, &types);
+            let boxes = Arc::new(GenerationBoxes::of(&block.clouds));
             let _ = tx.send(Generated {
                 index,
                 weather,
                 block,
+                boxes,
             });
         });
     }
@@ -235,6 +243,8 @@ pub struct FieldBlock {
     /// The clouds as generated (the sprites' fades follow from `phase`:
     /// [`super::lifecycle::alpha_at`]; nothing is rewritten per frame).
     pub block: CloudBlock,
+    /// Its clouds' core boxes ([`Generated::boxes`]).
+    pub boxes: Arc<GenerationBoxes>,
     /// Forming, steady or dissipating.
     pub phase: Phase,
     /// Unique to this generation in its field (a weather change never reuses one).
@@ -490,6 +500,7 @@ impl CloudField {
             self.membership += 1;
             slot.generations.push(FieldBlock {
                 block: done.block,
+                boxes: done.boxes,
                 phase,
                 serial: self.next_serial,
             });

@@ -19,6 +19,7 @@
 //! inside a cloud is f32 metres relative to the cloud centre, ready for a GPU.
 
 pub mod block;
+pub mod boxes;
 pub mod config;
 pub mod far_map;
 pub mod field;
@@ -31,6 +32,7 @@ pub mod probe;
 pub mod rain;
 pub mod rng;
 pub mod sheet;
+mod sight;
 pub mod storm;
 
 pub use block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};

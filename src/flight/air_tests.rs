@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use glam::{DVec2, DVec3};
 
 use super::*;
-use crate::clouds::probe::CloudBox;
+use crate::clouds::boxes::CloudBox;
 use crate::flight::WorldSettings;
 use crate::weather::field::{CloudTypeRule, FieldSettings};
 use crate::weather::{LocalFrame, WeatherInput};

@@ -1,0 +1,218 @@
+//! A cloud as the probe's queries see it: its core box (the box of its sprite centres plus a
+//! quarter of each sprite's size, rain shafts left out, the same box the renderer's in-cloud fog
+//! uses: `render::scene::SkyCloud::core_box_m`), and the boxes of a whole generation, worked out
+//! once on the generation worker ([`super::field::Generated::boxes`]).
+
+use glam::DVec3;
+
+use super::block::Cloud;
+use crate::weather::CloudType;
+
+/// A cloud's core box, in the field's (air) frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CloudBox {
+    /// Centre of the box, metres.
+    pub centre_m: DVec3,
+    /// Half extents, metres.
+    pub half_m: DVec3,
+    /// The cloud's own centre (its fades go by the distance from it), metres.
+    pub cloud_centre_m: DVec3,
+    /// The cloud's radius (`Cloud::radius_m`), metres.
+    pub radius_m: f64,
+    /// The radius of a sphere around the cloud centre holding every sprite, rain included.
+    pub sphere_m: f64,
+    /// Its type.
+    pub cloud_type: CloudType,
+    /// Which cloud of the block.
+    pub cloud: usize,
+}
+
+impl CloudBox {
+    /// The box of a cloud (`None` for one without cloud sprites).
+    pub fn of(cloud: &Cloud, index: usize) -> Option<Self> {
+        let mut lo = DVec3::splat(f64::MAX);
+        let mut hi = DVec3::splat(f64::MIN);
+        let mut any = false;
+        let mut sphere = 0.0f64;
+        for s in &cloud.sprites {
+            let o = DVec3::from_array(s.offset_m.map(f64::from));
+            sphere = sphere.max(o.length() + 0.5 * f64::from(s.width_m.max(s.height_m)));
+            if s.precipitation {
+                continue;
+            }
+            let r = DVec3::new(
+                f64::from(s.width_m),
+                f64::from(s.width_m),
+                f64::from(s.height_m),
+            ) * 0.25;
+            lo = lo.min(o - r);
+            hi = hi.max(o + r);
+            any = true;
+        }
+        any.then(|| Self {
+            centre_m: cloud.centre_m + (hi + lo) * 0.5,
+            half_m: (hi - lo) * 0.5,
+            cloud_centre_m: cloud.centre_m,
+            radius_m: f64::from(cloud.radius_m).max(1.0),
+            sphere_m: sphere,
+            cloud_type: cloud.cloud_type,
+            cloud: index,
+        })
+    }
+
+    /// How far inside the box `p` is: 0 outside, rising to 1 over `ramp` of the half-extent.
+    pub fn inside(&self, p: DVec3, ramp: f32) -> f32 {
+        if self.half_m.min_element() <= 0.0 {
+            return 0.0;
+        }
+        let rel = (p - self.centre_m).abs() / self.half_m;
+        let inside = (1.0 - rel.max_element()) as f32;
+        (inside / ramp.max(1e-3)).clamp(0.0, 1.0)
+    }
+
+    /// Distance from `p` to the box, metres (0 inside).
+    pub fn distance_m(&self, p: DVec3) -> f64 {
+        ((p - self.centre_m).abs() - self.half_m)
+            .max(DVec3::ZERO)
+            .length()
+    }
+
+    /// Where the segment `a + t (b - a)`, t in 0..=1, is inside the box: (t in, t out).
+    pub fn segment(&self, a: DVec3, b: DVec3) -> Option<(f64, f64)> {
+        slab(
+            a,
+            b,
+            self.centre_m - self.half_m,
+            self.centre_m + self.half_m,
+        )
+    }
+}
+
+/// The t range of the segment `a..b` inside the box `lo..hi` (the slab method).
+pub(super) fn slab(a: DVec3, b: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64)> {
+    let d = b - a;
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for k in 0..3 {
+        if d[k].abs() < 1e-12 {
+            if a[k] < lo[k] || a[k] > hi[k] {
+                return None;
+            }
+            continue;
+        }
+        let (u, v) = ((lo[k] - a[k]) / d[k], (hi[k] - a[k]) / d[k]);
+        t0 = t0.max(u.min(v));
+        t1 = t1.min(u.max(v));
+        if t0 > t1 {
+            return None;
+        }
+    }
+    Some((t0, t1))
+}
+
+/// The boxes of one generation and the bounds of them all.
+#[derive(Debug, PartialEq)]
+pub struct GenerationBoxes {
+    /// One per cloud with cloud sprites.
+    pub boxes: Vec<CloudBox>,
+    /// Bounds of every box (and sphere) of the generation, air frame.
+    pub lo_m: DVec3,
+    /// See `lo_m`.
+    pub hi_m: DVec3,
+}
+
+impl GenerationBoxes {
+    /// The boxes of a generation's clouds.
+    pub fn of(clouds: &[Cloud]) -> Self {
+        let boxes: Vec<CloudBox> = clouds
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| CloudBox::of(c, i))
+            .collect();
+        let mut lo = DVec3::splat(f64::MAX);
+        let mut hi = DVec3::splat(f64::MIN);
+        for b in &boxes {
+            let r = DVec3::splat(b.sphere_m);
+            lo = lo.min((b.centre_m - b.half_m).min(b.cloud_centre_m - r));
+            hi = hi.max((b.centre_m + b.half_m).max(b.cloud_centre_m + r));
+        }
+        Self {
+            boxes,
+            lo_m: lo,
+            hi_m: hi,
+        }
+    }
+
+    /// Distance from `p` to the bounds, metres (0 inside; infinite with no boxes).
+    pub fn distance_m(&self, p: DVec3) -> f64 {
+        if self.boxes.is_empty() {
+            return f64::INFINITY;
+        }
+        let c = (self.lo_m + self.hi_m) * 0.5;
+        let h = (self.hi_m - self.lo_m) * 0.5;
+        ((p - c).abs() - h).max(DVec3::ZERO).length()
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::clouds::block::{ColourLevel, Sprite};
+
+    /// A cloud of known geometry: sprites filling the box `centre ± half` (core boxes of
+    /// sprites `4 half` wide at the corners of a box of half extent 0: one sprite at the centre
+    /// whose core is exactly `half`).
+    pub(crate) fn cube_cloud(centre_m: DVec3, half_m: f32, cloud_type: CloudType) -> Cloud {
+        let sprite = Sprite {
+            offset_m: [0.0; 3],
+            width_m: 4.0 * half_m,
+            height_m: 4.0 * half_m,
+            rotation_deg: 0.0,
+            texture: 0,
+            shading_group: 0,
+            radius_fraction: 0.0,
+            alpha_morph: 1.0,
+            upright: false,
+            precipitation: false,
+        };
+        Cloud {
+            centre_m,
+            cloud_type,
+            layer: 0,
+            radius_m: half_m,
+            flat: false,
+            sunlit_depth_m: 0.0,
+            shaded_base_m: 0.0,
+            colour_levels: [ColourLevel {
+                height_m: 0.0,
+                rgba: [1.0; 4],
+            }; 5],
+            shading_groups: Vec::new(),
+            sprites: vec![sprite],
+        }
+    }
+
+    #[test]
+    fn a_segment_through_a_cloud_hits_its_near_boundary_and_clear_air_none() {
+        let c = cube_cloud(DVec3::new(1000.0, 0.0, 2000.0), 500.0, CloudType::Stratus);
+        let b = CloudBox::of(&c, 0).unwrap();
+        // From 2 km west to 2 km east of it, level through its middle: enters at x = 500.
+        let a = DVec3::new(-1000.0, 0.0, 2000.0);
+        let (t0, t1) = b.segment(a, DVec3::new(3000.0, 0.0, 2000.0)).unwrap();
+        let (enter, exit) = (t0 * 4000.0, t1 * 4000.0);
+        assert!((enter - 1500.0).abs() <= 0.1 * 1500.0, "{enter}");
+        assert!((exit - 2500.0).abs() < 1.0, "{exit}");
+        // Above it, and short of it: nothing.
+        assert!(
+            b.segment(
+                DVec3::new(-1000.0, 0.0, 2600.0),
+                DVec3::new(3000.0, 0.0, 2600.0)
+            )
+            .is_none()
+        );
+        assert!(b.segment(a, DVec3::new(400.0, 0.0, 2000.0)).is_none());
+        // In-cloud: 0 at the boundary, 1 in the core, and the distance outside.
+        assert_eq!(b.inside(DVec3::new(500.0, 0.0, 2000.0), 0.35), 0.0);
+        assert_eq!(b.inside(DVec3::new(1000.0, 0.0, 2000.0), 0.35), 1.0);
+        assert!((b.distance_m(DVec3::new(0.0, 0.0, 2000.0)) - 500.0).abs() < 1e-9);
+    }
+}

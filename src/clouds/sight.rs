@@ -1,0 +1,770 @@
+//! Lines of sight through the field's cloud boxes, on the CPU, for every frame.
+//!
+//! The field's blocks are cut into square tiles of [`TILE_BLOCKS`] blocks a side. Each tile
+//! holds the boxes of its blocks' generations in one list with a grid over them
+//! ([`SightBoxes`]); a grid of the tiles' bounds above them says which tiles a segment crosses,
+//! nearest first. When the field's membership changes, only a tile a generation joined is
+//! built again (a new block at the field's rim touches one or two tiles, not the whole field);
+//! a generation that went is passed over where it lies (the walk asks the field for its phase
+//! and finds none) until half a tile's boxes are of gone generations. Building the whole
+//! field's grid again on every change was 2 to 3 ms on the frame after each arrival.
+//!
+//! Every box entered is met once, whatever tile or cell lists it; a walk that wants only the
+//! first cloud stops once no tile, cell or box left can be entered before the nearest one met
+//! (Amanatides and Woo 1987, "A fast voxel traversal algorithm for ray tracing", at both levels).
+
+use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
+
+use glam::{DVec2, DVec3};
+
+use super::boxes::{CloudBox, GenerationBoxes, slab};
+use crate::weather::{BLOCK_SIZE_M, BlockIndex};
+
+/// Blocks a side of a tile of [`FieldSight`]: 16 km, so a 10 km line crosses a few tiles and
+/// an arrival builds a tile of 16 blocks, not the field's hundreds.
+const TILE_BLOCKS: i32 = 4;
+
+/// A generation a line of sight may meet: its block, its serial, and its boxes.
+pub(super) type SightMember = (BlockIndex, u64, Arc<GenerationBoxes>);
+
+/// The boxes of a field's generations in tiles, for lines of sight. See the module docs.
+#[derive(Debug)]
+pub(super) struct FieldSight {
+    /// The cell of the tiles' grids, metres.
+    cell_m: f64,
+    /// The tiles, west to east and south to north (the order the walk meets a cell's tiles in
+    /// does not depend on how the field was built).
+    tiles: Vec<Tile>,
+    /// A grid over the tiles' bounds, cells a tile wide.
+    top: BoxGrid,
+    /// The last line of sight's stamp (see [`SightBoxes::crossed`]).
+    stamp: u32,
+}
+
+/// The generations of one tile, with their boxes in one grid.
+#[derive(Debug)]
+struct Tile {
+    /// Which tile: its south-west block's index divided by [`TILE_BLOCKS`].
+    key: (i32, i32),
+    boxes: SightBoxes,
+    /// Block and serial of each generation, in the order [`SightBoxes`] counts them.
+    generations: Vec<(BlockIndex, u64)>,
+    /// The serials of `generations`, sorted, with how many boxes each has.
+    serials: Vec<(u64, usize)>,
+    /// Per box: the stamp of the last line of sight that tested it.
+    seen: Vec<u32>,
+    /// The stamp of the last line of sight that walked the tile.
+    walked: u32,
+}
+
+impl Tile {
+    fn of(key: (i32, i32), members: &[SightMember], cell_m: f64) -> Self {
+        let boxes = SightBoxes::of(members.iter().map(|m| Arc::clone(&m.2)).collect(), cell_m);
+        let mut serials: Vec<(u64, usize)> =
+            members.iter().map(|m| (m.1, m.2.boxes.len())).collect();
+        serials.sort_unstable();
+        Self {
+            key,
+            seen: vec![0; boxes.len()],
+            boxes,
+            generations: members.iter().map(|m| (m.0, m.1)).collect(),
+            serials,
+            walked: 0,
+        }
+    }
+
+    /// Whether the tile holds every one of `members` and no more than as many boxes again of
+    /// generations gone: then it serves as it is.
+    fn serves(&self, members: &[SightMember]) -> bool {
+        let mut living_boxes = 0;
+        for m in members {
+            match self.serials.binary_search_by_key(&m.1, |s| s.0) {
+                Ok(k) => living_boxes += self.serials[k].1,
+                Err(_) => return false,
+            }
+        }
+        2 * living_boxes >= self.boxes.len()
+    }
+}
+
+impl FieldSight {
+    /// No tiles yet, with grids of cells of `cell_m`.
+    pub(super) fn new(cell_m: f64) -> Self {
+        Self {
+            cell_m,
+            tiles: Vec::new(),
+            top: BoxGrid::of(&[], &[], 1.0),
+            stamp: 0,
+        }
+    }
+
+    /// The cell of the tiles' grids, metres.
+    pub(super) fn cell_m(&self) -> f64 {
+        self.cell_m
+    }
+
+    /// Brings the tiles up to the generations that can be met now (their boxes not empty),
+    /// building only the tiles a generation joined or that hold more gone boxes than living
+    /// ones; returns how many tiles it built.
+    pub(super) fn update(&mut self, living: impl IntoIterator<Item = SightMember>) -> usize {
+        let mut by_tile: BTreeMap<(i32, i32), Vec<SightMember>> = BTreeMap::new();
+        for member in living {
+            if member.2.boxes.is_empty() {
+                continue;
+            }
+            let key = (
+                member.0.i.div_euclid(TILE_BLOCKS),
+                member.0.j.div_euclid(TILE_BLOCKS),
+            );
+            by_tile.entry(key).or_default().push(member);
+        }
+        let mut old: HashMap<(i32, i32), Tile> =
+            self.tiles.drain(..).map(|tile| (tile.key, tile)).collect();
+        let mut built = 0;
+        for (key, members) in by_tile {
+            let tile = match old.remove(&key) {
+                Some(tile) if tile.serves(&members) => tile,
+                _ => {
+                    built += 1;
+                    Tile::of(key, &members, self.cell_m)
+                }
+            };
+            self.tiles.push(tile);
+        }
+        let corners: Vec<[DVec3; 2]> = self
+            .tiles
+            .iter()
+            .map(|t| [t.boxes.lo_m, t.boxes.hi_m])
+            .collect();
+        let all: Vec<u32> = (0..corners.len() as u32).collect();
+        let tile_m = f64::from(TILE_BLOCKS) * BLOCK_SIZE_M;
+        self.top = BoxGrid::of(&corners, &all, tile_m);
+        built
+    }
+
+    /// The boxes the segment `a..b` (air frame) enters, each once, nearest tiles and cells
+    /// first: `hit((block, serial), box, t in, t out)` says whether it counts and whether the
+    /// walk has met enough. With `whole` false the walk stops once no box left can be entered
+    /// before the nearest counted one.
+    pub(super) fn crossed(
+        &mut self,
+        a: DVec3,
+        b: DVec3,
+        whole: bool,
+        mut hit: impl FnMut((BlockIndex, u64), &CloudBox, f64, f64) -> Met,
+    ) {
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            for tile in &mut self.tiles {
+                tile.seen.fill(0);
+                tile.walked = 0;
+            }
+            self.stamp = 1;
+        }
+        let stamp = self.stamp;
+        let mut walk = Walk::new(whole);
+        let tiles = &mut self.tiles;
+        self.top.walk(a, b, 0.0, 1.0, |list, _, cell_out| {
+            for &t in list {
+                let tile = &mut tiles[t as usize];
+                if tile.walked == stamp {
+                    continue;
+                }
+                tile.walked = stamp;
+                let generations = &tile.generations;
+                tile.boxes
+                    .crossed(a, b, &mut walk, &mut tile.seen, stamp, |g, bx, t0, t1| {
+                        hit(generations[g], bx, t0, t1)
+                    });
+                if walk.enough {
+                    return false;
+                }
+            }
+            // A tile not walked yet is entered in a later cell, which lists it.
+            walk.whole || walk.best >= cell_out
+        });
+    }
+}
+
+/// The most cells a side of a [`BoxGrid`] has: 128 km at the shipped 500 m, more than a tile
+/// of the field holds; a coarser grid beyond that.
+const GRID_MAX_SIDE: usize = 256;
+
+/// The cloud boxes of some generations (a tile of the field's blocks) in one list, with one
+/// grid over them all for lines of sight: a segment walks one grid, not one per generation.
+#[derive(Debug)]
+struct SightBoxes {
+    /// Per box: its corners (the slab test reads only these, packed for the walk).
+    corners: Vec<[DVec3; 2]>,
+    /// Per box: the generation (an index into `generations`) and its box there.
+    owners: Vec<(u32, u32)>,
+    /// The generations' boxes, in the order `owners` counts them.
+    generations: Vec<Arc<GenerationBoxes>>,
+    /// Bounds of every box, air frame.
+    lo_m: DVec3,
+    /// See `lo_m`.
+    hi_m: DVec3,
+    /// The footprints of the boxes up to [`BIG_BOX_CELLS`] cells wide on a grid of the cells
+    /// asked for, and of the bigger ones (a cumulonimbus, an anvil, a stratus deck) on one
+    /// of cells [`BIG_BOX_CELLS`] times as wide: a big box listed in the fine cells filled
+    /// them (a storm's 1,800 boxes were 140,000 entries, each rebuilt with the membership).
+    grids: [BoxGrid; 2],
+}
+
+/// How many cells of the fine grid a box's footprint may span on a side before it goes to the
+/// coarse grid of [`SightBoxes`] (whose cells are this many times as wide).
+const BIG_BOX_CELLS: f64 = 8.0;
+
+impl SightBoxes {
+    /// One list and grid (cells of `cell_m`) over the boxes of `generations`.
+    fn of(generations: Vec<Arc<GenerationBoxes>>, cell_m: f64) -> Self {
+        let mut corners = Vec::new();
+        let mut owners = Vec::new();
+        for (g, boxes) in generations.iter().enumerate() {
+            for (k, b) in boxes.boxes.iter().enumerate() {
+                corners.push([b.centre_m - b.half_m, b.centre_m + b.half_m]);
+                owners.push((g as u32, k as u32));
+            }
+        }
+        let (lo_m, hi_m) = corners.iter().fold(
+            (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+            |(lo, hi), [a, z]| (lo.min(*a), hi.max(*z)),
+        );
+        let (big, small): (Vec<u32>, Vec<u32>) = (0..corners.len() as u32).partition(|&i| {
+            let [a, z] = corners[i as usize];
+            (z - a).truncate().max_element() > BIG_BOX_CELLS * cell_m
+        });
+        let grids = [
+            BoxGrid::of(&corners, &big, cell_m * BIG_BOX_CELLS),
+            BoxGrid::of(&corners, &small, cell_m),
+        ];
+        Self {
+            corners,
+            owners,
+            generations,
+            lo_m,
+            hi_m,
+            grids,
+        }
+    }
+
+    /// How many boxes.
+    fn len(&self) -> usize {
+        self.corners.len()
+    }
+
+    /// The boxes the segment `a..b` enters, each once, nearest cells first:
+    /// `hit(generation, box, t in, t out)` says whether it counts (a faded-out cloud does not)
+    /// and whether the walk has met enough. A walk that is not `whole` also stops once no box
+    /// left can be entered before the nearest counted one (`walk` carries that entry from the
+    /// grids walked before). `seen` is scratch, one entry per box, and `stamp` a number it does
+    /// not hold yet (a box is tested the first time a cell lists it, and marked with the stamp:
+    /// a big box is listed in many cells).
+    fn crossed(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        walk: &mut Walk,
+        seen: &mut [u32],
+        stamp: u32,
+        mut hit: impl FnMut(usize, &CloudBox, f64, f64) -> Met,
+    ) {
+        let Some((from, to)) = slab(a, b, self.lo_m, self.hi_m) else {
+            return;
+        };
+        if !walk.whole && from >= walk.best {
+            return;
+        }
+        // The big boxes first, then the small ones with the nearest big one's entry to beat.
+        // In each grid, once the nearest entry is before the cell is left, no box not yet met
+        // can be entered earlier (its entry point lies in a later cell, which lists it).
+        for grid in &self.grids {
+            if walk.enough {
+                return;
+            }
+            grid.walk(a, b, from, to, |list, _, cell_out| {
+                for &index in list {
+                    let index = index as usize;
+                    if seen[index] == stamp {
+                        continue;
+                    }
+                    seen[index] = stamp;
+                    let [lo, hi] = self.corners[index];
+                    let Some((t0, t1)) = slab(a, b, lo, hi) else {
+                        continue;
+                    };
+                    if !walk.whole && t0 >= walk.best {
+                        continue;
+                    }
+                    let (g, k) = self.owners[index];
+                    let bx = &self.generations[g as usize].boxes[k as usize];
+                    match hit(g as usize, bx, t0, t1) {
+                        Met::Passed => {}
+                        Met::Counted => walk.best = walk.best.min(t0),
+                        Met::Enough => {
+                            walk.enough = true;
+                            return false;
+                        }
+                    }
+                }
+                walk.whole || walk.best >= cell_out
+            });
+        }
+    }
+}
+
+/// One line of sight's walk over several grids: whether it wants every box, the nearest entry
+/// counted so far (t along the segment) and whether it has met enough.
+#[derive(Debug, Clone, Copy)]
+struct Walk {
+    whole: bool,
+    best: f64,
+    enough: bool,
+}
+
+impl Walk {
+    fn new(whole: bool) -> Self {
+        Self {
+            whole,
+            best: f64::INFINITY,
+            enough: false,
+        }
+    }
+}
+
+/// What a box a line of sight enters is to the walk.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Met {
+    /// It does not count (a faded-out cloud).
+    Passed,
+    /// It counts.
+    Counted,
+    /// It counts, and the walk has what it wants: it stops.
+    Enough,
+}
+
+/// A uniform horizontal grid over boxes: each cell lists the boxes whose footprint (padded by a
+/// metre against rounding) overlaps it, with the lowest bottom and highest top of them, so a
+/// segment walked through the cells it crosses (Amanatides and Woo 1987, "A fast voxel
+/// traversal algorithm for ray tracing") tests only the boxes near it, nearest cells first, and
+/// passes over a cell it crosses above or below all of them.
+#[derive(Debug)]
+struct BoxGrid {
+    /// South-west corner, air frame metres.
+    origin_m: DVec2,
+    /// Cell side, metres.
+    cell_m: f64,
+    /// Cells east and north.
+    nx: usize,
+    ny: usize,
+    /// Where each cell's list starts in `items` (`nx * ny + 1` entries).
+    starts: Vec<u32>,
+    /// Box indices, cell after cell.
+    items: Vec<u32>,
+    /// Per cell: the lowest bottom and highest top of its boxes, metres (none: +inf, -inf).
+    heights_m: Vec<[f64; 2]>,
+}
+
+impl BoxGrid {
+    /// The grid over the boxes `indices` of `corners`.
+    fn of(corners: &[[DVec3; 2]], indices: &[u32], cell_m: f64) -> Self {
+        let pad = DVec2::splat(1.0);
+        let mut lo = DVec2::splat(f64::MAX);
+        let mut hi = DVec2::splat(f64::MIN);
+        for [a, z] in indices.iter().map(|&i| &corners[i as usize]) {
+            lo = lo.min(a.truncate() - pad);
+            hi = hi.max(z.truncate() + pad);
+        }
+        if indices.is_empty() {
+            (lo, hi) = (DVec2::ZERO, DVec2::ONE);
+        }
+        let size = hi - lo;
+        let cell_m = cell_m
+            .max(size.max_element() / GRID_MAX_SIDE as f64)
+            .max(1.0);
+        let nx = ((size.x / cell_m).ceil() as usize).clamp(1, GRID_MAX_SIDE);
+        let ny = ((size.y / cell_m).ceil() as usize).clamp(1, GRID_MAX_SIDE);
+        let cells = |[a, z]: &[DVec3; 2]| {
+            let a = (a.truncate() - pad - lo) / cell_m;
+            let z = (z.truncate() + pad - lo) / cell_m;
+            let clamp = |v: f64, n: usize| (v.floor().max(0.0) as usize).min(n - 1);
+            (
+                clamp(a.x, nx)..=clamp(z.x, nx),
+                clamp(a.y, ny)..=clamp(z.y, ny),
+            )
+        };
+        // Counted, then filled: one allocation for every list.
+        let mut counts = vec![0u32; nx * ny + 1];
+        let mut heights_m = vec![[f64::INFINITY, f64::NEG_INFINITY]; nx * ny];
+        for c in indices.iter().map(|&i| &corners[i as usize]) {
+            let (xs, ys) = cells(c);
+            for y in ys {
+                for x in xs.clone() {
+                    counts[y * nx + x + 1] += 1;
+                    let h = &mut heights_m[y * nx + x];
+                    *h = [h[0].min(c[0].z), h[1].max(c[1].z)];
+                }
+            }
+        }
+        for k in 1..counts.len() {
+            counts[k] += counts[k - 1];
+        }
+        let starts = counts.clone();
+        let mut items = vec![0u32; counts[nx * ny] as usize];
+        for &index in indices {
+            let (xs, ys) = cells(&corners[index as usize]);
+            for y in ys {
+                for x in xs.clone() {
+                    let at = &mut counts[y * nx + x];
+                    items[*at as usize] = index;
+                    *at += 1;
+                }
+            }
+        }
+        Self {
+            origin_m: lo,
+            cell_m,
+            nx,
+            ny,
+            starts,
+            items,
+            heights_m,
+        }
+    }
+
+    /// Walks the cells the segment `a + t (b - a)` crosses for t in `t_from..=t_to`, in order:
+    /// `visit(boxes of the cell, t entering it, t leaving it)`, the first cell entered at
+    /// minus infinity and the last left at plus infinity (so every t belongs to one cell), no
+    /// boxes where the segment passes above or below them all; stops when `visit` says false. A grid of no boxes visits nothing.
+    fn walk(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        t_from: f64,
+        t_to: f64,
+        mut visit: impl FnMut(&[u32], f64, f64) -> bool,
+    ) {
+        // Most tiles have no big box: their coarse grid costs a line of sight nothing.
+        if self.items.is_empty() {
+            return;
+        }
+        let (a2, d) = (a.truncate(), (b - a).truncate());
+        let dz = b.z - a.z;
+        let hi = self.origin_m + DVec2::new(self.nx as f64, self.ny as f64) * self.cell_m;
+        // The part of the segment over the grid.
+        let Some((t0, t1)) = slab(
+            a2.extend(0.0),
+            (a2 + d).extend(0.0),
+            self.origin_m.extend(-1.0),
+            hi.extend(1.0),
+        ) else {
+            return;
+        };
+        let (t0, t1) = (t0.max(t_from), t1.min(t_to));
+        if t0 > t1 {
+            return;
+        }
+        let start = (a2 + d * t0 - self.origin_m) / self.cell_m;
+        let mut cell = [
+            (start.x.floor().max(0.0) as usize).min(self.nx - 1) as i64,
+            (start.y.floor().max(0.0) as usize).min(self.ny - 1) as i64,
+        ];
+        let n = [self.nx as i64, self.ny as i64];
+        let mut step = [0i64; 2];
+        let mut next = [f64::INFINITY; 2];
+        let mut delta = [f64::INFINITY; 2];
+        for k in 0..2 {
+            if d[k].abs() > 1e-12 {
+                step[k] = if d[k] > 0.0 { 1 } else { -1 };
+                let edge =
+                    self.origin_m[k] + (cell[k] + i64::from(d[k] > 0.0)) as f64 * self.cell_m;
+                next[k] = (edge - a2[k]) / d[k];
+                delta[k] = self.cell_m / d[k].abs();
+            }
+        }
+        let mut enter = f64::NEG_INFINITY;
+        loop {
+            let k = usize::from(next[1] < next[0]);
+            let last = next[k] >= t1 || !(0..n[k]).contains(&(cell[k] + step[k]));
+            let leave = if last { f64::INFINITY } else { next[k] };
+            let c = cell[1] as usize * self.nx + cell[0] as usize;
+            // The heights the segment has over the cell (a metre's margin, as the footprints).
+            let (z0, z1) = (a.z + dz * enter.max(t0), a.z + dz * leave.min(t1));
+            let [bottom, top] = self.heights_m[c];
+            let list = if z0.max(z1) + 1.0 < bottom || z0.min(z1) - 1.0 > top {
+                &[][..]
+            } else {
+                &self.items[self.starts[c] as usize..self.starts[c + 1] as usize]
+            };
+            if !visit(list, enter, leave) || last {
+                return;
+            }
+            enter = leave;
+            cell[k] += step[k];
+            next[k] += delta[k];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::clouds::block::Cloud;
+    use crate::clouds::boxes::tests::cube_cloud;
+    use crate::weather::CloudType;
+
+    /// The grid a line of sight walks finds what testing every box finds: on 300 clouds of
+    /// random size and place in three generations (overlapping) and 3,000 segments (level,
+    /// upright, axis-aligned, starting inside and outside the clouds, grazing a box's top),
+    /// every box entered is met exactly once, and the nearest entry (the first cloud) is the
+    /// same, for a fine, the shipped and a coarse grid.
+    #[test]
+    fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rand = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let generations: Vec<Arc<GenerationBoxes>> = (0..3)
+            .map(|_| {
+                let clouds: Vec<Cloud> = (0..100)
+                    .map(|_| {
+                        let c = DVec3::new(
+                            rand() * 12_000.0 - 2_000.0,
+                            rand() * 8_000.0,
+                            500.0 + rand() * 2_500.0,
+                        );
+                        let half = (30.0 + rand() * 1_500.0 * rand()) as f32;
+                        cube_cloud(c, half, CloudType::CumulusMediocris)
+                    })
+                    .collect();
+                Arc::new(GenerationBoxes::of(&clouds))
+            })
+            .collect();
+        let every: Vec<(usize, &CloudBox)> = generations
+            .iter()
+            .enumerate()
+            .flat_map(|(g, b)| b.boxes.iter().map(move |bx| (g, bx)))
+            .collect();
+        let mut met_first = 0;
+        let mut stamp = 0;
+        for cell_m in [120.0, 500.0, 4_000.0] {
+            let sight = SightBoxes::of(generations.clone(), cell_m);
+            assert_eq!(sight.len(), 300);
+            let mut seen = vec![0; sight.len()];
+            for k in 0..3_000 {
+                let mut a = DVec3::new(
+                    rand() * 16_000.0 - 4_000.0,
+                    rand() * 12_000.0 - 2_000.0,
+                    rand() * 3_500.0,
+                );
+                let mut b = a + DVec3::new(
+                    (rand() - 0.5) * 20_000.0,
+                    (rand() - 0.5) * 20_000.0,
+                    (rand() - 0.5) * 3_000.0,
+                );
+                match k % 7 {
+                    0 => b.z = a.z,
+                    1 => b = a.with_z(a.z + 3_000.0),
+                    2 => b.x = a.x,
+                    3 => a = every[k % every.len()].1.centre_m,
+                    // Level, grazing a box's top: the cells' heights must hold it.
+                    4 => {
+                        let bx = every[k % every.len()].1;
+                        a.z = bx.centre_m.z + bx.half_m.z - 0.5;
+                        b.z = a.z;
+                    }
+                    _ => {}
+                }
+                let mut all: Vec<(f64, usize, usize)> = every
+                    .iter()
+                    .filter_map(|(g, bx)| bx.segment(a, b).map(|(t0, _)| (t0, *g, bx.cloud)))
+                    .collect();
+                all.sort_by_key(|x| (x.1, x.2));
+                let mut met = Vec::new();
+                stamp += 1;
+                sight.crossed(
+                    a,
+                    b,
+                    &mut Walk::new(true),
+                    &mut seen,
+                    stamp,
+                    |g, bx, t0, _| {
+                        met.push((t0, g, bx.cloud));
+                        Met::Counted
+                    },
+                );
+                met.sort_by_key(|x| (x.1, x.2));
+                assert_eq!(met, all, "cell {cell_m} m, segment {k}: {a} to {b}");
+                // A walk that has enough after its first box meets no other, in any grid.
+                let mut walked = 0;
+                stamp += 1;
+                sight.crossed(
+                    a,
+                    b,
+                    &mut Walk::new(true),
+                    &mut seen,
+                    stamp,
+                    |_, _, _, _| {
+                        walked += 1;
+                        Met::Enough
+                    },
+                );
+                assert_eq!(walked, all.len().min(1), "cell {cell_m} m, segment {k}");
+                let nearest = all.iter().map(|h| h.0).fold(f64::INFINITY, f64::min);
+                let mut first = f64::INFINITY;
+                stamp += 1;
+                sight.crossed(
+                    a,
+                    b,
+                    &mut Walk::new(false),
+                    &mut seen,
+                    stamp,
+                    |_, _, t0, _| {
+                        first = first.min(t0);
+                        Met::Counted
+                    },
+                );
+                assert_eq!(first, nearest, "cell {cell_m} m, segment {k}");
+                met_first += nearest.is_finite() as usize;
+            }
+        }
+        // Both kinds of segment were asked about.
+        assert!((1_000..8_000).contains(&met_first), "{met_first}");
+    }
+
+    /// A random segment of up to 30 km at cloud heights over the area `0..size_m` (levels and
+    /// upright ones among them).
+    fn segment(rand: &mut dyn FnMut() -> f64, size_m: f64, k: usize) -> (DVec3, DVec3) {
+        let a = DVec3::new(rand() * size_m, rand() * size_m, rand() * 4_000.0);
+        let mut b = a + DVec3::new(
+            (rand() - 0.5) * 30_000.0,
+            (rand() - 0.5) * 30_000.0,
+            (rand() - 0.5) * 3_000.0,
+        );
+        match k % 5 {
+            0 => b.z = a.z,
+            1 => b = a.with_z(a.z + 3_000.0),
+            _ => {}
+        }
+        (a, b)
+    }
+
+    /// Asserts that `sight` meets what testing every box of `members` meets on 1,500 random
+    /// segments, the `gone` generations passed over.
+    fn check(
+        sight: &mut FieldSight,
+        members: &[SightMember],
+        gone: &[u64],
+        rand: &mut dyn FnMut() -> f64,
+        k0: usize,
+    ) {
+        let size_m = 12.0 * BLOCK_SIZE_M;
+        for k in k0..k0 + 1_500 {
+            let (a, b) = segment(&mut *rand, size_m, k);
+            let mut every: Vec<(u64, usize, u64)> = members
+                .iter()
+                .flat_map(|(_, serial, boxes)| {
+                    boxes.boxes.iter().filter_map(move |bx| {
+                        bx.segment(a, b)
+                            .map(|(t0, _)| (*serial, bx.cloud, t0.to_bits()))
+                    })
+                })
+                .collect();
+            every.sort_unstable();
+            let mut met = Vec::new();
+            sight.crossed(a, b, true, |(_, serial), bx, t0, _| {
+                if gone.contains(&serial) {
+                    return Met::Passed;
+                }
+                met.push((serial, bx.cloud, t0.to_bits()));
+                Met::Counted
+            });
+            met.sort_unstable();
+            assert_eq!(met, every, "segment {k}: {a} to {b}");
+            let nearest = every
+                .iter()
+                .map(|h| f64::from_bits(h.2))
+                .fold(f64::INFINITY, f64::min);
+            let mut first = f64::INFINITY;
+            sight.crossed(a, b, false, |(_, serial), _, t0, _| {
+                if gone.contains(&serial) {
+                    return Met::Passed;
+                }
+                first = first.min(t0);
+                Met::Counted
+            });
+            assert_eq!(first, nearest, "segment {k}: {a} to {b}");
+        }
+    }
+
+    /// The tiles find what testing every living box finds, before and after the membership
+    /// changes: on generations of random clouds (overhanging their blocks) over 12 x 12 blocks,
+    /// every living box a segment enters is counted once and the first cloud is the nearest;
+    /// once generations went and others joined, only the tile they joined is built again, and
+    /// the gone ones are passed over where they lie.
+    #[test]
+    fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rand = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let generation = |index: BlockIndex, serial: u64, rand: &mut dyn FnMut() -> f64| {
+            let corner = index.min_corner_m();
+            let clouds: Vec<Cloud> = (0..12)
+                .map(|_| {
+                    let c = DVec3::new(
+                        corner.x + rand() * BLOCK_SIZE_M,
+                        corner.y + rand() * BLOCK_SIZE_M,
+                        500.0 + rand() * 2_500.0,
+                    );
+                    let half = (30.0 + rand() * 1_500.0 * rand()) as f32;
+                    cube_cloud(c, half, CloudType::CumulusMediocris)
+                })
+                .collect();
+            (index, serial, Arc::new(GenerationBoxes::of(&clouds)))
+        };
+        let mut members: Vec<SightMember> = Vec::new();
+        for j in 0..12 {
+            for i in 0..12 {
+                let serial = members.len() as u64 + 1;
+                members.push(generation(BlockIndex::new(i, j), serial, &mut rand));
+            }
+        }
+        let mut sight = FieldSight::new(500.0);
+        assert_eq!(sight.update(members.iter().cloned()), 9);
+        check(&mut sight, &members, &[], &mut rand, 0);
+        // Five generations go, in four tiles; two join the block (5, 6), tile (1, 1), beside
+        // its old generation (which then goes too, as a weather change dissipates it).
+        let gone: Vec<u64> = [0, 13, 50, 77, 143, 66].map(|k| members[k].1).to_vec();
+        let mut living: Vec<SightMember> = members
+            .iter()
+            .filter(|m| !gone.contains(&m.1))
+            .cloned()
+            .collect();
+        for serial in [1_000, 1_001] {
+            living.push(generation(BlockIndex::new(5, 6), serial, &mut rand));
+        }
+        assert_eq!(sight.update(living.iter().cloned()), 1);
+        check(&mut sight, &living, &gone, &mut rand, 10_000);
+        // A tile that lost more than half its boxes' generations is built again.
+        let tile_00: Vec<u64> = living
+            .iter()
+            .filter(|m| m.0.i < 4 && m.0.j < 4)
+            .map(|m| m.1)
+            .collect();
+        let left: Vec<SightMember> = living
+            .iter()
+            .filter(|m| !tile_00[..12].contains(&m.1))
+            .cloned()
+            .collect();
+        assert_eq!(sight.update(left.iter().cloned()), 1);
+        check(&mut sight, &left, &gone, &mut rand, 20_000);
+    }
+}
