@@ -2,12 +2,14 @@
 //!
 //! The field's blocks are cut into square tiles of [`TILE_BLOCKS`] blocks a side. Each tile
 //! holds the boxes of its blocks' generations in one list with a grid over them
-//! ([`SightBoxes`]); a grid of the tiles' bounds above them says which tiles a segment crosses,
-//! nearest first. When the field's membership changes, only a tile a generation joined is
-//! built again (a new block at the field's rim touches one or two tiles, not the whole field);
-//! a generation that went is passed over where it lies (the walk asks the field for its phase
-//! and finds none) until half a tile's boxes are of gone generations. Building the whole
-//! field's grid again on every change was 2 to 3 ms on the frame after each arrival.
+//! ([`SightBoxes`]), built the first time a line of sight enters the tile's bounds; a grid of
+//! the tiles' bounds above them says which tiles a segment crosses, nearest first. When the
+//! field's membership changes, only a tile a generation joined is made anew, and its grid is
+//! built when a line of sight comes near: blocks join at the field's rim, tens of kilometres
+//! from where a host looks. A generation that went is passed over where it lies (the walk asks
+//! the field for its phase and finds none) until half a tile's boxes are of gone generations.
+//! Building the whole field's grid again on every change was 2 to 3 ms on the frame after each
+//! arrival (the cruise).
 //!
 //! Every box entered is met once, whatever tile or cell lists it; a walk that wants only the
 //! first cloud stops once no tile, cell or box left can be entered before the nearest one met
@@ -42,16 +44,23 @@ pub(super) struct FieldSight {
     stamp: u32,
 }
 
-/// The generations of one tile, with their boxes in one grid.
+/// The generations of one tile, with their boxes in one grid once a line of sight comes near.
 #[derive(Debug)]
 struct Tile {
     /// Which tile: its south-west block's index divided by [`TILE_BLOCKS`].
     key: (i32, i32),
-    boxes: SightBoxes,
-    /// Block and serial of each generation, in the order [`SightBoxes`] counts them.
-    generations: Vec<(BlockIndex, u64)>,
-    /// The serials of `generations`, sorted, with how many boxes each has.
+    /// Bounds of its generations' boxes, air frame.
+    lo_m: DVec3,
+    hi_m: DVec3,
+    /// The generations: block, serial and boxes, in the order [`SightBoxes`] counts them.
+    members: Vec<SightMember>,
+    /// Its boxes in one grid, built the first time a line of sight enters its bounds: the
+    /// field's rim, where blocks come and go as the camera flies on, is seldom looked along.
+    boxes: Option<SightBoxes>,
+    /// The serials of `members`, sorted, with how many boxes each has.
     serials: Vec<(u64, usize)>,
+    /// How many boxes it holds, living or not.
+    box_count: usize,
     /// Per box: the stamp of the last line of sight that tested it.
     seen: Vec<u32>,
     /// The stamp of the last line of sight that walked the tile.
@@ -59,17 +68,26 @@ struct Tile {
 }
 
 impl Tile {
-    fn of(key: (i32, i32), members: &[SightMember], cell_m: f64) -> Self {
-        let boxes = SightBoxes::of(members.iter().map(|m| Arc::clone(&m.2)).collect(), cell_m);
+    fn of(key: (i32, i32), members: Vec<SightMember>) -> Self {
         let mut serials: Vec<(u64, usize)> =
             members.iter().map(|m| (m.1, m.2.boxes.len())).collect();
         serials.sort_unstable();
+        // The bounds of the boxes themselves (a generation's own bounds hold its sprites'
+        // spheres, kilometres wider for a heap's), so that a line of sight near a tile's edge
+        // walks the tile beside it only where a box reaches over.
+        let (lo_m, hi_m) = members.iter().flat_map(|m| m.2.boxes.iter()).fold(
+            (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+            |(lo, hi), b| (lo.min(b.centre_m - b.half_m), hi.max(b.centre_m + b.half_m)),
+        );
         Self {
             key,
-            seen: vec![0; boxes.len()],
-            boxes,
-            generations: members.iter().map(|m| (m.0, m.1)).collect(),
+            lo_m,
+            hi_m,
+            box_count: serials.iter().map(|s| s.1).sum(),
+            members,
+            boxes: None,
             serials,
+            seen: Vec::new(),
             walked: 0,
         }
     }
@@ -84,7 +102,7 @@ impl Tile {
                 Err(_) => return false,
             }
         }
-        2 * living_boxes >= self.boxes.len()
+        2 * living_boxes >= self.box_count
     }
 }
 
@@ -105,8 +123,9 @@ impl FieldSight {
     }
 
     /// Brings the tiles up to the generations that can be met now (their boxes not empty),
-    /// building only the tiles a generation joined or that hold more gone boxes than living
-    /// ones; returns how many tiles it built.
+    /// making anew only the tiles a generation joined or that hold more gone boxes than living
+    /// ones (their grids are built when a line of sight first comes near); returns how many
+    /// tiles it made anew.
     pub(super) fn update(&mut self, living: impl IntoIterator<Item = SightMember>) -> usize {
         let mut by_tile: BTreeMap<(i32, i32), Vec<SightMember>> = BTreeMap::new();
         for member in living {
@@ -121,26 +140,28 @@ impl FieldSight {
         }
         let mut old: HashMap<(i32, i32), Tile> =
             self.tiles.drain(..).map(|tile| (tile.key, tile)).collect();
-        let mut built = 0;
+        let mut made = 0;
         for (key, members) in by_tile {
             let tile = match old.remove(&key) {
                 Some(tile) if tile.serves(&members) => tile,
                 _ => {
-                    built += 1;
-                    Tile::of(key, &members, self.cell_m)
+                    made += 1;
+                    Tile::of(key, members)
                 }
             };
             self.tiles.push(tile);
         }
-        let corners: Vec<[DVec3; 2]> = self
-            .tiles
-            .iter()
-            .map(|t| [t.boxes.lo_m, t.boxes.hi_m])
-            .collect();
+        let corners: Vec<[DVec3; 2]> = self.tiles.iter().map(|t| [t.lo_m, t.hi_m]).collect();
         let all: Vec<u32> = (0..corners.len() as u32).collect();
         let tile_m = f64::from(TILE_BLOCKS) * BLOCK_SIZE_M;
         self.top = BoxGrid::of(&corners, &all, tile_m);
-        built
+        made
+    }
+
+    /// How many tiles have their grid built (a line of sight came near them).
+    #[cfg(test)]
+    fn tiles_built(&self) -> usize {
+        self.tiles.iter().filter(|t| t.boxes.is_some()).count()
     }
 
     /// The boxes the segment `a..b` (air frame) enters, each once, nearest tiles and cells
@@ -164,6 +185,7 @@ impl FieldSight {
         }
         let stamp = self.stamp;
         let mut walk = Walk::new(whole);
+        let cell_m = self.cell_m;
         let tiles = &mut self.tiles;
         self.top.walk(a, b, 0.0, 1.0, |list, _, cell_out| {
             for &t in list {
@@ -172,11 +194,22 @@ impl FieldSight {
                     continue;
                 }
                 tile.walked = stamp;
-                let generations = &tile.generations;
-                tile.boxes
-                    .crossed(a, b, &mut walk, &mut tile.seen, stamp, |g, bx, t0, t1| {
-                        hit(generations[g], bx, t0, t1)
-                    });
+                // The grid cell lists every tile its square overlaps: only one whose bounds
+                // the segment enters (soon enough) is built and walked.
+                match slab(a, b, tile.lo_m, tile.hi_m) {
+                    Some((t0, _)) if walk.whole || t0 < walk.best => {}
+                    _ => continue,
+                }
+                let members = &tile.members;
+                let boxes = tile.boxes.get_or_insert_with(|| {
+                    SightBoxes::of(members.iter().map(|m| Arc::clone(&m.2)).collect(), cell_m)
+                });
+                if tile.seen.len() != boxes.len() {
+                    tile.seen = vec![0; boxes.len()];
+                }
+                boxes.crossed(a, b, &mut walk, &mut tile.seen, stamp, |g, bx, t0, t1| {
+                    hit((members[g].0, members[g].1), bx, t0, t1)
+                });
                 if walk.enough {
                     return false;
                 }
@@ -704,7 +737,7 @@ mod tests {
     /// The tiles find what testing every living box finds, before and after the membership
     /// changes: on generations of random clouds (overhanging their blocks) over 12 x 12 blocks,
     /// every living box a segment enters is counted once and the first cloud is the nearest;
-    /// once generations went and others joined, only the tile they joined is built again, and
+    /// once generations went and others joined, only the tile they joined is made anew, and
     /// the gone ones are passed over where they lie.
     #[test]
     fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
@@ -739,6 +772,14 @@ mod tests {
         }
         let mut sight = FieldSight::new(500.0);
         assert_eq!(sight.update(members.iter().cloned()), 9);
+        // A tile's grid is built when a line of sight first enters its bounds: a short one in
+        // the middle of tile (1, 1) builds that tile's alone.
+        assert_eq!(sight.tiles_built(), 0);
+        let middle = DVec3::new(6.0 * BLOCK_SIZE_M, 6.0 * BLOCK_SIZE_M, 1_000.0);
+        sight.crossed(middle, middle + DVec3::X * 100.0, true, |_, _, _, _| {
+            Met::Counted
+        });
+        assert_eq!(sight.tiles_built(), 1);
         check(&mut sight, &members, &[], &mut rand, 0);
         // Five generations go, in four tiles; two join the block (5, 6), tile (1, 1), beside
         // its old generation (which then goes too, as a weather change dissipates it).
