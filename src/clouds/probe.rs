@@ -15,7 +15,7 @@
 //! The boxes of a generation are worked out once, on the generation worker
 //! ([`super::field::FieldBlock::boxes`]). A point query looks only at the blocks within reach of
 //! the point, and skips a block whose clouds' bounds are out of reach; a line of sight walks the
-//! field's boxes in tiles ([`super::sight`]), a tile built again when a generation joins it.
+//! field's boxes in tiles (`clouds::sight`), a tile built again when a generation joins it.
 //! Positions are ground metres (east, north, up MSL); the field's drift is taken off to find the
 //! clouds.
 
