@@ -44,7 +44,7 @@ pub(super) struct FieldSight {
     stamp: u32,
 }
 
-/// The generations of one tile, with their boxes in one grid once a line of sight comes near.
+/// The generations of one tile, with their boxes in grids once a line of sight comes near.
 #[derive(Debug)]
 struct Tile {
     /// Which tile: its south-west block's index divided by [`TILE_BLOCKS`].
@@ -52,19 +52,45 @@ struct Tile {
     /// Bounds of its generations' boxes, air frame.
     lo_m: DVec3,
     hi_m: DVec3,
-    /// The generations: block, serial and boxes, in the order [`SightBoxes`] counts them.
+    /// The generations: block, serial and boxes, in the order the parts count them.
     members: Vec<SightMember>,
-    /// Its boxes in one grid, built the first time a line of sight enters its bounds: the
-    /// field's rim, where blocks come and go as the camera flies on, is seldom looked along.
-    boxes: Option<SightBoxes>,
+    /// Its boxes in grids, built the first time a line of sight enters its bounds (the field's
+    /// rim, where blocks come and go as the camera flies on, is seldom looked along): one part
+    /// over the members it had then, and one over each batch that joined after (a tile around
+    /// the aircraft in a changing sky is not built again whole for every generation that
+    /// forms in it), until there are [`MAX_PARTS`].
+    parts: Vec<Part>,
+    /// How many of `members` the parts hold (the first ones).
+    in_parts: usize,
     /// The serials of `members`, sorted, with how many boxes each has.
     serials: Vec<(u64, usize)>,
     /// How many boxes it holds, living or not.
     box_count: usize,
-    /// Per box: the stamp of the last line of sight that tested it.
-    seen: Vec<u32>,
     /// The stamp of the last line of sight that walked the tile.
     walked: u32,
+}
+
+/// Some of a tile's members' boxes in one grid.
+#[derive(Debug)]
+struct Part {
+    boxes: SightBoxes,
+    /// Which member its first generation is (its generations are the members from there).
+    first: usize,
+    /// Per box: the stamp of the last line of sight that tested it.
+    seen: Vec<u32>,
+}
+
+/// The most parts a tile has: one more is built with all the others, whole.
+const MAX_PARTS: usize = 4;
+
+/// The bounds of the boxes of `members` (a generation's own bounds hold its sprites' spheres,
+/// kilometres wider for a heap's, so that a line of sight near a tile's edge walks the tile
+/// beside it only where a box reaches over).
+fn box_bounds(members: &[SightMember]) -> (DVec3, DVec3) {
+    members.iter().flat_map(|m| m.2.boxes.iter()).fold(
+        (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+        |(lo, hi), b| (lo.min(b.centre_m - b.half_m), hi.max(b.centre_m + b.half_m)),
+    )
 }
 
 impl Tile {
@@ -72,37 +98,77 @@ impl Tile {
         let mut serials: Vec<(u64, usize)> =
             members.iter().map(|m| (m.1, m.2.boxes.len())).collect();
         serials.sort_unstable();
-        // The bounds of the boxes themselves (a generation's own bounds hold its sprites'
-        // spheres, kilometres wider for a heap's), so that a line of sight near a tile's edge
-        // walks the tile beside it only where a box reaches over.
-        let (lo_m, hi_m) = members.iter().flat_map(|m| m.2.boxes.iter()).fold(
-            (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
-            |(lo, hi), b| (lo.min(b.centre_m - b.half_m), hi.max(b.centre_m + b.half_m)),
-        );
+        let (lo_m, hi_m) = box_bounds(&members);
         Self {
             key,
             lo_m,
             hi_m,
             box_count: serials.iter().map(|s| s.1).sum(),
             members,
-            boxes: None,
+            parts: Vec::new(),
+            in_parts: 0,
             serials,
-            seen: Vec::new(),
             walked: 0,
         }
     }
 
-    /// Whether the tile holds every one of `members` and no more than as many boxes again of
-    /// generations gone: then it serves as it is.
-    fn serves(&self, members: &[SightMember]) -> bool {
+    /// Takes in `members`, the tile's generations now, if it can: the ones it does not hold
+    /// join it (a part of their own once a line comes near), the ones gone are passed over
+    /// where they lie; not when more of its boxes would be gone than living. Returns whether
+    /// it did, and whether any joined.
+    fn take(&mut self, members: Vec<SightMember>) -> Result<bool, Vec<SightMember>> {
         let mut living_boxes = 0;
-        for m in members {
+        let mut joined = Vec::new();
+        for m in &members {
             match self.serials.binary_search_by_key(&m.1, |s| s.0) {
                 Ok(k) => living_boxes += self.serials[k].1,
-                Err(_) => return false,
+                Err(_) => joined.push(Arc::clone(&m.2)),
             }
         }
-        2 * living_boxes >= self.box_count
+        if 2 * living_boxes < self.box_count {
+            return Err(members);
+        }
+        if joined.is_empty() {
+            return Ok(false);
+        }
+        let known = self.serials.clone();
+        for m in members {
+            if known.binary_search_by_key(&m.1, |s| s.0).is_err() {
+                self.serials.push((m.1, m.2.boxes.len()));
+                self.box_count += m.2.boxes.len();
+                let (lo, hi) = box_bounds(std::slice::from_ref(&m));
+                self.lo_m = self.lo_m.min(lo);
+                self.hi_m = self.hi_m.max(hi);
+                self.members.push(m);
+            }
+        }
+        self.serials.sort_unstable();
+        Ok(true)
+    }
+
+    /// Builds the parts a line of sight needs: the members not in one yet.
+    fn build(&mut self, cell_m: f64) {
+        if self.in_parts == self.members.len() {
+            return;
+        }
+        if self.parts.len() >= MAX_PARTS {
+            self.parts.clear();
+            self.in_parts = 0;
+        }
+        let first = self.in_parts;
+        let boxes = SightBoxes::of(
+            self.members[first..]
+                .iter()
+                .map(|m| Arc::clone(&m.2))
+                .collect(),
+            cell_m,
+        );
+        self.parts.push(Part {
+            seen: vec![0; boxes.len()],
+            boxes,
+            first,
+        });
+        self.in_parts = self.members.len();
     }
 }
 
@@ -122,10 +188,10 @@ impl FieldSight {
         self.cell_m
     }
 
-    /// Brings the tiles up to the generations that can be met now (their boxes not empty),
-    /// making anew only the tiles a generation joined or that hold more gone boxes than living
-    /// ones (their grids are built when a line of sight first comes near); returns how many
-    /// tiles it made anew.
+    /// Brings the tiles up to the generations that can be met now (their boxes not empty): a
+    /// generation that joins a tile is added to it (a grid of its own, when a line of sight first
+    /// comes near), one that went is passed over where it lies, and a tile that would hold more
+    /// gone boxes than living ones is made anew; returns how many tiles changed.
     pub(super) fn update(&mut self, living: impl IntoIterator<Item = SightMember>) -> usize {
         let mut by_tile: BTreeMap<(i32, i32), Vec<SightMember>> = BTreeMap::new();
         for member in living {
@@ -140,12 +206,19 @@ impl FieldSight {
         }
         let mut old: HashMap<(i32, i32), Tile> =
             self.tiles.drain(..).map(|tile| (tile.key, tile)).collect();
-        let mut made = 0;
+        let mut changed = 0;
         for (key, members) in by_tile {
-            let tile = match old.remove(&key) {
-                Some(tile) if tile.serves(&members) => tile,
-                _ => {
-                    made += 1;
+            let kept = match old.remove(&key) {
+                Some(mut tile) => tile.take(members).map(|joined| (joined, tile)),
+                None => Err(members),
+            };
+            let tile = match kept {
+                Ok((joined, tile)) => {
+                    changed += usize::from(joined);
+                    tile
+                }
+                Err(members) => {
+                    changed += 1;
                     Tile::of(key, members)
                 }
             };
@@ -155,13 +228,14 @@ impl FieldSight {
         let all: Vec<u32> = (0..corners.len() as u32).collect();
         let tile_m = f64::from(TILE_BLOCKS) * BLOCK_SIZE_M;
         self.top = BoxGrid::of(&corners, &all, tile_m);
-        made
+        changed
     }
 
-    /// How many tiles have their grid built (a line of sight came near them).
+    /// How many tiles have grids built (a line of sight came near them), and how many parts.
     #[cfg(test)]
-    fn tiles_built(&self) -> usize {
-        self.tiles.iter().filter(|t| t.boxes.is_some()).count()
+    fn tiles_built(&self) -> (usize, usize) {
+        let built = self.tiles.iter().filter(|t| !t.parts.is_empty());
+        (built.clone().count(), built.map(|t| t.parts.len()).sum())
     }
 
     /// The boxes the segment `a..b` (air frame) enters, each once, nearest tiles and cells
@@ -178,7 +252,9 @@ impl FieldSight {
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
             for tile in &mut self.tiles {
-                tile.seen.fill(0);
+                for part in &mut tile.parts {
+                    part.seen.fill(0);
+                }
                 tile.walked = 0;
             }
             self.stamp = 1;
@@ -200,16 +276,19 @@ impl FieldSight {
                     Some((t0, _)) if walk.whole || t0 < walk.best => {}
                     _ => continue,
                 }
+                tile.build(cell_m);
                 let members = &tile.members;
-                let boxes = tile.boxes.get_or_insert_with(|| {
-                    SightBoxes::of(members.iter().map(|m| Arc::clone(&m.2)).collect(), cell_m)
-                });
-                if tile.seen.len() != boxes.len() {
-                    tile.seen = vec![0; boxes.len()];
+                for part in &mut tile.parts {
+                    let first = part.first;
+                    part.boxes
+                        .crossed(a, b, &mut walk, &mut part.seen, stamp, |g, bx, t0, t1| {
+                            let m = &members[first + g];
+                            hit((m.0, m.1), bx, t0, t1)
+                        });
+                    if walk.enough {
+                        return false;
+                    }
                 }
-                boxes.crossed(a, b, &mut walk, &mut tile.seen, stamp, |g, bx, t0, t1| {
-                    hit((members[g].0, members[g].1), bx, t0, t1)
-                });
                 if walk.enough {
                     return false;
                 }
@@ -737,8 +816,8 @@ mod tests {
     /// The tiles find what testing every living box finds, before and after the membership
     /// changes: on generations of random clouds (overhanging their blocks) over 12 x 12 blocks,
     /// every living box a segment enters is counted once and the first cloud is the nearest;
-    /// once generations went and others joined, only the tile they joined is made anew, and
-    /// the gone ones are passed over where they lie.
+    /// once generations went and others joined, only the tile they joined changes (a part of
+    /// their own), and the gone ones are passed over where they lie.
     #[test]
     fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
@@ -774,13 +853,14 @@ mod tests {
         assert_eq!(sight.update(members.iter().cloned()), 9);
         // A tile's grid is built when a line of sight first enters its bounds: a short one in
         // the middle of tile (1, 1) builds that tile's alone.
-        assert_eq!(sight.tiles_built(), 0);
+        assert_eq!(sight.tiles_built(), (0, 0));
         let middle = DVec3::new(6.0 * BLOCK_SIZE_M, 6.0 * BLOCK_SIZE_M, 1_000.0);
         sight.crossed(middle, middle + DVec3::X * 100.0, true, |_, _, _, _| {
             Met::Counted
         });
-        assert_eq!(sight.tiles_built(), 1);
+        assert_eq!(sight.tiles_built(), (1, 1));
         check(&mut sight, &members, &[], &mut rand, 0);
+        assert_eq!(sight.tiles_built(), (9, 9));
         // Five generations go, in four tiles; two join the block (5, 6), tile (1, 1), beside
         // its old generation (which then goes too, as a weather change dissipates it).
         let gone: Vec<u64> = [0, 13, 50, 77, 143, 66].map(|k| members[k].1).to_vec();
@@ -794,6 +874,8 @@ mod tests {
         }
         assert_eq!(sight.update(living.iter().cloned()), 1);
         check(&mut sight, &living, &gone, &mut rand, 10_000);
+        // The two that joined have a part of their own: the tile was not built again whole.
+        assert_eq!(sight.tiles_built(), (9, 10));
         // A tile that lost more than half its boxes' generations is built again.
         let tile_00: Vec<u64> = living
             .iter()
@@ -807,5 +889,21 @@ mod tests {
             .collect();
         assert_eq!(sight.update(left.iter().cloned()), 1);
         check(&mut sight, &left, &gone, &mut rand, 20_000);
+        assert_eq!(sight.tiles_built(), (9, 10));
+        // Generations joining tile (2, 2) one by one, a line through it after each: a part
+        // each, until one more than `MAX_PARTS` builds the tile whole again.
+        let mut left = left;
+        let corner = DVec3::new(10.0 * BLOCK_SIZE_M, 10.0 * BLOCK_SIZE_M, 1_000.0);
+        let mut parts = Vec::new();
+        for serial in 2_000..2_000 + MAX_PARTS as u64 {
+            left.push(generation(BlockIndex::new(9, 9), serial, &mut rand));
+            assert_eq!(sight.update(left.iter().cloned()), 1);
+            sight.crossed(corner, corner + DVec3::Y * 100.0, true, |_, _, _, _| {
+                Met::Counted
+            });
+            parts.push(sight.tiles_built().1);
+        }
+        assert_eq!(parts, [11, 12, 13, 10]);
+        check(&mut sight, &left, &gone, &mut rand, 30_000);
     }
 }
