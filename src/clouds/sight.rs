@@ -1,15 +1,15 @@
 //! Lines of sight through the field's cloud boxes, on the CPU, for every frame.
 //!
 //! The field's blocks are cut into square tiles of [`TILE_BLOCKS`] blocks a side. Each tile
-//! holds the boxes of its blocks' generations in one list with a grid over them
-//! ([`SightBoxes`]), built the first time a line of sight enters the tile's bounds; a grid of
-//! the tiles' bounds above them says which tiles a segment crosses, nearest first. When the
-//! field's membership changes, only a tile a generation joined is made anew, and its grid is
-//! built when a line of sight comes near: blocks join at the field's rim, tens of kilometres
-//! from where a host looks. A generation that went is passed over where it lies (the walk asks
-//! the field for its phase and finds none) until half a tile's boxes are of gone generations.
-//! Building the whole field's grid again on every change was 2 to 3 ms on the frame after each
-//! arrival (the cruise).
+//! holds the boxes of its blocks' generations in grids ([`SightBoxes`]), built the first time a
+//! line of sight enters the tile's bounds; a grid of the tiles' bounds above them says which
+//! tiles a segment crosses, nearest first. When the field's membership changes, a generation
+//! that joins a tile gets a grid of its own beside the tile's when a line first comes near (a
+//! part; at [`MAX_PARTS`] the tile is built whole again), and blocks join at the field's rim,
+//! tens of kilometres from where a host looks. A generation that went is passed over where it
+//! lies (the walk asks the field for its phase and finds none) until half a tile's boxes are of
+//! gone generations: then the tile is made anew. Building the whole field's grid again on every
+//! change was 2 to 3 ms on the frame after each arrival (the cruise).
 //!
 //! Every box entered is met once, whatever tile or cell lists it; a walk that wants only the
 //! first cloud stops once no tile, cell or box left can be entered before the nearest one met
@@ -23,8 +23,8 @@ use glam::{DVec2, DVec3};
 use super::boxes::{CloudBox, GenerationBoxes, slab};
 use crate::weather::{BLOCK_SIZE_M, BlockIndex};
 
-/// Blocks a side of a tile of [`FieldSight`]: 16 km, so a 10 km line crosses a few tiles and
-/// an arrival builds a tile of 16 blocks, not the field's hundreds.
+/// Blocks a side of a tile of [`FieldSight`]: 16 km, so a 10 km line crosses a tile or two and
+/// a tile made anew holds 16 blocks, not the field's hundreds.
 const TILE_BLOCKS: i32 = 4;
 
 /// A generation a line of sight may meet: its block, its serial, and its boxes.
