@@ -1,0 +1,288 @@
+//! Tests of the lines of sight's grids and tiles: against testing every box, and what a change
+//! of the field builds.
+
+use super::*;
+use crate::clouds::block::Cloud;
+use crate::clouds::boxes::tests::cube_cloud;
+use crate::weather::CloudType;
+
+/// The grid a line of sight walks finds what testing every box finds: on 300 clouds of
+/// random size and place in three generations (overlapping) and 3,000 segments (level,
+/// upright, axis-aligned, starting inside and outside the clouds, grazing a box's top),
+/// every box entered is met exactly once, and the nearest entry (the first cloud) is the
+/// same, for a fine, the shipped and a coarse grid.
+#[test]
+fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut rand = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let generations: Vec<Arc<GenerationBoxes>> = (0..3)
+        .map(|_| {
+            let clouds: Vec<Cloud> = (0..100)
+                .map(|_| {
+                    let c = DVec3::new(
+                        rand() * 12_000.0 - 2_000.0,
+                        rand() * 8_000.0,
+                        500.0 + rand() * 2_500.0,
+                    );
+                    let half = (30.0 + rand() * 1_500.0 * rand()) as f32;
+                    cube_cloud(c, half, CloudType::CumulusMediocris)
+                })
+                .collect();
+            Arc::new(GenerationBoxes::of(&clouds))
+        })
+        .collect();
+    let every: Vec<(usize, &CloudBox)> = generations
+        .iter()
+        .enumerate()
+        .flat_map(|(g, b)| b.boxes.iter().map(move |bx| (g, bx)))
+        .collect();
+    let mut met_first = 0;
+    let mut stamp = 0;
+    for cell_m in [120.0, 500.0, 4_000.0] {
+        let sight = SightBoxes::of(generations.clone(), cell_m);
+        assert_eq!(sight.len(), 300);
+        let mut seen = vec![0; sight.len()];
+        for k in 0..3_000 {
+            let mut a = DVec3::new(
+                rand() * 16_000.0 - 4_000.0,
+                rand() * 12_000.0 - 2_000.0,
+                rand() * 3_500.0,
+            );
+            let mut b = a + DVec3::new(
+                (rand() - 0.5) * 20_000.0,
+                (rand() - 0.5) * 20_000.0,
+                (rand() - 0.5) * 3_000.0,
+            );
+            match k % 7 {
+                0 => b.z = a.z,
+                1 => b = a.with_z(a.z + 3_000.0),
+                2 => b.x = a.x,
+                3 => a = every[k % every.len()].1.centre_m,
+                // Level, grazing a box's top: the cells' heights must hold it.
+                4 => {
+                    let bx = every[k % every.len()].1;
+                    a.z = bx.centre_m.z + bx.half_m.z - 0.5;
+                    b.z = a.z;
+                }
+                _ => {}
+            }
+            let mut all: Vec<(f64, usize, usize)> = every
+                .iter()
+                .filter_map(|(g, bx)| bx.segment(a, b).map(|(t0, _)| (t0, *g, bx.cloud)))
+                .collect();
+            all.sort_by_key(|x| (x.1, x.2));
+            let mut met = Vec::new();
+            stamp += 1;
+            sight.crossed(
+                a,
+                b,
+                &mut Walk::new(true),
+                &mut seen,
+                stamp,
+                |g, bx, t0, _| {
+                    met.push((t0, g, bx.cloud));
+                    Met::Counted
+                },
+            );
+            met.sort_by_key(|x| (x.1, x.2));
+            assert_eq!(met, all, "cell {cell_m} m, segment {k}: {a} to {b}");
+            // A walk that has enough after its first box meets no other, in any grid.
+            let mut walked = 0;
+            stamp += 1;
+            sight.crossed(
+                a,
+                b,
+                &mut Walk::new(true),
+                &mut seen,
+                stamp,
+                |_, _, _, _| {
+                    walked += 1;
+                    Met::Enough
+                },
+            );
+            assert_eq!(walked, all.len().min(1), "cell {cell_m} m, segment {k}");
+            let nearest = all.iter().map(|h| h.0).fold(f64::INFINITY, f64::min);
+            let mut first = f64::INFINITY;
+            stamp += 1;
+            sight.crossed(
+                a,
+                b,
+                &mut Walk::new(false),
+                &mut seen,
+                stamp,
+                |_, _, t0, _| {
+                    first = first.min(t0);
+                    Met::Counted
+                },
+            );
+            assert_eq!(first, nearest, "cell {cell_m} m, segment {k}");
+            met_first += nearest.is_finite() as usize;
+        }
+    }
+    // Both kinds of segment were asked about.
+    assert!((1_000..8_000).contains(&met_first), "{met_first}");
+}
+
+/// A random segment of up to 30 km at cloud heights over the area `0..size_m` (levels and
+/// upright ones among them).
+fn segment(rand: &mut dyn FnMut() -> f64, size_m: f64, k: usize) -> (DVec3, DVec3) {
+    let a = DVec3::new(rand() * size_m, rand() * size_m, rand() * 4_000.0);
+    let mut b = a + DVec3::new(
+        (rand() - 0.5) * 30_000.0,
+        (rand() - 0.5) * 30_000.0,
+        (rand() - 0.5) * 3_000.0,
+    );
+    match k % 5 {
+        0 => b.z = a.z,
+        1 => b = a.with_z(a.z + 3_000.0),
+        _ => {}
+    }
+    (a, b)
+}
+
+/// Asserts that `sight` meets what testing every box of `members` meets on 1,500 random
+/// segments, the `gone` generations passed over.
+fn check(
+    sight: &mut FieldSight,
+    members: &[SightMember],
+    gone: &[u64],
+    rand: &mut dyn FnMut() -> f64,
+    k0: usize,
+) {
+    let size_m = 12.0 * BLOCK_SIZE_M;
+    for k in k0..k0 + 1_500 {
+        let (a, b) = segment(&mut *rand, size_m, k);
+        let mut every: Vec<(u64, usize, u64)> = members
+            .iter()
+            .flat_map(|(_, serial, boxes)| {
+                boxes.boxes.iter().filter_map(move |bx| {
+                    bx.segment(a, b)
+                        .map(|(t0, _)| (*serial, bx.cloud, t0.to_bits()))
+                })
+            })
+            .collect();
+        every.sort_unstable();
+        let mut met = Vec::new();
+        sight.crossed(a, b, true, |(_, serial), bx, t0, _| {
+            if gone.contains(&serial) {
+                return Met::Passed;
+            }
+            met.push((serial, bx.cloud, t0.to_bits()));
+            Met::Counted
+        });
+        met.sort_unstable();
+        assert_eq!(met, every, "segment {k}: {a} to {b}");
+        let nearest = every
+            .iter()
+            .map(|h| f64::from_bits(h.2))
+            .fold(f64::INFINITY, f64::min);
+        let mut first = f64::INFINITY;
+        sight.crossed(a, b, false, |(_, serial), _, t0, _| {
+            if gone.contains(&serial) {
+                return Met::Passed;
+            }
+            first = first.min(t0);
+            Met::Counted
+        });
+        assert_eq!(first, nearest, "segment {k}: {a} to {b}");
+    }
+}
+
+/// The tiles find what testing every living box finds, before and after the membership
+/// changes: on generations of random clouds (overhanging their blocks) over 12 x 12 blocks,
+/// every living box a segment enters is counted once and the first cloud is the nearest;
+/// once generations went and others joined, only the tile they joined changes (a part of
+/// their own), and the gone ones are passed over where they lie.
+#[test]
+fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut rand = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let generation = |index: BlockIndex, serial: u64, rand: &mut dyn FnMut() -> f64| {
+        let corner = index.min_corner_m();
+        let clouds: Vec<Cloud> = (0..12)
+            .map(|_| {
+                let c = DVec3::new(
+                    corner.x + rand() * BLOCK_SIZE_M,
+                    corner.y + rand() * BLOCK_SIZE_M,
+                    500.0 + rand() * 2_500.0,
+                );
+                let half = (30.0 + rand() * 1_500.0 * rand()) as f32;
+                cube_cloud(c, half, CloudType::CumulusMediocris)
+            })
+            .collect();
+        (index, serial, Arc::new(GenerationBoxes::of(&clouds)))
+    };
+    let mut members: Vec<SightMember> = Vec::new();
+    for j in 0..12 {
+        for i in 0..12 {
+            let serial = members.len() as u64 + 1;
+            members.push(generation(BlockIndex::new(i, j), serial, &mut rand));
+        }
+    }
+    let mut sight = FieldSight::new(500.0);
+    assert_eq!(sight.update(members.iter().cloned()), 9);
+    // A tile's grid is built when a line of sight first enters its bounds: a short one in
+    // the middle of tile (1, 1) builds that tile's alone.
+    assert_eq!(sight.tiles_built(), (0, 0));
+    let middle = DVec3::new(6.0 * BLOCK_SIZE_M, 6.0 * BLOCK_SIZE_M, 1_000.0);
+    sight.crossed(middle, middle + DVec3::X * 100.0, true, |_, _, _, _| {
+        Met::Counted
+    });
+    assert_eq!(sight.tiles_built(), (1, 1));
+    check(&mut sight, &members, &[], &mut rand, 0);
+    assert_eq!(sight.tiles_built(), (9, 9));
+    // Five generations go, in four tiles; two join the block (5, 6), tile (1, 1), beside
+    // its old generation (which then goes too, as a weather change dissipates it).
+    let gone: Vec<u64> = [0, 13, 50, 77, 143, 66].map(|k| members[k].1).to_vec();
+    let mut living: Vec<SightMember> = members
+        .iter()
+        .filter(|m| !gone.contains(&m.1))
+        .cloned()
+        .collect();
+    for serial in [1_000, 1_001] {
+        living.push(generation(BlockIndex::new(5, 6), serial, &mut rand));
+    }
+    assert_eq!(sight.update(living.iter().cloned()), 1);
+    check(&mut sight, &living, &gone, &mut rand, 10_000);
+    // The two that joined have a part of their own: the tile was not built again whole.
+    assert_eq!(sight.tiles_built(), (9, 10));
+    // A tile that lost more than half its boxes' generations is built again.
+    let tile_00: Vec<u64> = living
+        .iter()
+        .filter(|m| m.0.i < 4 && m.0.j < 4)
+        .map(|m| m.1)
+        .collect();
+    let left: Vec<SightMember> = living
+        .iter()
+        .filter(|m| !tile_00[..12].contains(&m.1))
+        .cloned()
+        .collect();
+    assert_eq!(sight.update(left.iter().cloned()), 1);
+    check(&mut sight, &left, &gone, &mut rand, 20_000);
+    assert_eq!(sight.tiles_built(), (9, 10));
+    // Generations joining tile (2, 2) one by one, a line through it after each: a part
+    // each, until one more than `MAX_PARTS` builds the tile whole again.
+    let mut left = left;
+    let corner = DVec3::new(10.0 * BLOCK_SIZE_M, 10.0 * BLOCK_SIZE_M, 1_000.0);
+    let mut parts = Vec::new();
+    for serial in 2_000..2_000 + MAX_PARTS as u64 {
+        left.push(generation(BlockIndex::new(9, 9), serial, &mut rand));
+        assert_eq!(sight.update(left.iter().cloned()), 1);
+        sight.crossed(corner, corner + DVec3::Y * 100.0, true, |_, _, _, _| {
+            Met::Counted
+        });
+        parts.push(sight.tiles_built().1);
+    }
+    assert_eq!(parts, [11, 12, 13, 10]);
+    check(&mut sight, &left, &gone, &mut rand, 30_000);
+}
