@@ -6,6 +6,16 @@ use crate::clouds::block::Cloud;
 use crate::clouds::boxes::tests::cube_cloud;
 use crate::weather::CloudType;
 
+/// Uniform numbers in 0..1 from a xorshift of `seed`: the same cases on every run.
+fn xorshift(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// The grid a line of sight walks finds what testing every box finds: on 300 clouds of
 /// random size and place in three generations (overlapping) and 3,000 segments (level,
 /// upright, axis-aligned, starting inside and outside the clouds, grazing a box's top),
@@ -13,13 +23,7 @@ use crate::weather::CloudType;
 /// same, for a fine, the shipped and a coarse grid.
 #[test]
 fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    let mut rand = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rand = xorshift(0x2545_f491_4f6c_dd1du64);
     let generations: Vec<Arc<GenerationBoxes>> = (0..3)
         .map(|_| {
             let clouds: Vec<Cloud> = (0..100)
@@ -200,13 +204,7 @@ fn check(
 /// their own), and the gone ones are passed over where they lie.
 #[test]
 fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
-    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-    let mut rand = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rand = xorshift(0x9e37_79b9_7f4a_7c15u64);
     let generation = |index: BlockIndex, serial: u64, rand: &mut dyn FnMut() -> f64| {
         let corner = index.min_corner_m();
         let clouds: Vec<Cloud> = (0..12)
