@@ -13,13 +13,14 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::Context;
 use clap::Args;
 use skycast::clouds::CloudsConfig;
 use skycast::demo::DemoHost;
 use skycast::flight::{FlightPlan, HostPosition, Weather};
+use skycast::render::Stopwatch;
 use skycast::weather::{LocalFrame, StationTable, theme};
 
 use super::render::{ElevationArgs, LookArgs, parse_size, parse_time, sky_config, time_or_default};
@@ -196,6 +197,11 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "ring_orders_rewritten",
         "gpu_wait_us",
         "preempted",
+        "sky_thread_us",
+        "field_thread_us",
+        "update_thread_us",
+        "record_thread_us",
+        "air_thread_us",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
@@ -246,11 +252,11 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         // What a simulator asks every frame: the air data where the aircraft is, and 64 lines
         // of sight (its sensors, landing lights), counted in the sky's CPU.
         let mut stats = stats;
-        let air_start = Instant::now();
+        let air_start = Stopwatch::start();
         let air = host.sky.air_at(HostPosition::Local(pose.position_m));
-        let air_at_us = air_start.elapsed().as_micros() as u64;
+        let air_at_us = air_start.wall_us();
         let sight_hits = sight_fan(&host.sky, pose.position_m, pose.heading_deg);
-        stats.air_us = air_start.elapsed().as_micros() as u64;
+        stats.set_air(air_start.spent());
         // Whether the system took the core away meanwhile (then the frame's times hold another
         // process's time slice too): a fact about the machine's load, reported, never excluded.
         let preempted = switches_before
@@ -311,6 +317,11 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             stats.ring_orders_rewritten.to_string(),
             stats.gpu_wait_us.to_string(),
             preempted,
+            stats.sky_thread_us().to_string(),
+            stats.thread.field_us.to_string(),
+            stats.thread.update_us.to_string(),
+            stats.thread.record_us.to_string(),
+            stats.thread.air_us.to_string(),
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);
@@ -349,12 +360,17 @@ fn sight_fan(sky: &skycast::SkySystem, at_m: glam::DVec3, heading_deg: f64) -> u
     hits
 }
 
-/// The flight's figures, printed when it ends: the sky's CPU a frame (`sky_cpu_us`), over all
-/// frames and over those that rebuild an impostor, the waits for the GPU apart from it, how much
-/// of the sort order came from the cache, the frame thread's time on weather, peak memory.
+/// The flight's figures, printed when it ends: the sky's CPU a frame on the frame thread's own
+/// clock (`sky_thread_us`) and on the wall clock (`sky_cpu_us`, which holds any time slice
+/// another thread took from the frame thread), over all frames and over those that rebuild an
+/// impostor, the waits for the GPU apart from both, how much of the sort order came from the
+/// cache, the frame thread's time on weather, peak memory.
 #[derive(Default)]
 struct Summary {
+    sky_thread_us: Vec<u64>,
     sky_cpu_us: Vec<u64>,
+    /// `sky_thread_us` of the frames that rebuild an impostor.
+    rebuild_thread_us: Vec<u64>,
     /// `sky_cpu_us` of the frames that rebuild an impostor.
     rebuild_cpu_us: Vec<u64>,
     /// `gpu_wait_us` of the frames that waited.
@@ -376,8 +392,10 @@ fn median_p99(v: &mut [u64]) -> (u64, u64) {
 
 impl Summary {
     fn add(&mut self, stats: &skycast::render::FrameStats) {
+        self.sky_thread_us.push(stats.sky_thread_us());
         self.sky_cpu_us.push(stats.sky_cpu_us());
         if stats.impostors_rebuilt > 0 {
+            self.rebuild_thread_us.push(stats.sky_thread_us());
             self.rebuild_cpu_us.push(stats.sky_cpu_us());
         }
         if stats.gpu_wait_us > 0 {
@@ -388,8 +406,10 @@ impl Summary {
     }
 
     fn line(&mut self) -> String {
-        let (median, p99) = median_p99(&mut self.sky_cpu_us);
-        let (rebuild_median, rebuild_p99) = median_p99(&mut self.rebuild_cpu_us);
+        let (median, p99) = median_p99(&mut self.sky_thread_us);
+        let (wall_median, wall_p99) = median_p99(&mut self.sky_cpu_us);
+        let (rebuild_median, rebuild_p99) = median_p99(&mut self.rebuild_thread_us);
+        let (rebuild_wall_median, rebuild_wall_p99) = median_p99(&mut self.rebuild_cpu_us);
         let (_, wait_p99) = median_p99(&mut self.gpu_wait_us);
         let wait_max = self.gpu_wait_us.last().copied().unwrap_or(0);
         self.cache_hit_rate.sort_by(f32::total_cmp);
@@ -402,11 +422,24 @@ impl Summary {
             || "unknown (no /proc/self/status)".to_string(),
             |b| format!("{:.0} MB", b as f64 / 1e6),
         );
+        // Without a per-thread clock the thread figures are all 0: only the wall clock's said.
+        let thread_clock = if self.sky_thread_us.iter().any(|&us| us > 0) {
+            format!(
+                "median {median} us, p99 {p99} us on the frame thread's CPU clock (the {} \
+                 frames that rebuild an impostor: median {rebuild_median} us, p99 \
+                 {rebuild_p99} us); ",
+                self.rebuild_thread_us.len()
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "sky CPU a frame: median {median} us, p99 {p99} us (the {} frames that rebuild an \
-             impostor: median {rebuild_median} us, p99 {rebuild_p99} us); waiting for the GPU, \
-             apart: {} frames, p99 {wait_p99} us, at most {wait_max} us; order cache hit rate, \
-             median: {:.1}%; weather on the frame thread: at most {} us; peak memory (RSS): {peak}",
+            "sky CPU a frame: {thread_clock}median {wall_median} us, p99 {wall_p99} us on the \
+             wall clock, with the time slices other threads took from the frame thread (the {} \
+             frames that rebuild an impostor: median {rebuild_wall_median} us, p99 \
+             {rebuild_wall_p99} us); waiting for the GPU, apart: {} frames, p99 {wait_p99} us, at \
+             most {wait_max} us; order cache hit rate, median: {:.1}%; weather on the frame \
+             thread: at most {} us; peak memory (RSS): {peak}",
             self.rebuild_cpu_us.len(),
             self.gpu_wait_us.len(),
             hit * 100.0,

@@ -224,7 +224,7 @@ impl DemoHost {
             &self.target.colour_view,
             &self.target.depth_view,
         )?;
-        stats.record_us = self.sky.last_record_us();
+        stats.set_record(self.sky.last_record());
         if let Some(t) = &self.timer {
             t.stamps.write(&mut encoder, 4);
             t.stamps.resolve(&mut encoder);

@@ -12,13 +12,13 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use glam::{DVec3, Mat4, Vec3};
 
 use super::world::{World, WorldSettings};
 use crate::render::{
-    Camera, FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView, ViewId,
+    Camera, FrameStats, HostTargets, RenderError, Sky, SkyConfig, SkyView, Stopwatch, ViewId,
 };
 use crate::shading::sun_position;
 use crate::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
@@ -417,7 +417,7 @@ impl SkySystem {
     ) -> Result<(FrameStats, Vec<Result<PathBuf, String>>), SkyError> {
         // A wrong depth convention is refused before the frame does any work.
         self.sky.targets().check_projection(camera.projection)?;
-        let start = Instant::now();
+        let start = Stopwatch::start();
         let dt_s = dt_s.max(0.0);
         self.dt_s = dt_s;
         self.clock_s += dt_s;
@@ -439,8 +439,8 @@ impl SkySystem {
             });
         }
         self.take_winds_aloft(&mut changes);
-        let weather_us = start.elapsed().as_micros() as u64;
-        self.sky.add_field_cpu_us(weather_us);
+        let weather = start.spent();
+        self.sky.add_field_cpu(weather);
         let position_m = self.local_m(camera.position);
         // The far field's map first: the far storm cells hand over in its band once it is
         // drawn (`flight::far_cells`).
@@ -468,9 +468,9 @@ impl SkySystem {
             projection: camera.projection,
         };
         let mut stats = self.sky.prepare(queue, view, &sun, dt_s);
-        stats.weather_us = weather_us;
+        stats.weather_us = weather.wall_us;
         // This frame is not recorded yet: the last recording is the previous frame's.
-        stats.record_us = self.sky.last_record_us();
+        stats.set_record(self.sky.last_record());
         Ok((stats, changes))
     }
 
@@ -535,7 +535,7 @@ impl SkySystem {
             projection: camera.projection,
         };
         let mut stats = self.sky.prepare_view(id, queue, view, &sun, self.dt_s);
-        stats.record_us = self.sky.view_record_us(id);
+        stats.set_record(self.sky.view_record(id));
         Ok(stats)
     }
 

@@ -7,7 +7,6 @@
 //! retired, and every frame the rest only move with the wind and fade.
 
 use std::collections::{HashMap, HashSet};
-use std::time::Instant;
 
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
@@ -19,7 +18,7 @@ use crate::clouds::{
     generate_block,
 };
 use crate::render::scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite};
-use crate::render::{RenderError, Sky, SpriteSheet};
+use crate::render::{RenderError, Sky, SpriteSheet, Stopwatch};
 use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
 use crate::weather::storms::{Flash, FlashKind, flashes_between};
@@ -462,7 +461,7 @@ impl World {
         camera_m: DVec3,
         dt_s: f64,
     ) -> Result<(), RenderError> {
-        let start = Instant::now();
+        let start = Stopwatch::start();
         if self.start_living()? {
             sky.set_lifecycle(self.clouds_config.lifecycle);
         }
@@ -522,12 +521,12 @@ impl World {
         let offset_m = DVec3::new(drift.x, drift.y, 0.0);
         let now = living.field.time_s();
         let lifecycle = *living.field.lifecycle();
-        let sky_before_us = sky.pending_cpu_us();
+        let sky_before = sky.pending_cpu();
         let same_members = living.membership == Some(living.field.membership());
         // Nothing came, went, forms, dissipates or arrives: only the drift changed.
         if same_members && living.was_fading.is_empty() && living.arriving.is_empty() {
             sky.set_drift(offset_m);
-            sky.add_field_cpu_us(start.elapsed().as_micros() as u64);
+            sky.add_field_cpu(start.spent());
             return Ok(());
         }
         // Nothing came or went: only the generations that were fading can be fading now (a
@@ -548,8 +547,8 @@ impl World {
             }
             std::mem::swap(&mut living.was_fading, &mut living.fading);
             sky.set_drift(offset_m);
-            let sky_us = sky.pending_cpu_us() - sky_before_us;
-            sky.add_field_cpu_us((start.elapsed().as_micros() as u64).saturating_sub(sky_us));
+            let sky_spent = sky.pending_cpu().saturating_sub(sky_before);
+            sky.add_field_cpu(start.spent().saturating_sub(sky_spent));
             return Ok(());
         }
         living.membership = Some(living.field.membership());
@@ -567,6 +566,8 @@ impl World {
         let fade_in = fade_in_s > 0.0 && !self.synchronous_clouds;
         let impostors = &sky.settings().impostors;
         let ring_m = impostors.enabled.then_some(impostors.ring_radius_m);
+        // Handed over in one batch after the walk: the sky times each call it is given.
+        let mut joined = Vec::new();
         for (index, fb) in living.field.blocks() {
             count += 1;
             let arrives = fb.serial > newest
@@ -591,7 +592,7 @@ impl World {
             if fb.serial > newest {
                 living.newest_serial = living.newest_serial.max(fb.serial);
                 living.in_sky.insert(fb.serial);
-                sky.insert_block(living_block(index, fb), BlockMotion { offset_m, fade });
+                joined.push((living_block(index, fb), BlockMotion { offset_m, fade }));
             } else if fade != Fade::Steady {
                 sky.set_block_fade(fb.serial, fade);
             }
@@ -599,6 +600,7 @@ impl World {
                 living.fading.push((fb.serial, fb.phase));
             }
         }
+        sky.insert_blocks(joined);
         // The ones that finished forming since the last frame.
         living.fading.sort_unstable_by_key(|f| f.0);
         for &(id, _) in &living.was_fading {
@@ -615,15 +617,15 @@ impl World {
                 .seen
                 .extend(living.field.blocks().map(|(_, fb)| fb.serial));
             let gone: Vec<u64> = living.in_sky.difference(&living.seen).copied().collect();
-            for id in gone {
-                living.in_sky.remove(&id);
-                living.arriving.remove(&id);
-                sky.remove_block(id);
+            for id in &gone {
+                living.in_sky.remove(id);
+                living.arriving.remove(id);
             }
+            sky.remove_blocks(gone);
         }
         // The sky counts its own share (the blocks inserted and removed) in its update.
-        let sky_us = sky.pending_cpu_us() - sky_before_us;
-        sky.add_field_cpu_us((start.elapsed().as_micros() as u64).saturating_sub(sky_us));
+        let sky_spent = sky.pending_cpu().saturating_sub(sky_before);
+        sky.add_field_cpu(start.spent().saturating_sub(sky_spent));
         Ok(())
     }
 }

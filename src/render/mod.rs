@@ -68,7 +68,7 @@ pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite}
 pub use settings::RenderSettings;
 pub use shadow::{CloudShadowMap, ShadowImage, ShadowSettings};
 pub use sky::{Sky, SkyConfig, SkyFlash, SpriteSheet};
-pub use stats::{FrameStats, Lighting, SkyMemory};
+pub use stats::{FrameStats, Lighting, SkyMemory, Spent, Stopwatch, ThreadCpu};
 pub use targets::{HostTargets, SkyView};
 pub use view::ViewId;
 

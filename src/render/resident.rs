@@ -19,6 +19,7 @@ use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, 
 use super::id_hash::{IdMap, IdSet};
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::SlotRanges;
+use super::stats::{Spent, Stopwatch};
 
 /// Bytes of GPU memory each sprite slot costs: its record, its order entry and its Harris and
 /// Lastra light (a cloud's record and list entry come on top, about a twentieth of it for
@@ -274,9 +275,9 @@ pub(super) struct ResidentSet {
     pub dirty_lists: Vec<Range<u32>>,
     /// Counts buffer rebuilds: bind groups made with the old buffers must be made again.
     pub generation: u64,
-    /// The time this frame spent submitting the copies of grown buffers, microseconds: a wait
+    /// The time this frame spent submitting the copies of grown buffers: a wait
     /// for the device (lavapipe runs a submission on the submitting thread), reported apart.
-    pub grow_wait_us: u64,
+    pub grow_wait: Spent,
     /// Whether this frame placed every block again (packed): they are all written again.
     repacked: bool,
     /// The blocks not placed or not written yet: what placing and writing look at each frame,
@@ -366,7 +367,7 @@ impl ResidentSet {
             lists_cpu: vec![GpuListCloud::default(); FIRST_CLOUDS as usize],
             dirty_lists: Vec::new(),
             generation: 0,
-            grow_wait_us: 0,
+            grow_wait: Spent::default(),
             repacked: false,
             waiting: IdSet::default(),
             changes: 0,
@@ -435,7 +436,7 @@ impl ResidentSet {
         budget_sprites: u32,
     ) -> (u64, u32) {
         self.repacked = false;
-        self.grow_wait_us = 0;
+        self.grow_wait = Spent::default();
         let blocks = &self.blocks;
         let mut waiting: Vec<(f64, &Resident)> = self
             .waiting
@@ -541,7 +542,7 @@ impl ResidentSet {
     /// Grows (or only packs) the buffers so that block `id` fits, if the limits allow.
     ///
     /// Growing keeps every block where it is: the device copies the old buffers into the new
-    /// ones (one submission, timed in [`Self::grow_wait_us`]) and the CPU writes only the orders
+    /// ones (one submission, timed in [`Self::grow_wait`]) and the CPU writes only the orders
     /// and lists it keeps copies of, 4 bytes a sprite slot. Placing and writing every block again
     /// instead (20 to 27 MB in one frame) made the frames where the buffers grew take 42 to
     /// 144 ms. A buffer that grows gets a sixteenth more than it needs.
@@ -645,9 +646,9 @@ impl ResidentSet {
         queue.write_buffer(&b.lists, 0, bytemuck::cast_slice(&self.lists_cpu));
         // Writes queued for the old buffers this frame reach them before the copies: a queue's
         // writes go ahead of the submission that follows them.
-        let wait = std::time::Instant::now();
+        let wait = Stopwatch::start();
         queue.submit([encoder.finish()]);
-        self.grow_wait_us += wait.elapsed().as_micros() as u64;
+        self.grow_wait += wait.spent();
         self.take_buffers(b);
     }
 

@@ -16,7 +16,6 @@
 //! own test runs the whole shader on every pixel.
 
 use std::collections::HashSet;
-use std::time::Instant;
 
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -37,7 +36,7 @@ use super::scatter::Scatter;
 use super::scene::{BlockMotion, SkyBlock};
 use super::settings::RenderSettings;
 use super::sprite_view::{self, ViewData, ViewLight};
-use super::stats::{FrameStats, Lighting, SkyMemory};
+use super::stats::{FrameStats, Lighting, SkyMemory, Spent, Stopwatch};
 use super::targets::{self, HostTargets, SkyView};
 use super::view::{View, ViewId, ViewShared};
 use crate::clouds::{CloudsConfig, LifecycleConfig};
@@ -130,8 +129,8 @@ pub struct Sky {
     far_field: super::far_field::FarField,
     elapsed_s: f64,
     /// CPU time of block changes since the last prepare, and the host's field time.
-    pending_us: u64,
-    field_us: u64,
+    pending: Spent,
+    field: Spent,
     /// Timestamps between the passes, while pass timing is on.
     pass_timer: Option<super::Timestamps>,
     /// Kept to make the pass timer.
@@ -383,8 +382,8 @@ impl Sky {
             far_field,
             lifecycle: CloudsConfig::builtin().lifecycle,
             elapsed_s: 0.0,
-            pending_us: 0,
-            field_us: 0,
+            pending: Spent::default(),
+            field: Spent::default(),
             pass_timer: None,
             queue: queue.clone(),
             clear_light: light,
@@ -449,7 +448,7 @@ impl Sky {
     /// field hands over its changes with [`Self::insert_block`], [`Self::remove_block`] and
     /// [`Self::set_block_motion`] instead.
     pub fn set_clouds(&mut self, blocks: Vec<SkyBlock>) {
-        let start = Instant::now();
+        let start = Stopwatch::start();
         let ids: HashSet<u64> = blocks.iter().map(|b| b.id).collect();
         let gone: Vec<u64> = self
             .resident
@@ -474,16 +473,24 @@ impl Sky {
                 _ => self.resident.insert(block, BlockMotion::default()),
             }
         }
-        self.pending_us += start.elapsed().as_micros() as u64;
+        self.pending += start.spent();
     }
 
     /// Adds a block (or replaces the one with its id); it is uploaded to the GPU once, by the
-    /// next [`Self::prepare`].
+    /// next [`Self::prepare`]. Many at once: [`Self::insert_blocks`].
     pub fn insert_block(&mut self, block: SkyBlock, motion: BlockMotion) {
-        let start = Instant::now();
-        self.retire(block.id);
-        self.resident.insert(block, motion);
-        self.pending_us += start.elapsed().as_micros() as u64;
+        self.insert_blocks([(block, motion)]);
+    }
+
+    /// [`Self::insert_block`] for each of `blocks`, timed once (reading the thread's CPU clock
+    /// costs about a microsecond, more than inserting a block).
+    pub fn insert_blocks(&mut self, blocks: impl IntoIterator<Item = (SkyBlock, BlockMotion)>) {
+        let start = Stopwatch::start();
+        for (block, motion) in blocks {
+            self.retire(block.id);
+            self.resident.insert(block, motion);
+        }
+        self.pending += start.spent();
     }
 
     /// Adds a block drawn as sprites however far it is, never into the impostor ring nor cut at
@@ -493,21 +500,27 @@ impl Sky {
     /// out there ([`Self::far_field_hand_over_m`]). Replaces the block with
     /// its id; uploaded once, by the next [`Self::prepare`].
     pub fn insert_distant_block(&mut self, block: SkyBlock, motion: BlockMotion) {
-        let start = Instant::now();
+        let start = Stopwatch::start();
         let id = block.id;
         self.retire(id);
         self.resident.insert(block, motion);
         if let Some(r) = self.resident.blocks.get_mut(&id) {
             r.distant = true;
         }
-        self.pending_us += start.elapsed().as_micros() as u64;
+        self.pending += start.spent();
     }
 
-    /// Retires a block; false if the sky did not hold it.
+    /// Retires a block; false if the sky did not hold it. Many at once:
+    /// [`Self::remove_blocks`].
     pub fn remove_block(&mut self, id: u64) -> bool {
-        let start = Instant::now();
-        let held = self.retire(id);
-        self.pending_us += start.elapsed().as_micros() as u64;
+        self.remove_blocks([id]) == 1
+    }
+
+    /// [`Self::remove_block`] for each of `ids`, timed once; returns how many the sky held.
+    pub fn remove_blocks(&mut self, ids: impl IntoIterator<Item = u64>) -> usize {
+        let start = Stopwatch::start();
+        let held = ids.into_iter().filter(|&id| self.retire(id)).count();
+        self.pending += start.spent();
         held
     }
 
@@ -602,17 +615,18 @@ impl Sky {
         }
     }
 
-    /// Counts `us` microseconds of the host's cloud field work for this frame into the next
-    /// prepared frame's [`FrameStats::field_us`].
-    pub fn add_field_cpu_us(&mut self, us: u64) {
-        self.field_us += us;
+    /// Counts what the host's cloud field work for this frame `spent` (time it with a
+    /// [`Stopwatch`]) into the next prepared frame's [`FrameStats::field_us`] and its thread
+    /// figure.
+    pub fn add_field_cpu(&mut self, spent: Spent) {
+        self.field += spent;
     }
 
-    /// CPU time of the block changes handed over since the last [`Self::prepare`] (inserts,
-    /// removals, [`Self::set_clouds`]), microseconds: part of the next frame's
-    /// [`FrameStats::cpu_update_us`].
-    pub fn pending_cpu_us(&self) -> u64 {
-        self.pending_us
+    /// Time spent on the block changes handed over since the last [`Self::prepare`] (inserts,
+    /// removals, [`Self::set_clouds`]): part of the next frame's
+    /// [`FrameStats::cpu_update_us`] and its thread figure.
+    pub fn pending_cpu(&self) -> Spent {
+        self.pending
     }
 
     /// The corners of the last prepared frame's sprites, four per sprite in drawing order, as
@@ -699,14 +713,16 @@ impl Sky {
         self.shadows.read_back(queue)
     }
 
-    /// CPU time of the last [`Self::record`], microseconds.
-    pub fn last_record_us(&self) -> u64 {
-        self.views[0].record_us.get()
+    /// Time the last [`Self::record`] spent.
+    pub fn last_record(&self) -> Spent {
+        self.views[0].record.get()
     }
 
-    /// CPU time of the last [`Self::record_view`] of `id`, microseconds (0 for an unknown view).
-    pub fn view_record_us(&self, id: ViewId) -> u64 {
-        self.views.get(id.0).map_or(0, |v| v.record_us.get())
+    /// Time the last [`Self::record_view`] of `id` spent (0 for an unknown view).
+    pub fn view_record(&self, id: ViewId) -> Spent {
+        self.views
+            .get(id.0)
+            .map_or_else(Spent::default, |v| v.record.get())
     }
 
     /// The host's targets the sky was made for.
@@ -952,18 +968,18 @@ impl Sky {
         sun: &SunPosition,
         dt_s: f64,
     ) -> FrameStats {
-        let start = Instant::now();
+        let start = Stopwatch::start();
         let i = if id.0 < self.views.len() { id.0 } else { 0 };
         let camera: SkyView = view.into();
         self.views[i].projection = Some(camera.projection);
-        let mut gpu_wait_us = 0;
+        let mut gpu_wait = Spent::default();
         if !self.views[i].recorded.replace(false) {
             // The last frame's writes never reached a submit: send them, so they are freed. A
             // device still busy with earlier work can hold the submit (lavapipe waits in it for
             // the submission before): timed apart, as a wait.
-            let wait = Instant::now();
+            let wait = Stopwatch::start();
             queue.submit([]);
-            gpu_wait_us = wait.elapsed().as_micros() as u64;
+            gpu_wait = wait.spent();
         }
         // The frame's clock is the main view's; the others use `dt_s` for their ring's
         // crossfade only.
@@ -1011,7 +1027,7 @@ impl Sky {
             self.settings.vertex_cache.max_uploaded_sprites_per_frame,
         );
         stats.blocks_left_out = left_out;
-        gpu_wait_us += self.resident.grow_wait_us;
+        gpu_wait += self.resident.grow_wait;
         upload_bytes += placed_bytes;
         upload_bytes += self.resident.relight(queue, camera.position_m);
         (stats.sprites_lit, stats.light_us) = (self.resident.lit_sprites, self.resident.light_us);
@@ -1203,9 +1219,9 @@ impl Sky {
             );
             // lavapipe runs the submission on the frame thread: counted as a wait, as the
             // flush above is.
-            let wait = Instant::now();
+            let wait = Stopwatch::start();
             queue.submit([encoder.finish()]);
-            gpu_wait_us += wait.elapsed().as_micros() as u64;
+            gpu_wait += wait.spent();
         }
         stats.cloud_scale = self.views[i].clouds.scale();
         stats.cloud_target_bytes = self.views[i].clouds.gpu_bytes();
@@ -1213,10 +1229,13 @@ impl Sky {
             + self.quads.0.size()
             + self.build.gpu_bytes()
             + self.views[i].view.gpu_bytes();
-        stats.field_us = std::mem::take(&mut self.field_us);
-        stats.gpu_wait_us = gpu_wait_us;
-        stats.cpu_update_us = (start.elapsed().as_micros() as u64).saturating_sub(gpu_wait_us)
-            + std::mem::take(&mut self.pending_us);
+        let field = std::mem::take(&mut self.field);
+        let update = start.spent().saturating_sub(gpu_wait) + std::mem::take(&mut self.pending);
+        stats.field_us = field.wall_us;
+        stats.thread.field_us = field.thread_us;
+        stats.gpu_wait_us = gpu_wait.wall_us;
+        stats.cpu_update_us = update.wall_us;
+        stats.thread.update_us = update.thread_us;
         stats
     }
 
@@ -1256,7 +1275,7 @@ impl Sky {
                 self.views.len()
             ))
         })?;
-        let start = Instant::now();
+        let start = Stopwatch::start();
         self.targets
             .check_textures(colour_view.texture(), depth_view.texture())?;
         if let Some(projection) = v.projection {
@@ -1397,7 +1416,7 @@ impl Sky {
             timer.resolve(encoder);
         }
         v.recorded.set(true);
-        v.record_us.set(start.elapsed().as_micros() as u64);
+        v.record.set(start.spent());
         Ok(())
     }
 

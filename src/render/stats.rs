@@ -1,5 +1,7 @@
-//! What a frame of the sky cost and drew ([`FrameStats`]), and the light it is shaded with
-//! ([`Lighting`]). Plain data.
+//! What a frame of the sky cost and drew ([`FrameStats`]), the two clocks its costs are read
+//! on ([`Stopwatch`], [`Spent`]), and the light it is shaded with ([`Lighting`]). Plain data.
+
+use std::time::Instant;
 
 use glam::Vec3;
 
@@ -49,7 +51,7 @@ pub struct FrameStats {
     pub gpu_wait_us: u64,
     /// CPU time the host's cloud field spent on the frame thread for this frame (drift,
     /// lifecycle, the blocks handed over), microseconds, as reported to the sky with
-    /// [`crate::render::Sky::add_field_cpu_us`].
+    /// [`crate::render::Sky::add_field_cpu`].
     pub field_us: u64,
     /// The host's weather step this frame (polling a watched file, switching in a new field;
     /// never reading one), microseconds; part of `field_us`.
@@ -101,15 +103,149 @@ pub struct FrameStats {
     /// CPU time of the host's air-data queries this frame (`SkySystem::air_at`, lines of
     /// sight), microseconds: set by the host that asks (`skycast fly` does), 0 otherwise.
     pub air_us: u64,
+    /// The same four sections (`field_us`, `cpu_update_us`, `record_us`, `air_us`) on the frame
+    /// thread's own CPU clock: what the sky computed, without the time the system gave the
+    /// thread's core to another thread meanwhile (which the wall-clock figures hold).
+    pub thread: ThreadCpu,
 }
 
 impl FrameStats {
-    /// All the CPU time the sky cost the frame thread: the cloud field, the update, the
-    /// recording and the host's air-data queries, microseconds; waits for the device
-    /// (`gpu_wait_us`) are not in it.
+    /// All the time the sky held the frame thread: the cloud field, the update, the recording
+    /// and the host's air-data queries, microseconds on the wall clock (so with any time slice
+    /// another thread took from it meanwhile; [`Self::sky_thread_us`] is without); waits for
+    /// the device (`gpu_wait_us`) are not in it.
     pub fn sky_cpu_us(&self) -> u64 {
         self.field_us + self.cpu_update_us + self.record_us + self.air_us
     }
+
+    /// The frame thread's own CPU time in the same sections as [`Self::sky_cpu_us`],
+    /// microseconds: the sky's computing alone. Equal to it but for preemption (and clock
+    /// rounding); 0 where the system has no per-thread clock.
+    pub fn sky_thread_us(&self) -> u64 {
+        self.thread.field_us + self.thread.update_us + self.thread.record_us + self.thread.air_us
+    }
+
+    /// Sets `record_us` and its thread figure from what a recording spent
+    /// ([`crate::render::Sky::last_record`]).
+    pub fn set_record(&mut self, spent: Spent) {
+        self.record_us = spent.wall_us;
+        self.thread.record_us = spent.thread_us;
+    }
+
+    /// Sets `air_us` and its thread figure from what the host's air-data queries spent.
+    pub fn set_air(&mut self, spent: Spent) {
+        self.air_us = spent.wall_us;
+        self.thread.air_us = spent.thread_us;
+    }
+}
+
+/// [`FrameStats`]' CPU sections on the frame thread's own CPU clock
+/// (`CLOCK_THREAD_CPUTIME_ID`), microseconds; all 0 where the system has none (only Linux and
+/// Android are read).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ThreadCpu {
+    /// Of [`FrameStats::field_us`].
+    pub field_us: u64,
+    /// Of [`FrameStats::cpu_update_us`].
+    pub update_us: u64,
+    /// Of [`FrameStats::record_us`].
+    pub record_us: u64,
+    /// Of [`FrameStats::air_us`].
+    pub air_us: u64,
+}
+
+/// Time spent on a span of the frame thread, read on two clocks, microseconds.
+///
+/// ```
+/// use skycast::render::Stopwatch;
+///
+/// let watch = Stopwatch::start();
+/// let sum: u64 = (0..100_000u64).map(|k| k * k % 7).sum();
+/// let spent = watch.spent();
+/// assert!(sum > 0 && spent.thread_us <= spent.wall_us); // a thread computes only while it runs
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Spent {
+    /// On the wall clock: what the frame waited, with any time slice another thread took.
+    pub wall_us: u64,
+    /// On the thread's own CPU clock: what the thread computed (0 where there is no such
+    /// clock).
+    pub thread_us: u64,
+}
+
+impl Spent {
+    /// `self` less `other` on both clocks, 0 at least.
+    pub fn saturating_sub(self, other: Spent) -> Spent {
+        Spent {
+            wall_us: self.wall_us.saturating_sub(other.wall_us),
+            thread_us: self.thread_us.saturating_sub(other.thread_us),
+        }
+    }
+}
+
+impl std::ops::Add for Spent {
+    type Output = Spent;
+    fn add(self, other: Spent) -> Spent {
+        Spent {
+            wall_us: self.wall_us + other.wall_us,
+            thread_us: self.thread_us + other.thread_us,
+        }
+    }
+}
+
+impl std::ops::AddAssign for Spent {
+    fn add_assign(&mut self, other: Spent) {
+        *self = *self + other;
+    }
+}
+
+/// The start of a span of the calling thread's work on both clocks of [`Spent`]; read it with
+/// [`Self::spent`] on the same thread.
+#[derive(Debug, Clone, Copy)]
+pub struct Stopwatch {
+    wall: Instant,
+    thread_ns: u64,
+}
+
+impl Stopwatch {
+    /// Starts now (two clocks read).
+    pub fn start() -> Self {
+        Self {
+            wall: Instant::now(),
+            thread_ns: thread_cpu_ns(),
+        }
+    }
+
+    /// The wall clock's part of [`Self::spent`] alone (without reading the thread's clock,
+    /// which costs about a microsecond).
+    pub fn wall_us(&self) -> u64 {
+        self.wall.elapsed().as_micros() as u64
+    }
+
+    /// What was spent since [`Self::start`] (two clocks read).
+    pub fn spent(&self) -> Spent {
+        // The thread's span lies inside the wall clock's (read after it at the start, before
+        // it here), so it is never the longer one.
+        let thread_ns = thread_cpu_ns().saturating_sub(self.thread_ns);
+        Spent {
+            wall_us: self.wall.elapsed().as_micros() as u64,
+            thread_us: thread_ns / 1_000,
+        }
+    }
+}
+
+/// The calling thread's CPU time so far, nanoseconds (a system call of well under a
+/// microsecond).
+#[cfg(any(target_os = "linux", target_os = "android"))]
+fn thread_cpu_ns() -> u64 {
+    let t = rustix::time::clock_gettime(rustix::time::ClockId::ThreadCPUTime);
+    t.tv_sec as u64 * 1_000_000_000 + t.tv_nsec as u64
+}
+
+/// No per-thread CPU clock read here: the thread figures stay 0.
+#[cfg(not(any(target_os = "linux", target_os = "android")))]
+fn thread_cpu_ns() -> u64 {
+    0
 }
 
 /// The light a frame is shaded with.

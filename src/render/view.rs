@@ -14,6 +14,7 @@ use super::gpu_types::{GpuDrawBlock, GpuFrame};
 use super::impostor::{ImpostorRing, RingShared};
 use super::settings::RenderSettings;
 use super::sprite_view::ViewBuffers;
+use super::stats::Spent;
 use super::targets::HostTargets;
 
 /// Which view of a [`Sky`](super::Sky): [`ViewId::MAIN`], made with it, or one of
@@ -50,7 +51,8 @@ pub(super) struct View {
     pub in_cloud: f32,
     /// How opaque the rain or snow shaft the camera is in is there (0: none): the fog thickens.
     pub in_rain: f32,
-    pub record_us: Cell<u64>,
+    /// What the last recording of this view spent.
+    pub record: Cell<Spent>,
     /// Whether the last prepared frame was recorded (if not, its writes are flushed).
     pub recorded: Cell<bool>,
     /// The projection of the last prepared frame: checked against the targets' depth
@@ -105,7 +107,7 @@ impl View {
             distant_sprites: 0,
             in_cloud: 0.0,
             in_rain: 0.0,
-            record_us: Cell::new(0),
+            record: Cell::new(Spent::default()),
             recorded: Cell::new(true),
             projection: None,
             ring,
