@@ -118,6 +118,8 @@ pub struct GenerationBoxes {
     pub lo_m: DVec3,
     /// See `lo_m`.
     pub hi_m: DVec3,
+    /// Whether any box is a cumulonimbus's (the air data looks farther for those).
+    pub has_cumulonimbus: bool,
 }
 
 impl GenerationBoxes {
@@ -136,6 +138,9 @@ impl GenerationBoxes {
             hi = hi.max((b.centre_m + b.half_m).max(b.cloud_centre_m + r));
         }
         Self {
+            has_cumulonimbus: boxes
+                .iter()
+                .any(|b| b.cloud_type == CloudType::Cumulonimbus),
             boxes,
             lo_m: lo,
             hi_m: hi,

@@ -234,9 +234,18 @@ impl<'a> CloudProbe<'a> {
             let (c, h) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
             ((q - c).abs() - h).max(DVec3::ZERO).length() <= reach
         };
-        let keep = |g, b: &Arc<GenerationBoxes>| Some((g, Arc::clone(b)));
-        for (g, boxes) in self.generations(q.truncate(), q.truncate(), reach, all, near, keep) {
-            if boxes.distance_m(q) > reach.min(nearest.max(nearest_cb)) {
+        let keep = |g, b: &Arc<GenerationBoxes>| Some((b.distance_m(q), g, Arc::clone(b)));
+        let mut generations = self.generations(q.truncate(), q.truncate(), reach, all, near, keep);
+        // Nearest first, so that the nearest cloud found soon passes over the rest. Stable: the
+        // generations around the point (at 0) keep their order, which decides between equally
+        // deep clouds.
+        generations.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (bounds_m, g, boxes) in generations {
+            // Its bounds hold every box and rain sphere: one beyond them all is out of the
+            // point's clouds and rain, and has no cloud nearer than the nearest, nor (without a
+            // cumulonimbus, or beyond the nearest one) a nearer cumulonimbus.
+            let farther = bounds_m > nearest && (!boxes.has_cumulonimbus || bounds_m >= nearest_cb);
+            if bounds_m > reach || (bounds_m > 0.0 && farther) {
                 continue;
             }
             for b in &boxes.boxes {

@@ -4,6 +4,9 @@
 //! `Sky::record` (or corner read-back); a frame prepared and never recorded keeps its patch for
 //! the next one, which writes only what it adds to it, and past the size of the buffers
 //! themselves the whole buffers are written instead, so nothing grows however the sky is driven.
+//! The spans' count is the first entry of their buffer, so the pass binds whole buffers and its
+//! bind group is made again only when one of them is replaced (making and dropping one every
+//! frame was a fifth of the patch's CPU time).
 
 use std::cell::Cell;
 use std::ops::Range;
@@ -23,7 +26,8 @@ pub(super) struct Scatter {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     values: Vec<u32>,
-    /// `[dst, src, count, target]`: target 0 the orders, 1 the cloud lists (as words).
+    /// `[dst, src, count, target]`: target 0 the orders, 1 the cloud lists (as words); the
+    /// first entry is the header, `[spans after it, 0, 0, 0]`.
     spans: Vec<[u32; 4]>,
     patch: wgpu::Buffer,
     span_buffer: wgpu::Buffer,
@@ -32,8 +36,11 @@ pub(super) struct Scatter {
     /// How many of `values` and `spans` the GPU buffers hold already: a patch kept over frames
     /// prepared and never drawn is added to there, not written again whole each frame.
     sent: (usize, usize),
-    /// The bind group of the patch written.
-    group: Option<wgpu::BindGroup>,
+    /// The bind group over the patch's buffers and the two it writes into, with those two (it
+    /// is made again when either is replaced).
+    group: Option<(wgpu::BindGroup, [wgpu::Buffer; 2])>,
+    /// Whether a patch was written that the next recording applies.
+    ready: bool,
     /// Whether that patch went into a recorded frame (then the next one starts afresh).
     applied: Cell<bool>,
 }
@@ -57,12 +64,13 @@ impl Scatter {
             layout: pipeline.get_bind_group_layout(0),
             pipeline,
             values: Vec::new(),
-            spans: Vec::new(),
+            spans: vec![[0; 4]],
             patch: storage_buffer(device, "sky.scatter_patch", 16 << 10),
             span_buffer: storage_buffer(device, "sky.scatter_spans", 4 << 10),
             no_lists: storage_buffer(device, "sky.scatter_no_lists", 16),
             sent: (0, 0),
             group: None,
+            ready: false,
             applied: Cell::new(true),
         }
     }
@@ -116,26 +124,26 @@ impl Scatter {
         let list_buffer = list_buffer.clone();
         if self.applied.replace(false) {
             self.values.clear();
-            self.spans.clear();
+            self.spans.truncate(1);
             self.sent = (0, 0);
         }
-        self.group = None;
+        self.ready = false;
         for r in dirty_orders.drain(..) {
             self.push(0, r.start, &orders[r.start as usize..r.end as usize]);
         }
-        let words = |l: &[GpuListCloud]| bytemuck::cast_slice::<GpuListCloud, u32>(l).to_vec();
         for r in dirty_lists.iter_mut().flat_map(|d| d.drain(..)) {
-            let part = words(&lists[r.start as usize..r.end as usize]);
-            self.push(1, r.start * 4, &part);
+            let part = &lists[r.start as usize..r.end as usize];
+            self.push(1, r.start * 4, bytemuck::cast_slice(part));
         }
-        if self.spans.is_empty() {
+        let n = self.spans.len() - 1;
+        if n == 0 {
             return 0;
         }
         let whole = orders.len() + lists.len() * 4;
         if self.values.len() > whole {
             // Frames prepared and never drawn piled up more than the buffers hold: write them.
             self.values.clear();
-            self.spans.clear();
+            self.spans.truncate(1);
             self.sent = (0, 0);
             queue.write_buffer(order_buffer, 0, bytemuck::cast_slice(orders));
             if !lists.is_empty() {
@@ -150,43 +158,71 @@ impl Scatter {
                 storage_buffer(device, "sky.scatter_patch", value_bytes.next_power_of_two());
             self.sent.0 = 0;
         }
+        let mut replaced = false;
+        if value_bytes > self.patch.size() {
+            self.patch =
+                storage_buffer(device, "sky.scatter_patch", value_bytes.next_power_of_two());
+            self.sent.0 = 0;
+            replaced = true;
+        }
         if span_bytes > self.span_buffer.size() {
             let bytes = span_bytes.next_power_of_two();
             self.span_buffer = storage_buffer(device, "sky.scatter_spans", bytes);
             self.sent.1 = 0;
+            replaced = true;
         }
-        // What the buffers do not hold yet (all of it, after a drawn frame or a new buffer).
+        self.spans[0][0] = n as u32;
+        // What the buffers do not hold yet (all of it, after a drawn frame or a new buffer),
+        // and the header, whose count changed.
         let (values, spans) = (&self.values[self.sent.0..], &self.spans[self.sent.1..]);
         let at = (self.sent.0 as u64 * 4, self.sent.1 as u64 * 16);
         if !values.is_empty() {
             queue.write_buffer(&self.patch, at.0, bytemuck::cast_slice(values));
         }
+        let mut written = (values.len() * 4 + spans.len() * 16) as u64;
+        if self.sent.1 > 0 {
+            queue.write_buffer(&self.span_buffer, 0, bytemuck::cast_slice(&self.spans[..1]));
+            written += 16;
+        }
         if !spans.is_empty() {
             queue.write_buffer(&self.span_buffer, at.1, bytemuck::cast_slice(spans));
         }
-        let written = (values.len() * 4 + spans.len() * 16) as u64;
         self.sent = (self.values.len(), self.spans.len());
-        fn binding(binding: u32, buffer: &wgpu::Buffer, size: u64) -> wgpu::BindGroupEntry<'_> {
+        let targets = [order_buffer.clone(), list_buffer];
+        if replaced
+            || self
+                .group
+                .as_ref()
+                .is_none_or(|(_, bound)| *bound != targets)
+        {
+            self.group = Some((self.bind_group(device, &targets), targets));
+        }
+        self.ready = true;
+        written
+    }
+
+    /// The pass's bind group: the patch and spans buffers and `[orders, lists]`, whole.
+    fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        [orders, lists]: &[wgpu::Buffer; 2],
+    ) -> wgpu::BindGroup {
+        fn whole(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry {
                 binding,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer,
-                    offset: 0,
-                    size: std::num::NonZeroU64::new(size),
-                }),
+                resource: buffer.as_entire_binding(),
             }
         }
-        self.group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sky.scatter"),
             layout: &self.layout,
             entries: &[
-                binding(0, &self.patch, value_bytes),
-                binding(1, &self.span_buffer, span_bytes),
-                binding(2, order_buffer, order_buffer.size()),
-                binding(3, &list_buffer, list_buffer.size()),
+                whole(0, &self.patch),
+                whole(1, &self.span_buffer),
+                whole(2, orders),
+                whole(3, lists),
             ],
-        }));
-        written
+        })
     }
 
     fn push(&mut self, target: u32, dst: u32, data: &[u32]) {
@@ -211,17 +247,18 @@ impl Scatter {
     /// shadow map's), so the patches, and the buffer they grow, are those of the frames the
     /// host records whether or not it comes.
     pub fn record_kept(&self, encoder: &mut wgpu::CommandEncoder) {
-        let Some(group) = &self.group else {
+        let Some((group, _)) = self.group.as_ref().filter(|_| self.ready) else {
             return;
         };
-        let n = self.spans.len() as u32;
+        let n = self.spans.len() as u32 - 1;
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("sky.scatter"),
             timestamp_writes: None,
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, group, &[]);
-        // One workgroup a span, in rows of 65,535; the last row's extra groups find no span.
+        // One workgroup a span, in rows of 65,535; the last row's extra groups find no span
+        // (the header's count bounds them).
         pass.dispatch_workgroups(n.min(ROW), n.div_ceil(ROW), 1);
     }
 }
