@@ -20,7 +20,9 @@
 //! - icing: visible moisture (in cloud from `in_cloud_min`, or in precipitation) between
 //!   `coldest_c` and `warmest_c`.
 
-use glam::DVec3;
+use std::sync::Mutex;
+
+use glam::{DVec2, DVec3};
 use serde::Serialize;
 
 use crate::clouds::probe::{BoxCache, CloudProbe, CloudsAtPoint, SightHit};
@@ -194,7 +196,9 @@ impl World {
     /// The air data at `point_m` (local metres east, north, and up above mean sea level), with
     /// the sun towards `sun_direction`. See the module docs.
     pub fn air_at(&self, point_m: DVec3, sun_direction: DVec3) -> AirData {
-        let weather = self.field().weather_at(point_m.truncate());
+        let s = &self.air.settings;
+        let (weather, gust, qnh) =
+            self.weather_here(point_m.truncate(), s.pressure.default_qnh_hpa);
         let clouds = self.clouds_at(point_m);
         // Towards the sun only as far as the highest cloud top over the point (plus a margin):
         // above it nothing hides the sun, and a low sun's 30 km ray would cross many blocks.
@@ -218,10 +222,6 @@ impl World {
             })
         };
         let lat_deg = self.field().frame().to_lat_lon_deg(point_m.truncate()).0;
-        let s = &self.air.settings;
-        let (gust, qnh) = self
-            .field()
-            .gust_and_qnh_at(point_m.truncate(), s.pressure.default_qnh_hpa);
         let surface = SurfaceAir::of(&weather, gust, qnh);
         let aloft = self
             .air
@@ -243,7 +243,44 @@ impl World {
             self.field().settings().precipitation.heavy,
         )
     }
+
+    /// The weather, gust excess and QNH at a ground point ([`WeatherField::weather_at`],
+    /// [`WeatherField::gust_and_qnh_at`]), kept for the next question about the same point and
+    /// field: a host asks the sky's update ([`Self::weather_over`]) and the air data about the
+    /// aircraft every frame, and each is three natural-neighbour interpolations.
+    ///
+    /// [`WeatherField::weather_at`]: crate::weather::field::WeatherField::weather_at
+    /// [`WeatherField::gust_and_qnh_at`]: crate::weather::field::WeatherField::gust_and_qnh_at
+    pub(super) fn weather_here(&self, point_m: DVec2, default_qnh_hpa: f64) -> HereWeather {
+        let key = (
+            point_m.x.to_bits(),
+            point_m.y.to_bits(),
+            self.field_version(),
+            default_qnh_hpa.to_bits(),
+        );
+        let mut kept = self
+            .air
+            .here
+            .lock()
+            .unwrap_or_else(|poison| poison.into_inner());
+        if let Some((k, answer)) = kept.as_ref()
+            && *k == key
+        {
+            return answer.clone();
+        }
+        let answer = self
+            .field()
+            .weather_gust_and_qnh_at(point_m, default_qnh_hpa);
+        *kept = Some((key, answer.clone()));
+        answer
+    }
 }
+
+/// The key of [`AirState::here`]: the point's bits, the field's version, the default QNH's bits.
+type HereKey = (u64, u64, u64, u64);
+
+/// The weather, gust excess (knots) and QNH (hPa) at a point.
+type HereWeather = (BlockWeather, f64, f64);
 
 /// What the world keeps for the air data: settings and the clouds' boxes.
 #[derive(Debug, Default)]
@@ -251,6 +288,8 @@ pub struct AirState {
     settings: AirSettings,
     fog: FogSettings,
     cache: BoxCache,
+    /// The last answer of [`World::weather_here`].
+    here: Mutex<Option<(HereKey, HereWeather)>>,
     /// The FB product's winds and temperatures aloft, placed in the world's frame.
     aloft: Option<WindsAloftField>,
 }

@@ -302,3 +302,41 @@ fn at_an_fb_site_and_level_the_air_is_the_fb_forecast() {
     }
     assert!(differs >= 7, "{differs}");
 }
+
+#[test]
+fn the_weather_kept_for_a_point_is_the_fields_and_goes_with_a_new_field() {
+    // Two places of the real file with different weather: the world at San Antonio, then
+    // given the field around Los Angeles (same local point, another place).
+    let mut w = world(REAL, 29.4270, -98.6080, false);
+    let qnh_default = w.air_settings().pressure.default_qnh_hpa;
+    let here = DVec2::new(1_234.5, -678.9);
+    let fresh = w.field().weather_at(here);
+    let (gust, qnh) = w.field().gust_and_qnh_at(here, qnh_default);
+    // The sky's update asks first; the air data's answer is the same as the field's.
+    assert_eq!(w.weather_over(here.extend(500.0)), fresh);
+    assert_eq!(
+        w.weather_here(here, qnh_default),
+        (fresh.clone(), gust, qnh)
+    );
+    // Another point is not the kept one.
+    let there = here + DVec2::new(40_000.0, 0.0);
+    assert_eq!(
+        w.weather_over(there.extend(500.0)),
+        w.field().weather_at(there)
+    );
+    // Another field at the same point.
+    let la = world(REAL, 33.90, -118.36, false);
+    let la_weather = la.field().weather_at(there);
+    assert_ne!(la_weather, w.field().weather_at(there));
+    let input = WeatherInput::load(&path(REAL), None).unwrap();
+    w.set_field(input.field(
+        LocalFrame::new(33.90, -118.36),
+        &FieldSettings::default(),
+        &CloudTypeRule::default(),
+    ));
+    assert_eq!(w.weather_over(there.extend(500.0)), la_weather);
+    assert_eq!(
+        w.air_at(there.extend(500.0), UP).temperature_c,
+        la.air_at(there.extend(500.0), UP).temperature_c
+    );
+}

@@ -273,7 +273,13 @@ impl World {
 
     /// The weather over `camera_m` (for [`crate::render::Sky::set_weather_overhead`]).
     pub fn weather_over(&self, camera_m: DVec3) -> BlockWeather {
-        self.field.weather_at(camera_m.truncate())
+        let default_qnh_hpa = self.air_settings().pressure.default_qnh_hpa;
+        self.weather_here(camera_m.truncate(), default_qnh_hpa).0
+    }
+
+    /// How many weather fields the world has taken ([`Self::set_field`]).
+    pub(super) fn field_version(&self) -> u64 {
+        self.field_version
     }
 
     /// The blocks that get clouds around `camera_m`, in a fixed order.

@@ -216,10 +216,26 @@ impl WeatherField {
 
     /// The weather at a local point (metres east/north).
     pub fn weather_at(&self, point_m: DVec2) -> BlockWeather {
-        let d = &self.settings.defaults;
+        self.weather_with(point_m, &weights(&self.surface, point_m))
+    }
+
+    /// [`Self::weather_at`] and [`Self::gust_and_qnh_at`] at once: the stations' weights at the
+    /// point are worked out once for both (what the air data asks every frame).
+    pub fn weather_gust_and_qnh_at(
+        &self,
+        point_m: DVec2,
+        default_qnh_hpa: f64,
+    ) -> (BlockWeather, f64, f64) {
         let w = weights(&self.surface, point_m);
+        let (gust, qnh) = self.gust_and_qnh_with(&w, default_qnh_hpa);
+        (self.weather_with(point_m, &w), gust, qnh)
+    }
+
+    /// The weather at `point_m` from the surface stations' weights `w` there.
+    fn weather_with(&self, point_m: DVec2, w: &Weights) -> BlockWeather {
+        let d = &self.settings.defaults;
         let value = |f: &dyn Fn(&StationSample) -> Option<f64>, default: f64| {
-            weighted(&w, &self.samples, f).unwrap_or(default)
+            weighted(w, &self.samples, f).unwrap_or(default)
         };
         let temperature_c = value(&|s| s.temperature_c, d.temperature_c);
         let dewpoint_c = value(&|s| s.dewpoint_c, d.dewpoint_c);
@@ -236,7 +252,7 @@ impl WeatherField {
         BlockWeather {
             layers: self.layers_at(point_m, surface),
             visibility_m: value(&|s| s.visibility_m, d.visibility_m) as f32,
-            obscuration: self.obscuration_at(&w),
+            obscuration: self.obscuration_at(w),
             wind,
             temperature_c: temperature_c as f32,
             dewpoint_c: dewpoint_c as f32,
@@ -250,9 +266,12 @@ impl WeatherField {
     /// wind) and the QNH (hPa, over those that report one; `default_qnh_hpa` where none does) at
     /// a local point: what [`crate::weather::air::SurfaceAir`] needs beyond the block weather.
     pub fn gust_and_qnh_at(&self, point_m: DVec2, default_qnh_hpa: f64) -> (f64, f64) {
-        let w = weights(&self.surface, point_m);
-        let gust = weighted(&w, &self.samples, &|s| s.gust_excess_kt).unwrap_or(0.0);
-        let qnh = weighted(&w, &self.samples, &|s| s.qnh_hpa).unwrap_or(default_qnh_hpa);
+        self.gust_and_qnh_with(&weights(&self.surface, point_m), default_qnh_hpa)
+    }
+
+    fn gust_and_qnh_with(&self, w: &Weights, default_qnh_hpa: f64) -> (f64, f64) {
+        let gust = weighted(w, &self.samples, &|s| s.gust_excess_kt).unwrap_or(0.0);
+        let qnh = weighted(w, &self.samples, &|s| s.qnh_hpa).unwrap_or(default_qnh_hpa);
         (gust, qnh)
     }
 
