@@ -475,18 +475,18 @@ fn the_sky_system_counts_its_recording_in_the_frame_cpu() {
     let t = &s.thread;
     assert_eq!(s.sky_thread_us(), t.field_us + t.update_us + t.record_us);
     // The thread's own clock is read (Linux has one): the update computes for well over a
-    // microsecond, and a section's computing fits in its wall time (1 us of rounding).
+    // microsecond, and the computing fits in the wall time (a microsecond of rounding a span).
+    // The recording is one span; the field is a span less the sky's work inside it, which the
+    // update counts, so only the two together are one span's worth (less any GPU wait: a core
+    // taken during the wait or the sky's part moves wall time between them, not thread time).
     if cfg!(target_os = "linux") {
         assert!(t.update_us > 0 && records[0].thread_us > 0, "{s:?}");
     }
-    for (thread, wall) in [
-        (t.field_us, s.field_us),
-        (t.update_us, s.cpu_update_us),
-        (t.record_us, s.record_us),
-    ] {
+    assert!(t.record_us <= s.record_us + 1, "{s:?}");
+    if s.gpu_wait_us == 0 {
         assert!(
-            thread <= wall + 1,
-            "{thread} us on the thread, {wall} us on the wall: {s:?}"
+            t.field_us + t.update_us <= s.field_us + s.cpu_update_us + 2,
+            "{s:?}"
         );
     }
 }

@@ -141,7 +141,10 @@ impl FrameStats {
 
 /// [`FrameStats`]' CPU sections on the frame thread's own CPU clock
 /// (`CLOCK_THREAD_CPUTIME_ID`), microseconds; all 0 where the system has none (only Linux and
-/// Android are read).
+/// Android are read). A section that is a span less a part counted elsewhere (the field less the
+/// sky's own work inside it, which the update counts; the update less its GPU waits) can show
+/// more here than on the wall clock when the core was taken during that part; the sum of the
+/// field and the update cannot, but for the waits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct ThreadCpu {
     /// Of [`FrameStats::field_us`].
