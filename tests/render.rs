@@ -2004,6 +2004,53 @@ fn from_fl350_the_clouds_reach_the_horizon() {
     assert!(today < 0.01, "the far field off still shows {today}");
 }
 
+/// From FL350 the geometric horizon lies 3.3 degrees below the level plane: between the two a
+/// pilot sees sky brightening down to the Earth's rim, not a flat band of the horizon's haze
+/// (which the sky drew when its gradient began at the level plane).
+#[test]
+fn from_fl350_the_sky_brightens_down_to_the_earths_rim() {
+    let mut settings = RenderSettings::default();
+    // 12 degrees on the band around the horizon: 15 rows a degree.
+    settings.camera.fov_y_deg = 12.0;
+    let ground = HeightField::from_fn(DVec2::ZERO, 120_000.0, 16, |_| 0.0);
+    let mut rig = Rig::with_settings(ground, settings);
+    let (pitch_deg, height_m) = (-1.5f64, 10_668.0);
+    let cam = rig.camera(DVec3::new(0.0, 0.0, height_m), 0.0, pitch_deg);
+    rig.host
+        .sky
+        .set_far_map(&rig.host.gpu.queue, &uniform_far_map(0.0), None);
+    let clear = rig.frame("fl350-horizon", &cam).0;
+    let row_at = |elevation_deg: f64| -> u32 {
+        let ndc = (elevation_deg - pitch_deg).to_radians().tan() / 6.0f64.to_radians().tan();
+        ((1.0 - ndc) * 0.5 * H as f64).floor() as u32
+    };
+    let r = 6_371_000.0f64;
+    let dip_deg = (r / (r + height_m)).acos().to_degrees();
+    // The middle columns' mean luminance on a row.
+    let row_luminance = |y: u32| -> f32 {
+        let xs = W / 4..3 * W / 4;
+        let n = xs.len() as f32;
+        xs.map(|x| luminance(clear.rgba[(y * W + x) as usize]))
+            .sum::<f32>()
+            / n
+    };
+    let level = row_at(0.0);
+    let above_rim = row_at(-dip_deg + 0.25);
+    let profile: Vec<f32> = (level..=above_rim).map(row_luminance).collect();
+    eprintln!("rows {level}..={above_rim} (dip {dip_deg:.2} deg): {profile:?}");
+    assert!(above_rim >= level + 40, "{level} {above_rim}");
+    // Brighter all the way down, and clearly so: not a flat band.
+    assert!(
+        profile.windows(2).all(|w| w[1] >= w[0] - 1e-3),
+        "not brightening towards the rim: {profile:?}"
+    );
+    let rise = profile[profile.len() - 1] - profile[0];
+    assert!(
+        rise > 0.02,
+        "the band below the level plane is flat: {rise}"
+    );
+}
+
 /// Mean luminance change per pixel between successive frames of a flight north towards cumulus 58
 /// to 62 km ahead over a far field of heaped cloud (cover 0.05, 0.15 with the ring): the clouds
 /// cross the end of the hand-over band at 60 km, where the clouds drawn nearer fade out and the far

@@ -107,9 +107,24 @@ fn fullscreen_position(vi: u32) -> vec4<f32> {
     return vec4<f32>(x, y, 0.0, 1.0);
 }
 
+// The sine of a unit direction's elevation above the geometric horizon, which on the round
+// Earth lies below the camera's level plane by the dip: sin(dip) = sqrt(h (2 rc - h)) / rc, h the
+// camera's height above the ground under it, rc its distance from the Earth's centre (0: the
+// flat frame, no dip). From FL350 the dip is 3.3 degrees: between the level plane and the
+// horizon a pilot sees sky, brightest where it meets the Earth's rim, not a flat band of the
+// horizon's haze (src/render/earth.rs `horizon_dip_rad`, keep in sync).
+fn above_horizon(dir: vec3<f32>) -> f32 {
+    let rc = frame.sky_horizon_rgb.w;
+    let h = clamp(frame.sky_zenith_rgb.w, 0.0, max(rc, 0.0));
+    let sin_dip = select(sqrt(h * (2.0 * rc - h)) / max(rc, 1.0), 0.0, rc <= 0.0);
+    let cos_dip = sqrt(max(1.0 - sin_dip * sin_dip, 0.0));
+    let z = clamp(dir.z, -1.0, 1.0);
+    return z * cos_dip + sqrt(max(1.0 - z * z, 0.0)) * sin_dip;
+}
+
 // Sky colour seen along a unit direction (east, north, up); also the horizon haze for fog.
 fn sky_colour(dir: vec3<f32>) -> vec3<f32> {
-    let up = clamp(dir.z, -1.0, 1.0);
+    let up = above_horizon(dir);
     let t = pow(clamp(up, 0.0, 1.0), 0.45);
     var c = mix(frame.sky_horizon_rgb.rgb, frame.sky_zenith_rgb.rgb, t);
     // Below the horizon: the haze darkens a little towards the ground.
@@ -130,7 +145,7 @@ fn background_along(far: vec4<f32>) -> vec3<f32> {
     let c = sky_colour(dir);
     let cos_sun = dot(dir, frame.sun_dir.xyz);
     let disc = smoothstep(frame.sun_dir.w - 0.00002, frame.sun_dir.w + 0.00002, cos_sun);
-    return mix(c, frame.sun_rgb.rgb * 4.0, disc * step(-0.01, dir.z));
+    return mix(c, frame.sun_rgb.rgb * 4.0, disc * step(-0.01, above_horizon(dir)));
 }
 
 // A point of the view ray (homogeneous world coordinates) at normalised device coordinates

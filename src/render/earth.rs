@@ -46,6 +46,22 @@ impl EarthSettings {
     }
 }
 
+/// How far below the camera's level plane the geometric horizon lies, radians: the dip, for a
+/// camera `height_m` above the ground under it and `camera_radius_m` from the Earth's centre (0:
+/// the flat frame, no dip). The sky's gradient starts there (`above_horizon` in
+/// `shaders/shared/frame.wgsl`, the same operations in f32): from FL350 it is 3.3 degrees, and a
+/// sky that started at the level plane showed a flat band of the horizon's haze above the Earth's
+/// rim.
+pub fn horizon_dip_rad(height_m: f32, camera_radius_m: f32) -> f32 {
+    if camera_radius_m <= 0.0 {
+        return 0.0;
+    }
+    let h = height_m.clamp(0.0, camera_radius_m);
+    ((h * (2.0 * camera_radius_m - h)).sqrt() / camera_radius_m)
+        .min(1.0)
+        .asin()
+}
+
 /// A camera-relative point of the flat frame placed on the round Earth, camera-relative; the
 /// point itself when `camera_radius_m` is 0 (no curvature). Keep in sync with `earth_curved`
 /// in `shaders/shared/frame.wgsl` and `shaders/terrain.wgsl` (the same operations in f32).
@@ -159,5 +175,34 @@ mod tests {
         assert!((moved.z + 0.0667).abs() < 0.002, "{moved}");
         assert!(moved.truncate().length() < 0.01, "{moved}");
         assert_eq!(curved_rel(near, 0.0), near);
+    }
+
+    #[test]
+    fn the_sky_starts_at_the_rim_of_the_ground_the_renderer_draws() {
+        // FL350 over sea-level ground: the dip is the sphere's tangent, 3.3 degrees.
+        let h = 35_000.0 * 0.3048;
+        let earth = EarthSettings::default();
+        let rc = earth.camera_radius_m(h);
+        let dip = horizon_dip_rad(h as f32, rc);
+        let truth = (6_371_000.0 / (6_371_000.0 + h)).acos();
+        assert!(
+            (f64::from(dip) - truth).abs() < 2e-5,
+            "{dip} against {truth}"
+        );
+        assert!(
+            (dip.to_degrees() - 3.31).abs() < 0.01,
+            "{}",
+            dip.to_degrees()
+        );
+        // The highest the renderer's ground (sea level through `curved_rel`) shows, out to 600
+        // km, is the dip below the level plane: there the sky's gradient begins.
+        let rim = (1..=600)
+            .map(|km| curved_rel(Vec3::new(0.0, km as f32 * 1000.0, -h as f32), rc))
+            .map(|p| (p.z / p.length()).asin())
+            .fold(f32::MIN, f32::max);
+        assert!((rim + dip).abs() < 2e-4, "rim {rim}, dip {dip}");
+        // The flat frame has no dip, nor has a camera on the ground.
+        assert_eq!(horizon_dip_rad(h as f32, 0.0), 0.0);
+        assert_eq!(horizon_dip_rad(0.0, rc), 0.0);
     }
 }
