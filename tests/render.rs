@@ -742,6 +742,18 @@ fn fly_command_writes_frames_and_csv() {
             .all(|r| r[column("clouds_recomputed")].parse::<u32>().is_ok())
     );
     assert!(dir.join("frame_00000.png").exists() && dir.join("frame_00006.png").exists());
+    // The far field: its whole map sampled on the first frame (the clouds synchronous), within
+    // the field's and the update's time; its map on the GPU on every frame (147 KB).
+    let number = |r: &Vec<&str>, name: &str| -> u64 { r[column(name)].parse().unwrap() };
+    let far_us = number(&rows[1], "far_field_us");
+    let within = number(&rows[1], "field_us") + number(&rows[1], "cpu_update_us");
+    assert!(far_us > 1000 && far_us <= within, "{far_us} us of {within}");
+    assert!(
+        rows[1..]
+            .iter()
+            .all(|r| number(r, "far_field_gpu_bytes") > 100_000),
+        "{rows:?}"
+    );
     // The closing summary quotes the frames' own numbers: its median sky CPU on each clock is
     // the column's.
     let said = String::from_utf8_lossy(&out.stdout);

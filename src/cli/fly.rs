@@ -202,6 +202,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "update_thread_us",
         "record_thread_us",
         "air_thread_us",
+        "far_field_us",
+        "far_field_gpu_bytes",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
@@ -322,6 +324,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             stats.thread.update_us.to_string(),
             stats.thread.record_us.to_string(),
             stats.thread.air_us.to_string(),
+            stats.far_field_us.to_string(),
+            stats.far_field_gpu_bytes.to_string(),
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);

@@ -444,6 +444,7 @@ impl SkySystem {
         let position_m = self.local_m(camera.position);
         // The far field's map first: the far storm cells hand over in its band once it is
         // drawn (`flight::far_cells`).
+        let field_part = Stopwatch::start();
         if self.sky.far_field_settings().enabled
             && let Some(map) = self.far_map.update(
                 position_m.truncate(),
@@ -454,14 +455,18 @@ impl SkySystem {
             let fade_s = self.world.arrival_fade_s();
             self.sky.set_far_map(queue, &map, fade_s);
         }
-        self.world.update_sky(&mut self.sky, position_m, dt_s)?;
-        self.sky.set_flash(self.world.flash_now());
+        // The far field's part alone on the wall clock (the thread's clock costs a microsecond
+        // a read); the weather and the sun over the camera go with it into the field's time.
+        self.sky.add_far_field_us(field_part.wall_us());
         self.sky
             .set_weather_overhead(&self.world.weather_over(position_m));
         let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
         let sun = sun_position(utc_unix_s, lat, lon);
         self.sun_direction = sun.direction_enu().as_vec3();
         self.sun = Some(sun);
+        self.sky.add_field_cpu(field_part.spent());
+        self.world.update_sky(&mut self.sky, position_m, dt_s)?;
+        self.sky.set_flash(self.world.flash_now());
         let view = SkyView {
             position_m,
             view: camera.view,

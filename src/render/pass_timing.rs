@@ -7,8 +7,8 @@
 //! [`Timestamps`] (a query set, resolved and read back) also times the demo host's frames.
 
 /// Timestamps of one frame: its start, after the compute passes, after the background or the
-/// downsample, after the ring, after the sprites, after the composite.
-pub(super) const STAMPS: u32 = 6;
+/// downsample, after the far field, after the ring, after the sprites, after the composite.
+pub(super) const STAMPS: u32 = 7;
 
 /// GPU milliseconds of one recorded frame's sky passes, by group.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -18,7 +18,10 @@ pub struct PassTimes {
     pub build_ms: f64,
     /// At full resolution the sky background; below it the farthest-depth downsample.
     pub background_ms: f64,
-    /// The impostor ring's full-screen pass.
+    /// The far field: the clouds from the hand-over band to the horizon
+    /// ([`crate::render::far_field`]); 0 when it is off or has no map yet.
+    pub far_field_ms: f64,
+    /// The impostor ring's full-screen pass, with the distant storm cells drawn behind it.
     pub ring_ms: f64,
     /// The sprites (with the corner builds of any later chunks) and the in-cloud fog.
     pub sprites_ms: f64,
@@ -35,6 +38,7 @@ impl PassTimes {
     pub fn total_ms(&self) -> f64 {
         self.build_ms
             + self.background_ms
+            + self.far_field_ms
             + self.ring_ms
             + self.sprites_ms
             + self.composite_ms
@@ -48,9 +52,10 @@ pub(super) enum Stamp {
     Start = 0,
     Build = 1,
     Background = 2,
-    Ring = 3,
-    Sprites = 4,
-    Composite = 5,
+    FarField = 3,
+    Ring = 4,
+    Sprites = 5,
+    Composite = 6,
 }
 
 /// Timestamps written between passes into a query set of their own, resolved and read back
@@ -153,7 +158,8 @@ pub(super) fn pass_times(stamps_ms: &[f64]) -> Option<PassTimes> {
     Some(PassTimes {
         build_ms: ms(Stamp::Start, Stamp::Build)?,
         background_ms: ms(Stamp::Build, Stamp::Background)?,
-        ring_ms: ms(Stamp::Background, Stamp::Ring)?,
+        far_field_ms: ms(Stamp::Background, Stamp::FarField)?,
+        ring_ms: ms(Stamp::FarField, Stamp::Ring)?,
         sprites_ms: ms(Stamp::Ring, Stamp::Sprites)?,
         composite_ms: ms(Stamp::Sprites, Stamp::Composite)?,
         shadow_ms: 0.0,

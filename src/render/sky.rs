@@ -131,6 +131,8 @@ pub struct Sky {
     /// CPU time of block changes since the last prepare, and the host's field time.
     pending: Spent,
     field: Spent,
+    /// The far field's CPU time since the last prepare, wall clock ([`FrameStats::far_field_us`]).
+    far_field_us: u64,
     /// Timestamps between the passes, while pass timing is on.
     pass_timer: Option<super::Timestamps>,
     /// Kept to make the pass timer.
@@ -384,6 +386,7 @@ impl Sky {
             elapsed_s: 0.0,
             pending: Spent::default(),
             field: Spent::default(),
+            far_field_us: 0,
             pass_timer: None,
             queue: queue.clone(),
             clear_light: light,
@@ -620,6 +623,14 @@ impl Sky {
     /// figure.
     pub fn add_field_cpu(&mut self, spent: Spent) {
         self.field += spent;
+    }
+
+    /// Counts the wall-clock microseconds the host's work on the far field's map took this frame
+    /// (sampling the weather into its rows, [`Self::set_far_map`]) into the next prepared
+    /// frame's [`FrameStats::far_field_us`]. They are part of the field's time too: count that
+    /// span with [`Self::add_field_cpu`] as well.
+    pub fn add_far_field_us(&mut self, us: u64) {
+        self.far_field_us += us;
     }
 
     /// Time spent on the block changes handed over since the last [`Self::prepare`] (inserts,
@@ -1164,12 +1175,14 @@ impl Sky {
             }),
         };
         queue.write_buffer(&self.views[i].frame_buffer, 0, bytemuck::bytes_of(&frame));
+        let far_field = std::time::Instant::now();
         self.far_field.prepare(
             queue,
             (camera.position_m, frame.sky_horizon_rgb[3]),
             &self.clear_light,
             self.elapsed_s,
         );
+        self.far_field_us += far_field.elapsed().as_micros() as u64;
         upload_bytes += std::mem::size_of::<GpuFrame>() as u64;
         let ring_frame = RingFrame {
             resident: &self.resident,
@@ -1231,6 +1244,8 @@ impl Sky {
             + self.views[i].view.gpu_bytes();
         let field = std::mem::take(&mut self.field);
         let update = start.spent().saturating_sub(gpu_wait) + std::mem::take(&mut self.pending);
+        stats.far_field_us = std::mem::take(&mut self.far_field_us);
+        stats.far_field_gpu_bytes = self.far_field.gpu_bytes();
         stats.field_us = field.wall_us;
         stats.thread.field_us = field.thread_us;
         stats.gpu_wait_us = gpu_wait.wall_us;
@@ -1371,6 +1386,14 @@ impl Sky {
         // list; split off when the frame's sprites are built in one part (with more, they are
         // drawn with the others, over the ring).
         self.far_field.draw(&mut pass, offscreen.is_some());
+        if timer.is_some() {
+            drop(pass);
+            stamp(encoder, Stamp::FarField);
+            pass = match &offscreen {
+                Some(target) => target.pass(encoder, false),
+                None => self.sky_pass(encoder, colour_view, &frame_group, None),
+            };
+        }
         let distant = if parts.len() == 1 {
             v.distant_sprites.min(v.sprites_to_draw)
         } else {

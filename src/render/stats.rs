@@ -81,6 +81,13 @@ pub struct FrameStats {
     pub crossfade_weight: f32,
     /// Bytes of the ring's GPU textures and buffers.
     pub ring_gpu_bytes: u64,
+    /// CPU time of the far field on the frame thread, microseconds on the wall clock: its map's
+    /// rows sampled and uploaded ([`crate::render::Sky::add_far_field_us`], part of `field_us`)
+    /// and its uniform and band of elevations written (part of `cpu_update_us`).
+    pub far_field_us: u64,
+    /// Bytes of the far field's map and uniform on the GPU (as
+    /// [`SkyMemory::far_field_bytes`]).
+    pub far_field_gpu_bytes: u64,
     /// Resolution of the clouds' off-screen target as a fraction of the host's (1: drawn
     /// straight into the host's colour; `[clouds] resolution_scale`).
     pub cloud_scale: f32,

@@ -240,6 +240,7 @@ fn passes_add_up_to_the_sky(dir: &std::path::Path, stdout: &str) {
         let parts = [
             "build_ms",
             "background_ms",
+            "far_field_ms",
             "ring_ms",
             "sprites_ms",
             "composite_ms",
@@ -248,9 +249,9 @@ fn passes_add_up_to_the_sky(dir: &std::path::Path, stdout: &str) {
         assert!(parts.iter().all(|&ms| ms >= 0.0), "{f:?}");
         let sum: f64 = parts.iter().sum();
         assert!(sum <= at(f, "sky_ms") + 0.5, "{sum} ms of passes in {f:?}");
-        assert!(parts[2] > 0.0 && parts[3] > 0.0, "{f:?}");
+        assert!(parts[3] > 0.0 && parts[4] > 0.0, "{f:?}");
         if at(f, "cloud_scale") < 1.0 {
-            assert!(parts[1] > 0.0 && parts[4] > 0.0, "{f:?}");
+            assert!(parts[1] > 0.0 && parts[5] > 0.0, "{f:?}");
         }
     }
 }

@@ -1,6 +1,6 @@
 //! `skycast bench --passes`: where each run's steady frames spend their GPU time, by group of
 //! the sky's passes ([`PassTimes`]: the compute build, the background or the downsample, the
-//! impostor ring, the sprites, the composite), medians over the steady frames.
+//! far field, the impostor ring, the sprites, the composite), medians over the steady frames.
 
 use skycast::render::PassTimes;
 
@@ -10,9 +10,10 @@ use super::{Run, quantile, scale_text};
 type Read = fn(&PassTimes) -> f64;
 
 /// The groups, as the table and `frames.csv` name them, and how to read each.
-pub const COLUMNS: [(&str, Read); 6] = [
+pub const COLUMNS: [(&str, Read); 7] = [
     ("build_ms", |p| p.build_ms),
     ("background_ms", |p| p.background_ms),
+    ("far_field_ms", |p| p.far_field_ms),
     ("ring_ms", |p| p.ring_ms),
     ("sprites_ms", |p| p.sprites_ms),
     ("composite_ms", |p| p.composite_ms),
@@ -30,15 +31,16 @@ pub fn print(runs: &[Run]) {
         return;
     }
     println!(
-        "where the sky's GPU time goes (medians of the steady frames, ms; the ring and the sprites in passes of their own):"
+        "where the sky's GPU time goes (medians of the steady frames, ms; the far field, the ring and the sprites in passes of their own):"
     );
     println!(
-        "{:<10} {:>9} {:>5} {:>8} {:>11} {:>8} {:>8} {:>10} {:>8} {:>8}",
+        "{:<10} {:>9} {:>5} {:>8} {:>11} {:>9} {:>8} {:>8} {:>10} {:>8} {:>8}",
         "scenario",
         "impostors",
         "scale",
         "build",
         "background",
+        "far field",
         "ring",
         "sprites",
         "composite",
@@ -48,15 +50,23 @@ pub fn print(runs: &[Run]) {
     for (run, passes) in timed {
         let median =
             |read: Read| quantile(&passes.iter().map(|p| read(p)).collect::<Vec<_>>(), 0.5);
-        let [build, background, ring, sprites, composite, shadows] =
-            COLUMNS.map(|(_, read)| median(read));
+        let [
+            build,
+            background,
+            far_field,
+            ring,
+            sprites,
+            composite,
+            shadows,
+        ] = COLUMNS.map(|(_, read)| median(read));
         println!(
-            "{:<10} {:>9} {:>5} {:>8.2} {:>11.2} {:>8.2} {:>8.2} {:>10.2} {:>8.2} {:>8.2}",
+            "{:<10} {:>9} {:>5} {:>8.2} {:>11.2} {:>9.2} {:>8.2} {:>8.2} {:>10.2} {:>8.2} {:>8.2}",
             run.scenario,
             if run.impostors { "on" } else { "off" },
             scale_text(run.cloud_scale),
             build,
             background,
+            far_field,
             ring,
             sprites,
             composite,
