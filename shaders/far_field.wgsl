@@ -359,9 +359,21 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
         height = mid;
     }
     // The hand-over: in over the band where the sprites and the ring fade out; out over the
-    // map's last two cells.
+    // map's last two cells. Over a closed layer the sprites' deck hides what lies behind it
+    // until it is gone, so the far field comes in under it over the band's first fifth: the
+    // two crossfaded alike, each half faded in the band's middle, let a quarter of the ground
+    // through there (a darker ring around the aircraft over an overcast, from FL350 and FL450).
+    // Over a scattered layer the crossfade stays even, or the far field's clouds would show in
+    // the sprites' gaps as well as theirs.
     let s = length(ground_xy);
-    let band = smoothstep(ff.noise_fade.z, ff.noise_fade.w, s);
+    let start = ff.noise_fade.z;
+    let end = ff.noise_fade.w;
+    let closed = smoothstep(0.5, 1.0, cell.x);
+    let band = mix(
+        smoothstep(start, end, s),
+        smoothstep(start, start + 0.2 * (end - start), s),
+        closed,
+    );
     let uv = (ground_xy - ff.centre_rel_size.xy) / ff.centre_rel_size.z + vec2<f32>(0.5);
     let edge = min(min(uv.x, uv.y), min(1.0 - uv.x, 1.0 - uv.y)) * ff.centre_rel_size.w;
     let weight = band * smoothstep(0.5, 2.0, edge) * ff.fade.x;

@@ -1952,6 +1952,92 @@ fn uniform_far_map(cover: f32) -> skycast::clouds::far_map::FarMap {
     }
 }
 
+/// From FL450 over San Antonio's overcast (the real bulk file: stratus, 8 oktas, base 2,300 ft
+/// over ground at 281 m, 600 ft thick), the hand-over from the sprites' deck to the far field
+/// (42 to 60 km out) shows no darker ring: crossfaded evenly, each half faded in the band's
+/// middle, the two let the ground through there, 3.4 out of 255 darker than the far field
+/// beyond (rows 116 to 119 of this frame), so over a closed layer the far field comes in early,
+/// under the deck. The band's rows are no darker than the far field's beyond it.
+#[test]
+fn over_an_overcast_the_hand_over_shows_no_darker_ring() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("fl450-san-antonio.png");
+    let (height_m, pitch_deg) = (45_000.0 * 0.3048, -3.0f64);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_skycast"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .args([
+            "render",
+            "--weather",
+            "weather/awc-metars-2025-01-27T22Z.cache.csv",
+        ])
+        .args([
+            "--at",
+            "29.4270,-98.6080",
+            "--alt-ft",
+            "45000",
+            "--heading",
+            "40",
+        ])
+        .args([
+            "--pitch",
+            "-3",
+            "--time",
+            "2025-01-27T18:00:00Z",
+            "--size",
+            "320x180",
+        ])
+        .arg("--out")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = image::open(&png).unwrap().to_rgba8();
+    let (w, h) = img.dimensions();
+    // How far out (km along the ground) a row's ray meets the deck's middle, 1,075 m above sea
+    // level, on the sphere (f64; the shipped 60 degree field of view).
+    let r = 6_371_000.0f64;
+    let deck_km = |row: u32| -> Option<f64> {
+        let ndc = 1.0 - 2.0 * (row as f64 + 0.5) / h as f64;
+        let elevation = pitch_deg.to_radians() + (ndc * 30.0f64.to_radians().tan()).atan();
+        let (rc, rl) = (r + height_m, r + 1075.0);
+        let b = rc * elevation.sin();
+        let disc = b * b - (rc * rc - rl * rl);
+        (disc >= 0.0 && b < 0.0).then(|| (-b - disc.sqrt()) / rl * r / 1000.0)
+    };
+    // Rows' mean luminance over the middle quarter of the columns, by where their rays meet it.
+    let rows = |km: std::ops::Range<f64>| -> Vec<f32> {
+        (0..h)
+            .filter(|&y| deck_km(y).is_some_and(|d| km.contains(&d)))
+            .map(|y| {
+                let xs = 3 * w / 8..5 * w / 8;
+                let n = xs.len() as f32;
+                xs.map(|x| {
+                    let p = img.get_pixel(x, y).0;
+                    luminance([0, 1, 2, 3].map(|k| f32::from(p[k]) / 255.0))
+                })
+                .sum::<f32>()
+                    / n
+            })
+            .collect()
+    };
+    let beyond = rows(64.0..80.0);
+    let band = rows(44.0..58.0);
+    assert!(beyond.len() >= 3 && band.len() >= 8, "{beyond:?} {band:?}");
+    let far = beyond.iter().sum::<f32>() / beyond.len() as f32;
+    let darkest = band.iter().copied().fold(f32::MAX, f32::min);
+    eprintln!("far field {far}, the band's darkest row {darkest}: {band:?}");
+    assert!(
+        darkest >= far - 1.5 / 255.0,
+        "a darker ring in the hand-over: {darkest} against {far}"
+    );
+}
+
 /// Issue 31, the far field: from FL350 over a heaped layer the weather has everywhere (half
 /// cover, 1,500 to 2,500 m), the rows of the frame whose rays meet the layer 150 to 400 km out
 /// (on the round Earth) show clouds: they differ from the same rows of a sky whose weather has
