@@ -177,21 +177,22 @@ pub fn sprites_back_to_front(cloud: &SkyCloud, cam_local_m: Vec3) -> Vec<(usize,
 /// equally far sprites by index.
 pub(super) type SortKeys = Vec<u64>;
 
-/// Writes the cloud's sprite slots (`base` + index), farthest from the camera first, into
-/// `slots` (`cam_local_m`: the camera relative to the cloud centre). The same order as
+/// Writes the slots (`base` + index) of a cloud's sprites at `offsets` (from its centre,
+/// [`super::resident::Resident::offsets_of`]), farthest from the camera first, into `slots`
+/// (`cam_local_m`: the camera relative to the cloud centre). The same order as
 /// [`sprites_back_to_front`], on integer keys (squared distances are positive floats, whose bits
 /// sort as integers; packed with the index into one `u64`, which sorts about twice as fast as a
 /// pair with a comparator) and a reused buffer: this runs for a hundred clouds a frame.
 pub(super) fn order_into(
-    cloud: &SkyCloud,
+    offsets: &[Vec3],
     cam_local_m: Vec3,
     base: u32,
     slots: &mut [u32],
     keys: &mut SortKeys,
 ) {
     keys.clear();
-    keys.extend(cloud.sprites.iter().enumerate().map(|(i, s)| {
-        let far = !s.offset_m.distance_squared(cam_local_m).to_bits();
+    keys.extend(offsets.iter().enumerate().map(|(i, offset)| {
+        let far = !offset.distance_squared(cam_local_m).to_bits();
         (u64::from(far) << 32) | i as u64
     }));
     keys.sort_unstable();
@@ -740,7 +741,7 @@ fn recheck(
             let base = state.sprite_base as usize;
             let slots = &mut orders[base..base + state.sprites as usize];
             order_into(
-                &r.block.clouds[ci],
+                &r.offsets[state.first_offset as usize..][..state.sprites as usize],
                 rel.as_vec3(),
                 state.sprite_base,
                 slots,

@@ -125,7 +125,8 @@ fn sprites_of_one_cloud_are_ordered_back_to_front_by_both_sorts() {
             assert!(w[0].1 >= w[1].1, "camera {cam}: {reference:?}");
         }
         let mut slots = vec![0u32; cloud.sprites.len()];
-        order_into(&cloud, cam, 100, &mut slots, &mut SortKeys::new());
+        let offsets: Vec<Vec3> = cloud.sprites.iter().map(|s| s.offset_m).collect();
+        order_into(&offsets, cam, 100, &mut slots, &mut SortKeys::new());
         let from_slots: Vec<usize> = slots.iter().map(|s| (s - 100) as usize).collect();
         let from_reference: Vec<usize> = reference.iter().map(|r| r.0).collect();
         assert_eq!(from_slots, from_reference, "camera {cam}");

@@ -168,7 +168,13 @@ impl RingOrders {
                 written: None,
             });
             kept.order.resize(cloud.sprites.len(), 0);
-            order_into(cloud, rel.as_vec3(), 0, &mut kept.order, &mut self.keys);
+            order_into(
+                r.offsets_of(ci),
+                rel.as_vec3(),
+                0,
+                &mut kept.order,
+                &mut self.keys,
+            );
             (kept.from_rel_m, kept.at_s) = (rel, when.time_s);
             let at = (state.sprite_base, state.sprites, r.place_serial);
             self.write((id, ci, r.clouds.len()), at);
