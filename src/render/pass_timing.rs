@@ -2,8 +2,9 @@
 //! ([`super::Sky::set_pass_timing`]), for devices with timestamp queries inside encoders.
 //! [`super::Sky::record`] writes a timestamp between its groups of passes, resolves them into a
 //! buffer of its own and copies them out; [`super::Sky::pass_times`] waits for the frame and
-//! reads them. While timing, the impostor ring and the sprites go in passes of their own, one
-//! pass boundary more than an untimed frame has. `skycast bench` reports them per frame.
+//! reads them. While timing, the far field, the impostor ring and the sprites go in passes of
+//! their own, two pass boundaries more than an untimed frame has. `skycast bench` reports them
+//! per frame.
 //! [`Timestamps`] (a query set, resolved and read back) also times the demo host's frames.
 
 /// Timestamps of one frame: its start, after the compute passes, after the background or the

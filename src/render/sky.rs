@@ -670,7 +670,8 @@ impl Sky {
     }
 
     /// Times each group of the sky's passes on the GPU from the next [`Self::record`] on (a
-    /// profiling aid: the ring and the sprites then go in passes of their own), or stops.
+    /// profiling aid: the far field, the ring and the sprites then go in passes of their own),
+    /// or stops.
     /// Returns whether timing is on: the device needs timestamp queries inside encoders
     /// (`wgpu::Features::TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS`).
     pub fn set_pass_timing(&mut self, on: bool) -> bool {
