@@ -1390,10 +1390,7 @@ impl Sky {
         if timer.is_some() {
             drop(pass);
             stamp(encoder, Stamp::FarField);
-            pass = match &offscreen {
-                Some(target) => target.pass(encoder, false),
-                None => self.sky_pass(encoder, colour_view, &frame_group, None),
-            };
+            pass = self.clouds_pass_again(encoder, offscreen.as_ref(), colour_view, &frame_group);
         }
         let distant = if parts.len() == 1 {
             v.distant_sprites.min(v.sprites_to_draw)
@@ -1407,10 +1404,7 @@ impl Sky {
         if timer.is_some() {
             drop(pass);
             stamp(encoder, Stamp::Ring);
-            pass = match &offscreen {
-                Some(target) => target.pass(encoder, false),
-                None => self.sky_pass(encoder, colour_view, &frame_group, None),
-            };
+            pass = self.clouds_pass_again(encoder, offscreen.as_ref(), colour_view, &frame_group);
         }
         for &(c, _, n) in &parts {
             if parts.len() > 1 {
@@ -1419,10 +1413,8 @@ impl Sky {
                     self.build
                         .record(encoder, group, &self.resident.group, (c, n));
                 }
-                pass = match &offscreen {
-                    Some(target) => target.pass(encoder, false),
-                    None => self.sky_pass(encoder, colour_view, &frame_group, None),
-                };
+                pass =
+                    self.clouds_pass_again(encoder, offscreen.as_ref(), colour_view, &frame_group);
             }
             self.draw_sprites(&mut pass, sprite_pipeline, distant.min(n)..n);
         }
@@ -1457,6 +1449,22 @@ impl Sky {
         pass.set_vertex_buffer(0, self.build.vertices().slice(..));
         pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(sprites.start * 6..sprites.end * 6, 0, 0..1);
+    }
+
+    /// The clouds' pass taken up again after a break between passes (a timestamp while timing,
+    /// a chunk's corner build): into the cloud target below full resolution, else over the
+    /// host's colour, nothing cleared.
+    fn clouds_pass_again<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        offscreen: Option<&super::cloud_target::CloudFrame<'_>>,
+        colour_view: &wgpu::TextureView,
+        frame_group: &wgpu::BindGroup,
+    ) -> wgpu::RenderPass<'e> {
+        match offscreen {
+            Some(target) => target.pass(encoder, false),
+            None => self.sky_pass(encoder, colour_view, frame_group, None),
+        }
     }
 
     /// A pass over the host's colour (kept), with the frame's group 0 bound, and the host's
