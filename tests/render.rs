@@ -1943,6 +1943,33 @@ fn from_fl350_near_cumulus_stand_out_from_the_ground_below() {
 
 /// A far map of 960 km a side around the origin, every cell a heaped layer from 1,500 to 2,500 m
 /// at `cover`.
+/// A rig for looking at the band around the horizon from high up: a view 12 degrees tall (15
+/// rows a degree), over flat ground at sea level 120 km across.
+fn narrow_view_rig() -> Rig {
+    let mut settings = RenderSettings::default();
+    settings.camera.fov_y_deg = 12.0;
+    let ground = HeightField::from_fn(DVec2::ZERO, 120_000.0, 16, |_| 0.0);
+    Rig::with_settings(ground, settings)
+}
+
+/// How far (km along the ray) the ray of image row `row` of `rows`, in the middle column, meets
+/// a sphere `layer_m` above sea level, from a camera `camera_m` up pitched `pitch_deg` with a
+/// vertical field of view `fov_deg`: the sphere's geometry in f64; `None` where it misses it.
+fn ray_to_layer_km(
+    row: u32,
+    rows: u32,
+    (camera_m, pitch_deg, fov_deg): (f64, f64, f64),
+    layer_m: f64,
+) -> Option<f64> {
+    let r = 6_371_000.0f64;
+    let ndc = 1.0 - 2.0 * (row as f64 + 0.5) / rows as f64;
+    let elevation = pitch_deg.to_radians() + (ndc * (0.5 * fov_deg).to_radians().tan()).atan();
+    let (rc, rl) = (r + camera_m, r + layer_m);
+    let b = rc * elevation.sin();
+    let disc = b * b - (rc * rc - rl * rl);
+    (disc >= 0.0 && b < 0.0).then(|| (-b - disc.sqrt()) / 1000.0)
+}
+
 fn uniform_far_map(cover: f32) -> skycast::clouds::far_map::FarMap {
     skycast::clouds::far_map::FarMap {
         texels: 96,
@@ -1999,17 +2026,9 @@ fn over_an_overcast_the_hand_over_shows_no_darker_ring() {
     );
     let img = image::open(&png).unwrap().to_rgba8();
     let (w, h) = img.dimensions();
-    // How far out (km along the ground) a row's ray meets the deck's middle, 1,075 m above sea
-    // level, on the sphere (f64; the shipped 60 degree field of view).
-    let r = 6_371_000.0f64;
-    let deck_km = |row: u32| -> Option<f64> {
-        let ndc = 1.0 - 2.0 * (row as f64 + 0.5) / h as f64;
-        let elevation = pitch_deg.to_radians() + (ndc * 30.0f64.to_radians().tan()).atan();
-        let (rc, rl) = (r + height_m, r + 1075.0);
-        let b = rc * elevation.sin();
-        let disc = b * b - (rc * rc - rl * rl);
-        (disc >= 0.0 && b < 0.0).then(|| (-b - disc.sqrt()) / rl * r / 1000.0)
-    };
+    // How far out a row's ray meets the deck's middle, 1,075 m above sea level (the shipped 60
+    // degree field of view).
+    let deck_km = |row: u32| ray_to_layer_km(row, h, (height_m, pitch_deg, 60.0), 1075.0);
     // Rows' mean luminance over the middle quarter of the columns, by where their rays meet it.
     let rows = |km: std::ops::Range<f64>| -> Vec<f32> {
         (0..h)
@@ -2044,11 +2063,7 @@ fn over_an_overcast_the_hand_over_shows_no_darker_ring() {
 /// none. The negative control is today's plate edge: with the far field off, nothing out there.
 #[test]
 fn from_fl350_the_clouds_reach_the_horizon() {
-    let mut settings = RenderSettings::default();
-    // A narrow view (12 degrees) on the band below the horizon: 15 rows a degree.
-    settings.camera.fov_y_deg = 12.0;
-    let ground = HeightField::from_fn(DVec2::ZERO, 120_000.0, 16, |_| 0.0);
-    let mut rig = Rig::with_settings(ground, settings);
+    let mut rig = narrow_view_rig();
     let cam_at = DVec3::new(0.0, 0.0, 10_668.0);
     let cam = rig.camera(cam_at, 0.0, -3.5);
     let mut frame = |name: &str, cover: f32, on: bool| {
@@ -2061,17 +2076,8 @@ fn from_fl350_the_clouds_reach_the_horizon() {
     let cloudy = frame("far-field", 0.5, true);
     let clear = frame("far-field-clear", 0.0, true);
     let plate = frame("far-field-off", 0.5, false);
-    // Where a row's ray (the middle column) meets the layer's middle, 2 km up: the sphere's
-    // geometry in f64.
-    let r = 6_371_000.0f64;
-    let layer_km = |row: u32| -> Option<f64> {
-        let ndc = 1.0 - 2.0 * (row as f64 + 0.5) / H as f64;
-        let elevation = (-3.5f64).to_radians() + (ndc * 6.0f64.to_radians().tan()).atan();
-        let (rc, rl) = (r + cam_at.z, r + 2000.0);
-        let b = rc * elevation.sin();
-        let disc = b * b - (rc * rc - rl * rl);
-        (disc >= 0.0 && b < 0.0).then(|| (-b - disc.sqrt()) / 1000.0)
-    };
+    // Where a row's ray (the middle column) meets the layer's middle, 2 km up.
+    let layer_km = |row: u32| ray_to_layer_km(row, H, (cam_at.z, -3.5, 12.0), 2000.0);
     let rows: Vec<u32> = (0..H)
         .filter(|&y| layer_km(y).is_some_and(|d| (150.0..=400.0).contains(&d)))
         .collect();
@@ -2107,11 +2113,7 @@ fn from_fl350_the_clouds_reach_the_horizon() {
 /// (which the sky drew when its gradient began at the level plane).
 #[test]
 fn from_fl350_the_sky_brightens_down_to_the_earths_rim() {
-    let mut settings = RenderSettings::default();
-    // 12 degrees on the band around the horizon: 15 rows a degree.
-    settings.camera.fov_y_deg = 12.0;
-    let ground = HeightField::from_fn(DVec2::ZERO, 120_000.0, 16, |_| 0.0);
-    let mut rig = Rig::with_settings(ground, settings);
+    let mut rig = narrow_view_rig();
     let (pitch_deg, height_m) = (-1.5f64, 10_668.0);
     let cam = rig.camera(DVec3::new(0.0, 0.0, height_m), 0.0, pitch_deg);
     rig.host
@@ -2462,15 +2464,7 @@ fn the_far_fields_cumulus_have_the_sprites_grain() {
     };
     // The rows whose middle column's ray meets the layer's middle (the sphere's geometry).
     let middle = f64::from(0.5 * (cell[1] + cell[2]));
-    let r = 6_371_000.0f64;
-    let layer_km = |row: u32| -> Option<f64> {
-        let ndc = 1.0 - 2.0 * (row as f64 + 0.5) / H as f64;
-        let elevation = pitch.to_radians() + (ndc * (0.5 * fov).to_radians().tan()).atan();
-        let (rc, rl) = (r + 10_668.0, r + middle);
-        let b = rc * elevation.sin();
-        let disc = b * b - (rc * rc - rl * rl);
-        (disc >= 0.0 && b < 0.0).then(|| (-b - disc.sqrt()) / 1000.0)
-    };
+    let layer_km = |row: u32| ray_to_layer_km(row, H, (10_668.0, pitch, fov), middle);
     let rows: Vec<u32> = (0..H)
         .filter(|&y| layer_km(y).is_some_and(|d| (60.0..=75.0).contains(&d)))
         .collect();
