@@ -229,6 +229,42 @@ fn sprites_are_sorted_back_to_front_and_face_the_camera() {
     }
 }
 
+/// Frames prepared and never drawn pile up their re-sorted orders in one patch (sent to the GPU
+/// and scattered into place there by the next drawn frame); once it outgrows the patch buffer
+/// the first drawn frame bound, the drawn frame still gets every order: the scatter pass reads
+/// the grown buffer.
+#[test]
+fn orders_outgrowing_the_patch_buffer_still_reach_the_gpu() {
+    let start = DVec3::new(0.0, 0.0, 1000.0);
+    let mut piled = host(TimeOfDayTable::default());
+    piled.sky.set_clouds(blocks());
+    corners(&mut piled, start, 0.0);
+    // Every frame moves 300 m, past every cloud's threshold: its 200 orders sorted again. Twenty
+    // frames make 4,000 orders and their lists: more than the 16 kB the patch starts with, less
+    // than the buffers themselves (past those the whole buffers would be written instead).
+    let mut at = start;
+    for _ in 0..20 {
+        at.x += 300.0;
+        let cam = camera(&piled, at);
+        let stats = piled.sky.prepare(&piled.gpu.queue, cam, &SUN, 1.0 / 30.0);
+        assert_eq!(stats.sprites_recomputed, 200);
+    }
+    let after_pile = piled
+        .sky
+        .read_back_corners(&piled.gpu.queue)
+        .expect("corners read back");
+    let mut fresh = host(TimeOfDayTable::default());
+    fresh.sky.set_clouds(blocks());
+    let from_the_start = corners(&mut fresh, at, 0.0);
+    assert_eq!(after_pile.len(), 200 * 4);
+    let differing = after_pile
+        .chunks(4)
+        .zip(from_the_start.chunks(4))
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(differing, 0, "{differing} of 200 sprites differ");
+}
+
 /// Each quad is cut to the part of its sheet cell the texture covers: on a sheet whose cell 0 is
 /// transparent in its left half, a sprite of cell 0 is as tall as before and spans only the
 /// right of its square (from the first visible texel, less the half texel a bilinear lookup

@@ -153,11 +153,7 @@ impl Scatter {
         }
         let value_bytes = self.values.len() as u64 * 4;
         let span_bytes = self.spans.len() as u64 * 16;
-        if value_bytes > self.patch.size() {
-            self.patch =
-                storage_buffer(device, "sky.scatter_patch", value_bytes.next_power_of_two());
-            self.sent.0 = 0;
-        }
+        // A buffer replaced is bound again (a bind group keeps the old one alive and reads it).
         let mut replaced = false;
         if value_bytes > self.patch.size() {
             self.patch =
