@@ -17,14 +17,46 @@ use std::time::Duration;
 
 use anyhow::Context;
 use clap::Args;
+use glam::DVec2;
 use skycast::clouds::CloudsConfig;
-use skycast::demo::DemoHost;
-use skycast::flight::{FlightPlan, HostPosition, Weather};
+use skycast::demo::{DemoHost, GroundSettings, HeightField, ground_from_field};
+use skycast::flight::{FlightPath, FlightPlan, HostPosition, Weather};
 use skycast::render::Stopwatch;
-use skycast::weather::{LocalFrame, StationTable, theme};
+use skycast::weather::{LocalFrame, METRES_PER_FOOT, StationTable, WeatherField, theme};
 
-use super::render::{ElevationArgs, LookArgs, parse_size, parse_time, sky_config, time_or_default};
+use super::render::{
+    ElevationArgs, LookArgs, demo_ground_reach_m, parse_size, parse_time, sky_config,
+    time_or_default,
+};
 use super::weather::{DEFAULT_STATIONS, WindsAloftArgs, load};
+
+/// The demo ground under a whole flight: over its track, with as much ground around it as is
+/// seen from its highest point ([`demo_ground_reach_m`]), at the shipped vertex count. A square
+/// around the start alone ended 65 km east of Los Angeles, which from FL350 three minutes into
+/// the eastbound flight showed as a straight edge across the cloud field (sky instead of
+/// ground between the clouds beyond it).
+fn ground_under_flight(field: &WeatherField, flight: &FlightPath) -> HeightField {
+    let (mut lo, mut hi) = (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN));
+    let mut top_m = f64::MIN;
+    // A pose every 5 s: a track bends little in that time.
+    let steps = (flight.duration_s() / 5.0).ceil().max(1.0) as u32;
+    for k in 0..=steps {
+        let t = flight.start_s() + flight.duration_s() * f64::from(k) / f64::from(steps);
+        let p = flight.pose_at(t).position_m;
+        (lo, hi) = (lo.min(p.truncate()), hi.max(p.truncate()));
+        top_m = top_m.max(p.z);
+    }
+    let shipped = GroundSettings::default();
+    let reach_m = demo_ground_reach_m(top_m / METRES_PER_FOOT);
+    let size_m = (hi - lo).max_element() + 2.0 * reach_m;
+    ground_from_field(
+        field,
+        (lo + hi) / 2.0,
+        size_m,
+        shipped.samples,
+        shipped.relief_m,
+    )
+}
 
 /// Flags of `skycast fly`.
 #[derive(Debug, Args)]
@@ -92,7 +124,10 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let field = loaded
         .input
         .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);
-    let ground = args.elevation.ground(&field)?;
+    let ground = match args.elevation.elevation {
+        Some(_) => args.elevation.ground(&field)?,
+        None => ground_under_flight(&field, &flight),
+    };
     // Live weather (the watched file, the flight's timed events) needs the station table for
     // report files; a theme places itself.
     let needs_table = (args.watch && !theme::is_theme_path(&args.weather))
@@ -469,4 +504,48 @@ fn peak_rss_bytes() -> Option<u64> {
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb * 1024)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use skycast::weather::{CloudTypeRule, FieldSettings, WeatherInput};
+
+    /// From every point of the shipped FL350 flight the demo ground reaches past the horizon
+    /// (and from low flights past the draw distance): the square around the start alone ended
+    /// 65 km east of it, 3 minutes into the 6-minute flight.
+    #[test]
+    fn the_ground_reaches_past_what_is_seen_from_every_point_of_a_flight() {
+        let input = WeatherInput::load(
+            std::path::Path::new("weather/themes/building_cumulus_cb_line.toml"),
+            None,
+        )
+        .expect("theme");
+        for (path, reach_m) in [
+            // The horizon from FL350 (sqrt(2 R h)).
+            (
+                "config/flights/cruise_fl350_los_angeles_east.toml",
+                369_000.0,
+            ),
+            // The sprites' draw distance.
+            ("config/flights/cruise_scattered_cumulus.toml", 60_000.0),
+        ] {
+            let plan = FlightPlan::load(std::path::Path::new(path)).expect("shipped flight");
+            let (lat, lon) = plan.origin_lat_lon_deg;
+            let frame = LocalFrame::new(lat, lon);
+            let flight = plan.place(&frame);
+            let field = input.field(frame, &FieldSettings::default(), &CloudTypeRule::default());
+            let ground = ground_under_flight(&field, &flight);
+            let half = ground.size_m / 2.0;
+            for k in 0..=flight.duration_s().ceil() as u32 {
+                let p = flight.pose_at(flight.start_s() + f64::from(k)).position_m;
+                let to_edge = half - (p.truncate() - ground.centre_m).abs().max_element();
+                assert!(
+                    to_edge >= reach_m,
+                    "{path} at {k} s: the ground ends {:.0} km away",
+                    to_edge / 1000.0
+                );
+            }
+        }
+    }
 }

@@ -147,6 +147,19 @@ impl ElevationArgs {
     }
 }
 
+/// How far the demo ground reaches around a camera at `alt_ft`, metres: the shipped square's
+/// half side, and from high up (above 18,000 ft) past the horizon (sqrt(2 R h), 370 km from
+/// FL350, and a tenth more), so its edge does not cut the far clouds' ground (coarser, at the
+/// same vertex count).
+pub fn demo_ground_reach_m(alt_ft: f64) -> f64 {
+    let shipped_m = GroundSettings::default().size_m / 2.0;
+    if alt_ft <= 18_000.0 {
+        return shipped_m;
+    }
+    let horizon_m = (2.0 * 6_371_000.0 * (alt_ft * METRES_PER_FOOT).max(0.0)).sqrt();
+    (1.1 * horizon_m).max(shipped_m)
+}
+
 /// Parses `MIN,MAX` metres with MIN below MAX.
 fn parse_range_m(s: &str) -> Result<(f64, f64), String> {
     let (a, b) = s
@@ -303,16 +316,13 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         .input
         .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);
     let mut ground = args.elevation.ground(&field)?;
-    // From high up (above 18,000 ft) the demo ground reaches the horizon (sqrt(2 R h), 370 km
-    // from FL350), so its square edge does not cut the far clouds' ground; coarser, at the same
-    // vertex count.
-    let horizon_m = (2.0 * 6_371_000.0 * (args.alt_ft * METRES_PER_FOOT).max(0.0)).sqrt();
+    let reach_m = demo_ground_reach_m(args.alt_ft);
     let shipped = GroundSettings::default();
-    if args.elevation.elevation.is_none() && args.alt_ft > 18_000.0 {
+    if args.elevation.elevation.is_none() && 2.0 * reach_m > shipped.size_m {
         ground = demo_ground(
             &field,
             &GroundSettings {
-                size_m: 2.2 * horizon_m,
+                size_m: 2.0 * reach_m,
                 ..shipped
             },
         );
