@@ -331,6 +331,8 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
     var t = -1.0;
     var cell = vec4<f32>(0.0);
     var ground_xy = vec2<f32>(0.0);
+    // How much of a crossfade's cell shows (below).
+    var presence = 1.0;
     // Meet the layer at its mean height, read the map there, meet it again at the height the
     // map gives (twice: the layer's height varies slowly across the map). Rays that meet it
     // short of the hand-over band (the sprites' clouds), off the map, or where the map has no
@@ -349,6 +351,23 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
             return none;
         }
         cell = textureSampleLevel(far_map, far_sampler, uv, layer, 0.0);
+        // A new weather crossfades from the map before it (texture layers 2 and 3): where both
+        // have cloud the cell goes from the one to the other; where one alone has, its clouds
+        // fade in or out whole (seen this far off, a layer of any cover shows as one, so a
+        // falling cover alone would keep them until it reached nothing).
+        presence = 1.0;
+        if (ff.fade.w < 1.0) {
+            let before = textureSampleLevel(far_map, far_sampler, uv, layer + 2, 0.0);
+            let had = before.x > 0.01;
+            if (had && cell.x > 0.01) {
+                cell = mix(before, cell, ff.fade.w);
+            } else if (had) {
+                cell = before;
+                presence = 1.0 - ff.fade.w;
+            } else {
+                presence = ff.fade.w;
+            }
+        }
         if (cell.x <= 0.01) {
             return none;
         }
@@ -376,7 +395,7 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
     );
     let uv = (ground_xy - ff.centre_rel_size.xy) / ff.centre_rel_size.z + vec2<f32>(0.5);
     let edge = min(min(uv.x, uv.y), min(1.0 - uv.x, 1.0 - uv.y)) * ff.centre_rel_size.w;
-    let weight = band * smoothstep(0.5, 2.0, edge) * ff.fade.x;
+    let weight = band * smoothstep(0.5, 2.0, edge) * ff.fade.x * presence;
     if (weight <= 0.0) {
         return none;
     }

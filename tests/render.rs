@@ -1976,6 +1976,7 @@ fn uniform_far_map(cover: f32) -> skycast::clouds::far_map::FarMap {
         texel_m: 10_000.0,
         centre_m: DVec2::ZERO,
         cells: vec![[cover, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
+        weather_epoch: 0,
     }
 }
 
@@ -2106,6 +2107,71 @@ fn from_fl350_the_clouds_reach_the_horizon() {
         "only {far} of the rows at 150-400 km show clouds"
     );
     assert!(today < 0.01, "the far field off still shows {today}");
+}
+
+/// Issue 31, live weather out to the horizon: a far map of another weather crossfades from the
+/// one shown over the clouds' formation time, as the blocks' clouds form and dissipate. Before,
+/// every weather update blanked the far field and faded it in from nothing over the arrival
+/// fade (3 s): the frame after the switch showed no clouds out to the horizon. Here that frame
+/// is the old weather's, half the formation time later the rows at 150-400 km are half way,
+/// and after it the new weather's; a map that only moved with the camera shows at once.
+#[test]
+fn a_new_weather_crossfades_the_far_field() {
+    let mut rig = narrow_view_rig();
+    let cam_at = DVec3::new(0.0, 0.0, 10_668.0);
+    let cam = rig.camera(cam_at, 0.0, -3.5);
+    let formation_s = f64::from(
+        skycast::clouds::CloudsConfig::builtin()
+            .lifecycle
+            .formation_s,
+    );
+    let layer_km = |row: u32| ray_to_layer_km(row, H, (cam_at.z, -3.5, 12.0), 2000.0);
+    let rows: Vec<u32> = (0..H)
+        .filter(|&y| layer_km(y).is_some_and(|d| (150.0..=400.0).contains(&d)))
+        .collect();
+    assert!(rows.len() >= 8, "rows {rows:?}");
+    let frame = |rig: &mut Rig, name: &str, dt_s: f64| -> f32 {
+        let (f, _) = rig.host.frame(&cam, &sun(), dt_s, 40_000.0).unwrap();
+        let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
+        std::fs::create_dir_all(&dir).unwrap();
+        f.write_png(&dir.join(format!("{name}.png"))).unwrap();
+        let sum: f32 = rows
+            .iter()
+            .flat_map(|&y| (0..W).map(move |x| (y * W + x) as usize))
+            .map(|i| luminance(f.rgba[i]))
+            .sum();
+        sum / (rows.len() as u32 * W) as f32
+    };
+    let map = |cover: f32, epoch: u64, east_cells: f64| skycast::clouds::far_map::FarMap {
+        weather_epoch: epoch,
+        centre_m: DVec2::new(east_cells * 10_000.0, 0.0),
+        ..uniform_far_map(cover)
+    };
+    let set = |rig: &mut Rig, m: &skycast::clouds::far_map::FarMap| {
+        rig.host.sky.set_far_map(&rig.host.gpu.queue, m, Some(3.0));
+    };
+    set(&mut rig, &map(0.5, 0, 0.0));
+    let cloudy = frame(&mut rig, "crossfade-before", 10.0);
+    set(&mut rig, &map(0.0, 1, 0.0));
+    let switched = frame(&mut rig, "crossfade-switch", 0.0);
+    let half = frame(&mut rig, "crossfade-half", 0.5 * formation_s);
+    // Moved by a cell with the camera half way: it goes on from where it was.
+    set(&mut rig, &map(0.0, 1, 1.0));
+    let moved = frame(&mut rig, "crossfade-moved", 0.0);
+    let clear = frame(&mut rig, "crossfade-after", formation_s);
+    eprintln!("cloudy {cloudy}, switched {switched}, half {half}, moved {moved}, clear {clear}");
+    let step = cloudy - clear;
+    assert!(step > 0.02, "the two weathers look alike: {cloudy} {clear}");
+    assert!(
+        (switched - cloudy).abs() < 0.05 * step,
+        "the far field changed at once: {switched} against {cloudy}"
+    );
+    let part = (half - clear) / step;
+    assert!((0.2..=0.8).contains(&part), "half way: {part}");
+    assert!(
+        (moved - half).abs() < 0.1 * step,
+        "a move restarted it: {moved} against {half}"
+    );
 }
 
 /// From FL350 the geometric horizon lies 3.3 degrees below the level plane: between the two a
@@ -2436,6 +2502,7 @@ fn the_far_fields_cumulus_have_the_sprites_grain() {
         texel_m: 10_000.0,
         centre_m: DVec2::ZERO,
         cells: vec![cell; 96 * 96],
+        weather_epoch: 0,
     };
     let (pitch, fov) = (-8.0f64, 12.0f64);
     let frame = |far: bool| {

@@ -32,6 +32,10 @@ pub struct FarMap {
     pub centre_m: DVec2,
     /// `texels * texels` cells, row by row from the south-west corner eastwards, then north.
     pub cells: Vec<FarCell>,
+    /// Which weather it was built from: [`FarMapFeed`] counts the weather changes, so a map
+    /// of another weather crossfades from the one shown where a map only moved with the camera
+    /// shows at once.
+    pub weather_epoch: u64,
 }
 
 impl FarMap {
@@ -56,6 +60,48 @@ impl FarMap {
     /// Bytes of the map on the GPU (two RGBA half-float layers a cell).
     pub fn gpu_bytes(&self) -> u64 {
         u64::from(self.texels) * u64::from(self.texels) * 16
+    }
+
+    /// This map's cells where `like` has its cells (a map of the same size whose centre is
+    /// whole cells away, as every map's centre is snapped to the grid): each cell keeps its
+    /// weather, and a cell this map does not cover takes `like`'s.
+    pub fn moved_to(&self, like: &FarMap) -> FarMap {
+        let n = i64::from(like.texels);
+        let shift = ((like.centre_m - self.centre_m) / self.texel_m).round();
+        let (dc, dr) = (shift.x as i64, shift.y as i64);
+        let own = i64::from(self.texels);
+        let cells = (0..n * n)
+            .map(|k| {
+                let (col, row) = (k % n + dc, k / n + dr);
+                let mine = (0..own).contains(&col) && (0..own).contains(&row);
+                let at = if mine { row * own + col } else { -1 };
+                usize::try_from(at)
+                    .ok()
+                    .and_then(|at| self.cells.get(at))
+                    .or_else(|| like.cells.get(k as usize))
+                    .copied()
+                    .unwrap_or_default()
+            })
+            .collect();
+        FarMap {
+            cells,
+            ..like.clone()
+        }
+    }
+
+    /// The cells `t` (0..=1) of the way from this map's to `to`'s (same centre and size), every
+    /// value linearly, as the far field's shader mixes them while it crossfades.
+    pub fn blended_towards(&self, to: &FarMap, t: f32) -> FarMap {
+        let cells = self
+            .cells
+            .iter()
+            .zip(&to.cells)
+            .map(|(a, b)| std::array::from_fn(|i| a[i] + (b[i] - a[i]) * t))
+            .collect();
+        FarMap {
+            cells,
+            ..to.clone()
+        }
     }
 }
 
@@ -148,6 +194,8 @@ pub struct FarMapFeed {
     shown_centre: Option<DVec2>,
     building: Option<Building>,
     stale: bool,
+    /// Weather changes so far: the epoch of the maps started since.
+    weather_epoch: u64,
 }
 
 impl FarMapFeed {
@@ -161,12 +209,16 @@ impl FarMapFeed {
             shown_centre: None,
             building: None,
             stale: true,
+            weather_epoch: 0,
         }
     }
 
-    /// The weather changed: the next frames build a new map.
+    /// The weather changed: the next frames build a new map (of a new epoch). A map half built
+    /// is started again: its rows before the change are of the old weather.
     pub fn weather_changed(&mut self) {
         self.stale = true;
+        self.weather_epoch += 1;
+        self.building = None;
     }
 
     /// One frame's share of the work around the camera at `camera_m` (local metres): a
@@ -190,6 +242,7 @@ impl FarMapFeed {
                     texel_m: self.texel_m,
                     centre_m: snapped,
                     cells: Vec::with_capacity((self.texels * self.texels) as usize),
+                    weather_epoch: self.weather_epoch,
                 },
                 next_row: 0,
             });
@@ -305,5 +358,55 @@ mod tests {
             feed.update(DVec2::new(25_000.0, 0.0), false, weather)
                 .is_none()
         );
+    }
+
+    /// A map moved by whole cells keeps each cell's weather where it is on the ground, and
+    /// takes the other map's cells where it has none; a blend goes linearly between two.
+    #[test]
+    fn a_map_moves_by_whole_cells_and_blends_linearly() {
+        let cell = |v: f32| [v, 1000.0 + v, 2000.0 + v, 1.0, 0.0, 0.0, 0.0, 0.0];
+        let map = |centre_cells: f64, value: &dyn Fn(u32, u32) -> f32| {
+            let cells = (0..16).map(|k| cell(value(k % 4, k / 4))).collect();
+            FarMap {
+                texels: 4,
+                texel_m: 100.0,
+                centre_m: DVec2::new(centre_cells * 100.0, 0.0),
+                cells,
+                weather_epoch: 0,
+            }
+        };
+        // Each cell's value is its column on the ground (the map at the origin: column - 2).
+        let old = map(0.0, &|col, _| col as f32);
+        let fill = map(1.0, &|_, _| 9.0);
+        let moved = old.moved_to(&fill);
+        assert_eq!(moved.centre_m, fill.centre_m);
+        for row in 0..4 {
+            // The moved map's column c is the old map's column c + 1; its last, none.
+            let values: Vec<f32> = (0..4).map(|col| moved.cells[row * 4 + col][0]).collect();
+            assert_eq!(values, [1.0, 2.0, 3.0, 9.0], "row {row}");
+        }
+        let half = old.blended_towards(&map(0.0, &|_, _| 4.0), 0.25);
+        assert_eq!(half.cells[1], cell(1.75));
+    }
+
+    /// A weather change starts a map of a new epoch, and a map half built when it came is
+    /// built again (its first rows were of the weather before).
+    #[test]
+    fn a_weather_change_starts_a_map_of_a_new_epoch() {
+        let mut feed = FarMapFeed::new(4, 100.0, 1.0, 2);
+        let clear = |_: DVec2| BlockWeather::default();
+        let first = feed
+            .update(DVec2::ZERO, true, clear)
+            .expect("built at once");
+        assert_eq!(first.weather_epoch, 0);
+        feed.weather_changed();
+        assert!(feed.update(DVec2::ZERO, false, clear).is_none());
+        feed.weather_changed();
+        // Two rows a frame: the map begun before the second change is started again.
+        assert!(feed.update(DVec2::ZERO, false, clear).is_none());
+        let next = feed
+            .update(DVec2::ZERO, false, clear)
+            .expect("two frames of rows");
+        assert_eq!(next.weather_epoch, 2);
     }
 }

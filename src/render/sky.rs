@@ -767,18 +767,24 @@ impl Sky {
     }
 
     /// Hands the far field a new cloud map ([`crate::clouds::far_map::FarMapFeed`] makes them
-    /// from the weather field as the camera moves); uploaded now. The first map, and a new
-    /// map of the same place (the weather changed), fade in over `fade_in_s` when given (as
-    /// arriving clouds do); a map moved with the camera shows at once (its cells keep their
-    /// weather).
+    /// from the weather field as the camera moves); uploaded now. The first map fades in over
+    /// `fade_in_s` when given (as arriving clouds do); a map of another weather
+    /// ([`crate::clouds::far_map::FarMap::weather_epoch`]) crossfades from the one shown over
+    /// the lifecycle's formation time, as the blocks' clouds form and dissipate; a map moved
+    /// with the camera shows at once (its cells keep their weather).
     pub fn set_far_map(
         &mut self,
         queue: &wgpu::Queue,
         map: &crate::clouds::far_map::FarMap,
         fade_in_s: Option<f64>,
     ) {
-        self.far_field
-            .set_map(&self.device, queue, map, (self.elapsed_s, fade_in_s));
+        let crossfade_s = Some(f64::from(self.lifecycle.formation_s));
+        self.far_field.set_map(
+            &self.device,
+            queue,
+            map,
+            (self.elapsed_s, fade_in_s, crossfade_s),
+        );
     }
 
     /// Where the far field takes over from the sprites and the ring while it is drawn: the band

@@ -6,8 +6,9 @@
 //! around the camera, not the whole screen: [`band_elevations`]), which meets two curved layers (the low and middle clouds, the high ones) on the
 //! round Earth ([`super::earth`]), cuts them into clouds with a world-anchored noise thresholded
 //! by the map's cover, and fades them in over the band where the sprites and the ring fade out.
-//! The map lives in one small texture (two RGBA half-float layers a cell: 96 x 96 cells of 10 km
-//! are 147 KB). Settings: `[far_field]` of `config/render.toml`.
+//! The map lives in one small texture (two RGBA half-float layers a cell, and two more for the
+//! map of the weather before while a new weather crossfades in: 96 x 96 cells of 10 km are
+//! 295 KB). Settings: `[far_field]` of `config/render.toml`.
 
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
@@ -202,7 +203,8 @@ pub struct GpuFarField {
     /// sheets' noise scale, metres; w: the noise's period, metres.
     pub heights: [f32; 4],
     /// x: how far the map has faded in, 0..=1; y, z: the band of elevations the pass is drawn
-    /// over, radians (lowest first; equal: nothing to draw); w unused.
+    /// over, radians (lowest first; equal: nothing to draw); w: how far the map has crossfaded
+    /// from the one before it (texture layers 2 and 3), 0..=1.
     pub fade: [f32; 4],
     /// The heaped layers' puffs: x, y: their smallest and largest diameter, metres; z: their
     /// greatest height over their diameter; w: [`FarFieldSettings::puff_share`].
@@ -248,6 +250,19 @@ pub struct FarField {
     map: Option<MapOnGpu>,
     /// When the shown map began to fade in (the sky's clock, seconds) and over how long.
     fade: Option<(f64, f64)>,
+    /// The map shown (its cells, kept to crossfade from when the weather changes).
+    shown: Option<FarMap>,
+    /// The map of the weather before, while the shown one crossfades from it: its cells (where
+    /// the shown map's are), when the crossfade began (the sky's clock) and over how long.
+    crossfade: Option<(FarMap, f64, f64)>,
+}
+
+/// How far a crossfade begun at `start_s` over `over_s` has come at `now_s`, 0..=1.
+fn crossfade_progress(now_s: f64, start_s: f64, over_s: f64) -> f32 {
+    if over_s <= 0.0 {
+        return 1.0;
+    }
+    ((now_s - start_s) / over_s).clamp(0.0, 1.0) as f32
 }
 
 impl FarField {
@@ -344,6 +359,8 @@ impl FarField {
             uniform,
             map: None,
             fade: None,
+            shown: None,
+            crossfade: None,
         }
     }
 
@@ -369,20 +386,18 @@ impl FarField {
             .then_some((self.settings.fade_start_m, self.settings.fade_end_m))
     }
 
-    /// Uploads a new map (a texture of its size; the old one is dropped). `(now_s, fade_in_s)`:
-    /// the sky's clock, and how long a first map or a new map of the same place (new weather)
-    /// takes to fade in (`None`: at once).
+    /// Uploads a new map (a texture of its size; the old one is dropped). `(now_s, fade_in_s,
+    /// crossfade_s)`: the sky's clock, how long the first map takes to fade in, and how long a
+    /// map of another weather ([`FarMap::weather_epoch`]) takes to crossfade from the one shown
+    /// (`None`: at once). A map that only moved with the camera shows at once: its cells keep
+    /// their weather.
     pub(super) fn set_map(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         map: &FarMap,
-        (now_s, fade_in_s): (f64, Option<f64>),
+        (now_s, fade_in_s, crossfade_s): (f64, Option<f64>, Option<f64>),
     ) {
-        let new_weather = self.map.as_ref().is_none_or(|m| m.centre_m == map.centre_m);
-        if new_weather {
-            self.fade = fade_in_s.map(|s| (now_s, s));
-        }
         let n = map.texels;
         if map.cells.len() != (n * n) as usize {
             log::warn!(
@@ -391,12 +406,35 @@ impl FarField {
             );
             return;
         }
+        match &self.shown {
+            None => {
+                self.fade = fade_in_s.map(|s| (now_s, s));
+                self.crossfade = None;
+            }
+            Some(shown) if shown.weather_epoch != map.weather_epoch => {
+                // From what shows now: a crossfade under way goes on from where it has come.
+                let now = match &self.crossfade {
+                    Some((old, start, over)) => {
+                        old.blended_towards(shown, crossfade_progress(now_s, *start, *over))
+                    }
+                    None => shown.clone(),
+                };
+                self.crossfade = crossfade_s.map(|over| (now, now_s, over));
+            }
+            Some(_) => {}
+        }
+        // The map from before where the new one's cells are (a crossfade outlives moves).
+        if let Some((old, _, _)) = &mut self.crossfade {
+            *old = old.moved_to(map);
+        }
+        self.shown = Some(map.clone());
+        let before = self.crossfade.as_ref().map_or(map, |(old, _, _)| old);
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("far_field.map"),
             size: wgpu::Extent3d {
                 width: n,
                 height: n,
-                depth_or_array_layers: 2,
+                depth_or_array_layers: 4,
             },
             mip_level_count: 1,
             sample_count: 1,
@@ -405,19 +443,26 @@ impl FarField {
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
+        // Texture layers 0 and 1: the map's low and high layers; 2 and 3: the map crossfaded
+        // from (the map again without a crossfade). The band and the layers' mean heights are
+        // those of both: clouds fading out are drawn too.
         let mut sums = [(0.0f64, 0.0f64); 2];
         let mut extents = Vec::new();
         for layer in 0..2usize {
             // Cells the shader takes for cloud (its cover above 0.01).
-            let clouded = map.cells.iter().filter(|c| c[layer * 4] > 0.01);
+            let clouded = [map, before]
+                .into_iter()
+                .flat_map(|m| &m.cells)
+                .filter(|c| c[layer * 4] > 0.01);
             let extent = clouded.fold(None, |e: Option<(f32, f32)>, c| {
                 let (base, top) = (c[layer * 4 + 1], c[layer * 4 + 2]);
                 Some(e.map_or((base, top), |(lo, hi)| (lo.min(base), hi.max(top))))
             });
             extents.extend(extent);
         }
-        for layer in 0..2u32 {
-            let data: Vec<u16> = map
+        for z in 0..4u32 {
+            let (source, layer) = if z < 2 { (map, z) } else { (before, z - 2) };
+            let data: Vec<u16> = source
                 .cells
                 .iter()
                 .flat_map(|c| {
@@ -434,11 +479,7 @@ impl FarField {
                 wgpu::TexelCopyTextureInfo {
                     texture: &texture,
                     mip_level: 0,
-                    origin: wgpu::Origin3d {
-                        x: 0,
-                        y: 0,
-                        z: layer,
-                    },
+                    origin: wgpu::Origin3d { x: 0, y: 0, z },
                     aspect: wgpu::TextureAspect::All,
                 },
                 bytemuck::cast_slice(&data),
@@ -546,7 +587,9 @@ impl FarField {
                 }),
                 band.0,
                 band.1,
-                0.0,
+                self.crossfade.as_ref().map_or(1.0, |(_, start, over)| {
+                    crossfade_progress(now_s, *start, *over)
+                }),
             ],
             puffs: [
                 s.heaped_cloud_size_m[0],
