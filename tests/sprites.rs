@@ -738,3 +738,172 @@ fn a_far_cloud_fades_into_the_horizon_haze() {
         "{from_hazed} vs {from_clear}"
     );
 }
+
+/// A block of `clouds` clouds of 20 sprites (those of [`blocks`], ten to a row 1.5 km apart,
+/// rows 100 m apart) centred `north_m` north. Each block's are its own: moved `id` x 70 m east
+/// and `id` x 3 m wider, so that a block drawn from another's slots shows.
+fn row_block(id: u64, north_m: f64, clouds: usize) -> SkyBlock {
+    let template = blocks().remove(0).clouds.remove(0);
+    let own = template
+        .sprites
+        .iter()
+        .map(|s| SkySprite {
+            width_m: s.width_m + 3.0 * id as f32,
+            height_m: s.height_m + 3.0 * id as f32,
+            ..*s
+        })
+        .collect::<Vec<_>>();
+    SkyBlock {
+        id,
+        centre_m: DVec3::new(0.0, north_m, 1500.0),
+        clouds: (0..clouds)
+            .map(|i| SkyCloud {
+                centre_m: DVec3::new(
+                    (i % 10) as f64 * 1500.0 + 70.0 * id as f64,
+                    north_m + (i / 10) as f64 * 100.0,
+                    1500.0,
+                ),
+                sprites: own.clone(),
+                ..template.clone()
+            })
+            .collect(),
+    }
+}
+
+/// Blocks 1 to `n` of 200 sprites (10 clouds) 4 km north and on, placed and written from `at`
+/// in the resident buffers' first 4,096 sprite slots, nearer first: block `k` holds slots
+/// `200 (k - 1)` on. Returns them.
+fn fill_slots(host: &mut DemoHost, n: u64, at: DVec3) -> Vec<SkyBlock> {
+    let all: Vec<SkyBlock> = (1..=n)
+        .map(|id| row_block(id, 3750.0 + 250.0 * id as f64, 10))
+        .collect();
+    host.sky.set_clouds(all.clone());
+    let c = camera(host, at);
+    let first = host.sky.prepare(&host.gpu.queue, c, &SUN, 0.0);
+    assert_eq!(first.sprites_drawn, 200 * n as u32, "{first:?}");
+    all
+}
+
+/// The blocks [`fill_slots`] placed, less blocks 3, 7, 11 and 15, which are taken away: their
+/// 800 slots are free in holes of 200.
+fn cut_up_slots(host: &mut DemoHost, all: Vec<SkyBlock>) -> Vec<SkyBlock> {
+    let taken = [3, 7, 11, 15];
+    assert_eq!(host.sky.remove_blocks(taken), 4);
+    all.into_iter().filter(|b| !taken.contains(&b.id)).collect()
+}
+
+/// A block that finds no range of free sprite slots long enough, where the slots free are
+/// enough in all (the blocks that went cut them up), packs the resident buffers at their size:
+/// the device moves the blocks held, and the frame writes the new block, the whole orders and
+/// lists (4 and 16 bytes a slot) and its usual few kB, not every sprite again. Placing and
+/// writing every block again instead, this frame wrote 156 kB here and re-sorted every cloud
+/// (and 21 to 27 MB on the FL350 cruise, every 30 s). The packed sky draws exactly what a fresh
+/// sky given the same blocks draws from the same camera, though a frame before it, prepared and
+/// never drawn, left a patch of orders for the slots of before.
+#[test]
+fn a_packing_moves_the_blocks_on_the_device_and_draws_the_same_sprites() {
+    let at = DVec3::new(0.0, 0.0, 1000.0);
+    let mut packed = host(TimeOfDayTable::default());
+    let all = fill_slots(&mut packed, 20, at - DVec3::Y * 600.0);
+    let mut kept = cut_up_slots(&mut packed, all);
+    // 600 m on, past every cloud's threshold: all 160 clouds sorted again, their orders in a
+    // patch that no frame applies before the packing.
+    let c = camera(&packed, at);
+    let undrawn = packed.sky.prepare(&packed.gpu.queue, c, &SUN, 0.0);
+    assert_eq!(undrawn.clouds_recomputed, 160, "{undrawn:?}");
+    let memory = packed.sky.memory();
+    assert_eq!(
+        (memory.sprite_slots, memory.sprite_slots_used),
+        (4096, 3200)
+    );
+    // 300 sprites in 15 clouds: no hole holds them (the last is 96), the 896 free in all do.
+    let new = row_block(21, 6100.0, 15);
+    packed.sky.insert_block(new.clone(), BlockMotion::default());
+    kept.push(new);
+    let c = camera(&packed, at);
+    let stats = packed.sky.prepare(&packed.gpu.queue, c, &SUN, 0.0);
+    let memory = packed.sky.memory();
+    // Packed at the same size (not grown), and the new block placed.
+    assert_eq!(
+        (memory.sprite_slots, memory.sprite_slots_used),
+        (4096, 3500)
+    );
+    assert_eq!((stats.blocks_left_out, stats.sprites_drawn), (0, 3500));
+    let sprite_bytes = std::mem::size_of::<skycast::render::gpu_types::GpuSprite>() as u64;
+    let held_bytes = 3500 * sprite_bytes;
+    assert!(
+        stats.upload_bytes < held_bytes / 2,
+        "{} bytes written, the sprites held are {held_bytes}",
+        stats.upload_bytes
+    );
+    // The blocks moved keep their orders: only the new block's clouds are sorted.
+    assert_eq!(stats.clouds_recomputed, 15, "{stats:?}");
+    let after = packed
+        .sky
+        .read_back_corners(&packed.gpu.queue)
+        .expect("corners read back");
+    let mut fresh = host(TimeOfDayTable::default());
+    fresh.sky.set_clouds(kept);
+    let expected = corners(&mut fresh, at, 0.0);
+    assert_eq!((after.len(), expected.len()), (3500 * 4, 3500 * 4));
+    let differing = after
+        .chunks(4)
+        .zip(expected.chunks(4))
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(differing, 0, "{differing} of 3,500 sprites differ");
+}
+
+/// Wang 3.3's facing lock is kept by sprite slot: when a packing moves the block of the sprite
+/// the camera is inside of, its lock moves with it. The camera locks the sprite facing north
+/// from 40 m south of it, then steps to 30 m east and 20 m south as the buffers pack: the sprite
+/// still faces north (forgotten at its old slot, it turned to face the camera).
+#[test]
+fn a_locked_facing_follows_its_sprite_when_the_buffers_pack() {
+    let mut host = host(TimeOfDayTable::default());
+    let locked_at = DVec3::new(0.0, -40.0, 1000.0);
+    // 19 blocks in slots 0..3,800, then the sprite's block after them.
+    let all = fill_slots(&mut host, 19, locked_at);
+    let sprite_m = DVec3::new(0.0, 0.0, 1000.0);
+    host.sky.insert_block(
+        SkyBlock {
+            id: 40,
+            centre_m: sprite_m,
+            clouds: vec![plain_cloud(
+                sprite_m,
+                vec![square_sprite(Vec3::ZERO, 200.0, 0, 0)],
+                ColourLevels::even(900.0, 1100.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
+            )],
+        },
+        BlockMotion::default(),
+    );
+    let sprite_near = |quads: &[SpriteCorner], at: DVec3| -> Vec<SpriteCorner> {
+        let rel = (sprite_m - at).as_vec3();
+        quads
+            .chunks(4)
+            .find(|q| (centre(q) - rel).length() < 1.0)
+            .unwrap_or_else(|| panic!("no sprite at {rel}"))
+            .to_vec()
+    };
+    let locked = sprite_near(&corners(&mut host, locked_at, 0.0), locked_at);
+    assert!(locked.iter().all(|c| (c.rel_m.y - 40.0).abs() < 1e-3));
+    // The holes of 200 and the 295 at the end hold no 300 sprites: the buffers pack, and the
+    // sprite moves from slot 3,800 to 3,000.
+    cut_up_slots(&mut host, all);
+    assert_eq!(host.sky.memory().sprite_slots_used, 3001);
+    host.sky
+        .insert_block(row_block(41, 6100.0, 15), BlockMotion::default());
+    let stepped_to = DVec3::new(30.0, -20.0, 1000.0);
+    let quads = corners(&mut host, stepped_to, 0.1);
+    let memory = host.sky.memory();
+    assert_eq!(
+        (memory.sprite_slots, memory.sprite_slots_used),
+        (4096, 3301)
+    );
+    let turned = sprite_near(&quads, stepped_to);
+    let ys: Vec<f32> = turned.iter().map(|c| c.rel_m.y).collect();
+    assert!(
+        ys.iter().all(|y| (y - 20.0).abs() < 1e-3),
+        "still facing north: {ys:?}"
+    );
+}

@@ -97,6 +97,21 @@ impl Locks {
         self.changed |= self.map.len() != before;
     }
 
+    /// Moves every lock to the slot `moved` says its sprite has now (the resident buffers were
+    /// packed), forgetting those it gives none.
+    pub fn follow(&mut self, moved: impl Fn(u32) -> Option<u32>) {
+        let before = std::mem::take(&mut self.map);
+        for (slot, lock) in before {
+            match moved(slot) {
+                Some(now) => {
+                    self.changed |= now != slot;
+                    self.map.insert(now, lock);
+                }
+                None => self.changed = true,
+            }
+        }
+    }
+
     /// Whether the locks changed since the last [`Self::take_changed`].
     pub fn take_changed(&mut self) -> bool {
         std::mem::take(&mut self.changed)

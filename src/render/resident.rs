@@ -1,12 +1,12 @@
 //! The clouds on the GPU. A block's sprites and clouds are written into storage buffers once,
-//! when it arrives, into a range of slots it keeps until it goes ([`SlotRanges`]); after that a
-//! frame writes only what changed: a cloud's back-to-front order when Wang's cache says so, and
-//! the small draw list. The buffers grow only when the blocks held at once need more slots
-//! than they have (to a sixteenth more, in steps of their first size), up to the device's limits
-//! (or the host's budget); past that the farthest blocks are left out and counted, never a
-//! validation error. So their size follows the most sprites and clouds ever held at once: during
-//! a weather change, the old generation dissipating while the new one forms
-//! (`docs/src/long-flights.md` gives the bound).
+//! when it arrives, into a range of slots ([`SlotRanges`]) that only the device moves them out
+//! of (when the slots are packed); after that a frame writes only what changed: a cloud's
+//! back-to-front order when Wang's cache says so, and the small draw list. The buffers grow
+//! only when the blocks held at once need more slots than they have (to a sixteenth more, in
+//! steps of their first size), up to the device's limits (or the host's budget); past that the
+//! farthest blocks are left out and counted, never a validation error. So their size follows
+//! the most sprites and clouds ever held at once: during a weather change, the old generation
+//! dissipating while the new one forms (`docs/src/long-flights.md` gives the bound).
 //!
 //! Units: metres; sprite and cloud data relative to the cloud centre, cloud centres f64.
 
@@ -18,7 +18,7 @@ use super::cloud_light::{BlockLight, CloudLight};
 use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT};
 use super::id_hash::{IdMap, IdSet};
 use super::scene::{BlockMotion, SkyBlock, SkyCloud};
-use super::slots::SlotRanges;
+use super::slots::{SlotRanges, copy_runs, pack};
 use super::stats::{Spent, Stopwatch};
 
 /// Bytes of GPU memory each sprite slot costs: its record, its order entry and its Harris and
@@ -301,8 +301,11 @@ pub(super) struct ResidentSet {
     /// The time this frame spent submitting the copies of grown buffers: a wait
     /// for the device (lavapipe runs a submission on the submitting thread), reported apart.
     pub grow_wait: Spent,
-    /// Whether this frame placed every block again (packed): they are all written again.
-    repacked: bool,
+    /// Where this frame's packings moved the sprite slots of the blocks held, one list of runs
+    /// a packing, in the order they came ([`Self::moved_slot`]).
+    packs: Vec<Vec<SlotMove>>,
+    /// Bytes of the orders and lists written whole this frame (the buffers grew or packed).
+    whole_bytes: u64,
     /// The blocks not placed or not written yet: what placing and writing look at each frame,
     /// not the thousands held.
     waiting: IdSet,
@@ -317,6 +320,18 @@ pub(super) struct ResidentSet {
     pub drift_m: DVec3,
     /// Placings of blocks so far ([`Resident::place_serial`]).
     placings: u64,
+}
+
+/// A run of sprite slots a packing moved: `from` now lies at `to..to + from.len()`.
+#[derive(Debug, Clone, PartialEq)]
+struct SlotMove {
+    from: Range<u32>,
+    to: u32,
+}
+
+/// `slot` of a range that started at `from` and starts at `to` now.
+fn rebase(slot: u32, from: u32, to: u32) -> u32 {
+    slot.wrapping_sub(from).wrapping_add(to)
 }
 
 const FIRST_SPRITES: u32 = 4096;
@@ -391,7 +406,8 @@ impl ResidentSet {
             dirty_lists: Vec::new(),
             generation: 0,
             grow_wait: Spent::default(),
-            repacked: false,
+            packs: Vec::new(),
+            whole_bytes: 0,
             waiting: IdSet::default(),
             changes: 0,
             fades: 0,
@@ -448,17 +464,18 @@ impl ResidentSet {
         }
     }
 
-    /// Places every block not on the GPU yet (growing the buffers where the limits allow;
-    /// past them the farthest from `camera_m` are left out) and writes the new ones, nearest
-    /// first, up to `budget_sprites` sprites (all of them after a packing: everything is
-    /// written again then). Returns the bytes written and the blocks left out.
+    /// Places every block not on the GPU yet (growing or packing the buffers where the limits
+    /// allow; past them the farthest from `camera_m` are left out) and writes the new ones,
+    /// nearest first, up to `budget_sprites` sprites. Returns the bytes written and the blocks
+    /// left out. Blocks a packing moved keep what was written ([`Self::moved_slot`]).
     pub fn place_and_upload(
         &mut self,
         queue: &wgpu::Queue,
         camera_m: DVec3,
         budget_sprites: u32,
     ) -> (u64, u32) {
-        self.repacked = false;
+        self.packs.clear();
+        self.whole_bytes = 0;
         self.grow_wait = Spent::default();
         let blocks = &self.blocks;
         let mut waiting: Vec<(f64, &Resident)> = self
@@ -484,12 +501,25 @@ impl ResidentSet {
             .filter_map(|id| blocks.get(id))
             .filter(|r| r.place.is_none())
             .count() as u32;
-        let budget = if self.repacked {
-            u32::MAX
-        } else {
-            budget_sprites
-        };
-        (self.upload(queue, camera_m, budget), left_out)
+        let written = self.upload(queue, camera_m, budget_sprites);
+        (written + self.whole_bytes, left_out)
+    }
+
+    /// Whether the last [`Self::place_and_upload`] packed the buffers (moved blocks to other
+    /// slots).
+    pub fn packed(&self) -> bool {
+        !self.packs.is_empty()
+    }
+
+    /// Where sprite slot `slot` of a block held before the last [`Self::place_and_upload`] is
+    /// now, after the packings it made (none: where it was); `None` if no block placed then
+    /// holds that slot now. For what keeps sprite slots across frames (the facing locks).
+    pub fn moved_slot(&self, slot: u32) -> Option<u32> {
+        self.packs.iter().try_fold(slot, |slot, moves| {
+            let i = moves.partition_point(|m| m.from.end <= slot);
+            let m = moves.get(i).filter(|m| m.from.contains(&slot))?;
+            Some(rebase(slot, m.from.start, m.to))
+        })
     }
 
     /// Places one block: in free slots, else after growing, else in place of farther ones.
@@ -571,9 +601,10 @@ impl ResidentSet {
     /// 144 ms. A buffer that grows gets a sixteenth more than it needs.
     ///
     /// A buffer with slots enough in pieces keeps its size ([`SlotRanges::capacity_for`]) and is
-    /// packed: every block is placed and written again. Growing it then (the cloud buffer went
-    /// from 256 slots to 4,096 when a block's clouds found no range) made the size depend on how
-    /// a long flight's changes had cut up the slots.
+    /// packed ([`Self::pack_in_place`]): the device moves the blocks to close the gaps, and the
+    /// CPU writes the orders and lists again, as when growing. Growing it instead (the cloud
+    /// buffer went from 256 slots to 4,096 when a block's clouds found no range) made the size
+    /// depend on how a long flight's changes had cut up the slots.
     fn grow_for(&mut self, queue: &wgpu::Queue, id: u64) -> bool {
         let Some(r) = self.blocks.get(&id) else {
             return false;
@@ -616,30 +647,125 @@ impl ResidentSet {
             self.grow_in_place(queue, sprites, clouds);
             return true;
         }
-        self.repacked = true;
-        self.take_buffers(buffers(&self.device, &self.layout, sprites, clouds));
-        self.sprite_slots = SlotRanges::new(sprites);
-        self.cloud_slots = SlotRanges::new(clouds);
-        self.orders_cpu = vec![0; sprites as usize];
-        self.dirty_orders.clear();
-        self.lists_cpu = vec![GpuListCloud::default(); clouds as usize];
-        self.dirty_lists.clear();
-        let mut placed: Vec<u64> = self
+        self.pack_in_place(queue);
+        true
+    }
+
+    /// Packs the blocks held into the start of new buffers of the same size, in the order
+    /// their slots lay in ([`pack`]), so that the free slots are one range. The device moves
+    /// them, as it does when the buffers grow: one copy of the sprites, lights and clouds of
+    /// each run of blocks that stay neighbours, in one submission (timed in
+    /// [`Self::grow_wait`]). The CPU moves what holds slot numbers: each block's slots, its
+    /// clouds' first sprite and cloud slots, its cloud list, and the orders (the sprite slots of
+    /// their clouds, 4 bytes a slot) and lists it keeps copies of, which it writes whole. The
+    /// order within each cloud stays, and with it the order cache. Placing and writing every
+    /// block again instead wrote 21 to 27 MB in one frame on the FL350 cruise, about every 30 s
+    /// (22 to 31 ms of the frame thread). A block placed and not written yet is moved too and
+    /// written later where it is then; a moved block gets a placing of its own
+    /// ([`Resident::place_serial`]), so that copies of its orders elsewhere (the impostor
+    /// ring's) are written again. [`Self::moved_slot`] says where a slot went.
+    fn pack_in_place(&mut self, queue: &wgpu::Queue) {
+        let (sprites, clouds) = (self.sprite_slots.capacity(), self.cloud_slots.capacity());
+        let mut placed: Vec<(u64, Range<u32>, Range<u32>, bool)> = self
             .blocks
             .values()
-            .filter(|r| r.place.is_some())
-            .map(|r| r.block.id)
+            .filter_map(|r| {
+                let (s, c) = r.place.clone()?;
+                Some((r.block.id, s, c, r.uploaded))
+            })
             .collect();
-        placed.sort_unstable();
-        for r in self.blocks.values_mut() {
-            r.place = None;
+        // A fixed order (the map's is not), for the placings' serials.
+        placed.sort_unstable_by_key(|p| (p.1.start, p.0));
+        let held: Vec<Range<u32>> = placed.iter().map(|p| p.1.clone()).collect();
+        let (sprite_slots, to_sprites) = pack(sprites, &held);
+        let held: Vec<Range<u32>> = placed.iter().map(|p| p.2.clone()).collect();
+        let (cloud_slots, to_clouds) = pack(clouds, &held);
+
+        // The device copies what was written: runs of written blocks that stay neighbours.
+        let b = buffers(&self.device, &self.layout, sprites, clouds);
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("sky.resident_pack"),
+            });
+        let written = || placed.iter().enumerate().filter(|(_, p)| p.3);
+        let sprite_runs = copy_runs(written().map(|(i, p)| (p.1.clone(), to_sprites[i].start)));
+        let sprite_bytes = std::mem::size_of::<GpuSprite>() as u64;
+        for &(from, to, len) in &sprite_runs {
+            for (old, new, bytes) in [
+                (&self.sprite_buffer, &b.sprites, sprite_bytes),
+                (&self.light_buffer, &b.lights, 4),
+            ] {
+                let (from, to, len) = (from as u64 * bytes, to as u64 * bytes, len as u64 * bytes);
+                encoder.copy_buffer_to_buffer(old, from, new, to, len);
+            }
         }
-        self.waiting.extend(self.blocks.keys().copied());
-        self.changes += 1;
-        for id in placed {
-            self.try_place(id);
+        let cloud_runs = copy_runs(written().map(|(i, p)| (p.2.clone(), to_clouds[i].start)));
+        let cloud_bytes = std::mem::size_of::<GpuCloud>() as u64;
+        for &(from, to, len) in &cloud_runs {
+            let (from, to, len) = (
+                from as u64 * cloud_bytes,
+                to as u64 * cloud_bytes,
+                len as u64 * cloud_bytes,
+            );
+            encoder.copy_buffer_to_buffer(&self.cloud_buffer, from, &b.clouds, to, len);
         }
-        true
+
+        // The CPU moves the slot numbers it holds.
+        let mut orders = vec![0u32; sprites as usize];
+        let mut lists = vec![GpuListCloud::default(); clouds as usize];
+        let mut moves = Vec::with_capacity(placed.len());
+        for (i, (id, old_s, old_c, _)) in placed.iter().enumerate() {
+            let (new_s, new_c) = (to_sprites[i].clone(), to_clouds[i].clone());
+            let (ds, dc) = ((old_s.start, new_s.start), (old_c.start, new_c.start));
+            let len = old_s.len();
+            let old_orders = &self.orders_cpu[old_s.start as usize..][..len];
+            for (to, &from) in orders[new_s.start as usize..][..len]
+                .iter_mut()
+                .zip(old_orders)
+            {
+                *to = rebase(from, ds.0, ds.1);
+            }
+            if !old_s.is_empty() {
+                moves.push(SlotMove {
+                    from: old_s.clone(),
+                    to: new_s.start,
+                });
+            }
+            let Some(r) = self.blocks.get_mut(id) else {
+                continue;
+            };
+            for state in &mut r.clouds {
+                state.sprite_base = rebase(state.sprite_base, ds.0, ds.1);
+                state.cloud_slot = rebase(state.cloud_slot, dc.0, dc.1);
+            }
+            for entry in &mut r.list {
+                entry.cloud = rebase(entry.cloud, dc.0, dc.1);
+                entry.order_base = rebase(entry.order_base, ds.0, ds.1);
+            }
+            // The GPU's copy of the list is the block's (`draw_list::main_view` writes both).
+            lists[new_c.start as usize..][..r.list.len()].copy_from_slice(&r.list);
+            if (old_s, old_c) != (&new_s, &new_c) {
+                self.placings += 1;
+                r.place_serial = self.placings;
+            }
+            r.place = Some((new_s, new_c));
+        }
+        moves.sort_by_key(|m| m.from.start);
+        self.packs.push(moves);
+        self.sprite_slots = sprite_slots;
+        self.cloud_slots = cloud_slots;
+        self.orders_cpu = orders;
+        self.lists_cpu = lists;
+        // What was dirty is in the copies, at the slots it has now.
+        self.dirty_orders.clear();
+        self.dirty_lists.clear();
+        self.write_whole(queue, &b);
+        // Writes queued for the old buffers this frame reach them before the copies.
+        let wait = Stopwatch::start();
+        queue.submit([encoder.finish()]);
+        self.grow_wait += wait.spent();
+        self.take_buffers(b);
     }
 
     /// New buffers of `sprites` and `clouds` slots (at least today's) holding every block where
@@ -665,14 +791,22 @@ impl ResidentSet {
         self.orders_cpu.resize(sprites as usize, 0);
         self.lists_cpu
             .resize(clouds as usize, GpuListCloud::default());
-        queue.write_buffer(&b.orders, 0, bytemuck::cast_slice(&self.orders_cpu));
-        queue.write_buffer(&b.lists, 0, bytemuck::cast_slice(&self.lists_cpu));
+        self.write_whole(queue, &b);
         // Writes queued for the old buffers this frame reach them before the copies: a queue's
         // writes go ahead of the submission that follows them.
         let wait = Stopwatch::start();
         queue.submit([encoder.finish()]);
         self.grow_wait += wait.spent();
         self.take_buffers(b);
+    }
+
+    /// Writes the orders and lists whole into `b`'s, from their CPU copies.
+    fn write_whole(&mut self, queue: &wgpu::Queue, b: &Buffers) {
+        let orders: &[u8] = bytemuck::cast_slice(&self.orders_cpu);
+        let lists: &[u8] = bytemuck::cast_slice(&self.lists_cpu);
+        queue.write_buffer(&b.orders, 0, orders);
+        queue.write_buffer(&b.lists, 0, lists);
+        self.whole_bytes += (orders.len() + lists.len()) as u64;
     }
 
     /// Puts `b` in place of the buffers held; bind groups made with the old ones are made again

@@ -230,6 +230,14 @@ impl Scatter {
         self.values.extend_from_slice(data);
     }
 
+    /// Drops a patch kept from frames prepared and never recorded: the buffers it was for were
+    /// written whole since (the resident buffers were packed; its spans are at the slots of
+    /// before).
+    pub fn forget_kept(&mut self) {
+        self.applied.set(true);
+        self.ready = false;
+    }
+
     /// Records the patch's pass into `encoder` (before anything reads the orders), if there is
     /// one; the next [`Self::prepare`] starts a new patch.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {

@@ -1046,6 +1046,16 @@ impl Sky {
         );
         stats.blocks_left_out = left_out;
         gpu_wait += self.resident.grow_wait;
+        if self.resident.packed() {
+            // Blocks moved to other slots: what holds sprite slots from frame to frame follows
+            // them, and a patch of orders kept for the old slots goes (the new buffers were
+            // written whole from the CPU's copies, which hold its values).
+            self.scatter.forget_kept();
+            let resident = &self.resident;
+            for view in &mut self.views {
+                view.locks.follow(|slot| resident.moved_slot(slot));
+            }
+        }
         upload_bytes += placed_bytes;
         upload_bytes += self.resident.relight(queue, camera.position_m);
         (stats.sprites_lit, stats.light_us) = (self.resident.lit_sprites, self.resident.light_us);

@@ -1,11 +1,11 @@
 //! Ranges of slots in a GPU buffer: blocks of sprites (and of clouds) take a contiguous range
-//! when they arrive and give it back when they go, so a block is written once and never moved.
+//! when they arrive and give it back when they go, so a block is written once by the CPU.
 //! First fit over a sorted free list, with neighbours merged on release: the field brings and
 //! retires a few blocks at a time, so the list stays short. When a block finds no range long
-//! enough, every block is placed again (see `resident`): packed at the same capacity when the
-//! slots free are enough in all, in a larger buffer only when they are not
-//! ([`SlotRanges::capacity_for`]), so the capacity follows the most slots ever held at once and
-//! never how the free ones happen to be cut up.
+//! enough, the blocks held are packed at the same capacity when the slots free are enough in
+//! all ([`pack`]: the device moves them, see `resident`), and kept where they are in a larger
+//! buffer only when they are not ([`SlotRanges::capacity_for`]), so the capacity follows the
+//! most slots ever held at once and never how the free ones happen to be cut up.
 
 use std::ops::Range;
 
@@ -101,9 +101,89 @@ impl SlotRanges {
     }
 }
 
+/// The ranges `held` (disjoint, within `capacity`) packed at the start of the slots, one after
+/// the other in the order they lie in: their new ranges (in the order of `held`) and the slots
+/// with them in use, the rest in one free range. Ranges keep their order, so those before the
+/// first gap stay where they are and neighbours stay neighbours ([`copy_runs`]).
+pub fn pack(capacity: u32, held: &[Range<u32>]) -> (SlotRanges, Vec<Range<u32>>) {
+    let mut by_start: Vec<usize> = (0..held.len()).collect();
+    by_start.sort_by_key(|&i| held[i].start);
+    let mut packed = vec![0..0; held.len()];
+    let mut next = 0u32;
+    for i in by_start {
+        let len = held[i].end - held[i].start;
+        // An empty range is where `allocate` puts one (nothing is moved for it).
+        if len > 0 {
+            packed[i] = next..next + len;
+            next += len;
+        }
+    }
+    debug_assert!(next <= capacity, "{next} slots held in {capacity}");
+    let slots = SlotRanges {
+        capacity,
+        free: (next < capacity)
+            .then_some(next..capacity)
+            .into_iter()
+            .collect(),
+    };
+    (slots, packed)
+}
+
+/// The copies that move each range `from` to start at `to` (as [`pack`] gives them), as
+/// `(source, destination, length)` in slots: ranges next to each other before and after are
+/// one copy, empty ones none.
+pub fn copy_runs(moves: impl IntoIterator<Item = (Range<u32>, u32)>) -> Vec<(u32, u32, u32)> {
+    let mut moves: Vec<(Range<u32>, u32)> = moves.into_iter().filter(|m| !m.0.is_empty()).collect();
+    moves.sort_by_key(|m| m.0.start);
+    let mut runs: Vec<(u32, u32, u32)> = Vec::new();
+    for (from, to) in moves {
+        let len = from.end - from.start;
+        match runs.last_mut() {
+            Some(run) if run.0 + run.2 == from.start && run.1 + run.2 == to => run.2 += len,
+            _ => runs.push((from.start, to, len)),
+        }
+    }
+    runs
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Packing moves the ranges held to the start in the order they lay in (the first stays,
+    /// the others close the gaps), leaves the rest as one free range, and the copies that do it
+    /// join neighbours: a range held between two gaps is a copy of its own.
+    #[test]
+    fn packing_closes_the_gaps_in_order_with_one_copy_a_run() {
+        let mut s = SlotRanges::new(100);
+        let held: Vec<_> = [10, 20, 5, 15, 30]
+            .iter()
+            .map(|&n| s.allocate(n).unwrap())
+            .collect();
+        // Gaps at 10..30 and 35..50; 0..10 and 30..35 stay, 50..80 moves as it is.
+        s.release(held[1].clone());
+        s.release(held[3].clone());
+        assert!(!s.fits(40));
+        let kept = [held[4].clone(), held[0].clone(), 0..0, held[2].clone()];
+        let (packed, to) = pack(s.capacity(), &kept);
+        assert_eq!(to, vec![15..45, 0..10, 0..0, 10..15]);
+        assert_eq!((packed.capacity(), packed.used()), (100, 45));
+        assert!(packed.fits(55) && !packed.fits(56));
+        let moves = kept.iter().cloned().zip(to.iter().map(|r| r.start));
+        assert_eq!(
+            copy_runs(moves),
+            vec![(0, 0, 10), (30, 10, 5), (50, 15, 30)]
+        );
+        // Nothing cut up: one copy of everything, to where it was.
+        let whole = [0..10, 10..40];
+        let (_, to) = pack(50, &whole);
+        assert_eq!(to, whole.to_vec());
+        let moves = whole.iter().cloned().zip(to.iter().map(|r| r.start));
+        assert_eq!(copy_runs(moves), vec![(0, 0, 40)]);
+        // Full: no free range left.
+        let (full, _) = pack(40, &whole);
+        assert!(!full.fits(1) && full.fits(0));
+    }
 
     #[test]
     fn extending_keeps_the_ranges_in_use_and_frees_the_new_slots() {
