@@ -304,8 +304,9 @@ pub(super) struct ResidentSet {
     /// Where this frame's packings moved the sprite slots of the blocks held, one list of runs
     /// a packing, in the order they came ([`Self::moved_slot`]).
     packs: Vec<Vec<SlotMove>>,
-    /// Bytes of the orders and lists written whole this frame (the buffers grew or packed).
-    whole_bytes: u64,
+    /// Whether the order and list buffers are new this frame (they grew or packed): written
+    /// whole from their CPU copies once the blocks are placed.
+    whole_due: bool,
     /// The blocks not placed or not written yet: what placing and writing look at each frame,
     /// not the thousands held.
     waiting: IdSet,
@@ -407,7 +408,7 @@ impl ResidentSet {
             generation: 0,
             grow_wait: Spent::default(),
             packs: Vec::new(),
-            whole_bytes: 0,
+            whole_due: false,
             waiting: IdSet::default(),
             changes: 0,
             fades: 0,
@@ -475,7 +476,6 @@ impl ResidentSet {
         budget_sprites: u32,
     ) -> (u64, u32) {
         self.packs.clear();
-        self.whole_bytes = 0;
         self.grow_wait = Spent::default();
         let blocks = &self.blocks;
         let mut waiting: Vec<(f64, &Resident)> = self
@@ -501,8 +501,14 @@ impl ResidentSet {
             .filter_map(|id| blocks.get(id))
             .filter(|r| r.place.is_none())
             .count() as u32;
-        let written = self.upload(queue, camera_m, budget_sprites);
-        (written + self.whole_bytes, left_out)
+        // Once, however many times the buffers grew or packed (the first frame of the FL350
+        // cruise grows them 71 times: 52 MB written whole into buffers dropped at once).
+        let mut written = 0;
+        if std::mem::take(&mut self.whole_due) {
+            written += self.write_whole(queue);
+        }
+        written += self.upload(queue, camera_m, budget_sprites);
+        (written, left_out)
     }
 
     /// Whether the last [`Self::place_and_upload`] packed the buffers (moved blocks to other
@@ -657,13 +663,13 @@ impl ResidentSet {
     /// each run of blocks that stay neighbours, in one submission (timed in
     /// [`Self::grow_wait`]). The CPU moves what holds slot numbers: each block's slots, its
     /// clouds' first sprite and cloud slots, its cloud list, and the orders (the sprite slots of
-    /// their clouds, 4 bytes a slot) and lists it keeps copies of, which it writes whole. The
-    /// order within each cloud stays, and with it the order cache. Placing and writing every
-    /// block again instead wrote 21 to 27 MB in one frame on the FL350 cruise, about every 30 s
-    /// (22 to 31 ms of the frame thread). A block placed and not written yet is moved too and
-    /// written later where it is then; a moved block gets a placing of its own
-    /// ([`Resident::place_serial`]), so that copies of its orders elsewhere (the impostor
-    /// ring's) are written again. [`Self::moved_slot`] says where a slot went.
+    /// their clouds, 4 bytes a slot) and lists it keeps copies of, written whole once the
+    /// frame's blocks are placed. The order within each cloud stays, and with it the order
+    /// cache. Placing and writing every block again instead wrote 21 to 27 MB in one frame on
+    /// the FL350 cruise, about every 30 s (22 to 53 ms of the frame thread). A block placed and
+    /// not written yet is moved too and written later where it is then; a moved block gets a
+    /// placing of its own ([`Resident::place_serial`]), so that copies of its orders elsewhere
+    /// (the impostor ring's) are written again. [`Self::moved_slot`] says where a slot went.
     fn pack_in_place(&mut self, queue: &wgpu::Queue) {
         let (sprites, clouds) = (self.sprite_slots.capacity(), self.cloud_slots.capacity());
         let mut placed: Vec<(u64, Range<u32>, Range<u32>, bool)> = self
@@ -760,7 +766,7 @@ impl ResidentSet {
         // What was dirty is in the copies, at the slots it has now.
         self.dirty_orders.clear();
         self.dirty_lists.clear();
-        self.write_whole(queue, &b);
+        self.whole_due = true;
         // Writes queued for the old buffers this frame reach them before the copies.
         let wait = Stopwatch::start();
         queue.submit([encoder.finish()]);
@@ -770,8 +776,8 @@ impl ResidentSet {
 
     /// New buffers of `sprites` and `clouds` slots (at least today's) holding every block where
     /// it is: the device copies the sprites, clouds and lights across; the orders and lists are
-    /// written from their CPU copies (an order patch not applied yet applies to the new buffers
-    /// as well, with the same values).
+    /// written from their CPU copies once the frame's blocks are placed (an order patch not
+    /// applied yet applies to the new buffers as well, with the same values).
     fn grow_in_place(&mut self, queue: &wgpu::Queue, sprites: u32, clouds: u32) {
         let b = buffers(&self.device, &self.layout, sprites, clouds);
         let mut encoder = self
@@ -791,7 +797,7 @@ impl ResidentSet {
         self.orders_cpu.resize(sprites as usize, 0);
         self.lists_cpu
             .resize(clouds as usize, GpuListCloud::default());
-        self.write_whole(queue, &b);
+        self.whole_due = true;
         // Writes queued for the old buffers this frame reach them before the copies: a queue's
         // writes go ahead of the submission that follows them.
         let wait = Stopwatch::start();
@@ -800,13 +806,13 @@ impl ResidentSet {
         self.take_buffers(b);
     }
 
-    /// Writes the orders and lists whole into `b`'s, from their CPU copies.
-    fn write_whole(&mut self, queue: &wgpu::Queue, b: &Buffers) {
+    /// Writes the order and list buffers whole from their CPU copies; returns the bytes.
+    fn write_whole(&self, queue: &wgpu::Queue) -> u64 {
         let orders: &[u8] = bytemuck::cast_slice(&self.orders_cpu);
         let lists: &[u8] = bytemuck::cast_slice(&self.lists_cpu);
-        queue.write_buffer(&b.orders, 0, orders);
-        queue.write_buffer(&b.lists, 0, lists);
-        self.whole_bytes += (orders.len() + lists.len()) as u64;
+        queue.write_buffer(&self.order_buffer, 0, orders);
+        queue.write_buffer(&self.list_buffer, 0, lists);
+        (orders.len() + lists.len()) as u64
     }
 
     /// Puts `b` in place of the buffers held; bind groups made with the old ones are made again
