@@ -2159,6 +2159,9 @@ fn a_new_weather_crossfades_the_far_field() {
     set(&mut rig, &map(0.0, 1, 1.0));
     let moved = frame(&mut rig, "crossfade-moved", 0.0);
     let clear = frame(&mut rig, "crossfade-after", formation_s);
+    // A move after the end: the new weather, the crossfade forgotten.
+    set(&mut rig, &map(0.0, 1, 2.0));
+    let later = frame(&mut rig, "crossfade-later", 0.0);
     eprintln!("cloudy {cloudy}, switched {switched}, half {half}, moved {moved}, clear {clear}");
     let step = cloudy - clear;
     assert!(step > 0.02, "the two weathers look alike: {cloudy} {clear}");
@@ -2171,6 +2174,10 @@ fn a_new_weather_crossfades_the_far_field() {
     assert!(
         (moved - half).abs() < 0.1 * step,
         "a move restarted it: {moved} against {half}"
+    );
+    assert!(
+        (later - clear).abs() < 0.05 * step,
+        "after the end a move shows {later} against {clear}"
     );
 }
 

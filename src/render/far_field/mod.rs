@@ -406,6 +406,14 @@ impl FarField {
             );
             return;
         }
+        // A crossfade that has ended is forgotten: its map no longer widens the band drawn.
+        if self
+            .crossfade
+            .as_ref()
+            .is_some_and(|(_, start, over)| crossfade_progress(now_s, *start, *over) >= 1.0)
+        {
+            self.crossfade = None;
+        }
         match &self.shown {
             None => {
                 self.fade = fade_in_s.map(|s| (now_s, s));
