@@ -116,6 +116,11 @@ fn corners_looking(host: &mut DemoHost, at: DVec3, pitch_deg: f64, dt_s: f64) ->
         .expect("corners read back")
 }
 
+/// How many sprites (quads of four corners, in drawing order) differ between two read-backs.
+fn quads_differing(a: &[SpriteCorner], b: &[SpriteCorner]) -> usize {
+    a.chunks(4).zip(b.chunks(4)).filter(|(a, b)| a != b).count()
+}
+
 fn centre(quad: &[SpriteCorner]) -> Vec3 {
     quad.iter().map(|c| c.rel_m).sum::<Vec3>() / 4.0
 }
@@ -257,11 +262,7 @@ fn orders_outgrowing_the_patch_buffer_still_reach_the_gpu() {
     fresh.sky.set_clouds(blocks());
     let from_the_start = corners(&mut fresh, at, 0.0);
     assert_eq!(after_pile.len(), 200 * 4);
-    let differing = after_pile
-        .chunks(4)
-        .zip(from_the_start.chunks(4))
-        .filter(|(a, b)| a != b)
-        .count();
+    let differing = quads_differing(&after_pile, &from_the_start);
     assert_eq!(differing, 0, "{differing} of 200 sprites differ");
 }
 
@@ -846,11 +847,7 @@ fn a_packing_moves_the_blocks_on_the_device_and_draws_the_same_sprites() {
     fresh.sky.set_clouds(kept);
     let expected = corners(&mut fresh, at, 0.0);
     assert_eq!((after.len(), expected.len()), (3500 * 4, 3500 * 4));
-    let differing = after
-        .chunks(4)
-        .zip(expected.chunks(4))
-        .filter(|(a, b)| a != b)
-        .count();
+    let differing = quads_differing(&after, &expected);
     assert_eq!(differing, 0, "{differing} of 3,500 sprites differ");
 }
 

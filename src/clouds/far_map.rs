@@ -74,9 +74,7 @@ impl FarMap {
             .map(|k| {
                 let (col, row) = (k % n + dc, k / n + dr);
                 let mine = (0..own).contains(&col) && (0..own).contains(&row);
-                let at = if mine { row * own + col } else { -1 };
-                usize::try_from(at)
-                    .ok()
+                mine.then(|| (row * own + col) as usize)
                     .and_then(|at| self.cells.get(at))
                     .or_else(|| like.cells.get(k as usize))
                     .copied()

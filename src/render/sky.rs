@@ -778,7 +778,7 @@ impl Sky {
         map: &crate::clouds::far_map::FarMap,
         fade_in_s: Option<f64>,
     ) {
-        let crossfade_s = Some(f64::from(self.lifecycle.formation_s));
+        let crossfade_s = f64::from(self.lifecycle.formation_s);
         self.far_field.set_map(
             &self.device,
             queue,

@@ -389,14 +389,14 @@ impl FarField {
     /// Uploads a new map (a texture of its size; the old one is dropped). `(now_s, fade_in_s,
     /// crossfade_s)`: the sky's clock, how long the first map takes to fade in, and how long a
     /// map of another weather ([`FarMap::weather_epoch`]) takes to crossfade from the one shown
-    /// (`None`: at once). A map that only moved with the camera shows at once: its cells keep
+    /// (0: at once). A map that only moved with the camera shows at once: its cells keep
     /// their weather.
     pub(super) fn set_map(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         map: &FarMap,
-        (now_s, fade_in_s, crossfade_s): (f64, Option<f64>, Option<f64>),
+        (now_s, fade_in_s, crossfade_s): (f64, Option<f64>, f64),
     ) {
         let n = map.texels;
         if map.cells.len() != (n * n) as usize {
@@ -427,7 +427,7 @@ impl FarField {
                     }
                     None => shown.clone(),
                 };
-                self.crossfade = crossfade_s.map(|over| (now, now_s, over));
+                self.crossfade = Some((now, now_s, crossfade_s));
             }
             Some(_) => {}
         }
