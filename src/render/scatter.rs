@@ -9,6 +9,7 @@
 //! frame was a fifth of the patch's CPU time).
 
 use std::cell::Cell;
+use std::collections::HashMap;
 use std::ops::Range;
 
 use super::gpu_types::GpuListCloud;
@@ -43,6 +44,9 @@ pub(super) struct Scatter {
     ready: bool,
     /// Whether that patch went into a recorded frame (then the next one starts afresh).
     applied: Cell<bool>,
+    /// The spans of the patch by target and first slot: a cloud sorted again in a frame never
+    /// drawn writes over its earlier span instead of adding one beside it ([`Self::push`]).
+    by_start: HashMap<(u32, u32), Vec<usize>>,
 }
 
 impl Scatter {
@@ -72,6 +76,7 @@ impl Scatter {
             group: None,
             ready: false,
             applied: Cell::new(true),
+            by_start: HashMap::new(),
         }
     }
 
@@ -123,9 +128,7 @@ impl Scatter {
         };
         let list_buffer = list_buffer.clone();
         if self.applied.replace(false) {
-            self.values.clear();
-            self.spans.truncate(1);
-            self.sent = (0, 0);
+            self.clear_patch();
         }
         self.ready = false;
         for r in dirty_orders.drain(..) {
@@ -142,9 +145,7 @@ impl Scatter {
         let whole = orders.len() + lists.len() * 4;
         if self.values.len() > whole {
             // Frames prepared and never drawn piled up more than the buffers hold: write them.
-            self.values.clear();
-            self.spans.truncate(1);
-            self.sent = (0, 0);
+            self.clear_patch();
             queue.write_buffer(order_buffer, 0, bytemuck::cast_slice(orders));
             if !lists.is_empty() {
                 queue.write_buffer(&list_buffer, 0, bytemuck::cast_slice(lists));
@@ -221,13 +222,40 @@ impl Scatter {
         })
     }
 
+    /// Starts an empty patch.
+    fn clear_patch(&mut self) {
+        self.values.clear();
+        self.spans.truncate(1);
+        self.sent = (0, 0);
+        self.by_start.clear();
+    }
+
+    /// Adds `data` for the slots from `dst` of `target`. One dispatch applies the spans in no
+    /// order, so spans over the same slots (a cloud sorted again in a frame prepared and never
+    /// drawn) must agree: the new values are written over the earlier spans from the same slot
+    /// (sent again), and a span that holds them all takes no new one. Spans from other first
+    /// slots do not meet in practice (a cloud's slots and a block's list stay put until the
+    /// block goes, and a packing drops the patch).
     fn push(&mut self, target: u32, dst: u32, data: &[u32]) {
         if data.is_empty() {
             return;
         }
+        let mut held = false;
+        for &i in self.by_start.get(&(target, dst)).into_iter().flatten() {
+            let [_, src, count, _] = self.spans[i];
+            let n = (count as usize).min(data.len());
+            self.values[src as usize..][..n].copy_from_slice(&data[..n]);
+            self.sent.0 = self.sent.0.min(src as usize);
+            held |= n == data.len();
+        }
+        if held {
+            return;
+        }
+        let index = self.spans.len();
         self.spans
             .push([dst, self.values.len() as u32, data.len() as u32, target]);
         self.values.extend_from_slice(data);
+        self.by_start.entry((target, dst)).or_default().push(index);
     }
 
     /// Drops a patch kept from frames prepared and never recorded: the buffers it was for were
