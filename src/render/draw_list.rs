@@ -187,10 +187,22 @@ pub fn sprites_back_to_front(cloud: &SkyCloud, cam_local_m: Vec3) -> Vec<(usize,
     order
 }
 
-/// Sort keys of a cloud's sprites: the complement of the squared distance's bits above the
+/// Sort keys of a cloud's sprites (the complement of the squared distance's bits above the
 /// sprite's index, so that one ascending sort of plain integers puts the farthest first and
-/// equally far sprites by index.
-pub(super) type SortKeys = Vec<u64>;
+/// equally far sprites by index), and scratch to check a previous order with.
+#[derive(Debug, Default)]
+pub(super) struct SortKeys {
+    keys: Vec<u64>,
+    /// One bit a sprite: seen in the previous order.
+    seen: Vec<u64>,
+}
+
+impl SortKeys {
+    /// Empty buffers.
+    pub(super) fn new() -> Self {
+        Self::default()
+    }
+}
 
 /// Writes the slots (`base` + index) of a cloud's sprites at `offsets` (from its centre,
 /// [`super::resident::Resident::offsets_of`]), farthest from the camera first, into `slots`
@@ -198,6 +210,12 @@ pub(super) type SortKeys = Vec<u64>;
 /// [`sprites_back_to_front`], on integer keys (squared distances are positive floats, whose bits
 /// sort as integers; packed with the index into one `u64`, which sorts about twice as fast as a
 /// pair with a comparator) and a reused buffer: this runs for a hundred clouds a frame.
+///
+/// Where `slots` already hold an order of the cloud's sprites (the one Wang's cache is
+/// replacing: the camera has moved a little since), the keys start in that order and an
+/// insertion sort puts right the few sprites that changed places: a handful of moves a sprite
+/// instead of a sort from scratch. Anything else in `slots` (a new cloud, another block's
+/// leftovers) is sorted from scratch; the result is the same either way.
 pub(super) fn order_into(
     offsets: &[Vec3],
     cam_local_m: Vec3,
@@ -205,15 +223,61 @@ pub(super) fn order_into(
     slots: &mut [u32],
     keys: &mut SortKeys,
 ) {
-    keys.clear();
-    keys.extend(offsets.iter().enumerate().map(|(i, offset)| {
-        let far = !offset.distance_squared(cam_local_m).to_bits();
+    let key = |i: usize| {
+        let far = !offsets[i].distance_squared(cam_local_m).to_bits();
         (u64::from(far) << 32) | i as u64
-    }));
-    keys.sort_unstable();
+    };
+    let n = offsets.len().min(slots.len());
+    let SortKeys { keys, seen } = keys;
+    keys.clear();
+    if holds_an_order(&slots[..n], base, seen) {
+        keys.extend(slots[..n].iter().map(|&s| key((s - base) as usize)));
+        // Past a few moves a sprite the camera has turned the cloud over: sorted afresh.
+        if !insertion_sort_within(keys, 4 * n) {
+            keys.sort_unstable();
+        }
+    } else {
+        keys.extend((0..n).map(key));
+        keys.sort_unstable();
+    }
     for (slot, &key) in slots.iter_mut().zip(keys.iter()) {
         *slot = base + key as u32;
     }
+}
+
+/// Whether `slots` hold each of `base..base + slots.len()` once (`seen`: scratch).
+fn holds_an_order(slots: &[u32], base: u32, seen: &mut Vec<u64>) -> bool {
+    let n = slots.len();
+    seen.clear();
+    seen.resize(n.div_ceil(64), 0);
+    slots.iter().all(|&s| {
+        let i = s.wrapping_sub(base) as usize;
+        if i >= n || seen[i / 64] & (1 << (i % 64)) != 0 {
+            return false;
+        }
+        seen[i / 64] |= 1 << (i % 64);
+        true
+    })
+}
+
+/// Sorts `v` by insertion while that takes at most `max_moves` moves; false (`v` part
+/// sorted, still holding every value) once it would take more.
+fn insertion_sort_within(v: &mut [u64], max_moves: usize) -> bool {
+    let mut moves = 0;
+    for i in 1..v.len() {
+        let x = v[i];
+        let mut j = i;
+        while j > 0 && v[j - 1] > x {
+            v[j] = v[j - 1];
+            j -= 1;
+        }
+        v[j] = x;
+        moves += i - j;
+        if moves > max_moves {
+            return false;
+        }
+    }
+    true
 }
 
 /// How much of a block a fade shows, 0..=1: its progress forming, what is left dissipating.
@@ -316,7 +380,7 @@ pub(super) fn main_view(
         lists,
         dirty_lists,
     } = copies;
-    let (mut scratch, mut keys) = (Vec::new(), Vec::new());
+    let (mut scratch, mut keys) = (Vec::new(), SortKeys::new());
     // Looked at again nearest first, so that the frame's sorting budget goes to what is near.
     let mut budget = budget;
     for (_, id) in order.iter().rev() {

@@ -135,6 +135,40 @@ fn sprites_of_one_cloud_are_ordered_back_to_front_by_both_sorts() {
     }
 }
 
+/// Sorting again from a cloud's previous order (the insertion sort of a camera that moved a
+/// little), from a far-off camera's (a full sort after too many moves) or from slots that hold
+/// no order of the cloud (duplicates, another block's slots) gives the order a fresh sort does.
+#[test]
+fn an_order_sorted_again_from_any_slots_is_the_fresh_order() {
+    let cloud = small_cloud();
+    let offsets: Vec<Vec3> = cloud.sprites.iter().map(|s| s.offset_m).collect();
+    let n = offsets.len();
+    let fresh = |cam: Vec3| {
+        let mut slots = vec![u32::MAX; n];
+        order_into(&offsets, cam, 100, &mut slots, &mut SortKeys::new());
+        slots
+    };
+    let mut keys = SortKeys::new();
+    let near = Vec3::new(30.0, -5.0, 2.0);
+    let moved = near + Vec3::new(0.7, 0.4, -0.2);
+    let opposite = -near;
+    let mut duplicates = vec![100u32; n];
+    duplicates[n - 1] = 101;
+    let elsewhere: Vec<u32> = (0..n as u32).map(|i| 5_000 + i).collect();
+    for (from, cam) in [
+        (fresh(near), moved),
+        (fresh(near), opposite),
+        (duplicates, moved),
+        (elsewhere, moved),
+    ] {
+        let mut slots = from;
+        order_into(&offsets, cam, 100, &mut slots, &mut keys);
+        assert_eq!(slots, fresh(cam), "camera {cam}");
+    }
+    // The moved camera's order differs from the first (the insertion sort had work to do).
+    assert_ne!(fresh(near), fresh(moved));
+}
+
 /// Blocks as far from the camera as each other (a camera on the corner of four blocks) come in
 /// the same order whatever ids they were given: the clouds stage hands ids out as its background
 /// generation finishes, in an order that differs from run to run, and the overlapping sprites of

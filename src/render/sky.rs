@@ -1271,6 +1271,28 @@ impl Sky {
         stats
     }
 
+    /// The frame bind group of a view: its frame uniform and the host's depth.
+    fn frame_group(
+        &self,
+        frame_buffer: &wgpu::Buffer,
+        depth_view: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
+        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sky.frame_group"),
+            layout: &self.frame_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: frame_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(depth_view),
+                },
+            ],
+        })
+    }
+
     /// Records the sky's passes into the host's encoder: sky background, then the ring, sprites
     /// and in-cloud fog, straight into the host's colour or, below full resolution, into the
     /// sky's cloud target composited over it (`cloud_target`; it follows the host's frame size).
@@ -1313,20 +1335,17 @@ impl Sky {
         if let Some(projection) = v.projection {
             self.targets.check_projection(projection)?;
         }
-        let frame_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sky.frame_group"),
-            layout: &self.frame_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: v.frame_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(depth_view),
-                },
-            ],
-        });
+        let frame_group = {
+            let mut kept = v.frame_group.borrow_mut();
+            match kept.as_ref().filter(|(depth, _)| depth == depth_view) {
+                Some((_, group)) => group.clone(),
+                None => {
+                    let group = self.frame_group(&v.frame_buffer, depth_view);
+                    *kept = Some((depth_view.clone(), group.clone()));
+                    group
+                }
+            }
+        };
         // The patch of changed orders, then the sky, the ring, the sprites a chunk at a time
         // (each built just before it is drawn; one pass when they fit one chunk), the in-cloud
         // fog.

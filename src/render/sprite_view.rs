@@ -132,6 +132,9 @@ pub(super) struct ViewBuffers {
     /// counts, the lock table after the header): one queue write instead of two, each a
     /// staging buffer of its own in wgpu (a few microseconds apiece).
     joined: Vec<u8>,
+    /// What the uniform buffer holds from its start (the header, then as much of the lock
+    /// table as was last written).
+    last_uniform: Vec<u8>,
 }
 
 /// A storage buffer that grows in powers of two.
@@ -205,6 +208,7 @@ impl ViewBuffers {
             group: None,
             external_generation: u64::MAX,
             joined: Vec::new(),
+            last_uniform: Vec::new(),
         }
     }
 
@@ -279,7 +283,18 @@ impl ViewBuffers {
             let table = bytemuck::cast_slice(&locks[..locks.len().min(MAX_LOCKS)]);
             self.joined.extend_from_slice(table);
         }
+        // The header stays the same over most frames (the light and the fades' settings): a
+        // queue write is a staging buffer of its own, so what the buffer holds is not sent
+        // again.
+        let held = self.last_uniform.len() >= self.joined.len()
+            && self.last_uniform[..self.joined.len()] == self.joined[..];
+        if held {
+            return bytes;
+        }
         queue.write_buffer(&self.uniform, 0, &self.joined);
+        let n = self.joined.len().max(self.last_uniform.len());
+        self.last_uniform.resize(n, 0);
+        self.last_uniform[..self.joined.len()].copy_from_slice(&self.joined);
         bytes + self.joined.len() as u64
     }
 

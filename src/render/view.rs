@@ -4,7 +4,7 @@
 //! stay the sky's, shared by every view. Several views are prepared and recorded into one
 //! encoder without overwriting each other's buffers: each writes only its own.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 use glam::Mat4;
 
@@ -61,6 +61,10 @@ pub(super) struct View {
     pub ring: ImpostorRing,
     /// Where the clouds are drawn: the host's colour (scale 1) or the off-screen cloud target.
     pub clouds: CloudTarget,
+    /// The frame bind group (the frame uniform and the host's depth) of the last recording,
+    /// with the depth view it was made for: a host that keeps its depth view from frame to
+    /// frame gets it again instead of a new one each frame.
+    pub frame_group: RefCell<Option<(wgpu::TextureView, wgpu::BindGroup)>>,
 }
 
 impl View {
@@ -108,6 +112,7 @@ impl View {
             in_cloud: 0.0,
             in_rain: 0.0,
             record: Cell::new(Spent::default()),
+            frame_group: RefCell::new(None),
             recorded: Cell::new(true),
             projection: None,
             ring,
