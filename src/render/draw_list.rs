@@ -360,20 +360,23 @@ pub(super) fn main_view(
     // A block out of view is not looked at again either: its slack check catches up with the
     // camera the frame it comes into view. Only the view's near blocks are looked up, not the
     // thousands held (most of them in the ring).
-    let mut order: Vec<(f64, &Resident)> = near
+    let mut order: Vec<(bool, f64, &Resident)> = near
         .iter()
         .filter_map(|id| blocks.get(id))
         .filter(|r| r.uploaded)
         .filter(|r| frustum.sees_sphere((r.centre_m() - camera_m).as_vec3(), r.radius_m as f32))
-        .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
+        .map(|r| (r.distant, (r.centre_m() - camera_m).length_squared(), r))
         .collect();
-    // Distant blocks (storm cells beyond the field) first: drawn behind the ring.
+    // Distant blocks (storm cells beyond the field) first: drawn behind the ring. The keys are
+    // copied out of the blocks: a comparison that reads a block costs a cache miss, and this
+    // sorts a few hundred blocks a frame.
     order.sort_by(|a, b| {
-        b.1.distant
-            .cmp(&a.1.distant)
-            .then_with(|| farthest_first(*a, *b))
+        b.0.cmp(&a.0)
+            .then_with(|| farthest_first((a.1, a.2), (b.1, b.2)))
     });
-    let order: Vec<(f64, u64)> = order.into_iter().map(|(d2, r)| (d2, r.block.id)).collect();
+    let order: Vec<(f64, u64)> = (order.into_iter())
+        .map(|(_, d2, r)| (d2, r.block.id))
+        .collect();
     let Copies {
         orders,
         dirty_orders,
@@ -879,6 +882,13 @@ fn inside_clouds(
             cam_local,
             settings.in_cloud.ramp_fraction,
         ));
+        // Most clouds whose sphere holds the camera (under a cumulus base) are not near
+        // enough any of their sprites for a lock or a shaft: their sprites are not read.
+        let reach = state.largest_half_side_m * lock_fraction.max(1.0);
+        let beyond = (cam_local - state.centres_centre_m).abs() - state.centres_half_m;
+        if beyond.max_element() > reach {
+            continue;
+        }
         if cloud.flat {
             continue;
         }

@@ -38,6 +38,12 @@ pub(super) struct CloudState {
     /// Half extents and centre offset of the box of its sprite cores (in-cloud fog).
     pub core_half_m: Vec3,
     pub core_centre_m: Vec3,
+    /// Half extents and centre offset of the box of its sprites' centres, and its largest
+    /// sprite's half side: a camera farther from that box than a lock's reach of that half side
+    /// (or the half side, if more) is within no sprite's facing lock nor rain shaft.
+    pub centres_half_m: Vec3,
+    pub centres_centre_m: Vec3,
+    pub largest_half_side_m: f32,
     /// First sprite slot (its order lives at the same slots of the order buffer).
     pub sprite_base: u32,
     /// Where its sprites' offsets start in the block's [`Resident::offsets`].
@@ -112,12 +118,16 @@ impl Resident {
             .iter()
             .map(|c| {
                 let (core_half_m, core_centre_m) = c.core_box_m();
+                let (centres_half_m, centres_centre_m, largest_half_side_m) = centres_box_m(c);
                 let state = CloudState {
                     centre_m: c.centre_m,
                     sprites: c.sprites.len() as u32,
                     radius_m: c.radius_m(),
                     core_half_m,
                     core_centre_m,
+                    centres_half_m,
+                    centres_centre_m,
+                    largest_half_side_m,
                     sprite_base: 0,
                     first_offset,
                     cloud_slot: 0,
@@ -208,6 +218,21 @@ impl Resident {
             .then(a.y.total_cmp(&b.y))
             .then(self.block.id.cmp(&other.block.id))
     }
+}
+
+/// The half extents and centre of the box of a cloud's sprite centres, and the largest half
+/// side of its sprites.
+fn centres_box_m(cloud: &SkyCloud) -> (Vec3, Vec3, f32) {
+    if cloud.sprites.is_empty() {
+        return (Vec3::ZERO, Vec3::ZERO, 0.0);
+    }
+    let (mut lo, mut hi, mut half) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN), 0.0f32);
+    for s in &cloud.sprites {
+        lo = lo.min(s.offset_m);
+        hi = hi.max(s.offset_m);
+        half = half.max(0.5 * s.width_m.max(s.height_m));
+    }
+    ((hi - lo) * 0.5, (hi + lo) * 0.5, half)
 }
 
 /// Two values as the low and high halves of a `u32` (WGSL's `pack2x16float`).
