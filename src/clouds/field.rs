@@ -131,6 +131,12 @@ impl BlockGenerator {
         });
     }
 
+    /// Runs `job` on the generator's pool (work that belongs beside the blocks' own, off the
+    /// caller's thread).
+    pub fn spawn(&self, job: impl FnOnce() + Send + 'static) {
+        self.pool.spawn(job);
+    }
+
     /// The blocks finished since the last call, without waiting for any.
     pub fn poll(&mut self) -> Vec<Generated> {
         let done: Vec<Generated> = self.rx.try_iter().collect();
@@ -596,6 +602,17 @@ impl CloudField {
         self.slots
             .get(&index)
             .map_or(&[][..], |s| s.generations.as_slice())
+    }
+
+    /// Runs `job` on the pool the blocks are generated on (work that belongs off the frame
+    /// thread beside theirs: the weather of the blocks ahead).
+    pub fn spawn(&self, job: impl FnOnce() + Send + 'static) {
+        self.generator.spawn(job);
+    }
+
+    /// The radius of the field: blocks within it of its centre exist, metres.
+    pub fn radius_m(&self) -> f64 {
+        self.config.field.radius_m
     }
 
     /// How far the air (and every cloud) has moved since time 0, metres east/north: add it to a

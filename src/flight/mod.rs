@@ -11,6 +11,7 @@
 //! between waypoints.
 
 pub mod air;
+mod block_weathers;
 mod far_cells;
 mod path;
 pub mod radar;

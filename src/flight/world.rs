@@ -23,6 +23,8 @@ use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
 use crate::weather::storms::{Flash, FlashKind, flashes_between};
 use crate::weather::{BlockIndex, BlockWeather};
+
+use super::block_weathers::BlockWeathers;
 use std::sync::Arc;
 
 /// Settings of the world (`render` and `fly` use the defaults; `bench` widens the cloud radius
@@ -99,7 +101,7 @@ impl From<&Cloud> for SkyCloud {
 /// as a [`World`] flies through it, and which of its generations the sky holds.
 pub struct LivingClouds {
     field: CloudField,
-    weather: HashMap<BlockIndex, BlockWeather>,
+    weather: BlockWeathers,
     /// The camera's air block, the drift's block and the field version when the blocks around
     /// were last asked for: asked again only when one changes.
     asked: Option<(BlockIndex, BlockIndex, u64)>,
@@ -121,7 +123,8 @@ pub struct LivingClouds {
 
 /// Weather field and cloud blocks around a reference point.
 pub struct World {
-    field: WeatherField,
+    /// Shared with the worker that works out the weather of the blocks ahead.
+    field: Arc<WeatherField>,
     types: CloudTypes,
     settings: WorldSettings,
     blocks: HashMap<BlockIndex, SkyBlock>,
@@ -145,7 +148,7 @@ impl World {
     /// The world of `field` (whose frame origin is the world's centre).
     pub fn new(field: WeatherField, settings: &WorldSettings) -> Self {
         Self {
-            field,
+            field: Arc::new(field),
             types: CloudTypes::builtin(),
             settings: *settings,
             blocks: HashMap::new(),
@@ -242,12 +245,10 @@ impl World {
     /// clouds of every block whose weather changed dissipate while the new ones form; unchanged
     /// blocks stay as they are.
     pub fn set_field(&mut self, field: WeatherField) {
-        let old = std::mem::replace(&mut self.field, field);
+        let old = std::mem::replace(&mut self.field, Arc::new(field));
+        // Block weathers are looked up again lazily, from the new field (the kept ones follow
+        // the version).
         self.field_version += 1;
-        // Block weathers are looked up again lazily, from the new field.
-        if let Some(living) = self.living.as_mut() {
-            living.weather.clear();
-        }
         let new = &self.field;
         self.blocks.retain(|&index, _| {
             !weather_changed(&old.block_weather(index), &new.block_weather(index))
@@ -353,7 +354,7 @@ impl World {
         self.clouds_config = config;
         self.living = Some(LivingClouds {
             field,
-            weather: HashMap::new(),
+            weather: BlockWeathers::default(),
             asked: None,
             in_sky: HashSet::new(),
             seen: HashSet::new(),
@@ -483,19 +484,21 @@ impl World {
             BlockIndex::containing(drift),
             self.field_version,
         );
+        let version = self.field_version;
         if living.asked != Some(key) {
             let cache = std::cell::RefCell::new(std::mem::take(&mut living.weather));
-            let weather = |index: BlockIndex| {
-                cache
-                    .borrow_mut()
-                    .entry(index)
-                    .or_insert_with(|| weather_field.block_weather(index))
-                    .clone()
-            };
+            let weather = |index: BlockIndex| cache.borrow_mut().get(weather_field, version, index);
             living.field.update(camera_m.truncate(), &weather);
             living.weather = cache.into_inner();
             living.asked = Some(key);
+            // The next row's weathers, off the frame thread before the camera brings it in.
+            let at = (camera_m.truncate() - drift, drift, living.field.radius_m());
+            let field = &living.field;
+            living
+                .weather
+                .ask_ahead(weather_field, version, at, |job| field.spawn(job));
         } else {
+            living.weather.take_ready(version);
             living.field.poll();
         }
         if self.synchronous_clouds {
