@@ -202,14 +202,18 @@ fn scattered_layer(
     let even = ctx.cover.is_uniform();
     // The share of sky to cover here (block metres), and its mean and greatest over the block.
     let share_at = |p: DVec2| (ctx.cover.oktas_at(p) as f64 / 8.0).clamp(0.0, 1.0);
+    let cell = BLOCK_SIZE_M / GRID as f64;
+    let shares: Vec<f64> = if even {
+        Vec::new()
+    } else {
+        (0..GRID * GRID)
+            .map(|c| share_at(DVec2::new((c % GRID) as f64 + 0.5, (c / GRID) as f64 + 0.5) * cell))
+            .collect()
+    };
     let (target, most, mean_oktas) = if even {
         let t = (layer.coverage_oktas as f64 / 8.0).clamp(0.0, 1.0);
         (t, t, layer.coverage_oktas)
     } else {
-        let cell = BLOCK_SIZE_M / GRID as f64;
-        let shares: Vec<f64> = (0..GRID * GRID)
-            .map(|c| share_at(DVec2::new((c % GRID) as f64 + 0.5, (c / GRID) as f64 + 0.5) * cell))
-            .collect();
         let t = shares.iter().sum::<f64>() / shares.len() as f64;
         (
             t,
@@ -262,7 +266,9 @@ fn scattered_layer(
         let (mut here, mut oktas) = (target, layer.coverage_oktas);
         if !even {
             here = share_at(centre - corner);
-            if rng.range_f64(0.0, 1.0) * most >= here {
+            if rng.range_f64(0.0, 1.0) * most >= here
+                || window_full(&grid, &shares, centre - corner)
+            {
                 continue;
             }
             d = size(here);
@@ -297,6 +303,28 @@ fn scattered_layer(
         out.push(cloud);
     }
     (covered as f64 / (GRID * GRID) as f64, boxes)
+}
+
+/// Cells either side of a candidate's cell in the window whose cover [`window_full`] weighs
+/// (1.2 km square: a few clouds wide).
+const WINDOW: usize = 6;
+
+/// Whether the coverage grid around `p` (block metres) is already covered as much as the
+/// `shares` of its cells ask: then a cloud there would overfill it (where the cover is high,
+/// clouds overlap and the covered share lags the cover; without this the block's mean was met
+/// with its cloudier side short).
+fn window_full(grid: &[bool], shares: &[f64], p: DVec2) -> bool {
+    let cell = BLOCK_SIZE_M / GRID as f64;
+    let at = |v: f64| ((v / cell).floor().max(0.0) as usize).min(GRID - 1);
+    let (x, y) = (at(p.x), at(p.y));
+    let (mut covered, mut wanted) = (0.0, 0.0);
+    for row in y.saturating_sub(WINDOW)..(y + WINDOW).min(GRID) {
+        for c in row * GRID + x.saturating_sub(WINDOW)..row * GRID + (x + WINDOW).min(GRID) {
+            covered += grid[c] as u8 as f64;
+            wanted += shares[c];
+        }
+    }
+    covered >= wanted
 }
 
 /// A sprite's dense core, the part that counts as cover: within 0.7 of its half extents, i.e.

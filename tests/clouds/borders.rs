@@ -39,7 +39,7 @@ const STRIP: i64 = 4;
 const MAX_STEP_OKTAS: f64 = 0.3;
 /// Seeds each block is generated with: the strips' shares are averaged over them, so that what
 /// is left is the cover the weather asks for there, not where one seed put its clouds.
-const SEEDS: usize = 8;
+const SEEDS: usize = 16;
 
 /// The 100 m world cells (east, north indices) under the dense cores of the clouds' sprites.
 fn covered_cells<'a>(clouds: impl Iterator<Item = &'a Cloud>) -> HashSet<(i64, i64)> {
