@@ -244,8 +244,12 @@ fn measure(place: &Place, reports: &[files::PlacedReport]) -> Vec<(&'static str,
     let mut out = Vec::new();
     for ((band, _), (border, control)) in bands.iter().zip(&diffs) {
         let (step, ctrl) = (systematic_step(border), systematic_step(control));
+        // Borders whose mean step over the seeds is an okta or more.
+        let mean = |d: &Vec<f64>| d.iter().sum::<f64>() / d.len() as f64;
+        let okta = border.iter().filter(|d| mean(d).abs() >= 1.0 / 8.0).count();
         eprintln!(
-            "{}: {band}: {} borders, step {:.2} oktas, control {:.2} oktas",
+            "{}: {band}: {} borders, step {:.2} oktas, control {:.2} oktas, {okta} borders \
+             of an okta or more",
             place.name,
             border.len(),
             8.0 * step,
