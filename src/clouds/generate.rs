@@ -34,6 +34,7 @@ use super::heap::heap_sprites;
 use super::rain::add_shafts;
 use super::rng::{SplitMix64, hash_keys};
 use super::storm::{CellCache, part_in_block};
+use super::uneven::{choose_by_cover, window_full};
 use crate::weather::storms::StormCell;
 use crate::weather::{
     BLOCK_SIZE_M, BlockCover, BlockIndex, BlockLayer, BlockWeather, CloudType, LayerCover,
@@ -42,9 +43,9 @@ use crate::weather::{
 
 /// Feet to metres.
 /// Cells per side of the coverage grid.
-const GRID: usize = 40;
+pub(super) const GRID: usize = 40;
 /// Layers at or above this coverage are placed on the lattice, whatever their type.
-const OVERCAST_OKTAS: f32 = 7.5;
+pub(super) const OVERCAST_OKTAS: f32 = 7.5;
 
 /// Generates the clouds of one block. Pure: equal inputs give byte-identical blocks. Its
 /// cumulonimbus layers are drawn as the block's own heaps: a block of the cloud field draws
@@ -305,28 +306,6 @@ fn scattered_layer(
     (covered as f64 / (GRID * GRID) as f64, boxes)
 }
 
-/// Cells either side of a candidate's cell in the window whose cover [`window_full`] weighs
-/// (1.2 km square: a few clouds wide).
-const WINDOW: usize = 6;
-
-/// Whether the coverage grid around `p` (block metres) is already covered as much as the
-/// `shares` of its cells ask: then a cloud there would overfill it (where the cover is high,
-/// clouds overlap and the covered share lags the cover; without this the block's mean was met
-/// with its cloudier side short).
-fn window_full(grid: &[bool], shares: &[f64], p: DVec2) -> bool {
-    let cell = BLOCK_SIZE_M / GRID as f64;
-    let at = |v: f64| ((v / cell).floor().max(0.0) as usize).min(GRID - 1);
-    let (x, y) = (at(p.x), at(p.y));
-    let (mut covered, mut wanted) = (0.0, 0.0);
-    for row in y.saturating_sub(WINDOW)..(y + WINDOW).min(GRID) {
-        for c in row * GRID + x.saturating_sub(WINDOW)..row * GRID + (x + WINDOW).min(GRID) {
-            covered += grid[c] as u8 as f64;
-            wanted += shares[c];
-        }
-    }
-    covered >= wanted
-}
-
 /// A sprite's dense core, the part that counts as cover: within 0.7 of its half extents, i.e.
 /// this fraction of its full width (and, flat, of its height) from its centre.
 const CORE_HALF_EXTENT: f64 = 0.35;
@@ -435,37 +414,6 @@ fn lattice_layer(index: BlockIndex, ctx: &LayerCtx, seed: u64, out: &mut Vec<Clo
         out.push(cloud);
     }
     (keep as f64 / cells.len().max(1) as f64, boxes)
-}
-
-/// Orders a block's lattice `cells` (key, column, row) by their key against the cover at each
-/// (`oktas_at` the cell): where it is overcast (at least [`OVERCAST_OKTAS`]) first, then the
-/// lowest key / cover first, so that a cell is kept about as often as the cover is there;
-/// returns how many to keep (the cells' covers added up, the overcast ones whole).
-fn choose_by_cover(cells: &mut [(u64, i64, i64)], oktas_at: impl Fn(i64, i64) -> f32) -> usize {
-    let mut wanted = 0.0;
-    let mut ranked: Vec<(bool, f64, (u64, i64, i64))> = Vec::with_capacity(cells.len());
-    for &c in cells.iter() {
-        let oktas = oktas_at(c.1, c.2);
-        let share = (oktas as f64 / 8.0).clamp(0.0, 1.0);
-        let overcast = oktas >= OVERCAST_OKTAS;
-        wanted += if overcast { 1.0 } else { share };
-        let key = c.0 as f64 / u64::MAX as f64;
-        let rank = if share > 0.0 {
-            key / share
-        } else {
-            f64::INFINITY
-        };
-        ranked.push((!overcast, rank, c));
-    }
-    ranked.sort_by(|a, b| {
-        (a.0.cmp(&b.0))
-            .then(a.1.total_cmp(&b.1))
-            .then(a.2.cmp(&b.2))
-    });
-    for (slot, r) in cells.iter_mut().zip(&ranked) {
-        *slot = r.2;
-    }
-    wanted.round() as usize
 }
 
 /// A sprite before texture, rotation and grouping: centre relative to the cloud's horizontal
