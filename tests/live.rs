@@ -202,6 +202,9 @@ fn fly_until_change(
 /// change or not (1.6x plain motion under a closed deck), which is not what these tests measure.
 const FIELD_RADIUS_M: f64 = 20_000.0;
 const DRAW_DISTANCE_M: f32 = (FIELD_RADIUS_M - 1.71 * BLOCK_SIZE_M) as f32;
+/// The blocks still in such a field, metres from the camera: the field holds the blocks within its
+/// radius of where the camera entered its block, at most a block's diagonal behind it.
+const STILL_IN_FIELD_M: f64 = FIELD_RADIUS_M - std::f64::consts::SQRT_2 * BLOCK_SIZE_M;
 
 /// Formation time of the rewrite test, seconds: a fifth of the shipped ten minutes, so the whole
 /// change fits a short test while each frame's fade stays as gentle as a simulator would see.
@@ -329,7 +332,7 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
         // end of the flight the camera has left them behind).
         let camera = flight.position().truncate();
         for (index, hashes) in before.iter().filter(|(i, _)| kept.contains(i)) {
-            if index.centre_m().distance(camera) > 10_000.0 {
+            if index.centre_m().distance(camera) > STILL_IN_FIELD_M {
                 continue;
             }
             let Some((_, v)) = hashes_now.iter().find(|(i, _)| i == index) else {
@@ -371,7 +374,7 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
     // Every block still inside the field is compared; only those behind the camera are not.
     let (mut checked_changed, mut checked_kept) = (0, 0);
     for (index, hashes) in &before {
-        if index.centre_m().distance(camera) > 10_000.0 {
+        if index.centre_m().distance(camera) > STILL_IN_FIELD_M {
             continue; // leaving the field: no longer updated
         }
         let Some((_, now)) = after.iter().find(|(i, _)| i == index) else {
@@ -391,7 +394,7 @@ fn a_rewritten_weather_file_changes_the_sky_without_a_pop_and_broken_files_keep_
     );
     let changed_in_field = changed
         .iter()
-        .filter(|i| i.centre_m().distance(camera) <= 10_000.0)
+        .filter(|i| i.centre_m().distance(camera) <= STILL_IN_FIELD_M)
         .count();
     assert_eq!(checked_changed, changed_in_field);
     assert!(checked_changed > 0 && checked_kept + kept_compared > 0);

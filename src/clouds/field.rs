@@ -29,7 +29,7 @@ use super::generate::{generate_block, generate_block_in_field};
 use super::lifecycle::{Phase, ends_at, phase_at};
 use super::storm::CellCache;
 use crate::weather::storms::{StormCell, StormContext, cells_over};
-use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockWeather, CloudType};
+use crate::weather::{BLOCK_SIZE_M, BlockCover, BlockIndex, BlockWeather, CloudType};
 
 /// A finished generation job.
 #[derive(Debug, Clone, PartialEq)]
@@ -202,9 +202,11 @@ pub fn blocks_within(centre_m: DVec2, radius_m: f64) -> Vec<BlockIndex> {
 }
 
 /// Whether two block weathers differ enough to re-form the clouds: a layer added or removed, a
-/// type changed, coverage by an okta or more, base or thickness by 300 ft or more.
+/// type changed, coverage by an okta or more (at the sample point or on the rim, see
+/// [`BlockCover::differs`]), base or thickness by 300 ft or more.
 pub fn weather_changed(a: &BlockWeather, b: &BlockWeather) -> bool {
-    a.layers.len() != b.layers.len()
+    BlockCover::differs(a.cover.as_ref(), b.cover.as_ref(), 1.0)
+        || a.layers.len() != b.layers.len()
         || a.layers.iter().zip(&b.layers).any(|(x, y)| {
             x.cloud_type != y.cloud_type
                 || (x.coverage_oktas - y.coverage_oktas).abs() >= 1.0

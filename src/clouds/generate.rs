@@ -13,6 +13,15 @@
 //!   lattice, seeded by the world cell, so neighbouring blocks agree and the layer runs on across
 //!   borders without a gap (clouds overhang their cell and block).
 //!
+//! The cover varies across the block as the weather says ([`LayerCover`]: the field at the
+//! block's sample point and rim, which the neighbours share), so a layer blends into the next
+//! block's instead of stepping at the border: scattered clouds stand where the cover is, as
+//! often as it is there (a candidate centre is kept with the chance cover / greatest cover, and
+//! placement stops at the block's mean cover), sized and packed by the cover where they stand;
+//! the lattice keeps a cell by its world key against the cover at the cell (the lowest
+//! key / cover first, as many as the cells' covers add up to). A block of even cover is
+//! generated as before, to the byte.
+//!
 //! Heights: base = ground elevation + base ft AGL x 0.3048; the thickness is the layer's, clamped
 //! into the type's range. Randomness: [`SplitMix64`] keyed by seed, block and layer (or world
 //! cell), with no trigonometry, so the block is the same bytes on every machine.
@@ -25,16 +34,18 @@ use super::heap::heap_sprites;
 use super::rain::add_shafts;
 use super::rng::{SplitMix64, hash_keys};
 use super::storm::{CellCache, part_in_block};
+use super::uneven::{choose_by_cover, window_full};
 use crate::weather::storms::StormCell;
 use crate::weather::{
-    BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, CloudType, METRES_PER_FOOT,
+    BLOCK_SIZE_M, BlockCover, BlockIndex, BlockLayer, BlockWeather, CloudType, LayerCover,
+    METRES_PER_FOOT,
 };
 
 /// Feet to metres.
 /// Cells per side of the coverage grid.
-const GRID: usize = 40;
+pub(super) const GRID: usize = 40;
 /// Layers at or above this coverage are placed on the lattice, whatever their type.
-const OVERCAST_OKTAS: f32 = 7.5;
+pub(super) const OVERCAST_OKTAS: f32 = 7.5;
 
 /// Generates the clouds of one block. Pure: equal inputs give byte-identical blocks. Its
 /// cumulonimbus layers are drawn as the block's own heaps: a block of the cloud field draws
@@ -90,7 +101,8 @@ fn generate_layers(
         layers: Vec::with_capacity(weather.layers.len()),
         clouds: Vec::new(),
     };
-    for (li, layer) in weather.layers.iter().enumerate() {
+    let layers = BlockCover::layers_over_block(weather.cover.as_ref(), &weather.layers);
+    for (li, (layer, cover)) in layers.iter().enumerate() {
         let config = types.get(layer.cloud_type);
         let frame = LayerFrame::new(layer, config, weather.ground_elevation_m as f64);
         let ctx = LayerCtx {
@@ -100,11 +112,12 @@ fn generate_layers(
             frame: &frame,
             // The only wind reported is the surface wind; high cloud streaks along it too.
             wind_axis_deg: 90.0 - weather.wind.from_deg as f64,
+            cover: *cover,
         };
         let first = block.clouds.len();
         // The field's cells are its cumulonimbus: no heaps of the block's own.
         let cells_instead = cells_decided && layer.cloud_type == CloudType::Cumulonimbus;
-        let (covered, boxes) = if layer.coverage_oktas <= 0.0 || cells_instead {
+        let (covered, boxes) = if cover.max_oktas() <= 0.0 || cells_instead {
             (0.0, 0)
         } else if config.continuous || layer.coverage_oktas >= OVERCAST_OKTAS {
             lattice_layer(index, &ctx, seed, &mut block.clouds)
@@ -186,15 +199,34 @@ fn scattered_layer(
         li as u64,
         type_key(layer.cloud_type),
     ]);
-    let target = (layer.coverage_oktas as f64 / 8.0).clamp(0.0, 1.0);
-    let budget = config.boxes_per_block.for_oktas(layer.coverage_oktas);
     let corner = index.min_corner_m();
+    let even = ctx.cover.is_uniform();
+    // The share of sky to cover here (block metres), and its mean and greatest over the block.
+    let share_at = |p: DVec2| (ctx.cover.oktas_at(p) as f64 / 8.0).clamp(0.0, 1.0);
+    let cell = BLOCK_SIZE_M / GRID as f64;
+    let shares: Vec<f64> = if even {
+        Vec::new()
+    } else {
+        (0..GRID * GRID)
+            .map(|c| share_at(DVec2::new((c % GRID) as f64 + 0.5, (c / GRID) as f64 + 0.5) * cell))
+            .collect()
+    };
+    let (target, most, mean_oktas) = if even {
+        let t = (layer.coverage_oktas as f64 / 8.0).clamp(0.0, 1.0);
+        (t, t, layer.coverage_oktas)
+    } else {
+        let t = shares.iter().sum::<f64>() / shares.len() as f64;
+        (
+            t,
+            shares.iter().fold(0.0, |m, &x| f64::max(m, x)),
+            (t * 8.0) as f32,
+        )
+    };
+    let budget = config.boxes_per_block.for_oktas(mean_oktas);
     let mut grid = vec![false; GRID * GRID];
     let mut covered = 0usize;
     let mut boxes = 0u32;
     let [dmin, dmax] = config.cloud_size_m.map(f64::from);
-    // Denser skies tolerate overlap; sparse ones keep clouds apart.
-    let min_new_share = if target > 0.6 { 0.15 } else { 0.5 };
     for _attempt in 0..2000 {
         let frac = covered as f64 / (GRID * GRID) as f64;
         if frac >= target || boxes >= budget {
@@ -203,20 +235,26 @@ fn scattered_layer(
         // Denser skies merge into bigger patches (and keep to the box budget).
         // (Sprites per box stay the same, so the patches of a scattered sky are looser than the
         // distinct heaps of a sparse one: Wang 2003 §6.3 has sparse 170 %, scattered 200 %.)
-        let mut d = rng.range_f64(dmin, dmax) * (1.0 + 3.0 * target * target);
+        let drawn = rng.range_f64(dmin, dmax);
         // Near the target, shrink the last clouds so they do not overshoot it.
         let remaining_m2 = (target - frac) * BLOCK_SIZE_M * BLOCK_SIZE_M;
-        let disc_m2 = std::f64::consts::FRAC_PI_4 * d * d;
         let streaks = config.flat && config.streak_length_over_width.is_some();
-        if !streaks && disc_m2 > remaining_m2 * 1.3 {
-            d = (remaining_m2 * 1.3 / std::f64::consts::FRAC_PI_4)
-                .sqrt()
-                .max(if config.anvil.is_some() {
-                    dmin
-                } else {
-                    dmin * 0.5
-                });
-        }
+        let size = |share: f64| {
+            let d = drawn * (1.0 + 3.0 * share * share);
+            let disc_m2 = std::f64::consts::FRAC_PI_4 * d * d;
+            if !streaks && disc_m2 > remaining_m2 * 1.3 {
+                (remaining_m2 * 1.3 / std::f64::consts::FRAC_PI_4)
+                    .sqrt()
+                    .max(if config.anvil.is_some() {
+                        dmin
+                    } else {
+                        dmin * 0.5
+                    })
+            } else {
+                d
+            }
+        };
+        let mut d = size(target);
         let margin = (d / 4.0).min(BLOCK_SIZE_M / 2.0);
         let centre = corner
             + DVec2::new(
@@ -224,7 +262,22 @@ fn scattered_layer(
                 rng.range_f64(margin, BLOCK_SIZE_M - margin),
             );
         let cloud_seed = rng.next_u64();
-        let (cloud, n_boxes) = build_cloud(ctx, centre, d, None, cloud_seed);
+        // Uneven cover: a centre is kept as often as the cover is there, and the cloud is as
+        // big, as dense and as packed as the cover there asks.
+        let (mut here, mut oktas) = (target, layer.coverage_oktas);
+        if !even {
+            here = share_at(centre - corner);
+            if rng.range_f64(0.0, 1.0) * most >= here
+                || window_full(&grid, &shares, centre - corner)
+            {
+                continue;
+            }
+            d = size(here);
+            oktas = (here * 8.0) as f32;
+        }
+        // Denser skies tolerate overlap; sparse ones keep clouds apart.
+        let min_new_share = if here > 0.6 { 0.15 } else { 0.5 };
+        let (cloud, n_boxes) = build_cloud(ctx, centre, d, None, oktas, cloud_seed);
         if streaks {
             // A streak bigger than the block's share is not shrunk to fit (every block would
             // get one dash of the same length, an even grid of them): it is drawn whole, as
@@ -328,14 +381,21 @@ fn lattice_layer(index: BlockIndex, ctx: &LayerCtx, seed: u64, out: &mut Vec<Clo
             cells.push((cell_key(ci, cj), ci, cj));
         }
     }
-    let fraction = (layer.coverage_oktas as f64 / 8.0).clamp(0.0, 1.0);
-    let keep = if layer.coverage_oktas >= OVERCAST_OKTAS {
-        cells.len()
-    } else {
-        (fraction * cells.len() as f64).round() as usize
-    };
     let mut chosen = cells.clone();
-    chosen.sort_unstable();
+    let keep = if ctx.cover.is_uniform() {
+        let fraction = (layer.coverage_oktas as f64 / 8.0).clamp(0.0, 1.0);
+        chosen.sort_unstable();
+        if layer.coverage_oktas >= OVERCAST_OKTAS {
+            cells.len()
+        } else {
+            (fraction * cells.len() as f64).round() as usize
+        }
+    } else {
+        choose_by_cover(&mut chosen, |ci, cj| {
+            let centre = DVec2::new((ci as f64 + 0.5) * s, (cj as f64 + 0.5) * s);
+            ctx.cover.oktas_at(centre - lo)
+        })
+    };
     chosen.truncate(keep);
     let mut boxes = 0;
     for &(key, ci, cj) in cells.iter().filter(|c| chosen.contains(c)) {
@@ -348,7 +408,8 @@ fn lattice_layer(index: BlockIndex, ctx: &LayerCtx, seed: u64, out: &mut Vec<Clo
         let [dmin, dmax] = config.cloud_size_m.map(f64::from);
         // Wide enough to cover the cell's corners.
         let d = rng.range_f64(dmin, dmax).max(s * 1.5);
-        let (cloud, n) = build_cloud(ctx, centre, d, Some(s), rng.next_u64());
+        let oktas = ctx.cover.oktas_at(centre - lo);
+        let (cloud, n) = build_cloud(ctx, centre, d, Some(s), oktas, rng.next_u64());
         boxes += n;
         out.push(cloud);
     }
@@ -371,8 +432,6 @@ pub(super) struct Raw {
     pub(super) category: Option<TextureCategory>,
 }
 
-/// Builds one cloud of `d` metres diameter centred (horizontally) at `centre`; returns the cloud
-/// and the number of boxes it used.
 /// What every cloud of one layer shares.
 pub(super) struct LayerCtx<'a> {
     pub(super) config: &'a CloudTypeConfig,
@@ -381,13 +440,18 @@ pub(super) struct LayerCtx<'a> {
     pub(super) frame: &'a LayerFrame,
     /// Direction of the wind's axis, degrees anticlockwise from east (streaks lie along it).
     pub(super) wind_axis_deg: f64,
+    /// The layer's own coverage over the block.
+    pub(super) cover: LayerCover,
 }
 
+/// Builds one cloud of `d` metres diameter centred (horizontally) at `centre`, as dense as a
+/// layer of `oktas`; returns the cloud and the number of boxes it used.
 fn build_cloud(
     ctx: &LayerCtx,
     centre: DVec2,
     d: f64,
     lattice_cell_m: Option<f64>,
+    oktas: f32,
     cloud_seed: u64,
 ) -> (Cloud, u32) {
     let LayerCtx { config, frame, .. } = *ctx;
@@ -401,7 +465,7 @@ fn build_cloud(
         Some(aspect) => along * v.x + along.perp() * (v.y / aspect as f64),
         None => v,
     };
-    let density = config.density_by_cover.for_oktas(ctx.layer.coverage_oktas) as f64;
+    let density = config.density_by_cover.for_oktas(oktas) as f64;
     // Heaped clouds stand on a flat base and end in a dome (or an anvil).
     if lattice_cell_m.is_none() && !config.continuous && !config.flat {
         let height = frame

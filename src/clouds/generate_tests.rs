@@ -20,6 +20,7 @@ fn weather(cloud_type: CloudType, oktas: f32, base_ft: f32, thickness_ft: f32) -
         precipitation: 0.0,
         thunder: 0.0,
         ground_elevation_m: 250.0,
+        cover: None,
     }
 }
 

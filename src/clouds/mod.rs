@@ -7,7 +7,8 @@
 //! - [`sheet`]: the 512 x 512 sheet of 16 procedural textures (3 foggy, 1 flat-bottomed, 6 wispy,
 //!   6 puffy, §3.2) with its mip chain down to 32 x 32, computed cell by cell.
 //! - [`generate`]: [`generate_block`], a pure function of (block index, block weather, seed):
-//!   clouds are boxes filled with random sprite centres, then culled (§3.1).
+//!   clouds are boxes filled with random sprite centres, then culled (§3.1); a layer whose
+//!   cover varies over its block is filled to the cover at each place (module `uneven`).
 //! - [`lifecycle`]: formation and dissipation as a per-sprite `alpha_morph` (§4).
 //! - [`field`]: [`CloudField`], the blocks around a point: background generation, weather changes
 //!   that dissipate old clouds while new ones form, and drift with the wind.
@@ -34,6 +35,7 @@ pub mod rng;
 pub mod sheet;
 mod sight;
 pub mod storm;
+mod uneven;
 
 pub use block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};
 pub use config::{CloudTypeConfig, CloudTypes, CloudsConfig, LifecycleConfig, TextureCategory};

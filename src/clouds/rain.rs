@@ -149,6 +149,7 @@ mod tests {
             precipitation,
             thunder: 0.0,
             ground_elevation_m: 100.0,
+            cover: None,
         }
     }
 

@@ -26,7 +26,7 @@ use super::heap::BASE_CENTRE_FRACTION;
 use super::rain::add_shafts;
 use super::rng::SplitMix64;
 use crate::weather::storms::StormCell;
-use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, TypeSource};
+use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, LayerCover, TypeSource};
 
 /// Keys the randomness of a cell's drawing apart from its placement.
 const DRAW_KEY: u64 = 0x6472_6177;
@@ -77,6 +77,7 @@ pub fn cell_cloud(cell: &StormCell, config: &CloudTypeConfig, weather: &BlockWea
         li: 0,
         frame: &frame,
         wind_axis_deg: 0.0,
+        cover: LayerCover::uniform(0.0),
     };
     let mut cloud = finish_cloud(&ctx, cell.centre(), kept, &mut rng);
     // The anvil is a veil of ice, thinner than the tower: its sprites half as opaque (two or

@@ -7,6 +7,7 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+use super::block_cover::BlockCover;
 use super::cloud_type::CloudType;
 
 /// Side of a block, metres (Wang 2003: 16 km2 blocks).
@@ -174,6 +175,10 @@ pub struct BlockWeather {
     pub thunder: f32,
     /// Ground elevation under the block, metres above mean sea level (from station elevations).
     pub ground_elevation_m: f32,
+    /// How the layers' cover varies across the block ([`BlockCover`]): what the field gives at
+    /// the block's rim. `None` (the weather at a point, a theme's block): the same everywhere.
+    #[serde(default)]
+    pub cover: Option<BlockCover>,
 }
 
 /// The sky covered seen from below at `height_ft` AGL, oktas: the layers with their base at or

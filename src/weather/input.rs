@@ -112,7 +112,15 @@ mod tests {
         let field = field_at(&input, 47.0, 11.0);
         let here = field.block_weather(BlockIndex::new(0, 0));
         let far = field.block_weather(BlockIndex::new(40, -25));
-        assert_eq!(here, far);
+        // The same but where the block is sampled (the theme's one place is in block (0, 0)).
+        let rims = |w: &crate::weather::BlockWeather| {
+            w.cover
+                .as_ref()
+                .map(|c| (c.rim.clone(), c.rim_only.clone()))
+        };
+        assert_eq!(rims(&here), rims(&far));
+        assert_eq!(here.layers, far.layers);
+        assert_eq!((here.visibility_m, here.wind), (far.visibility_m, far.wind));
         let types: Vec<_> = here
             .layers
             .iter()

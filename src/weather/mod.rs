@@ -3,10 +3,12 @@
 //! `metar` decodes reports; `files` reads bulk files (the aviation weather service's
 //! `metars.cache.csv`, NOAA cycle files, plain METAR lines) and places them with `stations`;
 //! `field` triangulates the placed reports (spade, Delaunay) and interpolates by natural
-//! neighbours; `block` holds the per-block result the clouds stage consumes.
+//! neighbours; `block` holds the per-block result the clouds stage consumes, `block_cover` how its
+//! cover varies across the block.
 
 pub mod air;
 pub mod block;
+pub mod block_cover;
 pub mod cloud_type;
 pub mod error;
 pub mod field;
@@ -25,6 +27,7 @@ pub mod winds_aloft;
 pub use block::{
     BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, METRES_PER_FOOT, TypeSource, Wind,
 };
+pub use block_cover::{BlockCover, LayerCover, RimLayer};
 pub use cloud_type::CloudType;
 pub use error::{LineWarning, SkipCount, Skipped, WarningKind, WeatherError};
 pub use field::{CloudTypeRule, FieldSettings, WeatherField};

@@ -2,5 +2,6 @@
 //! METARs through the weather and clouds stages; `cli` runs `skycast sheet`, `preview` and
 //! `block`.
 
+mod borders;
 mod cli;
 mod scenarios;

@@ -276,11 +276,16 @@ fn at_station(id: &str) -> skycast::weather::BlockWeather {
         &FieldSettings::default(),
         &CloudTypeRule::default(),
     );
-    // The block that holds the station, as the clouds stage asks for it.
+    // The block that holds the station, as the clouds stage asks for it: the weather at the
+    // station, and besides it the cover at the block's rim.
     let block =
         field.block_weather(frame.block_of(p.position.latitude_deg, p.position.longitude_deg));
+    assert!(block.cover.is_some());
     assert_eq!(
-        block,
+        skycast::weather::BlockWeather {
+            cover: None,
+            ..block.clone()
+        },
         field.weather_at_lat_lon(p.position.latitude_deg, p.position.longitude_deg)
     );
     block

@@ -16,9 +16,11 @@
 //! blended by their weights, and the covers follow the summation principle (`layers`). A block
 //! that holds a station is sampled at the station, not at its centre, so it is that station's
 //! report. Layer types come from [`CloudTypeRule`], vertical extents from the settings.
-//! Settings: `config/weather_field.toml`.
+//! The block also carries its layers' cover at its rim ([`crate::weather::BlockCover`], `rim`),
+//! so that its clouds blend into the neighbours'. Settings: `config/weather_field.toml`.
 
 mod layers;
+mod rim;
 mod rule;
 mod sample;
 mod settings;
@@ -35,6 +37,7 @@ use glam::DVec2;
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 
 use super::block::{BlockIndex, BlockLayer, BlockWeather, Obscuration, Wind};
+use super::block_cover::RIM_POINTS_M;
 use super::files::PlacedReport;
 use super::frame::LocalFrame;
 use super::theme::Theme;
@@ -195,9 +198,21 @@ impl WeatherField {
     }
 
     /// The weather of a block: queried at the station it holds (so the block is that station's
-    /// report), else at its centre.
+    /// report), else at its centre; with its layers' cover at the block's rim
+    /// ([`BlockWeather::cover`]), which the blocks sharing a side share.
     pub fn block_weather(&self, block: BlockIndex) -> BlockWeather {
-        self.weather_at(self.block_sample_point_m(block))
+        let sample = self.block_sample_point_m(block);
+        let mut weather = self.weather_at(sample);
+        let corner = block.min_corner_m();
+        let rim = RIM_POINTS_M.map(|p| self.layers_only_at(corner + p));
+        let sample_m = (sample - corner).as_vec2().to_array();
+        weather.cover = Some(rim::block_cover(
+            &weather.layers,
+            &rim,
+            sample_m,
+            &self.settings,
+        ));
+        weather
     }
 
     /// Where [`Self::block_weather`] samples a block, local metres: the station in it (a sky
@@ -231,8 +246,15 @@ impl WeatherField {
         (self.weather_with(point_m, &w), gust, qnh)
     }
 
-    /// The weather at `point_m` from the surface stations' weights `w` there.
-    fn weather_with(&self, point_m: DVec2, w: &Weights) -> BlockWeather {
+    /// The cloud layers at a local point: the layers of [`Self::weather_at`] alone.
+    fn layers_only_at(&self, point_m: DVec2) -> Vec<BlockLayer> {
+        let (surface, _) = self.surface_with(&weights(&self.surface, point_m));
+        self.layers_at(point_m, surface)
+    }
+
+    /// The surface facts the layers depend on, and the dewpoint, from the surface stations'
+    /// weights `w`.
+    fn surface_with(&self, w: &Weights) -> (layers::Surface, f64) {
         let d = &self.settings.defaults;
         let value = |f: &dyn Fn(&StationSample) -> Option<f64>, default: f64| {
             weighted(w, &self.samples, f).unwrap_or(default)
@@ -240,15 +262,26 @@ impl WeatherField {
         let temperature_c = value(&|s| s.temperature_c, d.temperature_c);
         let dewpoint_c = value(&|s| s.dewpoint_c, d.dewpoint_c);
         let precipitation = value(&|s| Some(s.precipitation), 0.0);
-        let thunder = value(&|s| Some(s.thunder), 0.0);
-        let east = value(&|s| s.wind_kt.map(|v| v[0]), 0.0);
-        let north = value(&|s| s.wind_kt.map(|v| v[1]), 0.0);
-        let wind = wind_from_velocity_kt(east, north);
         let surface = layers::Surface {
             precipitation,
             temperature_c,
             spread_c: temperature_c - dewpoint_c,
         };
+        (surface, dewpoint_c)
+    }
+
+    /// The weather at `point_m` from the surface stations' weights `w` there.
+    fn weather_with(&self, point_m: DVec2, w: &Weights) -> BlockWeather {
+        let d = &self.settings.defaults;
+        let value = |f: &dyn Fn(&StationSample) -> Option<f64>, default: f64| {
+            weighted(w, &self.samples, f).unwrap_or(default)
+        };
+        let (surface, dewpoint_c) = self.surface_with(w);
+        let (temperature_c, precipitation) = (surface.temperature_c, surface.precipitation);
+        let thunder = value(&|s| Some(s.thunder), 0.0);
+        let east = value(&|s| s.wind_kt.map(|v| v[0]), 0.0);
+        let north = value(&|s| s.wind_kt.map(|v| v[1]), 0.0);
+        let wind = wind_from_velocity_kt(east, north);
         BlockWeather {
             layers: self.layers_at(point_m, surface),
             visibility_m: value(&|s| s.visibility_m, d.visibility_m) as f32,
@@ -259,6 +292,7 @@ impl WeatherField {
             precipitation: precipitation as f32,
             thunder: thunder as f32,
             ground_elevation_m: value(&|s| s.elevation_m, d.ground_elevation_m) as f32,
+            cover: None,
         }
     }
 

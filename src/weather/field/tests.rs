@@ -238,6 +238,12 @@ fn a_block_without_a_station_is_the_field_at_its_centre() {
     let block = f.frame().block_of(49.6, 8.0);
     let centre = DVec2::new(block.i as f64 + 0.5, block.j as f64 + 0.5) * 4000.0;
     let w = f.block_weather(block);
+    let cover = w
+        .cover
+        .clone()
+        .expect("a block's weather has its cover at the rim");
+    assert_eq!(cover.sample_m, [2000.0, 2000.0]);
+    let w = BlockWeather { cover: None, ..w };
     assert_eq!(w, f.weather_at(centre));
     assert_ne!(w, f.weather_at(centre + DVec2::splat(1900.0)));
     assert_ne!(w, f.weather_at(DVec2::ZERO));
@@ -398,7 +404,14 @@ fn a_block_that_holds_a_station_is_its_report() {
     for (lat, lon) in [(49.5, 7.3), (50.0, 8.0), (50.5, 8.7)] {
         let block = f.frame().block_of(lat, lon);
         let at_station = f.weather_at_lat_lon(lat, lon);
-        assert_eq!(f.block_weather(block), at_station, "{lat},{lon}");
+        let w = f.block_weather(block);
+        let sample = f.block_sample_point_m(block) - block.min_corner_m();
+        let cover = w
+            .cover
+            .clone()
+            .expect("a block's weather has its cover at the rim");
+        assert_eq!(cover.sample_m, sample.as_vec2().to_array());
+        assert_eq!(BlockWeather { cover: None, ..w }, at_station, "{lat},{lon}");
         assert_ne!(f.block_sample_point_m(block), block.centre_m());
     }
 }
