@@ -303,7 +303,7 @@ impl FarCells {
                 .entry(block)
                 .or_insert_with(|| {
                     last.remove(&block)
-                        .unwrap_or_else(|| f.weather.block_weather(block))
+                        .unwrap_or_else(|| f.weather.block_layers_weather(block))
                 })
                 .clone()
         };
@@ -360,7 +360,7 @@ impl FarCells {
 fn far_block(id: u64, cell: &StormCell, f: &FarCellFrame, s: &FarCellSettings) -> SkyBlock {
     let weather = f
         .weather
-        .block_weather(BlockIndex::containing(cell.centre() + f.drift_m));
+        .block_layers_weather(BlockIndex::containing(cell.centre() + f.drift_m));
     let cloud = far_cell_cloud(
         cell,
         f.types.get(CloudType::Cumulonimbus),
@@ -439,6 +439,7 @@ mod tests {
             let near = cells_over(
                 c.centre() - square,
                 c.centre() + square,
+                // The near field's blocks carry their rim cover: the same cells.
                 &mut |p| weather.block_weather(BlockIndex::containing(p)),
                 &ctx,
                 SEED,
