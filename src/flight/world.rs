@@ -22,7 +22,7 @@ use crate::render::{RenderError, Sky, SpriteSheet, Stopwatch};
 use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
 use crate::weather::storms::{Flash, FlashKind, flashes_between};
-use crate::weather::{BlockIndex, BlockWeather};
+use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockWeather};
 
 use super::block_weathers::BlockWeathers;
 use std::sync::Arc;
@@ -487,7 +487,18 @@ impl World {
         let version = self.field_version;
         if living.asked != Some(key) {
             let cache = std::cell::RefCell::new(std::mem::take(&mut living.weather));
-            let weather = |index: BlockIndex| cache.borrow_mut().get(weather_field, version, index);
+            // The field's own blocks take their cover at the rim; the storm cells it decides
+            // reach well beyond them (a square and an anvil's reach around the radius), and a
+            // storm reads a block's layers alone, at a tenth of the cost.
+            let own_m = living.field.radius_m() + 2.0 * BLOCK_SIZE_M;
+            let ground_m = camera_m.truncate();
+            let weather = |index: BlockIndex| {
+                if (index.centre_m() - ground_m).length() <= own_m {
+                    cache.borrow_mut().get(weather_field, version, index)
+                } else {
+                    weather_field.block_layers_weather(index)
+                }
+            };
             living.field.update(camera_m.truncate(), &weather);
             living.weather = cache.into_inner();
             living.asked = Some(key);
