@@ -28,7 +28,8 @@ use std::cell::RefCell;
 
 use super::gpu_types::GpuSpriteVertex;
 use super::pipeline::{
-    PassDesc, SceneDepth, background_test, pipeline, pipeline_with_depth, premultiplied_over,
+    PassDesc, SceneDepth, background_test, frame_group, pipeline, pipeline_with_depth,
+    premultiplied_over,
 };
 
 /// The cloud target's colour: premultiplied linear RGBA in half floats. Eight-bit channels band
@@ -400,20 +401,13 @@ impl Offscreen {
         let colour = make("clouds.colour", CLOUD_COLOUR_FORMAT);
         let distance = make("clouds.distance", CLOUD_DISTANCE_FORMAT);
         let farthest = make("clouds.farthest_distance", FARTHEST_DISTANCE_FORMAT);
-        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("clouds.frame_group"),
-            layout: &self.frame_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: frame_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&farthest),
-                },
-            ],
-        });
+        let frame_group = frame_group(
+            device,
+            "clouds.frame_group",
+            &self.frame_layout,
+            frame_buffer,
+            &farthest,
+        );
         let composite_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("clouds.composite_group"),
             layout: &self.composite_layout,

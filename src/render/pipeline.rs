@@ -10,6 +10,32 @@ const SHARED_WGSL: &str = include_str!("../../shaders/shared/frame.wgsl");
 /// The shared WGSL's binding of the host's depth, single-sampled.
 const SINGLE_DEPTH: &str = "var scene_depth: texture_2d<f32>;";
 
+/// Group 0 of `shaders/shared/frame.wgsl` under `layout`: the frame uniform `frame_buffer` and
+/// the scene depth `depth_view` (the host's, the cloud target's farthest distance, or an
+/// impostor's empty scene).
+pub(super) fn frame_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    frame_buffer: &wgpu::Buffer,
+    depth_view: &wgpu::TextureView,
+) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: frame_buffer.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(depth_view),
+            },
+        ],
+    })
+}
+
 /// What a pass's `scene_depth` (group 0 of `shaders/shared/frame.wgsl`) holds, and so how its
 /// shader reads it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

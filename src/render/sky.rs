@@ -29,7 +29,8 @@ use super::impostor::RingFrame;
 use super::overhead_ease::OverheadEase;
 use super::pass_timing::{STAMPS, Stamp};
 use super::pipeline::{
-    PassDesc, SceneDepth, background_test, pipeline, pipeline_with_depth, premultiplied_over,
+    PassDesc, SceneDepth, background_test, frame_group, pipeline, pipeline_with_depth,
+    premultiplied_over,
 };
 use super::resident::{ResidentSet, quad_index_buffer};
 use super::scatter::Scatter;
@@ -1271,28 +1272,6 @@ impl Sky {
         stats
     }
 
-    /// The frame bind group of a view: its frame uniform and the host's depth.
-    fn frame_group(
-        &self,
-        frame_buffer: &wgpu::Buffer,
-        depth_view: &wgpu::TextureView,
-    ) -> wgpu::BindGroup {
-        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sky.frame_group"),
-            layout: &self.frame_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: frame_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(depth_view),
-                },
-            ],
-        })
-    }
-
     /// Records the sky's passes into the host's encoder: sky background, then the ring, sprites
     /// and in-cloud fog, straight into the host's colour or, below full resolution, into the
     /// sky's cloud target composited over it (`cloud_target`; it follows the host's frame size).
@@ -1340,7 +1319,13 @@ impl Sky {
             match kept.as_ref().filter(|(depth, _)| depth == depth_view) {
                 Some((_, group)) => group.clone(),
                 None => {
-                    let group = self.frame_group(&v.frame_buffer, depth_view);
+                    let group = frame_group(
+                        &self.device,
+                        "sky.frame_group",
+                        &self.frame_layout,
+                        &v.frame_buffer,
+                        depth_view,
+                    );
                     *kept = Some((depth_view.clone(), group.clone()));
                     group
                 }

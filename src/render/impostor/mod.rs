@@ -41,7 +41,7 @@ use layout::{impostor_camera, sectors_of};
 use super::build::{SpriteBuild, chunks};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuRing, GpuSpriteVertex};
 use super::id_hash::IdSet;
-use super::pipeline::{PassDesc, SceneDepth, pipeline, premultiplied_over};
+use super::pipeline::{PassDesc, SceneDepth, frame_group, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
 use super::settings::VertexCacheSettings;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
@@ -402,20 +402,13 @@ impl ImpostorRing {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
-            slot_groups.push(device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("ring.frame_group"),
-                layout: shared.frame_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&no_scene_view),
-                    },
-                ],
-            }));
+            slot_groups.push(frame_group(
+                device,
+                "ring.frame_group",
+                shared.frame_layout,
+                &buffer,
+                &no_scene_view,
+            ));
             bytes += buffer.size();
             slot_frames.push(buffer);
         }
