@@ -113,10 +113,10 @@ pub struct LivingClouds {
     /// Generations fading in as they arrive (see [`WorldSettings::arrival_fade_s`]), with the
     /// field time they arrived at.
     arriving: HashMap<u64, f64>,
-    /// Generations forming or dissipating this frame and the last (serial and phase), by
-    /// serial.
-    fading: Vec<(u64, Phase)>,
-    was_fading: Vec<(u64, Phase)>,
+    /// Generations forming or dissipating this frame and the last (serial, phase and the step
+    /// of the fade the sky was last given, see [`fade_step`]), by serial.
+    fading: Vec<(u64, Phase, FadeStep)>,
+    was_fading: Vec<(u64, Phase, FadeStep)>,
     /// Storm cells beyond the field, drawn whole.
     far_cells: super::far_cells::FarCells,
 }
@@ -555,14 +555,19 @@ impl World {
         // circle's building cumulus fade for minutes).
         if same_members && living.arriving.is_empty() {
             living.fading.clear();
-            for &(serial, phase) in &living.was_fading {
+            for &(serial, phase, shown) in &living.was_fading {
                 // The phase moves on with time alone (as `CloudField::advance` moves it); one
                 // that ended (gone) would have changed the membership.
                 let phase = phase_at(phase, now, &lifecycle);
                 let fade = fade_of(phase, None, now, &lifecycle);
-                sky.set_block_fade(serial, fade);
+                // Told only when it has moved on a step: a weather change's thousand forming
+                // generations were a thousand look-ups of the sky's blocks every frame.
+                let step = fade_step(serial, fade);
+                if step != shown {
+                    sky.set_block_fade(serial, fade);
+                }
                 if fade != Fade::Steady {
-                    living.fading.push((serial, phase));
+                    living.fading.push((serial, phase, step));
                 }
             }
             std::mem::swap(&mut living.was_fading, &mut living.fading);
@@ -617,13 +622,15 @@ impl World {
                 sky.set_block_fade(fb.serial, fade);
             }
             if fade != Fade::Steady {
-                living.fading.push((fb.serial, fb.phase));
+                living
+                    .fading
+                    .push((fb.serial, fb.phase, fade_step(fb.serial, fade)));
             }
         }
         sky.insert_blocks(joined);
         // The ones that finished forming since the last frame.
         living.fading.sort_unstable_by_key(|f| f.0);
-        for &(id, _) in &living.was_fading {
+        for &(id, _, _) in &living.was_fading {
             if living.fading.binary_search_by_key(&id, |f| f.0).is_err() {
                 sky.set_block_fade(id, Fade::Steady);
             }
@@ -668,6 +675,28 @@ pub fn block_id(index: BlockIndex) -> u64 {
     ((index.i as u32 as u64) << 32) | index.j as u32 as u64
 }
 
+/// Steps of a fade's progress (0 to 1) that the sky is told of. A step is 1/1024 of a
+/// formation (0.6 s of the shipped 10 minutes): its change of opacity is a quarter of what an
+/// 8-bit colour can show.
+const FADE_STEPS: f64 = 1024.0;
+
+/// A fade's kind (0 steady, 1 forming, 2 dissipating) and which of its [`FADE_STEPS`] its
+/// progress is at.
+type FadeStep = (u8, i64);
+
+/// The step of `fade` for generation `serial`. The steps of each generation are shifted by a
+/// fraction of a step of its own (from its serial), so that generations that began to fade
+/// together (every block around after a weather change) do not all step in the same frame.
+fn fade_step(serial: u64, fade: Fade) -> FadeStep {
+    let shift = (serial.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 11) as f64 / (1u64 << 53) as f64;
+    let at = |p: f32| (f64::from(p) * FADE_STEPS + shift).floor() as i64;
+    match fade {
+        Fade::Steady => (0, 0),
+        Fade::Forming(p) => (1, at(p)),
+        Fade::Dissipating(p) => (2, at(p)),
+    }
+}
+
 /// How a generation in `phase` is drawn at field time `now_s`: forming, dissipating or steady,
 /// or fading in by `arrival` (0..1) as it arrives.
 fn fade_of(phase: Phase, arrival: Option<f32>, now_s: f64, lifecycle: &LifecycleConfig) -> Fade {
@@ -678,5 +707,76 @@ fn fade_of(phase: Phase, arrival: Option<f32>, now_s: f64, lifecycle: &Lifecycle
         }
         Phase::Dissipating { .. } => Fade::Dissipating(progress(phase, now_s, lifecycle)),
         Phase::Gone => Fade::Dissipating(1.0),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// How opaque a block with `fade` is drawn as a whole (the renderer's own measure).
+    fn opacity(fade: Fade) -> f32 {
+        match fade {
+            Fade::Steady => 1.0,
+            Fade::Forming(p) => p,
+            Fade::Dissipating(q) => 1.0 - q,
+        }
+    }
+
+    /// A formation of 10 minutes seen at 60 frames a second: the fade the sky holds is never
+    /// more than a step behind the field's, and it is told about once a step, not every frame.
+    #[test]
+    fn a_fade_is_handed_over_a_step_at_a_time_and_never_lags_a_step() {
+        let lifecycle = crate::clouds::config::CloudsConfig::builtin().lifecycle;
+        let phase = Phase::Forming { since_s: 0.0 };
+        let frames = (f64::from(lifecycle.formation_s) * 60.0) as usize;
+        let (mut told, mut shown, mut shown_step) = (0, Fade::Forming(0.0), (9, 0));
+        for k in 0..=frames {
+            let now = k as f64 / 60.0;
+            let fade = fade_of(phase_at(phase, now, &lifecycle), None, now, &lifecycle);
+            let step = fade_step(7, fade);
+            if step != shown_step {
+                (told, shown, shown_step) = (told + 1, fade, step);
+            }
+            let behind = opacity(fade) - opacity(shown);
+            assert!(
+                (0.0..=1.0 / FADE_STEPS as f32 + 1e-6).contains(&behind),
+                "frame {k}: {behind}"
+            );
+        }
+        assert_eq!(shown, Fade::Steady);
+        assert!((1024..=1026).contains(&told), "{told} of {frames} frames");
+    }
+
+    /// A thousand generations that begin to form in the same frame (a weather change) step in
+    /// different frames: no frame tells the sky of much more than its share.
+    #[test]
+    fn generations_that_fade_together_step_in_different_frames() {
+        let lifecycle = crate::clouds::config::CloudsConfig::builtin().lifecycle;
+        let phase = Phase::Forming { since_s: 0.0 };
+        let serials: Vec<u64> = (1000..2000).collect();
+        let mut last: Vec<FadeStep> = serials
+            .iter()
+            .map(|&s| fade_step(s, Fade::Forming(0.0)))
+            .collect();
+        // 10 frames a second: about 10 steps of 1,024 per 6 s, 0.17 a frame for each generation.
+        let (mut most, mut all) = (0, 0);
+        for k in 1..=600 {
+            let now = k as f64 / 10.0;
+            let fade = fade_of(phase_at(phase, now, &lifecycle), None, now, &lifecycle);
+            let mut told = 0;
+            for (s, l) in serials.iter().zip(&mut last) {
+                let step = fade_step(*s, fade);
+                told += (step != *l) as usize;
+                *l = step;
+            }
+            (most, all) = (most.max(told), all + told);
+        }
+        let share = all as f64 / 600.0;
+        assert!((100.0..250.0).contains(&share), "{share} a frame");
+        assert!(
+            (most as f64) < 2.0 * share,
+            "{most} in one frame, {share} a frame on average"
+        );
     }
 }
