@@ -62,6 +62,8 @@ struct RingState {
     /// Mean distance of those blocks from the centre (the ring radius if none), metres: the
     /// first guess of the ring pass's depth reprojection.
     far_mean_m: f64,
+    /// Which build made it (the ring's count of builds then).
+    build: u64,
 }
 
 struct Build {
@@ -130,6 +132,9 @@ pub struct ImpostorRing {
     /// The ids of the blocks this view draws as sprites (held, not in the ring), as of the last
     /// pass over every block: what the view's draw list looks at, not the thousands held.
     near: Vec<u64>,
+    /// What `near` was found with: the blocks' changes and the build of the ring whose blocks
+    /// it leaves out. While both stand it stands, through builds and crossfades.
+    near_of: Option<(u64, Option<u64>)>,
 }
 
 /// What a pass over every block found while the ring was steady (shown, no build, no fade),
@@ -146,7 +151,6 @@ struct SplitCheck {
     drift_m: DVec3,
     far_now: usize,
     same: bool,
-    far_count: u32,
 }
 
 const SPRITES_WGSL: &str = include_str!("../../../shaders/sprites.wgsl");
@@ -442,6 +446,7 @@ impl ImpostorRing {
             clock_s: 0.0,
             builds: 0,
             last_split: None,
+            near_of: None,
             near: Vec::new(),
         }
     }
@@ -519,6 +524,7 @@ impl ImpostorRing {
         let blocks = &mut resident.blocks;
         self.blocks_far = 0;
         if !s.enabled {
+            self.near_of = None;
             self.near.clear();
             self.near.extend(blocks.keys());
             return;
@@ -541,7 +547,6 @@ impl ImpostorRing {
         let steady_shown = self.fade.is_none() && self.build.is_none();
         let mut far_now = 0;
         let mut same = true;
-        let mut far_count = 0;
         let slack_m = 0.1 * s.rebuild_move_fraction.min(s.rebuild_climb_fraction) * s.ring_radius_m;
         let kept = self.last_split.filter(|c| {
             steady_shown
@@ -550,33 +555,35 @@ impl ImpostorRing {
                 && c.view_radius_m == s.view_radius_m
                 && (c.camera_m - camera_m).length() + (c.drift_m - drift_m).length() <= slack_m
         });
-        if let Some(c) = kept {
-            (far_now, same, far_count) = (c.far_now, c.same, c.far_count);
-        } else {
-            let shown = self.shown.as_ref().map(|(_, st)| st);
-            let far = self
-                .fade
-                .as_ref()
-                .map(|(_, st, _)| &st.far_ids)
-                .or(shown.map(|st| &st.far_ids))
-                .or(self.build.as_ref().map(|b| &b.state.far_ids));
+        let shown = self.shown.as_ref().map(|(_, st)| st);
+        let far = (self.fade.as_ref().map(|(_, st, _)| st))
+            .or(shown)
+            .or(self.build.as_ref().map(|b| &b.state));
+        // The blocks drawn as sprites are the ones not in the ring shown (or fading in): they
+        // change with the blocks held and the ring, not with the camera.
+        let near_of = (changes, far.map(|st| st.build));
+        let far_ids = far.map(|st| &st.far_ids);
+        if self.near_of != Some(near_of) {
             self.near.clear();
+            self.near.extend(
+                (blocks.keys())
+                    .filter(|id| far_ids.is_none_or(|f| !f.contains(id)))
+                    .copied(),
+            );
+            self.near_of = Some(near_of);
+        }
+        let far_count = (blocks.len() - self.near.len()) as u32;
+        if let Some(c) = kept {
+            (far_now, same) = (c.far_now, c.same);
+        } else if steady_shown && let Some(st) = shown {
+            // Whether the blocks far from the shown ring's centre now are still the ones in it.
             for r in blocks.values() {
-                let in_far = far.is_some_and(|f| f.contains(&r.block.id));
-                if !in_far {
-                    self.near.push(r.block.id);
-                }
-                far_count += in_far as u32;
-                if steady_shown
-                    && !r.distant
-                    && let Some(st) = shown
-                    && is_far(r.nearest_height_m(camera_m.z), st.centre_m, camera_m, &s)
-                {
+                if !r.distant && is_far(r.nearest_height_m(camera_m.z), st.centre_m, camera_m, &s) {
                     far_now += 1;
-                    same &= in_far;
+                    same &= st.far_ids.contains(&r.block.id);
                 }
             }
-            self.last_split = steady_shown.then_some(SplitCheck {
+            self.last_split = Some(SplitCheck {
                 changes,
                 builds: self.builds,
                 view_radius_m: s.view_radius_m,
@@ -584,8 +591,9 @@ impl ImpostorRing {
                 drift_m,
                 far_now,
                 same,
-                far_count,
             });
+        } else {
+            self.last_split = None;
         }
         self.blocks_far = far_count;
         if self.build.is_some() {
@@ -648,6 +656,7 @@ impl ImpostorRing {
                 sun,
                 far_ids,
                 far_mean_m,
+                build: self.builds,
             },
         });
     }
