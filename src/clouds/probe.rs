@@ -58,7 +58,64 @@ struct CacheState {
 struct BlockBoxes {
     lo_m: DVec3,
     hi_m: DVec3,
-    generations: Vec<(u64, Arc<GenerationBoxes>)>,
+    generations: Vec<ListedGeneration>,
+}
+
+/// A generation in a block's list: its serial, its boxes and, copied out of them, their
+/// bounds (empty: the lowest corner above the highest) and whether one is a cumulonimbus.
+#[derive(Debug)]
+struct ListedGeneration {
+    serial: u64,
+    boxes: Arc<GenerationBoxes>,
+    lo_m: DVec3,
+    hi_m: DVec3,
+    has_cumulonimbus: bool,
+}
+
+impl BlockBoxes {
+    /// The living generations of block `index` that have clouds, and their bounds.
+    fn of(field: &CloudField, index: BlockIndex) -> Self {
+        let mut lo = DVec3::splat(f64::MAX);
+        let mut hi = DVec3::splat(f64::MIN);
+        let generations = field
+            .generations(index)
+            .iter()
+            .filter(|g| g.phase != Phase::Gone && !g.block.clouds.is_empty())
+            .map(|g| {
+                let boxes = Arc::clone(&g.boxes);
+                let (g_lo, g_hi) = if boxes.boxes.is_empty() {
+                    (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN))
+                } else {
+                    (boxes.lo_m, boxes.hi_m)
+                };
+                lo = lo.min(g_lo);
+                hi = hi.max(g_hi);
+                ListedGeneration {
+                    serial: g.serial,
+                    has_cumulonimbus: boxes.has_cumulonimbus,
+                    boxes,
+                    lo_m: g_lo,
+                    hi_m: g_hi,
+                }
+            })
+            .collect();
+        Self {
+            lo_m: lo,
+            hi_m: hi,
+            generations,
+        }
+    }
+}
+
+/// Distance from `p` to the box `lo..hi`, metres: 0 inside, infinite for an empty box (its
+/// lowest corner above its highest).
+fn bounds_distance_m(lo: DVec3, hi: DVec3, p: DVec3) -> f64 {
+    if lo.x > hi.x {
+        return f64::INFINITY;
+    }
+    ((p - (lo + hi) * 0.5).abs() - (hi - lo) * 0.5)
+        .max(DVec3::ZERO)
+        .length()
 }
 
 impl BoxCache {
@@ -135,75 +192,44 @@ impl<'a> CloudProbe<'a> {
         }
     }
 
-    /// Every generation of the blocks whose square reaches within `reach_m` of the air-frame
-    /// box `lo..hi` (horizontally) and passes `wanted` (its square padded by a block, for the
-    /// clouds that overhang it) and whose clouds' bounds pass `near`, as `keep` makes of it
-    /// and its boxes (`None`: left out). The cache is locked once for the query.
-    fn generations<T>(
-        &self,
-        lo: DVec2,
-        hi: DVec2,
+    /// The generations of the blocks within `reach_m` (and a block, for the clouds that
+    /// overhang theirs) of air point `q` whose bounds lie within `reach_m` of it: the distance
+    /// to their bounds, their block and their place in its list, nearest first. The block
+    /// lists are made for the blocks not listed yet. Stable: the generations around the point
+    /// (at 0) keep their order, which decides between equally deep clouds.
+    fn near_generations(
+        state: &mut CacheState,
+        field: &CloudField,
+        q: DVec3,
         reach_m: f64,
-        wanted: impl Fn(DVec2, DVec2) -> bool,
-        near: impl Fn(DVec3, DVec3) -> bool,
-        mut keep: impl FnMut(&'a FieldBlock, &Arc<GenerationBoxes>) -> Option<T>,
-    ) -> Vec<T> {
-        // Clouds overhang their block by up to a block.
+    ) -> Vec<(f64, BlockIndex, usize)> {
         let pad = reach_m + BLOCK_SIZE_M;
-        let a = BlockIndex::containing(lo - DVec2::splat(pad));
-        let b = BlockIndex::containing(hi + DVec2::splat(pad));
-        let field: &'a CloudField = self.field;
+        let a = BlockIndex::containing(q.truncate() - DVec2::splat(pad));
+        let b = BlockIndex::containing(q.truncate() + DVec2::splat(pad));
         let mut out = Vec::new();
-        let Ok(mut guard) = self.cache.state.lock() else {
-            return out;
-        };
-        let state = &mut *guard;
         for j in a.j..=b.j {
             for i in a.i..=b.i {
                 let index = BlockIndex::new(i, j);
-                let corner = index.min_corner_m();
-                let square = (
-                    corner - DVec2::splat(BLOCK_SIZE_M),
-                    corner + DVec2::splat(2.0 * BLOCK_SIZE_M),
-                );
-                if !wanted(square.0, square.1) {
+                let entry = state
+                    .blocks
+                    .entry(index)
+                    .or_insert_with(|| BlockBoxes::of(field, index));
+                if entry.generations.is_empty()
+                    || bounds_distance_m(entry.lo_m, entry.hi_m, q) > reach_m
+                {
                     continue;
                 }
-                let entry = state.blocks.entry(index).or_insert_with(|| {
-                    let mut lo = DVec3::splat(f64::MAX);
-                    let mut hi = DVec3::splat(f64::MIN);
-                    let generations = field
-                        .generations(index)
-                        .iter()
-                        .filter(|g| g.phase != Phase::Gone && !g.block.clouds.is_empty())
-                        .map(|g| {
-                            let boxes = Arc::clone(&g.boxes);
-                            if !boxes.boxes.is_empty() {
-                                lo = lo.min(boxes.lo_m);
-                                hi = hi.max(boxes.hi_m);
-                            }
-                            (g.serial, boxes)
-                        })
-                        .collect();
-                    BlockBoxes {
-                        lo_m: lo,
-                        hi_m: hi,
-                        generations,
-                    }
-                });
-                if entry.generations.is_empty() || !near(entry.lo_m, entry.hi_m) {
-                    continue;
-                }
-                let live = field.generations(index);
-                for (serial, boxes) in &entry.generations {
-                    if let Some(g) = live.iter().find(|g| g.serial == *serial)
-                        && let Some(kept) = keep(g, boxes)
-                    {
-                        out.push(kept);
+                // The bounds are read from the list, not from each generation's boxes (a
+                // cache miss each, for the many that lie out of reach).
+                for (k, g) in entry.generations.iter().enumerate() {
+                    let d = bounds_distance_m(g.lo_m, g.hi_m, q);
+                    if d <= reach_m {
+                        out.push((d, index, k));
                     }
                 }
             }
         }
+        out.sort_by(|x, y| x.0.total_cmp(&y.0));
         out
     }
 
@@ -229,25 +255,33 @@ impl<'a> CloudProbe<'a> {
         let mut out = CloudsAtPoint::default();
         let mut nearest = f64::INFINITY;
         let mut nearest_cb = f64::INFINITY;
-        let all = |_: DVec2, _: DVec2| true;
-        let near = |lo: DVec3, hi: DVec3| {
-            let (c, h) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
-            ((q - c).abs() - h).max(DVec3::ZERO).length() <= reach
+        let Ok(mut guard) = self.cache.state.lock() else {
+            return out;
         };
-        let keep = |g, b: &Arc<GenerationBoxes>| Some((b.distance_m(q), g, Arc::clone(b)));
-        let mut generations = self.generations(q.truncate(), q.truncate(), reach, all, near, keep);
-        // Nearest first, so that the nearest cloud found soon passes over the rest. Stable: the
-        // generations around the point (at 0) keep their order, which decides between equally
-        // deep clouds.
-        generations.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for (bounds_m, g, boxes) in generations {
+        let state = &mut *guard;
+        // Nearest first, so that the nearest cloud found soon passes over the rest.
+        let near = Self::near_generations(state, self.field, q, reach);
+        for (bounds_m, index, k) in near {
+            let Some(listed) = state.blocks.get(&index).and_then(|e| e.generations.get(k)) else {
+                continue;
+            };
             // Its bounds hold every box and rain sphere: one beyond them all is out of the
             // point's clouds and rain, and has no cloud nearer than the nearest, nor (without a
             // cumulonimbus, or beyond the nearest one) a nearer cumulonimbus.
-            let farther = bounds_m > nearest && (!boxes.has_cumulonimbus || bounds_m >= nearest_cb);
-            if bounds_m > reach || (bounds_m > 0.0 && farther) {
+            let farther =
+                bounds_m > nearest && (!listed.has_cumulonimbus || bounds_m >= nearest_cb);
+            if bounds_m > 0.0 && farther {
                 continue;
             }
+            let Some(g) = self
+                .field
+                .generations(index)
+                .iter()
+                .find(|g| g.serial == listed.serial)
+            else {
+                continue;
+            };
+            let boxes = &listed.boxes;
             for b in &boxes.boxes {
                 let d = b.distance_m(q);
                 let in_sphere = (q - b.cloud_centre_m).length_squared() < b.sphere_m * b.sphere_m;
