@@ -243,7 +243,8 @@ fn halves(low: f32, high: f32) -> u32 {
 
 /// Two values in 0..=1 as 16-bit fractions (WGSL's `pack2x16unorm`).
 fn fractions(low: f32, high: f32) -> u32 {
-    let u = |v: f32| (v.clamp(0.0, 1.0) * 65_535.0).round() as u32;
+    // Non-negative: a half added and truncated is `round` without its library call.
+    let u = |v: f32| (v.clamp(0.0, 1.0) * 65_535.0 + 0.5) as u32;
     u(low) | (u(high) << 16)
 }
 
@@ -254,8 +255,13 @@ pub fn gpu_sprite(cloud: &SkyCloud, s: &super::scene::SkySprite) -> GpuSprite {
         .get(s.group as usize)
         .copied()
         .unwrap_or(Vec3::ZERO);
-    let turns = s.rotation_deg.rem_euclid(360.0) / 360.0;
-    let rotation = ((turns * 65_536.0).round() as u32) & 0xffff;
+    // The rotation in 1/65,536 turns, wrapped into one turn. By truncation and a half, not
+    // `rem_euclid` and `round` (library calls on x86-64's baseline: a tenth of the cost of a
+    // frame of arrivals, which writes 32,768 records).
+    let turns = s.rotation_deg / 360.0;
+    let turns = turns - (turns as i64) as f32;
+    let turns = if turns < 0.0 { turns + 1.0 } else { turns };
+    let rotation = ((turns * 65_536.0 + 0.5) as u32) & 0xffff;
     GpuSprite {
         offset: s.offset_m.to_array(),
         size: halves(s.width_m, s.height_m),
@@ -1034,6 +1040,42 @@ mod tests {
     use crate::render::impostor::{ImpostorSettings, is_far};
     use crate::weather::storms::StormCell;
     use crate::weather::{BlockIndex, BlockWeather, CloudType};
+
+    /// A sprite's record packs its rotation into 1/65,536 turns wrapped into one turn, and its
+    /// morph and radius fractions into 16 bits each, as `rem_euclid` and `round` would (to a
+    /// unit where a value falls on a half), for any angle a block holds, negative or past a turn.
+    #[test]
+    fn a_sprite_record_packs_rotation_and_fractions_as_rounded() {
+        let cloud = crate::render::draw_list::tests::small_cloud();
+        let near = |a: u32, b: u32, modulo: u32| {
+            let d = a.abs_diff(b) % modulo;
+            d.min(modulo - d) <= 1
+        };
+        for k in -2_000..2_000 {
+            let degrees = k as f32 * 0.733;
+            let fraction = (k + 2_000) as f32 / 4_000.0;
+            let sprite = crate::render::scene::SkySprite {
+                rotation_deg: degrees,
+                alpha_morph: fraction,
+                radius_fraction: 1.0 - fraction,
+                ..crate::render::scene::square_sprite(glam::Vec3::ZERO, 10.0, 0, 0)
+            };
+            let record = gpu_sprite(&cloud, &sprite);
+            let turns = degrees.rem_euclid(360.0) / 360.0;
+            let rotation = ((turns * 65_536.0).round() as u32) & 0xffff;
+            assert!(
+                near(record.group_z_rotation >> 16, rotation, 65_536),
+                "{degrees} degrees"
+            );
+            let unit = |v: f32| (v * 65_535.0).round() as u32;
+            assert!(near(record.morph_radius & 0xffff, unit(fraction), u32::MAX));
+            assert!(near(
+                record.morph_radius >> 16,
+                unit(1.0 - fraction),
+                u32::MAX
+            ));
+        }
+    }
 
     /// A storm cell's part stands from its base to its anvil: its middle is more than 10,000
     /// ft above a camera at its base's height, yet the cell 40 km off spans that height and
