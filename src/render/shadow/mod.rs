@@ -124,6 +124,10 @@ pub struct CloudShadows {
     sprites_view: ViewBuffers,
     draws: Vec<GpuDrawBlock>,
     lists: Vec<GpuListCloud>,
+    /// Per block drawn: its clouds' lists as last built, with the placing and stride they were
+    /// built for and their sprites. A drawing copies a block's lists when both stand (a whole
+    /// drawing, every second while clouds form, read every cloud of every block it covers).
+    kept_lists: IdMap<KeptLists>,
     /// The cloud lists on the GPU (grown in powers of two) and how many times it was replaced
     /// (the view's group is made anew then).
     list_buffer: wgpu::Buffer,
@@ -317,6 +321,7 @@ impl CloudShadows {
             sprites_view: ViewBuffers::new(device, false),
             draws: Vec::new(),
             lists: Vec::new(),
+            kept_lists: IdMap::default(),
             list_buffer: storage_buffer(device, "sky.cloud_shadow_lists", 4096 * 16),
             list_buffers_made: 0,
             drawn: None,
@@ -631,16 +636,32 @@ impl CloudShadows {
         }
         // A fixed order (by place, then id): the half-float sums come out the same every run.
         // Blocks added to a map are a few of the thousands held: looked up, not searched for.
-        let mut order: Vec<&super::resident::Resident> = match only {
-            Some(ids) => ids.iter().filter_map(|id| blocks.get(id)).collect(),
+        // Sorted on keys copied out of the blocks (a comparison that reads two blocks costs two
+        // cache misses).
+        let mut order: Vec<(f64, f64, u64, &super::resident::Resident)> = match only {
+            Some(ids) => ids
+                .iter()
+                .filter_map(|id| blocks.get(id))
+                .collect::<Vec<_>>(),
             None => blocks.values().collect(),
-        };
-        order.retain(|r| is_covered(r, frame));
-        order.sort_by(|a, b| a.tie_order(b));
+        }
+        .into_iter()
+        .filter(|r| is_covered(r, frame))
+        .map(|r| (r.block.centre_m.x, r.block.centre_m.y, r.block.id, r))
+        .collect();
+        order.sort_by(|a, b| {
+            a.0.total_cmp(&b.0)
+                .then(a.1.total_cmp(&b.1))
+                .then(a.2.cmp(&b.2))
+        });
+        if only.is_none() {
+            // Lists of blocks no longer covered are not kept.
+            let covered: IdSet = order.iter().map(|o| o.2).collect();
+            self.kept_lists.retain(|id, _| covered.contains(id));
+        }
         let mut total = 0u32;
-        for r in order {
+        for (_, _, id, r) in order {
             let list_base = self.lists.len() as u32;
-            let mut first = 0u32;
             // Beyond `full_detail_m` across the rays, every `far_sprite_stride`th sprite of a
             // cloud stands for that many (its optical depth times the stride): far shadows lie
             // under the haze, and the far field holds most of the sprites.
@@ -649,15 +670,22 @@ impl CloudShadows {
             } else {
                 self.settings.far_sprite_stride
             };
-            for state in r.clouds.iter().filter(|c| c.sprites > 0) {
-                self.lists.push(GpuListCloud {
-                    cloud: state.cloud_slot,
-                    first,
-                    order_base: state.sprite_base,
-                    stride,
-                });
-                first += state.sprites.div_ceil(stride);
+            let kept = self.kept_lists.entry(id).or_default();
+            if kept.built_for != Some((r.place_serial, stride)) {
+                kept.lists.clear();
+                let mut first = 0u32;
+                for state in r.clouds.iter().filter(|c| c.sprites > 0) {
+                    kept.lists.push(GpuListCloud {
+                        cloud: state.cloud_slot,
+                        first,
+                        order_base: state.sprite_base,
+                        stride,
+                    });
+                    first += state.sprites.div_ceil(stride);
+                }
+                (kept.built_for, kept.sprites) = (Some((r.place_serial, stride)), first);
             }
+            self.lists.extend_from_slice(&kept.lists);
             let (fade_kind, fade_progress) = fade_code(r.motion.fade);
             self.draws.push(GpuDrawBlock {
                 origin_rel: (r.centre_m() - back_m - frame.eye_m).as_vec3().to_array(),
@@ -667,7 +695,7 @@ impl CloudShadows {
                 fade_kind,
                 fade_progress,
             });
-            total += first;
+            total += kept.sprites;
         }
         total
     }
@@ -843,6 +871,16 @@ fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (IdSet, bool) {
         })
         .collect();
     (ids, changing)
+}
+
+/// A block's cloud lists for the shadow map, kept between drawings.
+#[derive(Debug, Default)]
+struct KeptLists {
+    /// The block's placing and the stride the lists were built for.
+    built_for: Option<(u64, u32)>,
+    lists: Vec<GpuListCloud>,
+    /// The sprites they draw.
+    sprites: u32,
 }
 
 fn smoothstep(a: f64, b: f64, x: f64) -> f64 {
