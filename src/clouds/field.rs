@@ -272,6 +272,9 @@ pub struct FieldBlock {
 struct Slot {
     /// The weather of the newest generation asked for.
     weather: BlockWeather,
+    /// The ground block and the weather's version it was last asked for with
+    /// ([`CloudField::update_for`]; `None`: asked without a version).
+    asked: Option<(BlockIndex, u64)>,
     /// Oldest first; during a weather change the old one dissipates while the new one forms.
     generations: Vec<FieldBlock>,
     /// The phase its first generation starts in (`CloudField::joining_phase` when it joined).
@@ -379,6 +382,28 @@ impl CloudField {
     /// of a ground block; queues what is missing or changed and takes in what has finished.
     /// Never waits for generation.
     pub fn update(&mut self, centre_m: DVec2, weather: &dyn Fn(BlockIndex) -> BlockWeather) {
+        self.update_with(centre_m, weather, None);
+    }
+
+    /// [`Self::update`] with a weather that is one function of the ground block for each
+    /// `version`: a block over the same ground block as when it was last asked, at the same
+    /// version, keeps its weather without asking (a camera crossing into another block asked
+    /// again for the weather of every one of the field's ~700 blocks, most of them unchanged).
+    pub fn update_for(
+        &mut self,
+        centre_m: DVec2,
+        weather: &dyn Fn(BlockIndex) -> BlockWeather,
+        version: u64,
+    ) {
+        self.update_with(centre_m, weather, Some(version));
+    }
+
+    fn update_with(
+        &mut self,
+        centre_m: DVec2,
+        weather: &dyn Fn(BlockIndex) -> BlockWeather,
+        version: Option<u64>,
+    ) {
         let here = weather(BlockIndex::containing(centre_m));
         self.wind_m_s = here.wind.drift_m_s() * self.config.field.wind_factor;
         let air_centre = centre_m - self.drift_m;
@@ -392,15 +417,17 @@ impl CloudField {
                 .iter()
                 .any(|l| l.cloud_type == CloudType::Cumulonimbus)
         };
-        let asked: Vec<(BlockIndex, BlockWeather)> = wanted
+        let asked: Vec<(BlockIndex, BlockWeather, Option<(BlockIndex, u64)>)> = wanted
             .iter()
-            .map(|&index| {
+            .filter_map(|&index| {
                 let ground = BlockIndex::containing(index.centre_m() + self.drift_m);
-                (index, weather(ground))
+                let key = version.map(|v| (ground, v));
+                let kept = key.is_some() && self.slots.get(&index).is_some_and(|s| s.asked == key);
+                (!kept).then(|| (index, weather(ground), key))
             })
             .collect();
-        let cb_seen =
-            self.slots.values().any(|s| has_cb(&s.weather)) || asked.iter().any(|(_, w)| has_cb(w));
+        let cb_seen = self.slots.values().any(|s| has_cb(&s.weather))
+            || asked.iter().any(|(_, w, _)| has_cb(w));
         let mut cells: Option<Vec<StormCell>> = None;
         let mut cells_for = |field: &Self, index: BlockIndex| {
             if cells.is_none() && cb_seen {
@@ -416,7 +443,7 @@ impl CloudField {
                 .copied()
                 .collect::<Vec<_>>()
         };
-        for (index, w) in asked {
+        for (index, w, key) in asked {
             match self.slots.get(&index) {
                 None => {
                     let mine = cells_for(self, index);
@@ -428,6 +455,7 @@ impl CloudField {
                         index,
                         Slot {
                             weather: w,
+                            asked: key,
                             generations: Vec::new(),
                             joins,
                             ends_s: None,
@@ -438,10 +466,14 @@ impl CloudField {
                     let mine = cells_for(self, index);
                     self.generator.submit_in_field(index, w.clone(), mine, seed);
                     if let Some(slot) = self.slots.get_mut(&index) {
-                        slot.weather = w;
+                        (slot.weather, slot.asked) = (w, key);
                     }
                 }
-                Some(_) => {}
+                Some(_) => {
+                    if let Some(slot) = self.slots.get_mut(&index) {
+                        slot.asked = key;
+                    }
+                }
             }
         }
         if !cb_seen {
@@ -790,6 +822,44 @@ mod tests {
             let ground = i.centre_m() + field.drift_m();
             assert!(ground.length() <= 9_000.0 + BLOCK_SIZE_M * 1.5);
         }
+    }
+
+    /// Asked again at the same weather version, a field asks only the blocks it does not hold
+    /// (the one under the camera for the wind aside); a new version asks every block again and
+    /// a changed weather forms new generations.
+    #[test]
+    fn blocks_kept_at_one_weather_version_are_not_asked_again() {
+        let mut field = small_field();
+        let asked = std::cell::Cell::new(0);
+        let weather = |oktas: f32| {
+            let asked = &asked;
+            move |_: BlockIndex| {
+                asked.set(asked.get() + 1);
+                calm(oktas)
+            }
+        };
+        field.update_for(DVec2::ZERO, &weather(4.0), 1);
+        field.wait_for_pending();
+        let held = field.slots.len();
+        assert_eq!(
+            asked.get(),
+            held + 1,
+            "every block, and the one under the camera"
+        );
+        asked.set(0);
+        // A block east, at the same version: the new column only.
+        let east = DVec2::new(BLOCK_SIZE_M, 0.0);
+        field.update_for(east, &weather(4.0), 1);
+        field.wait_for_pending();
+        let new = asked.get() - 1;
+        assert!(new > 0 && new < held / 3, "{new} of {held} asked");
+        // A new version: every block again, and the changed cover forms new generations.
+        asked.set(0);
+        field.update_for(east, &weather(6.0), 2);
+        field.wait_for_pending();
+        let wanted = blocks_within(east, field.config.field.radius_m);
+        assert_eq!(asked.get(), wanted.len() + 1);
+        assert!(wanted.iter().all(|i| field.generations(*i).len() == 2));
     }
 
     #[test]

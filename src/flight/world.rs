@@ -499,7 +499,9 @@ impl World {
                     weather_field.block_layers_weather(index)
                 }
             };
-            living.field.update(camera_m.truncate(), &weather);
+            living
+                .field
+                .update_for(camera_m.truncate(), &weather, version);
             living.weather = cache.into_inner();
             living.asked = Some(key);
             // The next row's weathers, off the frame thread before the camera brings it in.
