@@ -274,7 +274,7 @@ struct Slot {
     weather: BlockWeather,
     /// The ground block and the weather's version it was last asked for with
     /// ([`CloudField::update_for`]; `None`: asked without a version).
-    asked: Option<(BlockIndex, u64)>,
+    asked: Option<AskedFor>,
     /// Oldest first; during a weather change the old one dissipates while the new one forms.
     generations: Vec<FieldBlock>,
     /// The phase its first generation starts in (`CloudField::joining_phase` when it joined).
@@ -282,6 +282,9 @@ struct Slot {
     /// Where it is in the field's queue of phase ends (`CloudField::phase_ends`).
     ends_s: Option<f64>,
 }
+
+/// A ground block and the version of the weather a field block over it was asked for with.
+type AskedFor = (BlockIndex, u64);
 
 /// The blocks around a point, advancing in time. See the module docs.
 #[derive(Debug)]
@@ -417,7 +420,7 @@ impl CloudField {
                 .iter()
                 .any(|l| l.cloud_type == CloudType::Cumulonimbus)
         };
-        let asked: Vec<(BlockIndex, BlockWeather, Option<(BlockIndex, u64)>)> = wanted
+        let asked: Vec<(BlockIndex, BlockWeather, Option<AskedFor>)> = wanted
             .iter()
             .filter_map(|&index| {
                 let ground = BlockIndex::containing(index.centre_m() + self.drift_m);
