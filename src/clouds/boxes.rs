@@ -149,13 +149,19 @@ impl GenerationBoxes {
 
     /// Distance from `p` to the bounds, metres (0 inside; infinite with no boxes).
     pub fn distance_m(&self, p: DVec3) -> f64 {
-        if self.boxes.is_empty() {
-            return f64::INFINITY;
-        }
-        let c = (self.lo_m + self.hi_m) * 0.5;
-        let h = (self.hi_m - self.lo_m) * 0.5;
-        ((p - c).abs() - h).max(DVec3::ZERO).length()
+        bounds_distance_m(self.lo_m, self.hi_m, p)
     }
+}
+
+/// Distance from `p` to the box `lo..hi`, metres: 0 inside, infinite for an empty box (its
+/// lowest corner above its highest, as the bounds of a generation without boxes are).
+pub fn bounds_distance_m(lo: DVec3, hi: DVec3, p: DVec3) -> f64 {
+    if lo.x > hi.x {
+        return f64::INFINITY;
+    }
+    ((p - (lo + hi) * 0.5).abs() - (hi - lo) * 0.5)
+        .max(DVec3::ZERO)
+        .length()
 }
 
 #[cfg(test)]

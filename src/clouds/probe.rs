@@ -25,7 +25,7 @@ use std::sync::{Arc, Mutex};
 use glam::{DVec2, DVec3};
 
 use super::block::Cloud;
-use super::boxes::{CloudBox, GenerationBoxes};
+use super::boxes::{CloudBox, GenerationBoxes, bounds_distance_m};
 use super::field::{CloudField, FieldBlock};
 use super::lifecycle::{Phase, alpha_at};
 use super::sight::{FieldSight, Met};
@@ -83,19 +83,15 @@ impl BlockBoxes {
             .filter(|g| g.phase != Phase::Gone && !g.block.clouds.is_empty())
             .map(|g| {
                 let boxes = Arc::clone(&g.boxes);
-                let (g_lo, g_hi) = if boxes.boxes.is_empty() {
-                    (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN))
-                } else {
-                    (boxes.lo_m, boxes.hi_m)
-                };
-                lo = lo.min(g_lo);
-                hi = hi.max(g_hi);
+                // Without boxes the bounds are empty (lowest corner above the highest).
+                lo = lo.min(boxes.lo_m);
+                hi = hi.max(boxes.hi_m);
                 ListedGeneration {
                     serial: g.serial,
                     has_cumulonimbus: boxes.has_cumulonimbus,
+                    lo_m: boxes.lo_m,
+                    hi_m: boxes.hi_m,
                     boxes,
-                    lo_m: g_lo,
-                    hi_m: g_hi,
                 }
             })
             .collect();
@@ -105,17 +101,6 @@ impl BlockBoxes {
             generations,
         }
     }
-}
-
-/// Distance from `p` to the box `lo..hi`, metres: 0 inside, infinite for an empty box (its
-/// lowest corner above its highest).
-fn bounds_distance_m(lo: DVec3, hi: DVec3, p: DVec3) -> f64 {
-    if lo.x > hi.x {
-        return f64::INFINITY;
-    }
-    ((p - (lo + hi) * 0.5).abs() - (hi - lo) * 0.5)
-        .max(DVec3::ZERO)
-        .length()
 }
 
 impl BoxCache {
