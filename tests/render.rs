@@ -2468,6 +2468,38 @@ fn a_block_arriving_adds_its_shadow_to_the_map() {
     );
 }
 
+/// A block the shadow map drew thinned out (beyond `full_detail_m`, every
+/// `far_sprite_stride`th sprite) casts all its sprites once the camera comes near: the cloud
+/// lists a drawing keeps for a block are made again when its stride changes.
+#[test]
+fn a_far_block_come_near_casts_every_sprite_in_the_shadow_map() {
+    let mut settings = RenderSettings::default();
+    settings.cloud_shadows.enabled = true;
+    let stride = settings.cloud_shadows.far_sprite_stride;
+    let full_m = settings.cloud_shadows.full_detail_m;
+    let mut rig = Rig::with_settings(flat_ground(0.0), settings);
+    let east = 2.0 * full_m;
+    let centre = DVec3::new(east, 0.0, 1300.0);
+    rig.set_clouds(vec![SkyBlock {
+        id: 1,
+        centre_m: centre,
+        clouds: vec![cumulus(centre)],
+    }]);
+    let far = rig.camera(DVec3::new(0.0, 0.0, 1000.0), 90.0, 3.0);
+    let (_, thinned) = rig.frame("shadow_stride_far", &far);
+    assert!(thinned.shadow_redrawn, "{thinned:?}");
+    assert_eq!(
+        thinned.shadow_sprites,
+        60u32.div_ceil(stride),
+        "{thinned:?}"
+    );
+    // Beside the block: the map is drawn again around the camera, with every sprite.
+    let near = rig.camera(DVec3::new(east - 2000.0, 0.0, 1000.0), 90.0, 3.0);
+    let (_, whole) = rig.frame("shadow_stride_near", &near);
+    assert!(whole.shadow_redrawn, "{whole:?}");
+    assert_eq!(whole.shadow_sprites, 60, "{whole:?}");
+}
+
 /// Mean luminance step from one pixel to the next along the rows `rows` of a frame: the fine
 /// grain of what those rows show.
 fn row_step(frame: &Frame, rows: &[u32]) -> f32 {
