@@ -620,13 +620,20 @@ impl World {
                 living.newest_serial = living.newest_serial.max(fb.serial);
                 living.in_sky.insert(fb.serial);
                 joined.push((living_block(index, fb), BlockMotion { offset_m, fade }));
-            } else if fade != Fade::Steady {
-                sky.set_block_fade(fb.serial, fade);
             }
             if fade != Fade::Steady {
-                living
-                    .fading
-                    .push((fb.serial, fb.phase, fade_step(fb.serial, fade)));
+                let step = fade_step(fb.serial, fade);
+                // Told only when it has moved on a step since the last frame, as when nothing
+                // came or went (`was_fading` is sorted by serial): a block crossing hands over a
+                // few generations, not the thousand that form after a weather change.
+                let shown = (living.was_fading)
+                    .binary_search_by_key(&fb.serial, |f| f.0)
+                    .ok()
+                    .map(|k| living.was_fading[k].2);
+                if fb.serial <= newest && shown != Some(step) {
+                    sky.set_block_fade(fb.serial, fade);
+                }
+                living.fading.push((fb.serial, fb.phase, step));
             }
         }
         sky.insert_blocks(joined);
