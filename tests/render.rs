@@ -11,7 +11,9 @@ use skycast::demo::terrain::HeightField;
 use skycast::demo::{DemoHost, Frame, headless};
 use skycast::flight::world::block_id;
 use skycast::render::square_sprite;
-use skycast::render::{Camera, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteSheet};
+use skycast::render::{
+    BlockMotion, Camera, Fade, RenderSettings, SkyBlock, SkyCloud, SkyConfig, SpriteSheet,
+};
 use skycast::shading::{ColourLevels, SunPosition, TimeOfDayTable};
 use skycast::weather::{BlockIndex, BlockLayer, BlockWeather, CloudType, TypeSource};
 
@@ -964,8 +966,10 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     let (_, stats) = rig.frame("ring_switched_on", &cam);
     assert_eq!(stats.impostors_rebuilt, 8, "{stats:?}");
     assert_eq!((stats.blocks_near, stats.blocks_far), (2, 1), "{stats:?}");
-    // A far block arriving while the ring stands (the camera still) goes into it: a rebuild
-    // starts (the ring keeps its look over the blocks between frames only while none comes).
+    // Far blocks arriving while the ring stands (the camera still): one that begins to form
+    // (at no opacity) goes into the ring once the ring shown was begun
+    // `rebuild_far_change_after_s` (20 s) ago, drawn as sprites until then (the frames here
+    // advance no time); one that arrives whole goes into it at once.
     let (_, steady) = rig.frame("ring_steady", &cam);
     assert_eq!(steady.impostors_rebuilt, 0, "{steady:?}");
     let mut more = ring_blocks(true);
@@ -975,12 +979,45 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
         centre_m: south,
         clouds: vec![big_cumulus(south, 6.0)],
     });
+    rig.set_clouds(more.clone());
+    let forming = BlockMotion {
+        offset_m: DVec3::ZERO,
+        fade: Fade::Forming(0.0),
+    };
+    assert!(rig.host.sky.set_block_motion(4, forming));
+    let waiting: Vec<_> = (0..3)
+        .map(|k| rig.frame(&format!("ring_forming_far_block_{k}"), &cam).1)
+        .map(|s| (s.impostors_rebuilt, s.blocks_near, s.blocks_far))
+        .collect();
+    assert_eq!(
+        waiting,
+        vec![(0, 3, 1); 3],
+        "rebuilt at once, or not a sprite meanwhile"
+    );
+    let wait_s = RenderSettings::default()
+        .impostors
+        .rebuild_far_change_after_s;
+    let (_, due) = rig.host.frame(&cam, &sun(), wait_s, 40_000.0).unwrap();
+    assert!(
+        due.impostors_rebuilt > 0,
+        "the forming far block started no rebuild {wait_s} s on: {due:?}"
+    );
+    // The rebuild over and faded in (half-second frames), a whole block arrives.
+    for _ in 0..12 {
+        rig.host.frame(&cam, &sun(), 0.5, 40_000.0).unwrap();
+    }
+    let east = DVec3::new(30_000.0, 0.0, 1500.0);
+    more.push(SkyBlock {
+        id: 5,
+        centre_m: east,
+        clouds: vec![big_cumulus(east, 6.0)],
+    });
     rig.set_clouds(more);
-    let rebuilt: u32 = (0..3)
-        .map(|k| rig.frame(&format!("ring_far_block_arrives_{k}"), &cam).1)
-        .map(|stats| stats.impostors_rebuilt)
-        .sum();
-    assert!(rebuilt > 0, "the arriving far block started no rebuild");
+    let (_, whole) = rig.frame("ring_whole_far_block", &cam);
+    assert!(
+        whole.impostors_rebuilt > 0,
+        "the whole far block waited for a rebuild: {whole:?}"
+    );
     // A sky made without the ring has no textures to turn it on with.
     assert!(!plain.host.sky.set_impostors(true));
 }

@@ -38,6 +38,13 @@ pub struct ImpostorSettings {
     pub rebuild_climb_fraction: f64,
     /// Rebuild after the sun direction turned by more than this, degrees.
     pub rebuild_sun_deg: f64,
+    /// A change of the far blocks that shows little (generations that begin to form or are
+    /// gone, blocks that arrive whole where the far field's hand-over band has faded the ring
+    /// more than halfway) rebuilds only once the ring shown was begun this long ago, seconds
+    /// (0: at once); a block that arrives whole nearer rebuilds at once. Meanwhile a new far
+    /// block is drawn as sprites and a gone one stays in the ring. Absent: 20.
+    #[serde(default = "far_change_after_s")]
+    pub rebuild_far_change_after_s: f64,
     /// Crossfade from the old ring to the new one over this time, seconds (0: switch at once).
     pub crossfade_s: f64,
     /// Blocks more than this above or below the camera are never put in impostors, feet.
@@ -47,6 +54,11 @@ pub struct ImpostorSettings {
     /// thresholds are `[vertex_cache]`'s). Absent: `[vertex_cache] move_fraction`.
     #[serde(default)]
     pub order_move_fraction: Option<f64>,
+}
+
+/// [`ImpostorSettings::rebuild_far_change_after_s`] when a table leaves it out.
+fn far_change_after_s() -> f64 {
+    20.0
 }
 
 impl Default for ImpostorSettings {
@@ -59,6 +71,7 @@ impl Default for ImpostorSettings {
             rebuild_move_fraction: 0.15,
             rebuild_climb_fraction: 0.02,
             rebuild_sun_deg: 2.0,
+            rebuild_far_change_after_s: far_change_after_s(),
             crossfade_s: 1.0,
             max_height_difference_ft: 10_000.0,
             order_move_fraction: None,
@@ -95,6 +108,10 @@ impl ImpostorSettings {
                 "impostors.view_radius_m",
                 "must be greater than impostors.ring_radius_m".into(),
             ));
+        }
+        if self.rebuild_far_change_after_s.is_nan() || self.rebuild_far_change_after_s < 0.0 {
+            let field = "impostors.rebuild_far_change_after_s";
+            return Some((field, "must be 0 or more".into()));
         }
         if self.crossfade_s.is_nan() || self.crossfade_s < 0.0 {
             return Some(("impostors.crossfade_s", "must be 0 or more".into()));

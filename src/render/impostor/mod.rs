@@ -7,8 +7,11 @@
 //!
 //! A rebuild starts when the camera has moved `rebuild_move_fraction` of the radius horizontally
 //! or `rebuild_climb_fraction` of it vertically, when the sun has turned more than
-//! `rebuild_sun_deg`, or when the set of far blocks changed. It renders one impostor per frame
-//! over 8 frames into the second ring, then crossfades old -> new over `crossfade_s`. The very
+//! `rebuild_sun_deg`, or when a far block arrived whole, or when the set of far blocks changed
+//! otherwise and the ring shown was begun `rebuild_far_change_after_s` ago (until then new far
+//! blocks are sprites). It renders one
+//! impostor per frame over 8 frames into the second ring, then crossfades old -> new over
+//! `crossfade_s`. The very
 //! first ring is built in one frame (there is nothing to fade from).
 //!
 //! In: the sky's blocks, camera, light and frame uniform. Out: which blocks are near (sprites),
@@ -43,6 +46,7 @@ use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuRing, GpuSpriteV
 use super::id_hash::IdSet;
 use super::pipeline::{PassDesc, SceneDepth, frame_group, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
+use super::scene::Fade;
 use super::settings::VertexCacheSettings;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
@@ -64,14 +68,15 @@ struct RingState {
     far_mean_m: f64,
     /// Which build made it (the ring's count of builds then).
     build: u64,
+    /// The ring's clock when that build started (orders sorted since are good for it; a change
+    /// of the far blocks alone rebuilds `rebuild_far_change_after_s` after it).
+    begun_s: f64,
 }
 
 struct Build {
     ring: usize,
     next: usize,
     state: RingState,
-    /// The ring's clock when it started (orders sorted since are good for it).
-    since_s: f64,
     /// Each impostor's blocks (of `state.far_ids`, in its sector), found in one pass when the
     /// build starts: the frames that gather its orders look at no other block.
     sectors: [Vec<u64>; IMPOSTORS],
@@ -118,6 +123,10 @@ pub struct ImpostorRing {
     /// radius): while the far field is drawn, the end of its hand-over band, beyond which the
     /// ring's blocks would be built faded out to nothing.
     reach_limit_m: Option<f64>,
+    /// Where the hand-over band has faded the ring halfway, metres (`None`: no band): a far
+    /// block that arrives whole beyond it (joining the field at its rim) is no reason to
+    /// rebuild at once.
+    half_faded_m: Option<f64>,
     bytes: u64,
     /// The far clouds' orders from the ring centre, kept between builds, and their GPU copy.
     sorts: RingOrders,
@@ -139,18 +148,22 @@ pub struct ImpostorRing {
 
 /// What a pass over every block found while the ring was steady (shown, no build, no fade),
 /// and what with: while no block came, went or was written, the same ring is shown and the
-/// camera and the drift moved less than a tenth of the ring's own rebuild distances, the
-/// blocks' near marks and the crossings stand, and the thousands of blocks are not walked
-/// again (a block that crossed the ring radius starts a rebuild that little later).
+/// camera's height and the drift moved less than a tenth of the ring's own rebuild distances
+/// (which blocks are far from the ring centre does not depend on where the camera is across
+/// the ground), the blocks' near marks and the crossings stand, and the thousands of blocks
+/// are not walked again (a block that drifted across the ring radius starts a rebuild that
+/// little later).
 #[derive(Debug, Clone, Copy)]
 struct SplitCheck {
     changes: u64,
     builds: u64,
     view_radius_m: f64,
-    camera_m: DVec3,
+    camera_z_m: f64,
     drift_m: DVec3,
     far_now: usize,
     same: bool,
+    /// Whether a far block not in the shown ring is drawn whole ([`Fade::Steady`]).
+    whole_new: bool,
 }
 
 const SPRITES_WGSL: &str = include_str!("../../../shaders/sprites.wgsl");
@@ -436,6 +449,7 @@ impl ImpostorRing {
             build: None,
             fade: None,
             reach_limit_m: None,
+            half_faded_m: None,
             pending: Vec::new(),
             recorded: Cell::new(false),
             quads: None,
@@ -482,13 +496,14 @@ impl ImpostorRing {
             }
     }
 
-    /// Limits how far the ring reaches (`None`: its view radius). While the far field is
-    /// drawn, the sprites, and the impostors built from them, fade out by the end of its
-    /// hand-over band: the ring's blocks beyond it would be sorted and drawn into the
-    /// impostors to show nothing. A change of the limit changes the far set, so the ring is
-    /// rebuilt.
-    pub(super) fn set_reach_limit(&mut self, limit_m: Option<f64>) {
-        self.reach_limit_m = limit_m;
+    /// Limits how far the ring reaches (`None`: its view radius) to the hand-over band
+    /// `(start, end)`. While the far field is drawn, the sprites, and the impostors built from
+    /// them, fade out by the end of the band: the ring's blocks beyond it would be sorted and
+    /// drawn into the impostors to show nothing. A change of the limit changes the far set, so
+    /// the ring is rebuilt.
+    pub(super) fn set_reach_limit(&mut self, band_m: Option<(f64, f64)>) {
+        self.reach_limit_m = band_m.map(|(_, end)| end);
+        self.half_faded_m = band_m.map(|(start, end)| 0.5 * (start + end));
     }
 
     /// The settings with the view radius cut to the reach limit (kept beyond the ring radius).
@@ -545,17 +560,21 @@ impl ImpostorRing {
         // The far set shown (or fading in), and whether the blocks far from the shown ring's
         // centre are still the ones in it (else a rebuild starts).
         let steady_shown = self.fade.is_none() && self.build.is_none();
+        let shown = self.shown.as_ref().map(|(_, st)| st);
         let mut far_now = 0;
         let mut same = true;
+        let mut whole_new = false;
+        // Which blocks are far depends on the camera's height alone (`is_far`), not on where
+        // it is across the ground: a level flight walks the blocks again only when they or
+        // the drift changed.
         let slack_m = 0.1 * s.rebuild_move_fraction.min(s.rebuild_climb_fraction) * s.ring_radius_m;
         let kept = self.last_split.filter(|c| {
             steady_shown
                 && c.changes == changes
                 && c.builds == self.builds
                 && c.view_radius_m == s.view_radius_m
-                && (c.camera_m - camera_m).length() + (c.drift_m - drift_m).length() <= slack_m
+                && (c.camera_z_m - camera_m.z).abs() + (c.drift_m - drift_m).length() <= slack_m
         });
-        let shown = self.shown.as_ref().map(|(_, st)| st);
         let far = (self.fade.as_ref().map(|(_, st, _)| st))
             .or(shown)
             .or(self.build.as_ref().map(|b| &b.state));
@@ -574,23 +593,32 @@ impl ImpostorRing {
         }
         let far_count = (blocks.len() - self.near.len()) as u32;
         if let Some(c) = kept {
-            (far_now, same) = (c.far_now, c.same);
+            (far_now, same, whole_new) = (c.far_now, c.same, c.whole_new);
         } else if steady_shown && let Some(st) = shown {
-            // Whether the blocks far from the shown ring's centre now are still the ones in it.
+            // Whether the blocks far from the shown ring's centre now are still the ones in it,
+            // and whether one not in it is drawn whole (not forming) short of where the band
+            // has faded the ring halfway.
             for r in blocks.values() {
                 if !r.distant && is_far(r.nearest_height_m(camera_m.z), st.centre_m, camera_m, &s) {
                     far_now += 1;
-                    same &= st.far_ids.contains(&r.block.id);
+                    if !st.far_ids.contains(&r.block.id) {
+                        same = false;
+                        let shown = self.half_faded_m.is_none_or(|half| {
+                            (r.centre_m() - st.centre_m).truncate().length() - r.radius_m < half
+                        });
+                        whole_new |= shown && r.motion.fade == Fade::Steady;
+                    }
                 }
             }
             self.last_split = Some(SplitCheck {
                 changes,
                 builds: self.builds,
                 view_radius_m: s.view_radius_m,
-                camera_m,
+                camera_z_m: camera_m.z,
                 drift_m,
                 far_now,
                 same,
+                whole_new,
             });
         } else {
             self.last_split = None;
@@ -602,9 +630,13 @@ impl ImpostorRing {
         let start = match (&self.shown, &self.fade) {
             (None, None) => true,
             (Some((_, st)), None) => {
+                // A block that arrives whole goes into the ring at once (it would stand as
+                // sprites until the next rebuild, then swap into the ring); generations that
+                // begin to form (at no opacity) or are gone (dissipated) wait their turn.
+                let far_change_due = self.clock_s - st.begun_s >= s.rebuild_far_change_after_s;
                 needs_rebuild(st.centre_m, st.sun, camera_m, sun, &s)
-                    || !same
-                    || far_now != st.far_ids.len()
+                    || whole_new
+                    || (far_change_due && (!same || far_now != st.far_ids.len()))
             }
             _ => false,
         };
@@ -649,7 +681,6 @@ impl ImpostorRing {
         self.build = Some(Build {
             ring,
             next: 0,
-            since_s: self.clock_s,
             sectors,
             state: RingState {
                 centre_m: camera_m,
@@ -657,6 +688,7 @@ impl ImpostorRing {
                 far_ids,
                 far_mean_m,
                 build: self.builds,
+                begun_s: self.clock_s,
             },
         });
     }
@@ -712,7 +744,7 @@ impl ImpostorRing {
             };
             let mut when = RingSort {
                 gather: 0,
-                since_s: build.since_s,
+                since_s: build.state.begun_s,
                 time_s: self.clock_s,
                 cache: &ring_cache,
                 largest,
