@@ -347,7 +347,7 @@ impl<'a> CloudProbe<'a> {
                 field
                     .blocks()
                     .filter(|(_, g)| g.phase != Phase::Gone)
-                    .map(|(index, g)| (index, g.serial, Arc::clone(&g.boxes))),
+                    .map(|(index, g)| (index, g.serial, &g.boxes)),
             );
         }
         let mut first: Option<(f64, f64, CloudType)> = None;

@@ -30,6 +30,16 @@ const TILE_BLOCKS: i32 = 4;
 /// A generation a line of sight may meet: its block, its serial, and its boxes.
 pub(super) type SightMember = (BlockIndex, u64, Arc<GenerationBoxes>);
 
+/// A [`SightMember`] as the field holds it: its boxes borrowed, shared only by a tile that
+/// takes it in (a membership change of the Cb circle's thousands of generations cloned every
+/// one's boxes, a cache miss each).
+pub(super) type LivingMember<'a> = (BlockIndex, u64, &'a Arc<GenerationBoxes>);
+
+/// `member` with its boxes shared.
+fn shared((index, serial, boxes): LivingMember<'_>) -> SightMember {
+    (index, serial, Arc::clone(boxes))
+}
+
 /// The boxes of a field's generations in tiles, for lines of sight. See the module docs.
 #[derive(Debug)]
 pub(super) struct FieldSight {
@@ -116,24 +126,26 @@ impl Tile {
     /// join it (a part of their own once a line comes near), the ones gone are passed over
     /// where they lie; not when more of its boxes would be gone than living. Returns whether
     /// it did, and whether any joined.
-    fn take(&mut self, members: Vec<SightMember>) -> Result<bool, Vec<SightMember>> {
+    fn take<'a>(&mut self, members: Vec<LivingMember<'a>>) -> Result<bool, Vec<LivingMember<'a>>> {
         let mut living_boxes = 0;
-        let mut joined = Vec::new();
+        let mut joined = 0;
         for m in &members {
             match self.serials.binary_search_by_key(&m.1, |s| s.0) {
                 Ok(k) => living_boxes += self.serials[k].1,
-                Err(_) => joined.push(Arc::clone(&m.2)),
+                // A generation without boxes is never met (only a joining one is looked at).
+                Err(_) => joined += usize::from(!m.2.boxes.is_empty()),
             }
         }
         if 2 * living_boxes < self.box_count {
             return Err(members);
         }
-        if joined.is_empty() {
+        if joined == 0 {
             return Ok(false);
         }
         let known = self.serials.clone();
         for m in members {
-            if known.binary_search_by_key(&m.1, |s| s.0).is_err() {
+            if known.binary_search_by_key(&m.1, |s| s.0).is_err() && !m.2.boxes.is_empty() {
+                let m = shared(m);
                 self.serials.push((m.1, m.2.boxes.len()));
                 self.box_count += m.2.boxes.len();
                 let (lo, hi) = box_bounds(std::slice::from_ref(&m));
@@ -192,12 +204,12 @@ impl FieldSight {
     /// generation that joins a tile is added to it (a grid of its own, when a line of sight first
     /// comes near), one that went is passed over where it lies, and a tile that would hold more
     /// gone boxes than living ones is made anew; returns how many tiles changed.
-    pub(super) fn update(&mut self, living: impl IntoIterator<Item = SightMember>) -> usize {
-        let mut by_tile: BTreeMap<(i32, i32), Vec<SightMember>> = BTreeMap::new();
+    pub(super) fn update<'a>(
+        &mut self,
+        living: impl IntoIterator<Item = LivingMember<'a>>,
+    ) -> usize {
+        let mut by_tile: BTreeMap<(i32, i32), Vec<LivingMember<'a>>> = BTreeMap::new();
         for member in living {
-            if member.2.boxes.is_empty() {
-                continue;
-            }
             let key = (
                 member.0.i.div_euclid(TILE_BLOCKS),
                 member.0.j.div_euclid(TILE_BLOCKS),
@@ -218,6 +230,13 @@ impl FieldSight {
                     tile
                 }
                 Err(members) => {
+                    let members: Vec<SightMember> = (members.into_iter())
+                        .filter(|m| !m.2.boxes.is_empty())
+                        .map(shared)
+                        .collect();
+                    if members.is_empty() {
+                        continue;
+                    }
                     changed += 1;
                     Tile::of(key, members)
                 }

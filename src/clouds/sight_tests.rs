@@ -228,7 +228,7 @@ fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
         }
     }
     let mut sight = FieldSight::new(500.0);
-    assert_eq!(sight.update(members.iter().cloned()), 9);
+    assert_eq!(sight.update(members.iter().map(|m| (m.0, m.1, &m.2))), 9);
     // A tile's grid is built when a line of sight first enters its bounds: a short one in
     // the middle of tile (1, 1) builds that tile's alone.
     assert_eq!(sight.tiles_built(), (0, 0));
@@ -250,7 +250,7 @@ fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
     for serial in [1_000, 1_001] {
         living.push(generation(BlockIndex::new(5, 6), serial, &mut rand));
     }
-    assert_eq!(sight.update(living.iter().cloned()), 1);
+    assert_eq!(sight.update(living.iter().map(|m| (m.0, m.1, &m.2))), 1);
     check(&mut sight, &living, &gone, &mut rand, 10_000);
     // The two that joined have a part of their own: the tile was not built again whole.
     assert_eq!(sight.tiles_built(), (9, 10));
@@ -265,7 +265,7 @@ fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
         .filter(|m| !tile_00[..12].contains(&m.1))
         .cloned()
         .collect();
-    assert_eq!(sight.update(left.iter().cloned()), 1);
+    assert_eq!(sight.update(left.iter().map(|m| (m.0, m.1, &m.2))), 1);
     check(&mut sight, &left, &gone, &mut rand, 20_000);
     assert_eq!(sight.tiles_built(), (9, 10));
     // Generations joining tile (2, 2) one by one, a line through it after each: a part
@@ -275,7 +275,7 @@ fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
     let mut parts = Vec::new();
     for serial in 2_000..2_000 + MAX_PARTS as u64 {
         left.push(generation(BlockIndex::new(9, 9), serial, &mut rand));
-        assert_eq!(sight.update(left.iter().cloned()), 1);
+        assert_eq!(sight.update(left.iter().map(|m| (m.0, m.1, &m.2))), 1);
         sight.crossed(corner, corner + DVec3::Y * 100.0, true, |_, _, _, _| {
             Met::Counted
         });
