@@ -13,6 +13,8 @@
 
 use std::collections::HashMap;
 
+use rustc_hash::FxHashMap;
+
 use glam::{DVec2, DVec3};
 
 use crate::clouds::CloudTypes;
@@ -87,11 +89,14 @@ pub(super) struct FarCells {
     decided: Option<(u64, DVec2, Option<f64>)>,
     /// Shown cells forming or dissipating.
     fading: usize,
-    /// The block weather the search under way looked up, and what the last one looked up
-    /// (taken over as this one meets it): a search 8 km on meets the same squares, and a
-    /// look-up in the weather field was most of a search frame's 0.9 ms (the cruise).
-    weather: HashMap<BlockIndex, BlockWeather>,
-    last_weather: HashMap<BlockIndex, BlockWeather>,
+    /// The block weather searches looked up, with the count of the last search that met it
+    /// (a finished search drops what it did not meet): a search 8 km on meets the same
+    /// squares, and a look-up in the weather field was most of a search frame's 0.9 ms (the
+    /// cruise). Hashed with Fx: moving each entry from the last search's map to this one's
+    /// with std's SipHash was over half of a search frame's time (the Cb circle).
+    weather: FxHashMap<BlockIndex, (u64, BlockWeather)>,
+    /// How many block weathers the search under way looked up in the weather field.
+    looked_up: usize,
 }
 
 /// The camera moves this far, metres, before the shown set is decided again (cells join and
@@ -110,8 +115,8 @@ impl FarCells {
             searches: 0,
             decided: None,
             fading: 0,
-            weather: HashMap::new(),
-            last_weather: HashMap::new(),
+            weather: FxHashMap::default(),
+            looked_up: 0,
         }
     }
 
@@ -272,10 +277,10 @@ impl FarCells {
             let hi = ((f.camera_air_m + DVec2::splat(reach)) / grid).ceil();
             // The last search's block weather is good for this one while the weather is the
             // same.
-            self.last_weather = std::mem::take(&mut self.weather);
             if self.found.as_ref().is_none_or(|found| found.1 != f.version) {
-                self.last_weather.clear();
+                self.weather.clear();
             }
+            self.looked_up = 0;
             self.search = Some(Search {
                 centre_m: f.camera_air_m,
                 version: f.version,
@@ -296,16 +301,16 @@ impl FarCells {
         };
         let end = (search.next_row + rows).min(search.rows.end);
         let drift = f.drift_m;
-        let (known, last) = (&mut self.weather, &mut self.last_weather);
+        let (known, looked_up) = (&mut self.weather, &mut self.looked_up);
+        let stamp = self.searches + 1;
         let mut weather = |p: DVec2| {
             let block = BlockIndex::containing(p + drift);
-            known
-                .entry(block)
-                .or_insert_with(|| {
-                    last.remove(&block)
-                        .unwrap_or_else(|| f.weather.block_layers_weather(block))
-                })
-                .clone()
+            let entry = known.entry(block).or_insert_with(|| {
+                *looked_up += 1;
+                (stamp, f.weather.block_layers_weather(block))
+            });
+            entry.0 = stamp;
+            entry.1.clone()
         };
         let reach = s.reach_m + f.storms.0.settings.reach_m();
         for cj in search.next_row..end {
@@ -325,6 +330,8 @@ impl FarCells {
         {
             self.found = Some((done.centre_m, done.version, done.cells));
             self.searches += 1;
+            let met = self.searches;
+            self.weather.retain(|_, (stamp, _)| *stamp == met);
         }
     }
 
@@ -481,10 +488,10 @@ mod tests {
             slow.found.as_ref().map(|found| &found.2),
             fresh.found.as_ref().map(|found| &found.2)
         );
-        let (met, left) = (slow.weather.len(), slow.last_weather.len());
+        let (met, looked_up) = (slow.weather.len(), slow.looked_up);
         assert!(
-            met > 1_000 && left * 20 < met,
-            "{left} left over, {met} met"
+            met > 1_000 && looked_up * 5 < met,
+            "{looked_up} looked up, {met} met"
         );
         // With the far field drawn, every cell reaching past its hand-over band's start is
         // drawn whole too (the near sprites fade out there): cells centred within the field.
