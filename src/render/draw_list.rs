@@ -230,34 +230,33 @@ pub(super) fn order_into(
     let n = offsets.len().min(slots.len());
     let SortKeys { keys, seen } = keys;
     keys.clear();
-    if holds_an_order(&slots[..n], base, seen) {
-        keys.extend(slots[..n].iter().map(|&s| key((s - base) as usize)));
+    keys.reserve(n);
+    // The keys in the slots' order, as long as the slots hold each of the cloud's sprites once
+    // (checked on the same pass: the slots' first read is a cache miss, the second was not).
+    seen.clear();
+    seen.resize(n.div_ceil(64), 0);
+    let held = slots[..n].iter().all(|&s| {
+        let i = s.wrapping_sub(base) as usize;
+        if i >= n || seen[i / 64] & (1 << (i % 64)) != 0 {
+            return false;
+        }
+        seen[i / 64] |= 1 << (i % 64);
+        keys.push(key(i));
+        true
+    });
+    if held {
         // Past a few moves a sprite the camera has turned the cloud over: sorted afresh.
         if !insertion_sort_within(keys, 4 * n) {
             keys.sort_unstable();
         }
     } else {
+        keys.clear();
         keys.extend((0..n).map(key));
         keys.sort_unstable();
     }
     for (slot, &key) in slots.iter_mut().zip(keys.iter()) {
         *slot = base + key as u32;
     }
-}
-
-/// Whether `slots` hold each of `base..base + slots.len()` once (`seen`: scratch).
-fn holds_an_order(slots: &[u32], base: u32, seen: &mut Vec<u64>) -> bool {
-    let n = slots.len();
-    seen.clear();
-    seen.resize(n.div_ceil(64), 0);
-    slots.iter().all(|&s| {
-        let i = s.wrapping_sub(base) as usize;
-        if i >= n || seen[i / 64] & (1 << (i % 64)) != 0 {
-            return false;
-        }
-        seen[i / 64] |= 1 << (i % 64);
-        true
-    })
 }
 
 /// Sorts `v` by insertion while that takes at most `max_moves` moves; false (`v` part
