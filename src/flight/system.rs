@@ -439,12 +439,14 @@ impl SkySystem {
             });
         }
         self.take_winds_aloft(&mut changes);
-        let weather = start.spent();
-        self.sky.add_field_cpu(weather);
+        // The weather's part on the wall clock alone: the thread's clock is a system call of
+        // a microsecond or two a read, and this span goes on into the field's (read once, at
+        // its end).
+        let weather_us = start.wall_us();
         let position_m = self.local_m(camera.position);
         // The far field's map first: the far storm cells hand over in its band once it is
         // drawn (`flight::far_cells`).
-        let field_part = Stopwatch::start();
+        let far_part = std::time::Instant::now();
         if self.sky.far_field_settings().enabled
             && let Some(map) = self.far_map.update(
                 position_m.truncate(),
@@ -455,16 +457,17 @@ impl SkySystem {
             let fade_s = self.world.arrival_fade_s();
             self.sky.set_far_map(queue, &map, fade_s);
         }
-        // The far field's part alone on the wall clock (the thread's clock costs a microsecond
-        // a read); the weather and the sun over the camera go with it into the field's time.
-        self.sky.add_far_field_us(field_part.wall_us());
+        // The far field's part alone on the wall clock; the weather and the sun over the
+        // camera go with it into the field's time.
+        self.sky
+            .add_far_field_us(far_part.elapsed().as_micros() as u64);
         self.sky
             .set_weather_overhead(&self.world.weather_over(position_m));
         let (lat, lon) = self.frame.to_lat_lon_deg(position_m.truncate());
         let sun = sun_position(utc_unix_s, lat, lon);
         self.sun_direction = sun.direction_enu().as_vec3();
         self.sun = Some(sun);
-        self.sky.add_field_cpu(field_part.spent());
+        self.sky.add_field_cpu(start.spent());
         self.world.update_sky(&mut self.sky, position_m, dt_s)?;
         self.sky.set_flash(self.world.flash_now());
         let view = SkyView {
@@ -473,7 +476,7 @@ impl SkySystem {
             projection: camera.projection,
         };
         let mut stats = self.sky.prepare(queue, view, &sun, dt_s);
-        stats.weather_us = weather.wall_us;
+        stats.weather_us = weather_us;
         // This frame is not recorded yet: the last recording is the previous frame's.
         stats.set_record(self.sky.last_record());
         Ok((stats, changes))
