@@ -485,7 +485,17 @@ impl World {
             self.field_version,
         );
         let version = self.field_version;
-        if living.asked != Some(key) {
+        // A new weather field's block weathers are worked out on the field's pool first; its
+        // blocks stay those of the last weather until then (offline frames take it at once).
+        let filling =
+            living.asked.is_some_and(|asked| asked.2 != version) && !self.synchronous_clouds && {
+                let at = (camera_m.truncate() - drift, drift, living.field.radius_m());
+                let field = &living.field;
+                living
+                    .weather
+                    .fill(weather_field, version, at, |job| field.spawn(job))
+            };
+        if living.asked != Some(key) && !filling {
             let cache = std::cell::RefCell::new(std::mem::take(&mut living.weather));
             // The field's own blocks take their cover at the rim; the storm cells it decides
             // reach well beyond them (a square and an anvil's reach around the radius), and a
