@@ -9,10 +9,9 @@
 //! or `rebuild_climb_fraction` of it vertically, when the sun has turned more than
 //! `rebuild_sun_deg`, or when a far block arrived whole, or when the set of far blocks changed
 //! otherwise and the ring shown was begun `rebuild_far_change_after_s` ago (until then new far
-//! blocks are sprites). It renders one
-//! impostor per frame over 8 frames into the second ring, then crossfades old -> new over
-//! `crossfade_s`. The very
-//! first ring is built in one frame (there is nothing to fade from).
+//! blocks are sprites). It renders one impostor per frame over 8 frames into the second ring,
+//! then crossfades old -> new over `crossfade_s`. The very first ring is built in one frame
+//! (there is nothing to fade from).
 //!
 //! In: the sky's blocks, camera, light and frame uniform. Out: which blocks are near (sprites),
 //! the impostor render passes, and one full-screen ring pass into the host frame
