@@ -485,15 +485,16 @@ impl World {
             self.field_version,
         );
         let version = self.field_version;
+        // Where the block weathers are worked out ahead of the field (`BlockWeathers`).
+        let around = (camera_m.truncate() - drift, drift, living.field.radius_m());
         // A new weather field's block weathers are worked out on the field's pool first; its
         // blocks stay those of the last weather until then (offline frames take it at once).
         let filling =
             living.asked.is_some_and(|asked| asked.2 != version) && !self.synchronous_clouds && {
-                let at = (camera_m.truncate() - drift, drift, living.field.radius_m());
                 let field = &living.field;
                 living
                     .weather
-                    .fill(weather_field, version, at, |job| field.spawn(job))
+                    .fill(weather_field, version, around, |job| field.spawn(job))
             };
         if living.asked != Some(key) && !filling {
             let cache = std::cell::RefCell::new(std::mem::take(&mut living.weather));
@@ -515,11 +516,10 @@ impl World {
             living.weather = cache.into_inner();
             living.asked = Some(key);
             // The next row's weathers, off the frame thread before the camera brings it in.
-            let at = (camera_m.truncate() - drift, drift, living.field.radius_m());
             let field = &living.field;
             living
                 .weather
-                .ask_ahead(weather_field, version, at, |job| field.spawn(job));
+                .ask_ahead(weather_field, version, around, |job| field.spawn(job));
         } else {
             living.weather.take_ready(version);
             living.field.poll();

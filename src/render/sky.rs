@@ -1063,15 +1063,13 @@ impl Sky {
         // While the far field is drawn every sprite has faded out by the end of its hand-over
         // band (a twentieth more: the band is horizontal, the draw distance along the ray):
         // neither the ring nor the sprites go farther.
-        let hand_over_m = self.far_field.hand_over_m();
-        let hand_over_end_m = hand_over_m.map(|(_, end)| 1.05 * end);
+        let band_m = (self.far_field.hand_over_m()).map(|(start, end)| (start, 1.05 * end));
         let mut drawn = self.settings;
-        if let Some(end) = hand_over_end_m {
+        if let Some((_, end)) = band_m {
             drawn.clouds.draw_distance_m = drawn.clouds.draw_distance_m.min(end);
         }
-        self.views[i].ring.set_reach_limit(
-            hand_over_m.map(|(start, end)| (f64::from(start), f64::from(1.05 * end))),
-        );
+        (self.views[i].ring)
+            .set_reach_limit(band_m.map(|(start, end)| (f64::from(start), f64::from(end))));
         self.views[i]
             .ring
             .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
