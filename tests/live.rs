@@ -601,3 +601,99 @@ fn field_of_text(dir: &Path) -> WeatherField {
     std::fs::write(&path, reports("FEW045")).unwrap();
     field_of(&path)
 }
+
+/// A weather change hands the sky its new generations a budget of sprites a frame, the nearest
+/// first (`WorldSettings::joined_sprites_per_frame`), after the new field's block weathers are
+/// worked out off the frame thread: in the frame that takes the new field the cloud field
+/// keeps the last weather's generations and asks for none (`BlockWeathers::fill`), and every
+/// generation is in the sky in the end. Clouds generated on the field's pool, as in a
+/// simulator's frame loop.
+#[test]
+fn a_weather_change_reaches_the_sky_a_budget_of_sprites_a_frame() {
+    const BUDGET: u32 = 4_000;
+    let dir = temp_dir("budget");
+    let all = |cover: &str| reports(cover).replace("FEW045", cover);
+    let (old, new) = (dir.join("old.txt"), dir.join("new.txt"));
+    std::fs::write(&old, all("SCT040")).unwrap();
+    std::fs::write(&new, all("BKN035")).unwrap();
+    let mut config = SkySystemConfig::new(skycast::demo::headless::TARGETS, ORIGIN);
+    config.world.cloud_radius_m = 12_000.0;
+    config.world.joined_sprites_per_frame = BUDGET;
+    config.sky.settings.cloud_shadows.enabled = false;
+    config.stations = Some(stations());
+    let ground = GroundSettings {
+        size_m: 30_000.0,
+        samples: 33,
+        ..GroundSettings::default()
+    };
+    let field = field_of(&old);
+    let mut host = DemoHost::new(W, H, &demo_ground(&field, &ground), config)
+        .unwrap_or_else(|e| panic!("live tests need an adapter: {e}"));
+    host.sky.set_weather_field(field);
+    let camera = host.camera(DVec3::new(0.0, 0.0, 900.0), 90.0, 8.0);
+    let step = |host: &mut DemoHost| {
+        host.step(&camera, UTC_S, 0.05, false).unwrap();
+        let m = host.sky.memory();
+        (m.blocks, m.sprites)
+    };
+    // Until the field is generated and handed over whole (the first frames are budgeted too).
+    let settled = |host: &DemoHost| {
+        let field = host.sky.world().living_field().unwrap();
+        (field.pending() == 0).then(|| field.blocks().count() as u32)
+    };
+    let mut held = step(&mut host);
+    for _ in 0..2_000 {
+        if settled(&host).is_some_and(|n| n > 0 && n == held.0) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+        held = step(&mut host);
+    }
+    let before = settled(&host).expect("the first field generated");
+    assert_eq!(
+        held.0, before,
+        "every generation of the first field in the sky"
+    );
+
+    host.sky.set_weather_field(field_of(&new));
+    let after_swap = step(&mut host);
+    let field = host.sky.world().living_field().unwrap();
+    assert_eq!(
+        (field.pending(), field.blocks().count() as u32, after_swap),
+        (0, before, held),
+        "the frame that takes the new field keeps the last weather's generations and asks for \
+         none while its block weathers are worked out"
+    );
+    // Then the new generations come, at most a budget of sprites a frame (or one generation).
+    let (mut frames, mut most, mut last) = (0, 0, after_swap);
+    for _ in 0..4_000 {
+        std::thread::sleep(Duration::from_millis(5));
+        let now = step(&mut host);
+        let (blocks, sprites) = (now.0 - last.0, now.1 - last.1);
+        assert!(
+            sprites <= BUDGET || blocks <= 1,
+            "{blocks} generations of {sprites} sprites handed over in one frame"
+        );
+        if blocks > 0 {
+            frames += 1;
+            most = most.max(sprites);
+        }
+        last = now;
+        let field = host.sky.world().living_field().unwrap();
+        if field.pending() == 0 && field.blocks().count() as u32 == now.0 && now.0 > before {
+            break;
+        }
+    }
+    let field = host.sky.world().living_field().unwrap();
+    let (held, generations) = (last.0, field.blocks().count() as u32);
+    eprintln!(
+        "{before} generations, then {generations}: the new ones over {frames} frames, at most \
+         {most} sprites a frame"
+    );
+    assert_eq!(held, generations, "every generation in the sky in the end");
+    assert!(generations > before, "the change made new generations");
+    assert!(
+        frames >= 3,
+        "the change took {frames} frames: too small to tell a budget"
+    );
+}

@@ -42,6 +42,17 @@ pub struct WorldSettings {
     /// crossfade instead. Not while clouds are synchronous ([`World::set_synchronous_clouds`]).
     #[serde(default = "default_arrival_fade_s")]
     pub arrival_fade_s: f64,
+    /// Sprites of new generations handed to the sky a frame, at most (the nearest first; at
+    /// least one generation a frame): a weather change forms every block of the field anew,
+    /// hundreds of thousands of sprites, and handing them over in the frames they are
+    /// generated in took 10 to 14 ms of the frame thread twice. They form from no opacity, so
+    /// a few frames late shows nothing. Not while clouds are synchronous.
+    #[serde(default = "default_joined_sprites_per_frame")]
+    pub joined_sprites_per_frame: u32,
+}
+
+fn default_joined_sprites_per_frame() -> u32 {
+    WorldSettings::default().joined_sprites_per_frame
 }
 
 fn default_arrival_fade_s() -> f64 {
@@ -56,6 +67,7 @@ impl Default for WorldSettings {
             cloud_radius_m: 60_000.0,
             seed: 2003,
             arrival_fade_s: 3.0,
+            joined_sprites_per_frame: 40_000,
         }
     }
 }
@@ -107,8 +119,11 @@ pub struct LivingClouds {
     asked: Option<(BlockIndex, BlockIndex, u64)>,
     in_sky: HashSet<u64>,
     seen: HashSet<u64>,
-    /// The newest generation handed to the sky, and the field's membership count then.
+    /// The newest generation met, and the field's membership count then.
     newest_serial: u64,
+    /// Generations met that the frames' budget of sprites has not handed to the sky yet
+    /// ([`WorldSettings::joined_sprites_per_frame`]).
+    waiting: HashSet<u64>,
     membership: Option<u64>,
     /// Generations fading in as they arrive (see [`WorldSettings::arrival_fade_s`]), with the
     /// field time they arrived at.
@@ -359,6 +374,7 @@ impl World {
             in_sky: HashSet::new(),
             seen: HashSet::new(),
             newest_serial: 0,
+            waiting: HashSet::new(),
             membership: None,
             arriving: HashMap::new(),
             fading: Vec::new(),
@@ -554,7 +570,9 @@ impl World {
         let now = living.field.time_s();
         let lifecycle = *living.field.lifecycle();
         let sky_before = sky.pending_cpu();
-        let same_members = living.membership == Some(living.field.membership());
+        // (Generations still waiting to be handed over are looked for every frame.)
+        let same_members =
+            living.membership == Some(living.field.membership()) && living.waiting.is_empty();
         // Nothing came, went, forms, dissipates or arrives: only the drift changed.
         if same_members && living.was_fading.is_empty() && living.arriving.is_empty() {
             sky.set_drift(offset_m);
@@ -589,9 +607,9 @@ impl World {
             return Ok(());
         }
         living.membership = Some(living.field.membership());
-        // Generations are handed over when they appear (serials only grow) and when they go;
-        // per frame only the drift (one value) and the fades of the blocks forming or
-        // dissipating change.
+        // Generations are handed over when they appear (serials only grow; those a frame's
+        // budget left waiting are in `waiting`) and when they go; per frame only the drift (one
+        // value) and the fades of the blocks forming or dissipating change.
         let mut count = 0;
         let newest = living.newest_serial;
         living.fading.clear();
@@ -603,17 +621,18 @@ impl World {
         let fade_in = fade_in_s > 0.0 && !self.synchronous_clouds;
         let impostors = &sky.settings().impostors;
         let ring_m = impostors.enabled.then_some(impostors.ring_radius_m);
-        // Handed over in one batch after the walk: the sky times each call it is given.
-        let mut joined = Vec::new();
+        let ground_m = camera_m.truncate();
+        // The new generations, nearest first after the walk: (distance squared, serial,
+        // index, generation).
+        let mut new: Vec<(f64, u64, BlockIndex, &FieldBlock)> = Vec::new();
         for (index, fb) in living.field.blocks() {
             count += 1;
-            let arrives = fb.serial > newest
-                && fade_in
-                && fb.phase == Phase::Steady
-                && ring_m
-                    .is_none_or(|r| (index.centre_m() + drift).distance(camera_m.truncate()) <= r);
-            if arrives {
-                living.arriving.insert(fb.serial, now);
+            let is_new = fb.serial > newest
+                || (!living.waiting.is_empty() && living.waiting.contains(&fb.serial));
+            if is_new {
+                let d2 = (index.centre_m() + drift).distance_squared(ground_m);
+                new.push((d2, fb.serial, index, fb));
+                living.newest_serial = living.newest_serial.max(fb.serial);
             }
             // Arrivals are few and brief (the first frames, a jump): with none, the field's
             // thousands of blocks cost no lookup each a frame.
@@ -626,11 +645,6 @@ impl World {
                 living.arriving.remove(&fb.serial);
             }
             let fade = fade_of(fb.phase, arrival, now, &lifecycle);
-            if fb.serial > newest {
-                living.newest_serial = living.newest_serial.max(fb.serial);
-                living.in_sky.insert(fb.serial);
-                joined.push((living_block(index, fb), BlockMotion { offset_m, fade }));
-            }
             if fade != Fade::Steady {
                 let step = fade_step(fb.serial, fade);
                 // Told only when it has moved on a step since the last frame, as when nothing
@@ -640,12 +654,47 @@ impl World {
                     .binary_search_by_key(&fb.serial, |f| f.0)
                     .ok()
                     .map(|k| living.was_fading[k].2);
-                if fb.serial <= newest && shown != Some(step) {
+                if !is_new && shown != Some(step) {
                     sky.set_block_fade(fb.serial, fade);
                 }
                 living.fading.push((fb.serial, fb.phase, step));
             }
         }
+        // The nearest first, as many as the frame's budget of sprites (offline frames: all).
+        new.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let budget = match self.synchronous_clouds {
+            true => u64::MAX,
+            false => u64::from(self.settings.joined_sprites_per_frame),
+        };
+        let (mut spent, mut joined, mut waiting_sprites) = (0u64, Vec::new(), 0u64);
+        let mut waiting_clouds = 0u64;
+        for &(d2, serial, index, fb) in &new {
+            let sprites: u64 = fb.block.clouds.iter().map(|c| c.sprites.len() as u64).sum();
+            if !joined.is_empty() && spent + sprites > budget {
+                living.waiting.insert(serial);
+                waiting_sprites += sprites;
+                waiting_clouds += fb.block.clouds.len() as u64;
+                continue;
+            }
+            spent += sprites;
+            living.waiting.remove(&serial);
+            let arrives =
+                fade_in && fb.phase == Phase::Steady && ring_m.is_none_or(|r| d2 <= r * r);
+            let arrival = arrives.then(|| {
+                living.arriving.insert(serial, now);
+                0.0
+            });
+            let fade = fade_of(fb.phase, arrival, now, &lifecycle);
+            if arrives {
+                // Its fade, kept with the others' (it was steady in the walk).
+                let step = fade_step(serial, fade);
+                living.fading.push((serial, fb.phase, step));
+            }
+            living.in_sky.insert(serial);
+            joined.push((living_block(index, fb), BlockMotion { offset_m, fade }));
+        }
+        // What still waits, so that the sky grows its buffers once for all of it.
+        sky.expect_blocks(waiting_sprites, waiting_clouds);
         sky.insert_blocks(joined);
         // The ones that finished forming since the last frame.
         living.fading.sort_unstable_by_key(|f| f.0);
@@ -656,8 +705,8 @@ impl World {
         }
         std::mem::swap(&mut living.was_fading, &mut living.fading);
         sky.set_drift(offset_m);
-        // Every block of the field is in the sky; more there means some went.
-        if living.in_sky.len() != count {
+        // Every block of the field is in the sky or waits; more there means some went.
+        if living.in_sky.len() + living.waiting.len() != count {
             living.seen.clear();
             living
                 .seen
@@ -667,6 +716,8 @@ impl World {
                 living.in_sky.remove(id);
                 living.arriving.remove(id);
             }
+            let seen = &living.seen;
+            living.waiting.retain(|id| seen.contains(id));
             sky.remove_blocks(gone);
         }
         // The sky counts its own share (the blocks inserted and removed) in its update.

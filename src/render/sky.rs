@@ -497,6 +497,14 @@ impl Sky {
         self.pending += start.spent();
     }
 
+    /// Says that blocks of `sprites` sprites and `clouds` clouds in all will be inserted in
+    /// the next frames (a weather change handed over a part a frame): when the buffers next
+    /// grow, they grow for those as well, once. Each call replaces the last; 0, 0 when none
+    /// wait.
+    pub fn expect_blocks(&mut self, sprites: u64, clouds: u64) {
+        self.resident.expected = (sprites, clouds);
+    }
+
     /// Adds a block drawn as sprites however far it is, never into the impostor ring nor cut at
     /// the draw distance: what the ring and the far field cannot draw beyond the cloud field,
     /// a storm cell's tower seen from 100-450 km (`flight::far_cells`). While the far field is
