@@ -205,6 +205,14 @@ pub struct CloudTypeConfig {
     pub continuous: bool,
     /// Lattice spacing for continuous types, metres (ignored otherwise).
     pub lattice_spacing_m: f32,
+    /// How much a layer on the lattice covers beyond the cells it keeps: keeping a share `p` of
+    /// its cells it covers `p + k p (1 - p)` of the sky (its clouds' sprites reach past their
+    /// cells; below 0 where they leave gaps inside them), so the lattice keeps the share that
+    /// covers what the weather asks. Measured per type by the test
+    /// `a_layer_on_the_lattice_covers_what_the_weather_asks` (it prints the fit). -1 ..= 2;
+    /// absent: 0.
+    #[serde(default)]
+    pub lattice_overhang: f32,
     /// Drawn as flat horizontal rectangles (cirrus, Wang 2003 §7.1).
     pub flat: bool,
     /// Cloud thickness range, metres; the layer's reported thickness is clamped into it.
@@ -532,6 +540,12 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
         !c.continuous || (100.0..=4_000.0).contains(&c.lattice_spacing_m),
         "lattice_spacing_m",
         "must be 100..=4000 metres for a continuous type",
+    )?;
+    v.check(
+        (-1.0..=2.0).contains(&c.lattice_overhang),
+        "lattice_overhang",
+        "must be -1..=2 (the share of the sky a lattice keeping half its cells covers beyond \
+         half, times 4)",
     )?;
     v.range_u32(c.boxes_per_cloud, "boxes_per_cloud", 1, 50)?;
     v.check(
