@@ -44,6 +44,10 @@ use crate::weather::{
 /// Feet to metres.
 /// Cells per side of the coverage grid.
 pub(super) const GRID: usize = 40;
+/// A round lattice cell's radius over half its side: a little more than the disc of the
+/// square's area (2 / sqrt(pi), 1.13), so that the corners where four kept cells meet stay
+/// covered by their sprites.
+const ROUND_CELL: f64 = 1.25;
 /// Layers at or above this coverage are placed on the lattice, whatever their type.
 pub(super) const OVERCAST_OKTAS: f32 = 7.5;
 
@@ -409,13 +413,22 @@ fn lattice_layer(index: BlockIndex, ctx: &LayerCtx, seed: u64, out: &mut Vec<Clo
         // Off the lattice's own points by up to a twentieth of a cell, so that the cells' sides
         // (where one cloud's sprites, sorted as a whole, overlap its neighbour's) do not lie on
         // a regular grid: on it, straight down, every cell side showed alike (1 km rows).
-        let jitter = DVec2::new(rng.range_f64(-0.05, 0.05), rng.range_f64(-0.05, 0.05)) * s;
-        let centre = DVec2::new((ci as f64 + 0.5) * s, (cj as f64 + 0.5) * s) + jitter;
+        // A round cell (below) by up to a fifth: its clearings then lie off the axes too.
+        let on_lattice = DVec2::new((ci as f64 + 0.5) * s, (cj as f64 + 0.5) * s);
+        let round = config.continuous && ctx.cover.oktas_at(on_lattice - lo) < OVERCAST_OKTAS;
+        let reach = if round { 0.2 } else { 0.05 };
+        let jitter = DVec2::new(rng.range_f64(-1.0, 1.0), rng.range_f64(-1.0, 1.0)) * reach * s;
+        let centre = on_lattice + jitter;
         let [dmin, dmax] = config.cloud_size_m.map(f64::from);
         // Wide enough to cover the cell's corners.
         let d = rng.range_f64(dmin, dmax).max(s * 1.5);
         let oktas = ctx.cover.oktas_at(centre - lo);
-        let (cloud, n) = build_cloud(ctx, centre, d, Some(s), oktas, rng.next_u64());
+        // A cell of a broken continuous layer is a round cloud: its gaps are then round
+        // clearings, where square cells left square holes (a grid of them from FL350 over a
+        // broken altostratus). (Other types take the lattice at an overcast only, and keep
+        // its square cells; the small sprites of altocumulus leave gaps in a round one.)
+        let cell = LatticeCell { side_m: s, round };
+        let (cloud, n) = build_cloud(ctx, centre, d, Some(cell), oktas, rng.next_u64());
         boxes += n;
         out.push(cloud);
     }
@@ -465,17 +478,27 @@ pub(super) struct LayerCtx<'a> {
     pub(super) cover: LayerCover,
 }
 
+/// A lattice cell a cloud fills: its side, and whether it is a round cloud (a cell of a
+/// broken layer) rather than the whole square (an overcast's).
+#[derive(Debug, Clone, Copy)]
+struct LatticeCell {
+    side_m: f64,
+    round: bool,
+}
+
 /// Builds one cloud of `d` metres diameter centred (horizontally) at `centre`, as dense as a
 /// layer of `oktas`; returns the cloud and the number of boxes it used.
 fn build_cloud(
     ctx: &LayerCtx,
     centre: DVec2,
     d: f64,
-    lattice_cell_m: Option<f64>,
+    lattice: Option<LatticeCell>,
     oktas: f32,
     cloud_seed: u64,
 ) -> (Cloud, u32) {
     let LayerCtx { config, frame, .. } = *ctx;
+    let lattice_cell_m = lattice.map(|c| c.side_m);
+    let round = lattice.is_some_and(|c| c.round);
     let mut rng = SplitMix64::new(cloud_seed);
     // Streaks: the footprint squeezed across the wind axis, every sprite along it.
     let streak = config
@@ -540,10 +563,18 @@ fn build_cloud(
                 // jitter of a fifth of it left a regular grid that read as squares from above.
                 let (gx, gy) = ((s % m) as f64, ((s / m) % m) as f64);
                 let cell = 2.0 / m as f64;
-                (
+                let (x, y) = (
                     -1.0 + cell * (gx + rng.range_f64(0.0, 1.0)),
                     -1.0 + cell * (gy + rng.range_f64(0.0, 1.0)),
-                )
+                );
+                if round {
+                    // The square onto a disc of the square's area, evenly (each point along
+                    // its own ray from the centre, the square's edge to the circle's).
+                    let k = (x.abs().max(y.abs()) / x.hypot(y).max(1e-9)) * ROUND_CELL;
+                    (x * k, y * k)
+                } else {
+                    (x, y)
+                }
             } else {
                 // A random point in the box's elliptic footprint (rejection, no trigonometry).
                 loop {
