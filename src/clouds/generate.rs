@@ -568,8 +568,9 @@ fn build_cloud(
                     -1.0 + cell * (gy + rng.range_f64(0.0, 1.0)),
                 );
                 if round {
-                    // The square onto a disc of the square's area, evenly (each point along
-                    // its own ray from the centre, the square's edge to the circle's).
+                    // The square onto a disc (`ROUND_CELL` half-sides across), evenly: each
+                    // point along its own ray from the centre, the square's edge to the
+                    // circle's.
                     let k = (x.abs().max(y.abs()) / x.hypot(y).max(1e-9)) * ROUND_CELL;
                     (x * k, y * k)
                 } else {
