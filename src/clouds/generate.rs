@@ -19,8 +19,8 @@
 //! often as it is there (a candidate centre is kept with the chance cover / greatest cover, and
 //! placement stops at the block's mean cover), sized and packed by the cover where they stand;
 //! the lattice keeps a cell by its world key against the cover at the cell (the lowest
-//! key / cover first, as many as the cells' covers add up to). A block of even cover is
-//! generated as before, to the byte.
+//! key / cover first, as many as the cells' covers add up to). A block of even cover takes
+//! none of this: its layers are placed as one cover over the whole block.
 //!
 //! Heights: base = ground elevation + base ft AGL x 0.3048; the thickness is the layer's, clamped
 //! into the type's range. Randomness: [`SplitMix64`] keyed by seed, block and layer (or world
