@@ -33,6 +33,11 @@ struct FarField {
     // diameter, metres; z: their greatest height over their diameter; w: the share of the
     // layer they cover when every cell holds one.
     puffs: vec4<f32>,
+    // rgb: a sheet's top's ambient light, in the near decks' textures' hue (times its type's
+    // top level's grey, from the map's looks).
+    sheet_ambient_rgb: vec4<f32>,
+    // rgb: a sheet's top's sunlight, in that hue.
+    sheet_sun_rgb: vec4<f32>,
 };
 
 struct FarOut {
@@ -312,9 +317,24 @@ fn heaped_puffs(
     return acc;
 }
 
-// How much the grain (`far_layer`) lights and shades a sheet's and a heaped layer's tops.
-const GRAIN_SHEET: f32 = 0.12;
+// How much the grain (`far_layer`) lights and shades a sheet's and a heaped layer's tops. (A
+// sheet's 1 km grain mottles it at 4 km too: at 0.12 the band from FL350 over San Antonio was
+// twice as blotchy as the deck's sprites beside it, docs/src/horizon.md.)
+const GRAIN_SHEET: f32 = 0.06;
 const GRAIN_HEAPED: f32 = 0.5;
+// A sheet's top in the sun, over its light: a broken sheet's, and a closed one's (a deck's
+// sprites seen at a slant are lit tops only; measured against San Antonio's stratus deck from
+// FL350 and FL450, docs/src/horizon.md), and how much its broad patches (`cloud_noise`) light
+// and shade it.
+const SHEET_TOP: f32 = 0.64;
+const SHEET_TOP_CLOSED: f32 = 0.69;
+const SHEET_RELIEF: f32 = 0.03;
+
+// The look of layer `layer` (0 low, 1 high) from the map's texture layer of looks: the grey and
+// the alpha of the top colour level of its most covering type (src/clouds/far_map.rs).
+fn layer_look(looks: vec4<f32>, layer: i32) -> vec2<f32> {
+    return select(looks.xy, looks.zw, layer == 1);
+}
 
 // One layer along the ray: premultiplied colour and the distance of its clouds.
 struct FarHit {
@@ -333,6 +353,8 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
     var ground_xy = vec2<f32>(0.0);
     // How much of a crossfade's cell shows (below).
     var presence = 1.0;
+    // The layer's type's top level's grey and alpha (`layer_look`).
+    var look = vec2<f32>(1.0);
     // Meet the layer at its mean height, read the map there, meet it again at the height the
     // map gives (twice: the layer's height varies slowly across the map). Rays that meet it
     // short of the hand-over band (the sprites' clouds), off the map, or where the map has no
@@ -351,6 +373,7 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
             return none;
         }
         cell = textureSampleLevel(far_map, far_sampler, uv, layer, 0.0);
+        look = layer_look(textureSampleLevel(far_map, far_sampler, uv, 4, 0.0), layer);
         // A new weather crossfades from the map before it (texture layers 2 and 3): where both
         // have cloud the cell goes from the one to the other; where one alone has, its clouds
         // fade in or out whole (seen this far off, a layer of any cover shows as one, so a
@@ -358,11 +381,15 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
         presence = 1.0;
         if (ff.fade.w < 1.0) {
             let before = textureSampleLevel(far_map, far_sampler, uv, layer + 2, 0.0);
+            let look_before =
+                layer_look(textureSampleLevel(far_map, far_sampler, uv, 5, 0.0), layer);
             let had = before.x > 0.01;
             if (had && cell.x > 0.01) {
                 cell = mix(before, cell, ff.fade.w);
+                look = mix(look_before, look, ff.fade.w);
             } else if (had) {
                 cell = before;
+                look = look_before;
                 presence = 1.0 - ff.fade.w;
             } else {
                 presence = ff.fade.w;
@@ -432,11 +459,16 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
     // The far side of a layer below is seen from under it.
     let from_above = select(smoothstep(cell.y, cell.z, camera), 0.0, far_side);
     let relief = select(
-        0.6 + 0.08 * n + GRAIN_SHEET * grain,
+        mix(SHEET_TOP, SHEET_TOP_CLOSED, smoothstep(0.9, 1.0, cell.x))
+            + SHEET_RELIEF * (n - 0.5)
+            + GRAIN_SHEET * grain,
         0.66 + 0.8 * (n - max(threshold, 0.4)) + GRAIN_HEAPED * grain,
         heaped,
     );
-    var rgb = mix(ff.shade_rgb.rgb, ff.lit_rgb.rgb * clamp(relief, 0.5, 1.1), from_above);
+    // A sheet in its type's top level's grey, as its near sprites are drawn.
+    let sheet_rgb = ff.sheet_ambient_rgb.rgb * look.x + ff.sheet_sun_rgb.rgb;
+    let top_rgb = select(sheet_rgb, ff.lit_rgb.rgb, heaped);
+    var rgb = mix(ff.shade_rgb.rgb, top_rgb * clamp(relief, 0.5, 1.1), from_above);
     // Where a pixel resolves them, a heaped layer's clouds one by one (`heaped_puffs`), as the
     // sprites draw them nearer: they take over from the noise as the puffs grow to a few
     // pixels (their width, or their height seen at the ray's slant, whichever is less).
@@ -475,7 +507,9 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
         );
         body = mix(body, puffs, resolve);
     }
-    var alpha = body.a * weight;
+    // As translucent as its type's near sprites' tops (an altostratus deck shows the ground
+    // through it).
+    var alpha = body.a * weight * look.y;
     rgb = body.rgb / max(body.a, 1.0e-6);
     // The altitude haze between the camera and the clouds (the flat frame's height: the true).
     let haze = haze_transmittance(t, height - camera);

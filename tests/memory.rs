@@ -57,9 +57,8 @@ fn fly(model: ShadingModel, warm_up: u32, frames: u32) -> (u64, u64) {
     let mut demo = DemoHost::new(W, H, &ground, config).expect("demo host");
     // The far field's map, made once (the circle stays within one map's reach), so that its
     // pass is drawn every frame.
-    let field = world.field();
     let far_map = FarMapFeed::new(far.texels, far.texel_m, far.move_texels, 1)
-        .update(DVec2::ZERO, true, |p| field.weather_at(p))
+        .update(DVec2::ZERO, true, world.far_map_cell())
         .expect("a first far map");
     demo.sky.set_far_map(&demo.gpu.queue, &far_map, None);
     let sun = sun_position(UNIX_S, AT.0, AT.1);

@@ -745,7 +745,7 @@ fn fly_command_writes_frames_and_csv() {
     );
     assert!(dir.join("frame_00000.png").exists() && dir.join("frame_00006.png").exists());
     // The far field: its whole map sampled on the first frame (the clouds synchronous), within
-    // the field's and the update's time; its map on the GPU on every frame (147 KB).
+    // the field's and the update's time; its map on the GPU on every frame (442 KB).
     let number = |r: &Vec<&str>, name: &str| -> u64 { r[column(name)].parse().unwrap() };
     let far_us = number(&rows[1], "far_field_us");
     let within = number(&rows[1], "field_us") + number(&rows[1], "cpu_update_us");
@@ -2015,23 +2015,24 @@ fn uniform_far_map(cover: f32) -> skycast::clouds::far_map::FarMap {
         texels: 96,
         texel_m: 10_000.0,
         centre_m: DVec2::ZERO,
-        cells: vec![[cover, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0]; 96 * 96],
+        cells: vec![
+            [
+                cover, 1500.0, 2500.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0
+            ];
+            96 * 96
+        ],
         weather_epoch: 0,
     }
 }
 
-/// From FL450 over San Antonio's overcast (the real bulk file: stratus, 8 oktas, base 2,300 ft
-/// over ground at 281 m, 600 ft thick), the hand-over from the sprites' deck to the far field
-/// (42 to 60 km out) shows no darker ring: crossfaded evenly, each half faded in the band's
-/// middle, the two let the ground through there, 3.4 out of 255 darker than the far field
-/// beyond (rows 116 to 119 of this frame), so over a closed layer the far field comes in early,
-/// under the deck. The band's rows are no darker than the far field's beyond it.
-#[test]
-fn over_an_overcast_the_hand_over_shows_no_darker_ring() {
+/// The rows' mean luminance (the middle quarter of the columns) of a 320 x 180 frame over San
+/// Antonio's overcast (the real bulk file: stratus, 8 oktas, base 2,300 ft over ground at 281
+/// m, 600 ft thick) from `alt_ft`, heading 40, pitch -3, by where their rays meet the deck's
+/// middle (1,075 m above sea level): one value for each distance bin, km.
+fn san_antonio_deck_rows(alt_ft: u32, bins: &[(f64, f64)]) -> Vec<f32> {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-tests");
     std::fs::create_dir_all(&dir).unwrap();
-    let png = dir.join("fl450-san-antonio.png");
-    let (height_m, pitch_deg) = (45_000.0 * 0.3048, -3.0f64);
+    let png = dir.join(format!("fl{}-san-antonio.png", alt_ft / 100));
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_skycast"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .env("XDG_RUNTIME_DIR", "/tmp")
@@ -2040,14 +2041,8 @@ fn over_an_overcast_the_hand_over_shows_no_darker_ring() {
             "--weather",
             "weather/awc-metars-2025-01-27T22Z.cache.csv",
         ])
-        .args([
-            "--at",
-            "29.4270,-98.6080",
-            "--alt-ft",
-            "45000",
-            "--heading",
-            "40",
-        ])
+        .args(["--at", "29.4270,-98.6080", "--heading", "40"])
+        .args(["--alt-ft", &alt_ft.to_string()])
         .args([
             "--pitch",
             "-3",
@@ -2067,34 +2062,75 @@ fn over_an_overcast_the_hand_over_shows_no_darker_ring() {
     );
     let img = image::open(&png).unwrap().to_rgba8();
     let (w, h) = img.dimensions();
-    // How far out a row's ray meets the deck's middle, 1,075 m above sea level (the shipped 60
-    // degree field of view).
-    let deck_km = |row: u32| ray_to_layer_km(row, h, (height_m, pitch_deg, 60.0), 1075.0);
-    // Rows' mean luminance over the middle quarter of the columns, by where their rays meet it.
-    let rows = |km: std::ops::Range<f64>| -> Vec<f32> {
-        (0..h)
-            .filter(|&y| deck_km(y).is_some_and(|d| km.contains(&d)))
-            .map(|y| {
-                let xs = 3 * w / 8..5 * w / 8;
-                let n = xs.len() as f32;
-                xs.map(|x| {
-                    let p = img.get_pixel(x, y).0;
-                    luminance([0, 1, 2, 3].map(|k| f32::from(p[k]) / 255.0))
-                })
-                .sum::<f32>()
-                    / n
-            })
-            .collect()
+    let height_m = f64::from(alt_ft) * 0.3048;
+    // How far out a row's ray meets the deck's middle (the shipped 60 degree field of view).
+    let deck_km = |row: u32| ray_to_layer_km(row, h, (height_m, -3.0, 60.0), 1075.0);
+    let row_mean = |y: u32| {
+        let xs = 3 * w / 8..5 * w / 8;
+        let n = xs.len() as f32;
+        xs.map(|x| {
+            let p = img.get_pixel(x, y).0;
+            luminance([0, 1, 2, 3].map(|k| f32::from(p[k]) / 255.0))
+        })
+        .sum::<f32>()
+            / n
     };
-    let beyond = rows(64.0..80.0);
-    let band = rows(44.0..58.0);
-    assert!(beyond.len() >= 3 && band.len() >= 8, "{beyond:?} {band:?}");
-    let far = beyond.iter().sum::<f32>() / beyond.len() as f32;
-    let darkest = band.iter().copied().fold(f32::MAX, f32::min);
-    eprintln!("far field {far}, the band's darkest row {darkest}: {band:?}");
+    bins.iter()
+        .map(|&(near, far)| {
+            let rows: Vec<f32> = (0..h)
+                .filter(|&y| deck_km(y).is_some_and(|d| (near..far).contains(&d)))
+                .map(row_mean)
+                .collect();
+            assert!(!rows.is_empty(), "no row {near} to {far} km out");
+            rows.iter().sum::<f32>() / rows.len() as f32
+        })
+        .collect()
+}
+
+/// From FL450 over San Antonio's overcast, the hand-over from the sprites' deck to the far
+/// field (42 to 60 km out) shows no darker ring: crossfaded evenly, each half faded in the
+/// band's middle, the two let the ground through there, 3.4 out of 255 darker than the far
+/// field beyond (rows 116 to 119 of this frame), so over a closed layer the far field comes in
+/// early, under the deck. The band's rows are no darker than the far field's beyond it.
+///
+/// And from FL350 the deck runs on into the far field with neither a step nor a ring: going
+/// out, no 4 km of it is brighter than the 4 km before (a ring is a dip), and the far field
+/// 64-80 km out is within 4.5/255 of the deck's sprites 30-42 km out (the haze takes about
+/// 0.1/255 a kilometre off the deck, measured with the far field off). Before the far field's
+/// sheet took the closed deck's light and the deck's sprites faded from the deepest up, the
+/// sheet was 6.8/255 darker (a brightening towards the aircraft), and with the sheet matched but
+/// the deck's sprites faded all alike, the band was a ring 1.5/255 darker than both sides.
+#[test]
+fn over_an_overcast_the_hand_over_shows_no_darker_ring() {
+    let band = [(44.0, 47.5), (47.5, 51.0), (51.0, 54.5), (54.5, 58.0)];
+    let rows = san_antonio_deck_rows(45_000, &[band[0], band[1], band[2], band[3], (64.0, 80.0)]);
+    let far = rows[4];
+    let darkest = rows[..4].iter().copied().fold(f32::MAX, f32::min);
+    eprintln!("FL450: far field {far}, the band's darkest 3.5 km {darkest}: {rows:?}");
     assert!(
         darkest >= far - 1.5 / 255.0,
         "a darker ring in the hand-over: {darkest} against {far}"
+    );
+
+    let out: Vec<(f64, f64)> = (0..12)
+        .map(|k| (30.0 + 4.0 * f64::from(k), 34.0 + 4.0 * f64::from(k)))
+        .chain([(30.0, 42.0), (64.0, 80.0)])
+        .collect();
+    let rows = san_antonio_deck_rows(35_000, &out);
+    eprintln!("FL350, 30 to 78 km out by 4 km, then 30-42 and 64-80 km: {rows:?}");
+    for (k, pair) in rows[..12].windows(2).enumerate() {
+        assert!(
+            pair[1] <= pair[0] + 0.3 / 255.0,
+            "a ring: {} km out is brighter than the 4 km before it ({} against {})",
+            34 + 4 * k,
+            pair[1] * 255.0,
+            pair[0] * 255.0
+        );
+    }
+    let step = (rows[12] - rows[13]) * 255.0;
+    assert!(
+        step <= 4.5,
+        "the far field 64-80 km out is {step}/255 darker than the deck 30-42 km out"
     );
 }
 
@@ -2575,7 +2611,7 @@ fn the_far_fields_cumulus_have_the_sprites_grain() {
     let types = CloudTypes::builtin();
     // Blocks of 4 km over the view 52 to 84 km ahead.
     let blocks = generated_blocks(&weather, &types, (-5..5, 13..21), 2000.0);
-    let cell = skycast::clouds::far_map::far_cell(&weather);
+    let cell = skycast::clouds::far_map::far_cell(&weather, &types);
     let map = skycast::clouds::far_map::FarMap {
         texels: 96,
         texel_m: 10_000.0,

@@ -284,7 +284,7 @@ fn fly(
         skycast::clouds::far_map::FarMapFeed::new(f.texels, f.texel_m, f.move_texels, 1).update(
             DVec2::ZERO,
             true,
-            world.far_map_weather(),
+            world.far_map_cell(),
         )
     });
     let mut hosts = Vec::new();

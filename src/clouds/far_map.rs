@@ -9,17 +9,22 @@
 //! (cirrus, cirrocumulus, cirrostratus). A layer is its cover (0..1, the layers of its kind
 //! overlapping at random, `1 - prod(1 - c)`), the base and top of its most covering member
 //! (metres above sea level) and whether that member is heaped (cumuliform: the far field's
-//! texture is then small and lumpy) or a sheet. Built a few rows a frame ([`FarMapFeed`]) and
+//! texture is then small and lumpy) or a sheet, and that member's type's look from above: the
+//! grey and the alpha of its top colour level (`config/cloud_types.toml`), which its near
+//! sprites are drawn with (an altostratus deck translucent, a nimbostratus one grey). Built a few
+//! rows a frame ([`FarMapFeed`]) and
 //! rebuilt after the camera moved `move_texels` cells or the weather changed (at once for offline
 //! frames).
 
 use glam::DVec2;
 
+use super::CloudTypes;
 use crate::weather::{BlockWeather, CloudType, METRES_PER_FOOT};
 
 /// One cell of the map: `[cover, base_msl_m, top_msl_m, heaped]` of the low / middle layer,
-/// then of the high layer.
-pub type FarCell = [f32; 8];
+/// then of the high layer, then `[grey, alpha]` of the low layer's top colour level and of the
+/// high layer's (1, 1 where a layer has no cloud).
+pub type FarCell = [f32; 12];
 
 /// The far field's cloud map (module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -57,9 +62,9 @@ impl FarMap {
             .get(row as usize * self.texels as usize + col as usize)
     }
 
-    /// Bytes of the map on the GPU (two RGBA half-float layers a cell).
+    /// Bytes of the map on the GPU (three RGBA half-float layers a cell).
     pub fn gpu_bytes(&self) -> u64 {
-        u64::from(self.texels) * u64::from(self.texels) * 16
+        u64::from(self.texels) * u64::from(self.texels) * 24
     }
 
     /// This map's cells where `like` has its cells (a map of the same size whose centre is
@@ -135,9 +140,10 @@ fn is_heaped(t: CloudType, oktas: f32) -> bool {
     ) || (t == CloudType::Stratocumulus && oktas < 8.0)
 }
 
-/// The cell of a weather (module docs).
-pub fn far_cell(weather: &BlockWeather) -> FarCell {
-    let mut cell = [0.0f32; 8];
+/// The cell of a weather (module docs), with the looks of `types`.
+pub fn far_cell(weather: &BlockWeather, types: &CloudTypes) -> FarCell {
+    let mut cell = [0.0f32; 12];
+    cell[8..].fill(1.0);
     let ground = if weather.ground_elevation_m.is_finite() {
         weather.ground_elevation_m
     } else {
@@ -145,7 +151,7 @@ pub fn far_cell(weather: &BlockWeather) -> FarCell {
     };
     for high in [false, true] {
         let mut clear = 1.0f32;
-        let mut best: Option<(f32, f32, f32, bool)> = None;
+        let mut best: Option<(f32, f32, f32, CloudType, f32)> = None;
         for l in weather
             .layers
             .iter()
@@ -159,15 +165,21 @@ pub fn far_cell(weather: &BlockWeather) -> FarCell {
             let base = ground + l.base_ft_agl * METRES_PER_FOOT as f32;
             let top = base + l.thickness_ft.max(0.0) * METRES_PER_FOOT as f32;
             if best.is_none_or(|b| cover > b.0) {
-                best = Some((cover, base, top, is_heaped(l.cloud_type, l.coverage_oktas)));
+                best = Some((cover, base, top, l.cloud_type, l.coverage_oktas));
             }
         }
-        if let Some((_, base, top, heaped)) = best {
+        if let Some((_, base, top, cloud_type, oktas)) = best {
             let at = if high { 4 } else { 0 };
             cell[at] = 1.0 - clear;
             cell[at + 1] = base;
             cell[at + 2] = top.max(base + 1.0);
-            cell[at + 3] = f32::from(u8::from(heaped));
+            cell[at + 3] = f32::from(u8::from(is_heaped(cloud_type, oktas)));
+            let top_level = types.get(cloud_type).colour_levels.last().map(|l| l.rgba);
+            if let Some([r, g, b, a]) = top_level {
+                let look = if high { 10 } else { 8 };
+                cell[look] = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+                cell[look + 1] = a;
+            }
         }
     }
     cell
@@ -222,11 +234,12 @@ impl FarMapFeed {
     /// One frame's share of the work around the camera at `camera_m` (local metres): a
     /// finished map when there is one to show. `whole`: build the first map at once (offline
     /// frames, the warm-up); otherwise, and for every later map, `rows_per_frame` rows a frame.
+    /// `cell`: the cell at a point ([`far_cell`] of the weather there).
     pub fn update(
         &mut self,
         camera_m: DVec2,
         whole: bool,
-        weather: impl Fn(DVec2) -> BlockWeather,
+        cell: impl Fn(DVec2) -> FarCell,
     ) -> Option<FarMap> {
         let snapped = (camera_m / self.texel_m).round() * self.texel_m;
         let moved = self
@@ -255,7 +268,7 @@ impl FarMapFeed {
         for row in b.next_row..end {
             for col in 0..b.map.texels {
                 let at = b.map.cell_centre_m(col, row);
-                b.map.cells.push(far_cell(&weather(at)));
+                b.map.cells.push(cell(at));
             }
         }
         b.next_row = end;
@@ -294,7 +307,8 @@ mod tests {
             ground_elevation_m: 200.0,
             ..BlockWeather::default()
         };
-        let c = far_cell(&w);
+        let types = CloudTypes::builtin();
+        let c = far_cell(&w, &types);
         // Half and a quarter, overlapping at random: 1 - 0.5 x 0.75.
         assert!((c[0] - 0.625).abs() < 1e-6, "{c:?}");
         // The most covering low layer's base and top, above sea level; heaped.
@@ -302,26 +316,45 @@ mod tests {
         assert!((c[2] - (200.0 + 1828.8)).abs() < 0.1, "{c:?}");
         assert_eq!(c[3], 1.0);
         assert!((c[4] - 0.75).abs() < 1e-6 && c[7] == 0.0, "{c:?}");
-        assert_eq!(far_cell(&BlockWeather::default())[0], 0.0);
+        // The looks of cumulus mediocris' and cirrus' top levels.
+        assert!((c[8] - 1.0).abs() < 1e-6 && c[9] == 1.0, "{c:?}");
+        assert!(
+            (c[10] - 1.0).abs() < 1e-6 && (c[11] - 0.55).abs() < 1e-6,
+            "{c:?}"
+        );
+        let clear = far_cell(&BlockWeather::default(), &types);
+        assert_eq!(clear[0], 0.0);
+        assert_eq!(clear[8..], [1.0; 4]);
+        // An altostratus deck is translucent, a nimbostratus one grey (their sprites' tops).
+        let deck = |t| BlockWeather {
+            layers: vec![layer(t, 8.0, 8000.0, 1000.0)],
+            ..BlockWeather::default()
+        };
+        assert!((far_cell(&deck(CloudType::Altostratus), &types)[9] - 0.8).abs() < 1e-6);
+        assert!(far_cell(&deck(CloudType::Nimbostratus), &types)[8] < 0.8);
         // Broken stratocumulus is separate clouds, an overcast one a sheet.
         let sc = |oktas| BlockWeather {
             layers: vec![layer(CloudType::Stratocumulus, oktas, 4000.0, 1000.0)],
             ..BlockWeather::default()
         };
-        assert_eq!(far_cell(&sc(6.0))[3], 1.0);
-        assert_eq!(far_cell(&sc(8.0))[3], 0.0);
+        assert_eq!(far_cell(&sc(6.0), &types)[3], 1.0);
+        assert_eq!(far_cell(&sc(8.0), &types)[3], 0.0);
     }
 
     #[test]
     fn the_feed_builds_a_whole_map_at_once_or_a_few_rows_a_frame() {
         // Cloud only north of y = 70 km.
-        let weather = |p: DVec2| BlockWeather {
-            layers: if p.y > 70_000.0 {
-                vec![layer(CloudType::Stratus, 8.0, 1000.0, 1000.0)]
-            } else {
-                Vec::new()
-            },
-            ..BlockWeather::default()
+        let types = CloudTypes::builtin();
+        let weather = |p: DVec2| {
+            let w = BlockWeather {
+                layers: if p.y > 70_000.0 {
+                    vec![layer(CloudType::Stratus, 8.0, 1000.0, 1000.0)]
+                } else {
+                    Vec::new()
+                },
+                ..BlockWeather::default()
+            };
+            far_cell(&w, &types)
         };
         let mut feed = FarMapFeed::new(16, 10_000.0, 2.0, 4);
         let map = feed
@@ -332,7 +365,7 @@ mod tests {
         assert_eq!(map.cell_at(DVec2::new(0.0, 75_000.0)).unwrap()[0], 1.0);
         assert_eq!(map.cell_at(DVec2::new(0.0, 65_000.0)).unwrap()[0], 0.0);
         assert!(map.cell_at(DVec2::new(0.0, 81_000.0)).is_none());
-        assert_eq!(map.gpu_bytes(), 16 * 16 * 16);
+        assert_eq!(map.gpu_bytes(), 16 * 16 * 24);
         // Within two cells nothing is built; past them, four frames of four rows.
         assert!(
             feed.update(DVec2::new(15_000.0, 0.0), false, weather)
@@ -362,7 +395,22 @@ mod tests {
     /// takes the other map's cells where it has none; a blend goes linearly between two.
     #[test]
     fn a_map_moves_by_whole_cells_and_blends_linearly() {
-        let cell = |v: f32| [v, 1000.0 + v, 2000.0 + v, 1.0, 0.0, 0.0, 0.0, 0.0];
+        let cell = |v: f32| {
+            [
+                v,
+                1000.0 + v,
+                2000.0 + v,
+                1.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                1.0,
+                1.0,
+                1.0,
+                1.0,
+            ]
+        };
         let map = |centre_cells: f64, value: &dyn Fn(u32, u32) -> f32| {
             let cells = (0..16).map(|k| cell(value(k % 4, k / 4))).collect();
             FarMap {
@@ -392,7 +440,8 @@ mod tests {
     #[test]
     fn a_weather_change_starts_a_map_of_a_new_epoch() {
         let mut feed = FarMapFeed::new(4, 100.0, 1.0, 2);
-        let clear = |_: DVec2| BlockWeather::default();
+        let types = CloudTypes::builtin();
+        let clear = |_: DVec2| far_cell(&BlockWeather::default(), &types);
         let first = feed
             .update(DVec2::ZERO, true, clear)
             .expect("built at once");

@@ -451,7 +451,7 @@ impl SkySystem {
             && let Some(map) = self.far_map.update(
                 position_m.truncate(),
                 self.world.synchronous_clouds(),
-                self.world.far_map_weather(),
+                self.world.far_map_cell(),
             )
         {
             let fade_s = self.world.arrival_fade_s();

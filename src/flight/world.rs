@@ -429,11 +429,11 @@ impl World {
         }
     }
 
-    /// The weather the far field's map is made of at a point: the field's, without its
-    /// cumulonimbus while storm cells beyond the cloud field are drawn as cells
+    /// The far field's map's cell at a point, of the weather there with the world's cloud types'
+    /// looks: the field's weather, without its cumulonimbus while storm cells beyond the cloud field are drawn as cells
     /// ([`Self::draws_far_cells`]), not as a layer from base to top. Decided once, for the
     /// thousands of points of a map.
-    pub fn far_map_weather(&self) -> impl Fn(DVec2) -> BlockWeather + '_ {
+    pub fn far_map_cell(&self) -> impl Fn(DVec2) -> crate::clouds::far_map::FarCell + '_ {
         let cells_apart = self.draws_far_cells();
         move |p| {
             let mut w = self.field.weather_at(p);
@@ -441,7 +441,7 @@ impl World {
                 w.layers
                     .retain(|l| l.cloud_type != crate::weather::CloudType::Cumulonimbus);
             }
-            w
+            crate::clouds::far_map::far_cell(&w, &self.types)
         }
     }
 

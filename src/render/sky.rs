@@ -90,6 +90,35 @@ impl SpriteSheet {
                 .collect(),
         }
     }
+
+    /// The alpha-weighted mean colour of the textures in `cells` (row-major cells of a 4 x 4
+    /// sheet), from the smallest mip level; black where they have no alpha.
+    pub fn mean_rgb(&self, cells: std::ops::Range<u8>) -> Vec3 {
+        let Some((level, bytes)) = self.mips.iter().enumerate().next_back() else {
+            return Vec3::ZERO;
+        };
+        let side = (self.size_px >> level).max(4) as usize;
+        let cell_px = side / 4;
+        let (mut sum, mut weight) = (Vec3::ZERO, 0.0f32);
+        for cell in cells.map(usize::from).filter(|&c| c < 16) {
+            let (cx, cy) = (cell % 4 * cell_px, cell / 4 * cell_px);
+            for y in cy..cy + cell_px {
+                for x in cx..cx + cell_px {
+                    let Some(p) = bytes.get((y * side + x) * 4..(y * side + x) * 4 + 4) else {
+                        continue;
+                    };
+                    let a = f32::from(p[3]) / 255.0;
+                    sum += Vec3::new(f32::from(p[0]), f32::from(p[1]), f32::from(p[2])) * a;
+                    weight += a;
+                }
+            }
+        }
+        if weight > 0.0 {
+            sum / (255.0 * weight)
+        } else {
+            Vec3::ZERO
+        }
+    }
 }
 
 /// The sky subsystem: pipelines, the GPU-resident clouds, their sprite orders and the ring.
@@ -341,6 +370,9 @@ impl Sky {
                 offscreen_frame_layout: &ring_frame_layout,
                 targets: config.targets,
                 cloud_targets: Some(&offscreen_targets[..]),
+                sheet_rgb: config
+                    .sheet
+                    .mean_rgb(crate::clouds::TextureCategory::Foggy.cells()),
             },
         );
         let main = View::new(

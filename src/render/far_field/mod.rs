@@ -6,9 +6,9 @@
 //! around the camera, not the whole screen: [`band_elevations`]), which meets two curved layers (the low and middle clouds, the high ones) on the
 //! round Earth ([`super::earth`]), cuts them into clouds with a world-anchored noise thresholded
 //! by the map's cover, and fades them in over the band where the sprites and the ring fade out.
-//! The map lives in one small texture (two RGBA half-float layers a cell, and two more for the
-//! map of the weather before while a new weather crossfades in: 96 x 96 cells of 10 km are
-//! 295 KB). Settings: `[far_field]` of `config/render.toml`.
+//! The map lives in one small texture (three RGBA half-float layers a cell: the two layers and
+//! their types' looks, and three more for the map of the weather before while a new weather
+//! crossfades in: 96 x 96 cells of 10 km are 442 KB). Settings: `[far_field]` of `config/render.toml`.
 
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
@@ -209,8 +209,13 @@ pub struct GpuFarField {
     /// The heaped layers' puffs: x, y: their smallest and largest diameter, metres; z: their
     /// greatest height over their diameter; w: [`FarFieldSettings::puff_share`].
     pub puffs: [f32; 4],
+    /// rgb: a sheet's top's ambient light in the hue of the near decks' textures (times its
+    /// type's top level's grey, from the map).
+    pub sheet_ambient_rgb: [f32; 4],
+    /// rgb: a sheet's top's sunlight, in that hue.
+    pub sheet_sun_rgb: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuFarField>() == 112);
+const _: () = assert!(std::mem::size_of::<GpuFarField>() == 144);
 
 /// What the far field needs of the sky's layouts and targets.
 pub(super) struct FarFieldShared<'a> {
@@ -223,6 +228,19 @@ pub(super) struct FarFieldShared<'a> {
     /// The off-screen cloud target's colour targets, where the clouds are drawn below full
     /// resolution.
     pub cloud_targets: Option<&'a [(wgpu::TextureFormat, Option<wgpu::BlendState>)]>,
+    /// The mean colour of the sheet's foggy textures, which the near decks' sprites are drawn
+    /// with ([`super::sky::SpriteSheet::mean_rgb`]): its hue tints the far field's sheets.
+    pub sheet_rgb: Vec3,
+}
+
+/// The hue of a mean texture colour: the colour over its luminance (white where it is black).
+fn hue(rgb: Vec3) -> Vec3 {
+    let luminance = rgb.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    if luminance > 1e-3 {
+        rgb / luminance
+    } else {
+        Vec3::ONE
+    }
 }
 
 /// The map on the GPU.
@@ -255,6 +273,8 @@ pub struct FarField {
     /// The map of the weather before, while the shown one crossfades from it: its cells (where
     /// the shown map's are), when the crossfade began (the sky's clock) and over how long.
     crossfade: Option<(FarMap, f64, f64)>,
+    /// The hue of the near decks' textures ([`FarFieldShared::sheet_rgb`]).
+    sheet_hue: Vec3,
 }
 
 /// How far a crossfade begun at `start_s` over `over_s` has come at `now_s`, 0..=1.
@@ -361,6 +381,7 @@ impl FarField {
             fade: None,
             shown: None,
             crossfade: None,
+            sheet_hue: hue(shared.sheet_rgb),
         }
     }
 
@@ -442,7 +463,7 @@ impl FarField {
             size: wgpu::Extent3d {
                 width: n,
                 height: n,
-                depth_or_array_layers: 4,
+                depth_or_array_layers: 6,
             },
             mip_level_count: 1,
             sample_count: 1,
@@ -452,8 +473,8 @@ impl FarField {
             view_formats: &[],
         });
         // Texture layers 0 and 1: the map's low and high layers; 2 and 3: the map crossfaded
-        // from (the map again without a crossfade). The band and the layers' mean heights are
-        // those of both: clouds fading out are drawn too.
+        // from (the map again without a crossfade); 4 and 5: the two maps' layers' looks. The
+        // band and the layers' mean heights are those of both: clouds fading out are drawn too.
         let mut sums = [(0.0f64, 0.0f64); 2];
         let mut extents = Vec::new();
         for layer in 0..2usize {
@@ -468,16 +489,22 @@ impl FarField {
             });
             extents.extend(extent);
         }
-        for z in 0..4u32 {
-            let (source, layer) = if z < 2 { (map, z) } else { (before, z - 2) };
+        for z in 0..6u32 {
+            let (source, at) = match z {
+                0 | 1 => (map, z as usize * 4),
+                2 | 3 => (before, (z - 2) as usize * 4),
+                4 => (map, 8),
+                _ => (before, 8),
+            };
             let data: Vec<u16> = source
                 .cells
                 .iter()
                 .flat_map(|c| {
-                    let at = layer as usize * 4;
-                    let (s, w) = &mut sums[layer as usize];
-                    *s += f64::from(c[at] * 0.5 * (c[at + 1] + c[at + 2]));
-                    *w += f64::from(c[at]);
+                    if at < 8 {
+                        let (s, w) = &mut sums[at / 4];
+                        *s += f64::from(c[at] * 0.5 * (c[at + 1] + c[at + 2]));
+                        *w += f64::from(c[at]);
+                    }
                     c[at..at + 4]
                         .iter()
                         .map(|&v| half::f16::from_f32(v).to_bits())
@@ -564,6 +591,10 @@ impl FarField {
         // sun's share of its median directional shading on the top.
         let ambient = light.ambient_percent;
         let lit: Vec3 = Vec3::splat(0.9) * ambient + light.directional_rgb * 0.6;
+        // A sheet's, in the hue of the textures the near decks are drawn with (the foggy ones are
+        // blue-grey); the shader multiplies its type's top level into the ambient part.
+        let sheet_ambient = Vec3::splat(ambient) * self.sheet_hue;
+        let sheet_sun = light.directional_rgb * 0.6 * self.sheet_hue;
         let shade: Vec3 = Vec3::splat(0.62) * ambient + light.directional_rgb * 0.12;
         // The shader leaves out rays that meet a layer nearer than sqrt(0.8) of the band's
         // start, or off the map.
@@ -605,6 +636,8 @@ impl FarField {
                 s.heaped_height_over_size,
                 s.puff_share(),
             ],
+            sheet_ambient_rgb: sheet_ambient.extend(0.0).to_array(),
+            sheet_sun_rgb: sheet_sun.extend(0.0).to_array(),
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&gpu));
     }
@@ -645,6 +678,21 @@ mod tests {
         let theta = s / (r + c);
         let (x, z) = ((r + h) * theta.sin(), (r + h) * theta.cos() - (r + c));
         z.atan2(x)
+    }
+
+    /// The far field's sheets take the hue of the near decks' foggy textures: blue-grey, at
+    /// the luminance of white.
+    #[test]
+    fn the_sheets_take_the_foggy_textures_hue() {
+        let sheet = super::super::sky::SpriteSheet::generated();
+        let foggy = sheet.mean_rgb(crate::clouds::TextureCategory::Foggy.cells());
+        let h = hue(foggy);
+        assert!(foggy.min_element() > 0.3, "{foggy}");
+        assert!(h.z > h.x * 1.02, "not blue-grey: {h}");
+        let luminance = h.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        assert!((luminance - 1.0).abs() < 1e-5, "{luminance}");
+        assert_eq!(hue(Vec3::ZERO), Vec3::ONE);
+        assert_eq!(sheet.mean_rgb(20..24), Vec3::ZERO);
     }
 
     /// The shipped far field's heaped clouds are the near cumulus' size and shape: their
