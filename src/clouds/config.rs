@@ -745,6 +745,24 @@ mod tests {
         assert_eq!(c.lifecycle.inner_radius_fraction, 0.5);
     }
 
+    /// Every deck's top seen from above is a thick cloud's, white in the sun whatever the type
+    /// (its greys are in its body below): the top colour level of each type laid as a deck on
+    /// the lattice is at least 0.85 grey. A nimbostratus top of 0.74 read from FL350 as a grey
+    /// patch in a stratus overcast.
+    #[test]
+    fn every_decks_top_is_a_thick_clouds() {
+        let types = CloudTypes::builtin();
+        for t in CloudType::ALL {
+            let c = types.get(t);
+            if c.sunlit_depth_m.is_none() {
+                continue;
+            }
+            let top = c.colour_levels.last().map_or([0.0; 4], |l| l.rgba);
+            let grey = 0.2126 * top[0] + 0.7152 * top[1] + 0.0722 * top[2];
+            assert!(grey >= 0.85, "{t:?}: its deck's top is {grey} grey");
+        }
+    }
+
     #[test]
     fn every_out_of_range_field_is_named_with_its_line() {
         // (section, text to replace, replacement, field named in the error)
