@@ -186,6 +186,35 @@ fn cloud_noise(world: vec2<f32>, scale_m: f32, footprint_m: f32) -> f32 {
     return n + 0.2 * octave(world, scale_m * 0.25, vec2<f32>(3.7, 41.9), footprint_m, 0.5, 1.0);
 }
 
+// The share of `cloud_noise`'s spread a pixel of `footprint_m` still resolves: 1 where every
+// octave is kept, less as `octave` fades them to their mean (the octaves' weights 0.5, 0.3, 0.2
+// added in quadrature).
+fn noise_spread(scale_m: f32, footprint_m: f32) -> f32 {
+    let cells = footprint_m / (scale_m * vec3<f32>(1.0, 0.5, 0.25));
+    let kept = vec3<f32>(1.0) - smoothstep(vec3<f32>(0.5), vec3<f32>(1.0), cells);
+    return length(vec3<f32>(0.5, 0.3, 0.2) * kept) / length(vec3<f32>(0.5, 0.3, 0.2));
+}
+
+// How much of a layer of cover `cover` the noise `n` (`cloud_noise`, whose spread a pixel
+// resolves `spread` of) makes cloud, over its soft edge `soft`: the noise above a threshold
+// that leaves `cover` of it (its three octaves are near normal, of 0.133 spread; a logistic of
+// 0.087 fits their quantiles from 5% to 95% within 0.02 of cover), the threshold and the edge
+// closer to the mean as octaves fade, and the cover itself where a pixel resolves none: a
+// fixed threshold made a layer of three quarters cover 0.86 of it, and made any layer over
+// half cover whole once its noise faded far out.
+fn cover_cut(n: f32, cover: f32, spread: f32, soft: f32) -> f32 {
+    let s = max(spread, 0.05);
+    let threshold = cover_threshold(cover, s);
+    let cut = smoothstep(threshold - soft * s, threshold + soft * s, n);
+    return select(mix(cover, cut, smoothstep(0.1, 0.4, spread)), 1.0, cover > 0.97);
+}
+
+// The threshold of `cover_cut`.
+fn cover_threshold(cover: f32, spread: f32) -> f32 {
+    let c = clamp(cover, 0.02, 0.98);
+    return 0.5 - 0.087 * spread * log(c / (1.0 - c));
+}
+
 // 32 random bits of a lattice cell (and a salt), for four 8-bit values of one puff.
 fn hash_u32(c: vec2<i32>, salt: u32) -> u32 {
     var h = (u32(c.x) * 747796405u) ^ (u32(c.y) * 2891336453u) ^ (salt * 2246822519u);
@@ -449,8 +478,9 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
     let cover = 1.0 - pow(1.0 - clamp(cell.x, 0.0, 1.0), 1.0 + min(sides, 8.0));
     // Heaped clouds' edges crisp (the near cumulus' are), sheets' soft.
     let soft = select(0.12, 0.03, heaped);
-    let threshold = mix(0.78, 0.22, cover);
-    let density = select(smoothstep(threshold - soft, threshold + soft, n), 1.0, cover > 0.97);
+    let spread = noise_spread(scale, footprint);
+    let density = cover_cut(n, cover, spread, soft);
+    let threshold = cover_threshold(cover, max(spread, 0.05));
     // Seen from above its top the sunlit side, from below its base the shade, in between mixed;
     // the lumps of a heaped layer lit on their tops and shaded at their edges, also where
     // their sides close the gaps at a slant (the threshold low: lit by the noise about its

@@ -2185,6 +2185,68 @@ fn from_fl350_the_clouds_reach_the_horizon() {
     assert!(today < 0.01, "the far field off still shows {today}");
 }
 
+/// The far field's sheets cover what the map asks. From 400 km up, straight down (about 460 km
+/// across, some 800 of the sheets' 16 km patches), over a sheet layer (1,500 to 2,500 m) of
+/// cover 0.25 and of 0.8: each pixel's share of cloud (linear light, between the frame with no
+/// cloud and the frame with a closed layer, which is lit a little brighter) is taken as cloud
+/// where it is over half a fully clouded pixel's (the cover-0.8 frame's 95th percentile), and
+/// that many pixels are the cover within 0.04 (now 0.27 and 0.81). A fixed threshold of the
+/// noise (the far field until 5 December) covered 0.10 of the layer of 0.25.
+#[test]
+fn the_far_fields_sheets_cover_what_the_map_asks() {
+    let mut settings = RenderSettings::default();
+    settings.far_field.fade_start_m = 1_000.0;
+    settings.far_field.fade_end_m = 2_000.0;
+    let ground = HeightField::from_fn(DVec2::ZERO, 1_200_000.0, 16, |_| 0.0);
+    let mut rig = Rig::with_settings(ground, settings);
+    let cam = rig.camera(DVec3::new(0.0, 0.0, 400_000.0), 0.0, -89.0);
+    let mut frame = |name: &str, cover: f32| {
+        let mut map = uniform_far_map(cover);
+        for cell in &mut map.cells {
+            cell[3] = 0.0;
+        }
+        rig.host.sky.set_far_map(&rig.host.gpu.queue, &map, None);
+        rig.frame(name, &cam).0
+    };
+    let clear = frame("far-sheet-clear", 0.0);
+    let closed = frame("far-sheet-closed", 1.0);
+    let covers = [0.25f32, 0.8];
+    let shares: Vec<Vec<f32>> = covers
+        .iter()
+        .map(|&cover| {
+            let part = frame(&format!("far-sheet-{cover}"), cover);
+            let mut shares: Vec<f32> = (0..part.rgba.len())
+                .filter_map(|i| {
+                    let (c, l0, l1) = (
+                        luminance(part.rgba[i]),
+                        luminance(clear.rgba[i]),
+                        luminance(closed.rgba[i]),
+                    );
+                    ((l1 - l0).abs() > 0.02).then(|| ((c - l0) / (l1 - l0)).clamp(0.0, 1.0))
+                })
+                .collect();
+            assert!(
+                shares.len() > part.rgba.len() / 2,
+                "the closed layer differs from the clear sky in {} pixels",
+                shares.len()
+            );
+            shares.sort_by(f32::total_cmp);
+            shares
+        })
+        .collect();
+    // A fully clouded pixel's share: the mostly clouded frame's 95th percentile.
+    let full = shares[1][shares[1].len() * 95 / 100];
+    for (cover, shares) in covers.iter().zip(&shares) {
+        let covered =
+            shares.iter().filter(|&&s| s > 0.5 * full).count() as f32 / shares.len() as f32;
+        eprintln!("cover {cover}: the far field covers {covered} (a clouded pixel {full})");
+        assert!(
+            (covered - cover).abs() < 0.04,
+            "a sheet of cover {cover} covers {covered}"
+        );
+    }
+}
+
 /// Issue 31, live weather out to the horizon: a far map of another weather crossfades from the
 /// one shown over the clouds' formation time, as the blocks' clouds form and dissipate. Before,
 /// every weather update blanked the far field and faded it in from nothing over the arrival
