@@ -142,36 +142,13 @@ fn upright_facing(to_cam: vec3<f32>) -> Facing {
 // deck from above) they reach it whole, the deck running on to the haze. `to_cam`: from the
 // sprite to the view's camera.
 // While the far field is drawn (`hl_deck.z`), every sprite fades over its hand-over band, below
-// the horizon too, as the far field fades in there (`shaders/far_field.wgsl`). A deck's sprites
-// fade over a part of the band by how deep they lie as seen from the camera's side (`deep`, 0 on
-// the side it faces, 1 on the far side): the deepest over its first half, the nearest over its
-// second. Faded all alike, the sprites a deck's sunlit top hides would show through it, darker,
-// and the band would read as a grey ring (2/255 from FL350 over San Antonio's stratus); so the top
-// stays whole over the far field, which matches it, until it fades last.
-const DECK_FADE_WINDOW: f32 = 0.3;
-
-fn far_fade(to_cam: vec3<f32>, deep: f32) -> f32 {
+// the horizon too, as the far field fades in there (`shaders/far_field.wgsl`); a deck's sprites
+// take its top's light as they fade (`build_sprite`).
+fn far_fade(to_cam: vec3<f32>) -> f32 {
     let dist = length(to_cam);
     let above_horizon = max(smoothstep(0.0, 0.02, -to_cam.z / max(dist, 1.0)), view.hl_deck.z);
     let fade = view.far_fade_layer_turn;
-    let span = max(fade.y - fade.x, 1.0);
-    let q = clamp(deep, 0.0, 1.0);
-    let lead = select(0.0, 1.0, deep >= 0.0) * view.hl_deck.z;
-    let start = fade.x + lead * (1.0 - q) * (1.0 - DECK_FADE_WINDOW) * span;
-    let end = start + mix(1.0, DECK_FADE_WINDOW, lead) * span;
-    return 1.0 - above_horizon * smoothstep(start, end, dist);
-}
-
-// How deep a deck's sprite at `height_msl` lies seen from the camera at `camera_z` (0 on the
-// deck's side the camera faces, 1 on the other; from inside, from the nearer side), or -1 for
-// a sprite not of a deck (`far_fade`).
-fn deck_depth_seen(c: Cloud, height_msl: f32, camera_z: f32) -> f32 {
-    let base = c.level_height.x;
-    let top = c.level4_radius_flat.x;
-    let thickness = max(top - base, 1.0);
-    let from_top = clamp((top - height_msl) / thickness, 0.0, 1.0);
-    let below = clamp((top - camera_z) / thickness, 0.0, 1.0);
-    return select(-1.0, mix(from_top, 1.0 - from_top, below), c.level4_radius_flat.w > 0.0);
+    return 1.0 - above_horizon * smoothstep(fade.x, max(fade.y, fade.x + 1.0), dist);
 }
 
 // A layer sprite (not flat, wider than tall: the puffs of stratus, nimbostratus, altostratus,
@@ -427,9 +404,7 @@ fn build_sprite(k: u32, at: u32) {
     // `DISTANT_BLOCK` in src/render/draw_list.rs), drawn however far; while the far field is
     // drawn (`hl_deck.z`) it fades in over the hand-over band as the near sprites fade out.
     let morph = morph_radius.x * lifecycle_alpha(b.fade_kind & 3u, b.fade_progress, morph_radius.y);
-    let camera_z = view.sun_dir_camera_z.w;
-    let deep = deck_depth_seen(cloud, camera_z + centre_rel.z + offset.z, camera_z);
-    let faded = far_fade(to_cam, deep);
+    let faded = far_fade(to_cam);
     alpha *= select(faded, 1.0 - view.hl_deck.z * faded, (b.fade_kind & 4u) != 0u);
     if (!(alpha > 0.0 && morph > 0.0)) {
         // Faded out: the draw puts its corners outside the clip volume.
@@ -460,12 +435,20 @@ fn build_sprite(k: u32, at: u32) {
     let harris_lastra = view.hl_phase.x > 0.5;
     let hl_light = unpack4x8unorm(lights[slot]);
     let crop = cell_crop(cell);
+    // Over the hand-over band a deck's sprites, fading alike, are lit more and more as its side
+    // the camera sees (its top from above, its base from below), as the far field's sheet is:
+    // the sprites its top had hidden show through as they fade, and lit by their own depth they
+    // made the band a ring 1.5 to 2/255 darker than both sides (San Antonio from FL350).
+    let deck_top = cloud.level4_radius_flat.x;
+    let deck_span = max(deck_top - cloud.level_height.x, 1.0);
+    let seen_side = deck_top - deck_span * clamp((deck_top - view.sun_dir_camera_z.w) / deck_span, 0.0, 1.0);
+    let to_side = select(0.0, (1.0 - faded) * view.hl_deck.z, deck);
     for (var c = 0u; c < 4u; c++) {
         // The corner on the cut quad: texture coordinates across it (v down), and where it is.
         let across = mix(crop.xy, crop.zw, vec2<f32>(f32(c & 1u), f32(c >> 1u)));
         let p = offset + right * ((across.x - 0.5) * width) + up * ((0.5 - across.y) * quad_height);
         // Wang eq. (3): (ambient + directional) x alpha_morph; the texture is the fragment's.
-        let height_msl = view.sun_dir_camera_z.w + centre_rel.z + p.z;
+        let height_msl = mix(view.sun_dir_camera_z.w + centre_rel.z + p.z, seen_side, to_side);
         let ambient = level_colour(cloud, height_msl);
         let view_dir = normalize_or(p - cam_local, vec3<f32>(0.0));
         let rim = length(p) / flat_radius.y;

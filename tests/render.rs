@@ -2097,9 +2097,9 @@ fn san_antonio_deck_rows(alt_ft: u32, bins: &[(f64, f64)]) -> Vec<f32> {
 /// out, no 4 km of it is brighter than the 4 km before (a ring is a dip), and the far field
 /// 64-80 km out is within 4.5/255 of the deck's sprites 30-42 km out (the haze takes about
 /// 0.1/255 a kilometre off the deck, measured with the far field off). Before the far field's
-/// sheet took the closed deck's light and the deck's sprites faded from the deepest up, the
-/// sheet was 6.8/255 darker (a brightening towards the aircraft), and with the sheet matched but
-/// the deck's sprites faded all alike, the band was a ring 1.5/255 darker than both sides.
+/// sheet took the closed deck's light, the sheet was 6.8/255 darker (a brightening towards the
+/// aircraft), and with the sheet matched but the deck's fading sprites lit by their own depth,
+/// the band was a ring 1.5/255 darker than both sides.
 #[test]
 fn over_an_overcast_the_hand_over_shows_no_darker_ring() {
     let band = [(44.0, 47.5), (47.5, 51.0), (51.0, 54.5), (54.5, 58.0)];
