@@ -143,7 +143,7 @@ fn upright_facing(to_cam: vec3<f32>) -> Facing {
 // sprite to the view's camera.
 // While the far field is drawn (`hl_deck.z`), every sprite fades over its hand-over band, below
 // the horizon too, as the far field fades in there (`shaders/far_field.wgsl`); a deck's sprites
-// take its top's light as they fade (`build_sprite`).
+// take the light of its side the camera sees as they fade (`build_sprite`).
 fn far_fade(to_cam: vec3<f32>) -> f32 {
     let dist = length(to_cam);
     let above_horizon = max(smoothstep(0.0, 0.02, -to_cam.z / max(dist, 1.0)), view.hl_deck.z);
@@ -441,7 +441,8 @@ fn build_sprite(k: u32, at: u32) {
     // made the band a ring 1.5 to 2/255 darker than both sides (San Antonio from FL350).
     let deck_top = cloud.level4_radius_flat.x;
     let deck_span = max(deck_top - cloud.level_height.x, 1.0);
-    let seen_side = deck_top - deck_span * clamp((deck_top - view.sun_dir_camera_z.w) / deck_span, 0.0, 1.0);
+    let below_top = clamp((deck_top - view.sun_dir_camera_z.w) / deck_span, 0.0, 1.0);
+    let seen_side = deck_top - deck_span * below_top;
     let to_side = select(0.0, (1.0 - faded) * view.hl_deck.z, deck);
     for (var c = 0u; c < 4u; c++) {
         // The corner on the cut quad: texture coordinates across it (v down), and where it is.

@@ -8,7 +8,8 @@
 //! by the map's cover, and fades them in over the band where the sprites and the ring fade out.
 //! The map lives in one small texture (three RGBA half-float layers a cell: the two layers and
 //! their types' looks, and three more for the map of the weather before while a new weather
-//! crossfades in: 96 x 96 cells of 10 km are 442 KB). Settings: `[far_field]` of `config/render.toml`.
+//! crossfades in: 96 x 96 cells of 10 km are 442 KB). Settings: `[far_field]` of
+//! `config/render.toml`.
 
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
