@@ -430,9 +430,9 @@ impl World {
     }
 
     /// The far field's map's cell at a point, of the weather there with the world's cloud types'
-    /// looks: the field's weather, without its cumulonimbus while storm cells beyond the cloud field are drawn as cells
-    /// ([`Self::draws_far_cells`]), not as a layer from base to top. Decided once, for the
-    /// thousands of points of a map.
+    /// looks: the field's weather, without its cumulonimbus while storm cells beyond the cloud
+    /// field are drawn as cells ([`Self::draws_far_cells`]), not as a layer from base to top.
+    /// Decided once, for the thousands of points of a map.
     pub fn far_map_cell(&self) -> impl Fn(DVec2) -> crate::clouds::far_map::FarCell + '_ {
         let cells_apart = self.draws_far_cells();
         move |p| {

@@ -91,17 +91,22 @@ impl SpriteSheet {
         }
     }
 
-    /// The alpha-weighted mean colour of the textures in `cells` (row-major cells of a 4 x 4
-    /// sheet), from the smallest mip level; black where they have no alpha.
+    /// The alpha-weighted mean colour of the textures in `cells` (row-major cells of the
+    /// clouds stage's layout, [`crate::clouds::CELLS_PER_ROW`] a row), from the smallest mip
+    /// level; black where they have no alpha.
     pub fn mean_rgb(&self, cells: std::ops::Range<u8>) -> Vec3 {
         let Some((level, bytes)) = self.mips.iter().enumerate().next_back() else {
             return Vec3::ZERO;
         };
-        let side = (self.size_px >> level).max(4) as usize;
-        let cell_px = side / 4;
+        let per_row = crate::clouds::CELLS_PER_ROW as usize;
+        let side = ((self.size_px >> level) as usize).max(per_row);
+        let cell_px = side / per_row;
         let (mut sum, mut weight) = (Vec3::ZERO, 0.0f32);
-        for cell in cells.map(usize::from).filter(|&c| c < 16) {
-            let (cx, cy) = (cell % 4 * cell_px, cell / 4 * cell_px);
+        for cell in cells
+            .filter(|&c| c < crate::clouds::TEXTURE_COUNT)
+            .map(usize::from)
+        {
+            let (cx, cy) = (cell % per_row * cell_px, cell / per_row * cell_px);
             for y in cy..cy + cell_px {
                 for x in cx..cx + cell_px {
                     let Some(p) = bytes.get((y * side + x) * 4..(y * side + x) * 4 + 4) else {

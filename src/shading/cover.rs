@@ -11,7 +11,7 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::TimeOfDay;
+use super::{TimeOfDay, luminance};
 use crate::weather::{BlockLayer, CloudType, METRES_PER_FOOT};
 
 const M_PER_FT: f32 = METRES_PER_FOOT as f32;
@@ -115,10 +115,6 @@ pub fn hidden_above(
         clear * (1.0 - cover * opacity)
     });
     (1.0 - clear).clamp(0.0, 1.0)
-}
-
-fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
 fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {

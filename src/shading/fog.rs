@@ -27,6 +27,7 @@ use std::path::Path;
 use glam::Vec3;
 use serde::Deserialize;
 
+use super::luminance;
 use crate::config::{ConfigError, parse_toml};
 use crate::weather::block::{BlockWeather, Obscuration};
 
@@ -232,7 +233,6 @@ impl FogSettings {
             None => horizon_rgb,
             Some(o) => {
                 let own = self.colours.get(o);
-                let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
                 let scaled = own * (luminance(horizon_rgb) / luminance(own).max(1e-4));
                 horizon_rgb.lerp(scaled, self.tint)
             }
@@ -330,8 +330,7 @@ mod tests {
         // Greyer than the blue horizon, about as bright.
         let spread = |c: Vec3| c.max_element() - c.min_element();
         assert!(spread(fog.rgb) < 0.5 * spread(horizon), "{}", fog.rgb);
-        let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
-        assert!((lum(fog.rgb) - lum(horizon)).abs() < 0.02);
+        assert!((luminance(fog.rgb) - luminance(horizon)).abs() < 0.02);
         // The clouds fade by the same law: 63% at a third of the visibility.
         assert!((s.haze_distance_m(&fog, 50_000.0) - 800.0 / 3.0).abs() < 1e-3);
     }

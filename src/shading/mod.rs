@@ -67,6 +67,11 @@ pub fn vertex_colour(ambient: Vec4, directional_rgb: Vec3, alpha_morph: f32) -> 
     rgb.extend(ambient.w * alpha_morph)
 }
 
+/// The luminance of a linear RGB colour (Rec. 709 weights).
+pub fn luminance(rgb: Vec3) -> f32 {
+    rgb.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

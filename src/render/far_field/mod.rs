@@ -236,7 +236,7 @@ pub(super) struct FarFieldShared<'a> {
 
 /// The hue of a mean texture colour: the colour over its luminance (white where it is black).
 fn hue(rgb: Vec3) -> Vec3 {
-    let luminance = rgb.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let luminance = crate::shading::luminance(rgb);
     if luminance > 1e-3 {
         rgb / luminance
     } else {
@@ -690,7 +690,7 @@ mod tests {
         let h = hue(foggy);
         assert!(foggy.min_element() > 0.3, "{foggy}");
         assert!(h.z > h.x * 1.02, "not blue-grey: {h}");
-        let luminance = h.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        let luminance = crate::shading::luminance(h);
         assert!((luminance - 1.0).abs() < 1e-5, "{luminance}");
         assert_eq!(hue(Vec3::ZERO), Vec3::ONE);
         assert_eq!(sheet.mean_rgb(20..24), Vec3::ZERO);
