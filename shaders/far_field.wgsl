@@ -196,23 +196,22 @@ fn noise_spread(scale_m: f32, footprint_m: f32) -> f32 {
 }
 
 // How much of a layer of cover `cover` the noise `n` (`cloud_noise`, whose spread a pixel
-// resolves `spread` of) makes cloud, over its soft edge `soft`: the noise above a threshold
-// that leaves `cover` of it (its three octaves are near normal, of 0.133 spread; a logistic of
+// resolves `spread` of) makes cloud, over its soft edge `soft`: the noise above `threshold`
+// (`cover_threshold`), which leaves `cover` of it (its three octaves are near normal, of 0.133 spread; a logistic of
 // 0.087 fits their quantiles from 5% to 95% within 0.02 of cover), the threshold and the edge
 // closer to the mean as octaves fade, and the cover itself where a pixel resolves none: a
 // fixed threshold made a layer of three quarters cover 0.86 of it, and made any layer over
 // half cover whole once its noise faded far out.
-fn cover_cut(n: f32, cover: f32, spread: f32, soft: f32) -> f32 {
+fn cover_cut(n: f32, cover: f32, threshold: f32, spread: f32, soft: f32) -> f32 {
     let s = max(spread, 0.05);
-    let threshold = cover_threshold(cover, s);
     let cut = smoothstep(threshold - soft * s, threshold + soft * s, n);
     return select(mix(cover, cut, smoothstep(0.1, 0.4, spread)), 1.0, cover > 0.97);
 }
 
-// The threshold of `cover_cut`.
+// The threshold of `cover_cut` for `cover` where a pixel resolves `spread` of the noise.
 fn cover_threshold(cover: f32, spread: f32) -> f32 {
     let c = clamp(cover, 0.02, 0.98);
-    return 0.5 - 0.087 * spread * log(c / (1.0 - c));
+    return 0.5 - 0.087 * max(spread, 0.05) * log(c / (1.0 - c));
 }
 
 // 32 random bits of a lattice cell (and a salt), for four 8-bit values of one puff.
@@ -479,8 +478,8 @@ fn far_layer(dir: vec3<f32>, pixel: f32, layer: i32, frag_xy: vec2<f32>, far_sid
     // Heaped clouds' edges crisp (the near cumulus' are), sheets' soft.
     let soft = select(0.12, 0.03, heaped);
     let spread = noise_spread(scale, footprint);
-    let density = cover_cut(n, cover, spread, soft);
-    let threshold = cover_threshold(cover, max(spread, 0.05));
+    let threshold = cover_threshold(cover, spread);
+    let density = cover_cut(n, cover, threshold, spread, soft);
     // Seen from above its top the sunlit side, from below its base the shade, in between mixed;
     // the lumps of a heaped layer lit on their tops and shaded at their edges, also where
     // their sides close the gaps at a slant (the threshold low: lit by the noise about its
