@@ -4,7 +4,9 @@
 //! - `bench`: the `skycast bench` command at a tiny size.
 //! - `clouds`: the paper's overdraw scenarios from real METARs, and the `skycast sheet`,
 //!   `preview` and `block` commands.
+//! - `product`: the command line from any directory, `--config-dir`, the OpenGL backend.
 
 mod bench;
 mod clouds;
+mod product;
 mod weather;

@@ -45,7 +45,6 @@ use skycast::weather::{
 };
 
 use super::render::{load_look, parse_cloud_scale, parse_size, parse_time, time_or_default};
-use super::weather::DEFAULT_STATIONS;
 
 mod passes;
 mod plot;
@@ -78,8 +77,9 @@ pub struct BenchArgs {
     #[arg(long, default_value = "weather/scenarios")]
     pub scenarios: PathBuf,
     /// Station table placing the scenario reports.
-    #[arg(long, default_value = DEFAULT_STATIONS)]
-    pub stations: PathBuf,
+    /// (default: NOAA's table built into skycast).
+    #[arg(long)]
+    pub stations: Option<PathBuf>,
     /// Renderer settings (default: the shipped config/render.toml); `[impostors]` is switched on
     /// and off by the benchmark.
     #[arg(long)]
@@ -214,7 +214,10 @@ fn scenario_world(
     settings: &WorldSettings,
 ) -> anyhow::Result<(World, (f64, f64))> {
     let path = dir.join(format!("{name}.metar"));
-    let input = WeatherInput::load(&path, Some(stations))?;
+    let input = match super::defaults::shipped(&path) {
+        Some(bytes) => WeatherInput::parse(&path, bytes, Some(stations))?,
+        None => WeatherInput::load(&path, Some(stations))?,
+    };
     let WeatherInput::Reports(file) = &input else {
         anyhow::bail!(
             "{}: a scenario is a report file, not a theme",
@@ -459,8 +462,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         scales.push(1.0);
     }
     let unix_s = time_or_default(args.time)?;
-    let stations =
-        StationTable::load(&args.stations).context("station table (choose one with --stations)")?;
+    let stations = super::defaults::station_table(args.stations.as_deref())?;
     let view_radius_m = match args.view_km {
         Some(km) if (1.0..=200.0).contains(&km) => km * 1000.0,
         Some(km) => anyhow::bail!("--view-km {km} is outside 1..=200"),

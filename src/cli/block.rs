@@ -11,7 +11,7 @@ use skycast::clouds::preview::{self, PreviewSettings};
 use skycast::clouds::{CloudBlock, CloudTypes, CloudsConfig, TextureSheet, generate_block};
 use skycast::weather::BlockWeather;
 
-use super::weather::{DEFAULT_STATIONS, at_block, load, parse_lat_lon};
+use super::weather::{at_block, load, parse_lat_lon};
 
 /// Flags of `skycast block`.
 #[derive(Debug, Args)]
@@ -20,8 +20,9 @@ pub struct BlockArgs {
     #[arg(long)]
     pub weather: PathBuf,
     /// Station table placing reports the file does not place.
-    #[arg(long, default_value = DEFAULT_STATIONS)]
-    pub stations: PathBuf,
+    /// (default: NOAA's table built into skycast).
+    #[arg(long)]
+    pub stations: Option<PathBuf>,
     /// Where: latitude,longitude in degrees (the block whose south-west corner is there).
     #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
     pub at: (f64, f64),
@@ -51,15 +52,15 @@ struct JsonOut<'a> {
 
 /// Generates the block and prints it.
 pub fn run(args: &BlockArgs) -> anyhow::Result<()> {
-    let types = match &args.types {
-        Some(path) => CloudTypes::load(path)?,
+    let types = match super::defaults::settings_file(args.types.as_deref(), "cloud_types.toml") {
+        Some(path) => CloudTypes::load(&path)?,
         None => CloudTypes::builtin(),
     };
-    let config = match &args.clouds {
-        Some(path) => CloudsConfig::load(path)?,
+    let config = match super::defaults::settings_file(args.clouds.as_deref(), "clouds.toml") {
+        Some(path) => CloudsConfig::load(&path)?,
         None => CloudsConfig::builtin(),
     };
-    let loaded = load(&args.weather, &args.stations, None, None)?;
+    let loaded = load(&args.weather, args.stations.as_deref(), None, None)?;
     let (lat, lon) = args.at;
     let at = at_block(&loaded, lat, lon);
     let block = generate_block(at.block, &at.weather, config.field.seed, &types);

@@ -9,9 +9,7 @@ use clap::Args;
 
 use skycast::weather::WeatherInput;
 
-use super::weather::{
-    DEFAULT_STATIONS, Summary, at_block, describe_block, describe_file, describe_theme, load,
-};
+use super::weather::{Summary, at_block, describe_block, describe_file, describe_theme, load};
 
 /// The shipped bulk weather file.
 pub const DEFAULT_WEATHER: &str = "weather/awc-metars-2025-01-27T22Z.cache.csv";
@@ -42,8 +40,9 @@ pub struct DemoArgs {
     #[arg(long, default_value = DEFAULT_WEATHER)]
     pub weather: PathBuf,
     /// Station table.
-    #[arg(long, default_value = DEFAULT_STATIONS)]
-    pub stations: PathBuf,
+    /// (default: NOAA's table built into skycast).
+    #[arg(long)]
+    pub stations: Option<PathBuf>,
     /// The flight to render.
     #[arg(long, default_value = DEFAULT_FLIGHT)]
     pub flight: PathBuf,
@@ -66,7 +65,7 @@ pub const DEFAULT_FLIGHT: &str = "config/flights/demo_coast_under_cumulus.toml";
 
 /// Runs `skycast demo`.
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
-    let loaded = load(&args.weather, &args.stations, None, None)?;
+    let loaded = load(&args.weather, args.stations.as_deref(), None, None)?;
     match &loaded.input {
         WeatherInput::Reports(file) => print!("{}", describe_file(file, &Summary::of(file), false)),
         WeatherInput::Theme(theme) => print!("{}", describe_theme(&args.weather, theme)),

@@ -12,7 +12,6 @@
 //! (`weather_us`: polling and switching, never loading) and which file was applied.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Context;
@@ -22,13 +21,13 @@ use skycast::clouds::CloudsConfig;
 use skycast::demo::{DemoHost, GroundSettings, HeightField, ground_from_field};
 use skycast::flight::{FlightPath, FlightPlan, HostPosition, Weather};
 use skycast::render::Stopwatch;
-use skycast::weather::{LocalFrame, METRES_PER_FOOT, StationTable, WeatherField, theme};
+use skycast::weather::{LocalFrame, METRES_PER_FOOT, WeatherField, theme};
 
 use super::render::{
     ElevationArgs, LookArgs, demo_ground_reach_m, parse_size, parse_time, sky_config,
     time_or_default,
 };
-use super::weather::{DEFAULT_STATIONS, WindsAloftArgs, load};
+use super::weather::{WindsAloftArgs, load};
 
 /// The demo ground under a whole flight: over its track, with as much ground around it as is
 /// seen from its highest point ([`demo_ground_reach_m`]), at the shipped vertex count. A square
@@ -65,8 +64,9 @@ pub struct FlyArgs {
     #[arg(long)]
     pub weather: PathBuf,
     /// Station table placing reports the file does not place.
-    #[arg(long, default_value = DEFAULT_STATIONS)]
-    pub stations: PathBuf,
+    /// (default: NOAA's table built into skycast).
+    #[arg(long)]
+    pub stations: Option<PathBuf>,
     /// The winds aloft for the air data (watched with `--watch`).
     #[command(flatten)]
     pub aloft: WindsAloftArgs,
@@ -115,11 +115,14 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     if args.every == 0 {
         anyhow::bail!("--every must be at least 1");
     }
-    let plan = FlightPlan::load(&args.path)?;
+    let plan = match super::defaults::shipped(&args.path) {
+        Some(bytes) => FlightPlan::parse(&String::from_utf8_lossy(bytes), &args.path)?,
+        None => FlightPlan::load(&args.path)?,
+    };
     let (lat, lon) = plan.origin_lat_lon_deg;
     let flight = plan.place(&LocalFrame::new(lat, lon));
     let (settings, table) = args.look.load()?;
-    let loaded = load(&args.weather, &args.stations, None, None)?;
+    let loaded = load(&args.weather, args.stations.as_deref(), None, None)?;
     let start_unix_s = time_or_default(args.time)?;
     let field = loaded
         .input
@@ -137,7 +140,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             .any(|e| !theme::is_theme_path(&e.weather));
     let mut config = sky_config((lat, lon), (settings, table), &loaded);
     if needs_table {
-        config.stations = Some(Arc::new(StationTable::load(&args.stations)?));
+        config.stations = Some(super::defaults::station_table(args.stations.as_deref())?);
     }
     let mut host = DemoHost::new(args.size.0, args.size.1, &ground, config)?;
     host.sky.set_weather_field(field);
@@ -152,7 +155,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             "winds aloft: {}: {placed} sites placed; watching it",
             path.display()
         );
-    } else if let Some((fb, table)) = args.aloft.load(&args.stations)? {
+    } else if let Some((fb, table)) = args.aloft.load(args.stations.as_deref())? {
         let (placed, _) = host.sky.world_mut().set_winds_aloft(Some(&fb), &table);
         eprintln!(
             "winds aloft: {}: {placed} of {} sites placed",
@@ -160,10 +163,10 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             fb.sites.len()
         );
     }
-    if let Some(path) = &args.clouds {
+    if let Some(path) = super::defaults::settings_file(args.clouds.as_deref(), "clouds.toml") {
         host.sky
             .world_mut()
-            .set_clouds_config(CloudsConfig::load(path)?);
+            .set_clouds_config(CloudsConfig::load(&path)?);
     }
     for event in &plan.weather_events {
         host.sky

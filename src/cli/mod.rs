@@ -7,6 +7,7 @@ use clap::{Parser, Subcommand};
 
 mod bench;
 mod block;
+mod defaults;
 mod demo;
 mod fly;
 mod metar;
@@ -21,6 +22,11 @@ mod weather;
 #[derive(Debug, Parser)]
 #[command(name = "skycast", version, about, long_about = None)]
 struct Cli {
+    /// A folder of config files replacing the built-in ones by name (render.toml,
+    /// time_of_day.toml, clouds.toml, cloud_types.toml, air.toml, cloud_type_rule.toml,
+    /// weather_field.toml, nsd_cccc.txt); a flag naming a file wins.
+    #[arg(long, global = true, value_name = "DIR", env = defaults::CONFIG_DIR_ENV)]
+    config_dir: Option<std::path::PathBuf>,
     #[command(subcommand)]
     command: Command,
 }
@@ -71,6 +77,10 @@ pub fn main() -> ExitCode {
         unsafe { std::env::set_var("XDG_RUNTIME_DIR", "/tmp") };
     }
     let cli = Cli::parse();
+    if let Err(err) = defaults::set_config_dir(cli.config_dir) {
+        eprintln!("skycast: error: {}", message(&err));
+        return ExitCode::from(2);
+    }
     let result: anyhow::Result<()> = match cli.command {
         Command::Types => {
             for cloud_type in skycast::weather::CloudType::ALL {

@@ -42,8 +42,8 @@ pub struct PreviewArgs {
 
 /// Draws the block(s) and writes the PNG(s).
 pub fn run(args: &PreviewArgs) -> anyhow::Result<()> {
-    let types = match &args.types {
-        Some(path) => CloudTypes::load(path)?,
+    let types = match super::defaults::settings_file(args.types.as_deref(), "cloud_types.toml") {
+        Some(path) => CloudTypes::load(&path)?,
         None => CloudTypes::builtin(),
     };
     if !(16..=4096).contains(&args.width) || !(16..=4096).contains(&args.height) {

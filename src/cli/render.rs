@@ -12,7 +12,8 @@ use skycast::render::RenderSettings;
 use skycast::shading::{ShadingModel, TimeOfDayTable, sun_position};
 use skycast::weather::{LocalFrame, METRES_PER_FOOT, WeatherField};
 
-use super::weather::{DEFAULT_STATIONS, Loaded, load, parse_lat_lon};
+use super::defaults;
+use super::weather::{Loaded, load, parse_lat_lon};
 
 /// Flags of `skycast render`.
 #[derive(Debug, Args)]
@@ -22,8 +23,9 @@ pub struct RenderArgs {
     #[arg(long)]
     pub weather: PathBuf,
     /// Station table placing reports the file does not place.
-    #[arg(long, default_value = DEFAULT_STATIONS)]
-    pub stations: PathBuf,
+    /// (default: NOAA's table built into skycast).
+    #[arg(long)]
+    pub stations: Option<PathBuf>,
     /// Camera latitude,longitude, degrees.
     #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
     pub at: (f64, f64),
@@ -264,15 +266,16 @@ pub fn load_look(
     time_of_day: Option<&PathBuf>,
     cloud_scale: Option<f32>,
 ) -> anyhow::Result<(RenderSettings, TimeOfDayTable)> {
-    let mut settings = match render {
-        Some(p) => RenderSettings::load(p)?,
+    let mut settings = match defaults::settings_file(render.map(PathBuf::as_path), "render.toml") {
+        Some(p) => RenderSettings::load(&p)?,
         None => RenderSettings::default(),
     };
     if let Some(scale) = cloud_scale {
         settings.clouds.resolution_scale = scale;
     }
-    let table = match time_of_day {
-        Some(p) => TimeOfDayTable::load(p)?,
+    let table = match defaults::settings_file(time_of_day.map(PathBuf::as_path), "time_of_day.toml")
+    {
+        Some(p) => TimeOfDayTable::load(&p)?,
         None => TimeOfDayTable::default(),
     };
     Ok((settings, table))
@@ -310,7 +313,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     // lattice cell as a square from FL350 and the sorted blocks' edge as a staircase.)
     settings.vertex_cache.max_uploaded_sprites_per_frame = u32::MAX;
     settings.vertex_cache.max_sorted_sprites_per_frame = u32::MAX;
-    let loaded = load(&args.weather, &args.stations, None, None)?;
+    let loaded = load(&args.weather, args.stations.as_deref(), None, None)?;
     let unix_s = time_or_default(args.time)?;
     let field = loaded
         .input

@@ -6,6 +6,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use std::sync::Arc;
+
 use anyhow::Context;
 use clap::Args;
 use glam::{DVec2, DVec3};
@@ -20,12 +22,11 @@ use skycast::weather::metar::{ConvectiveKind, Cover, SkyCode};
 use skycast::weather::storms::{StormContext, cells_over};
 use skycast::weather::theme::{self, Theme};
 use skycast::weather::winds_aloft::WindsAloft;
+
+use super::defaults;
 use skycast::weather::{
     BlockIndex, BlockWeather, LineWarning, LocalFrame, StationTable, WeatherInput,
 };
-
-/// The station table used when `--stations` is not given.
-pub const DEFAULT_STATIONS: &str = "weather/nsd_cccc.txt";
 
 /// Flags of `skycast weather`.
 #[derive(Debug, Args)]
@@ -33,9 +34,10 @@ pub struct WeatherArgs {
     /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, or a weather
     /// theme (`.toml`, see weather/themes/).
     pub file: PathBuf,
-    /// Station table (NOAA nsd_cccc.txt format) placing reports the file does not place.
-    #[arg(long, default_value = DEFAULT_STATIONS)]
-    pub stations: PathBuf,
+    /// Station table (NOAA nsd_cccc.txt format) placing reports the file does not place
+    /// (default: NOAA's table built into skycast).
+    #[arg(long)]
+    pub stations: Option<PathBuf>,
     /// Also print the interpolated weather of the block at this latitude,longitude (degrees).
     #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
     pub at: Option<(f64, f64)>,
@@ -74,13 +76,19 @@ pub struct WindsAloftArgs {
 
 impl WindsAloftArgs {
     /// The FB product and the station table to place its sites with, if asked for.
-    pub fn load(&self, stations: &Path) -> anyhow::Result<Option<(WindsAloft, StationTable)>> {
+    pub fn load(
+        &self,
+        stations: Option<&Path>,
+    ) -> anyhow::Result<Option<(WindsAloft, Arc<StationTable>)>> {
         let Some(path) = &self.winds_aloft else {
             return Ok(None);
         };
         Ok(Some((
-            WindsAloft::load(path)?,
-            StationTable::load(stations)?,
+            match defaults::shipped(path) {
+                Some(bytes) => WindsAloft::parse(&String::from_utf8_lossy(bytes), path)?,
+                None => WindsAloft::load(path)?,
+            },
+            defaults::station_table(stations)?,
         )))
     }
 }
@@ -216,7 +224,7 @@ pub struct Loaded {
 /// Loads the file (with the station table), the rule and the settings.
 pub fn load(
     file: &Path,
-    stations: &Path,
+    stations: Option<&Path>,
     rule: Option<&Path>,
     field_settings: Option<&Path>,
 ) -> anyhow::Result<Loaded> {
@@ -224,15 +232,18 @@ pub fn load(
     let table = if theme::is_theme_path(file) {
         None
     } else {
-        Some(StationTable::load(stations).context("station table (choose one with --stations)")?)
+        Some(defaults::station_table(stations)?)
     };
-    let input = WeatherInput::load(file, table.as_ref())?;
-    let rule = match rule {
-        Some(path) => CloudTypeRule::load(path)?,
+    let input = match defaults::shipped(file) {
+        Some(bytes) => WeatherInput::parse(file, bytes, table.as_deref())?,
+        None => WeatherInput::load(file, table.as_deref())?,
+    };
+    let rule = match defaults::settings_file(rule, "cloud_type_rule.toml") {
+        Some(path) => CloudTypeRule::load(&path)?,
         None => CloudTypeRule::default(),
     };
-    let settings = match field_settings {
-        Some(path) => FieldSettings::load(path)?,
+    let settings = match defaults::settings_file(field_settings, "weather_field.toml") {
+        Some(path) => FieldSettings::load(&path)?,
         None => FieldSettings::default(),
     };
     Ok(Loaded {
@@ -260,7 +271,7 @@ pub fn at_block(loaded: &Loaded, lat_deg: f64, lon_deg: f64) -> AtBlock {
 pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
     let loaded = load(
         &args.file,
-        &args.stations,
+        args.stations.as_deref(),
         args.rule.as_deref(),
         args.field_settings.as_deref(),
     )?;
@@ -274,11 +285,11 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
     }
     let air = match (args.at, args.alt_ft) {
         (Some((lat, lon)), Some(alt_ft)) => {
-            let settings = match &args.air_settings {
-                Some(path) => AirSettings::load(path)?,
+            let settings = match defaults::settings_file(args.air_settings.as_deref(), "air.toml") {
+                Some(path) => AirSettings::load(&path)?,
                 None => AirSettings::default(),
             };
-            let aloft = args.aloft.load(&args.stations)?;
+            let aloft = args.aloft.load(args.stations.as_deref())?;
             Some(air_at(&loaded, lat, lon, alt_ft, settings, aloft.as_ref())?)
         }
         _ => None,
@@ -439,7 +450,7 @@ pub fn air_at(
     lon_deg: f64,
     alt_ft: f64,
     settings: AirSettings,
-    aloft: Option<&(WindsAloft, StationTable)>,
+    aloft: Option<&(WindsAloft, Arc<StationTable>)>,
 ) -> anyhow::Result<AirData> {
     let frame = LocalFrame::new(lat_deg, lon_deg);
     let field = loaded.input.field(frame, &loaded.settings, &loaded.rule);

@@ -35,6 +35,7 @@
 
 mod build;
 pub mod camera;
+pub mod capabilities;
 mod cloud_light;
 pub mod cloud_target;
 pub mod draw_list;
@@ -88,6 +89,9 @@ pub enum RenderError {
     /// The adapter refused a device, or a device operation failed.
     #[error("graphics device: {0}")]
     Device(String),
+    /// The device lacks a format, limit or feature the sky needs (checked in [`Sky::new`]).
+    #[error("this graphics device cannot draw the sky: {0}")]
+    Unsupported(String),
     /// The requested image size is zero or beyond the device's limit.
     #[error("image size {width}x{height} is not drawable (each side 1..={max})")]
     Size {

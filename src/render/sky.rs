@@ -209,19 +209,39 @@ const SPRITES_WGSL: &str = include_str!("../../shaders/sprites.wgsl");
 const IN_CLOUD_WGSL: &str = include_str!("../../shaders/in_cloud.wgsl");
 
 impl Sky {
-    /// Creates pipelines, the sheet texture and buffers on the host's device.
+    /// Creates pipelines, the sheet texture and buffers on the host's device. The device is
+    /// checked first ([`super::capabilities`]): one short of what the sky needs gets
+    /// [`RenderError::Unsupported`] naming it, and anything the device still refuses while the
+    /// sky is built is returned the same way, never wgpu's panic. Where the device cannot draw
+    /// into R32Float textures the clouds draw at full resolution (a warning is logged).
     pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mut config: SkyConfig,
+    ) -> Result<Self, RenderError> {
+        config.targets.validate()?;
+        let capabilities = super::capabilities::check(device, &config.targets)?;
+        let scale = &mut config.settings.clouds.resolution_scale;
+        if !capabilities.r32float_renderable && *scale < 1.0 {
+            log::warn!(
+                "this device cannot draw into R32Float textures (the off-screen cloud target's farthest distance): the clouds are drawn at full resolution instead of {scale}"
+            );
+            *scale = 1.0;
+        }
+        let (sky, refused) =
+            super::capabilities::refused(device, || Self::build(device, queue, config));
+        match refused {
+            Some(why) => Err(RenderError::Unsupported(why)),
+            None => sky,
+        }
+    }
+
+    /// [`Self::new`] once the device is checked.
+    fn build(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         config: SkyConfig,
     ) -> Result<Self, RenderError> {
-        config.targets.validate()?;
-        let stage_buffers = device.limits().max_storage_buffers_per_shader_stage;
-        if stage_buffers < 7 {
-            return Err(RenderError::Device(format!(
-                "the sky builds its sprites in a compute pass reading 7 storage buffers (WebGPU's default limit is 8); this device was created with {stage_buffers}"
-            )));
-        }
         let sheet = &config.sheet;
         if sheet.mips.is_empty() || sheet.size_px == 0 {
             return Err(RenderError::Sheet("the sprite sheet has no pixels".into()));

@@ -9,14 +9,13 @@
 //! Without a display (no X server) it says so and names `render` and `fly`, exit status 2.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Duration;
 
 use clap::Args;
-use skycast::weather::{LocalFrame, METRES_PER_FOOT, StationTable, theme};
+use skycast::weather::{LocalFrame, METRES_PER_FOOT, theme};
 
 use super::render::{ElevationArgs, LookArgs, parse_size, parse_time, sky_config, time_or_default};
-use super::weather::{DEFAULT_STATIONS, load};
+use super::weather::load;
 
 mod app;
 mod controls;
@@ -36,8 +35,9 @@ pub struct ViewArgs {
     #[arg(long)]
     pub weather: PathBuf,
     /// Station table placing reports the file does not place.
-    #[arg(long, default_value = DEFAULT_STATIONS)]
-    pub stations: PathBuf,
+    /// (default: NOAA's table built into skycast).
+    #[arg(long)]
+    pub stations: Option<PathBuf>,
     /// Start latitude,longitude, degrees (the middle of the area flown).
     #[arg(long, value_name = "LAT,LON", value_parser = super::weather::parse_lat_lon, allow_hyphen_values = true)]
     pub at: (f64, f64),
@@ -117,7 +117,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         anyhow::anyhow!(NO_DISPLAY)
     })?;
     let look = args.look.load()?;
-    let loaded = load(&args.weather, &args.stations, None, None)?;
+    let loaded = load(&args.weather, args.stations.as_deref(), None, None)?;
     let field = loaded
         .input
         .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);
@@ -125,7 +125,9 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
     let mut config = sky_config((lat, lon), look, &loaded);
     let watch = if args.watch {
         if !theme::is_theme_path(&args.weather) {
-            config.stations = Some(Arc::new(StationTable::load(&args.stations)?));
+            config.stations = Some(crate::cli::defaults::station_table(
+                args.stations.as_deref(),
+            )?);
         }
         Some(args.weather.clone())
     } else {
