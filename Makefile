@@ -24,6 +24,10 @@ test: vulkan xvfb
 	# A simulator embedding the library compiles none of the command line's crates.
 	cargo clippy --lib --no-default-features -- -D warnings
 	! cargo tree -e normal --no-default-features | grep -E '^[^a-z]*(clap|indicatif|env_logger|anyhow|exr|winit|noto-sans-mono-bitmap) '
+	# The crate as published stays under crates.io's 10 MB (Cargo.toml's `exclude`).
+	@bytes=$$(cargo package --list --allow-dirty --quiet | while read -r f; do [ -f "$$f" ] && stat -c %s "$$f"; done | awk '{ s += $$1 } END { print s + 0 }'); \
+	echo "cargo package: $$bytes bytes of files"; \
+	[ "$$bytes" -gt 0 ] && [ "$$bytes" -lt 10000000 ] || { echo "the package is over 10 MB: exclude more in Cargo.toml"; exit 1; }
 
 # Hours of flight (tests/soak.rs; `make test` flies one): SOAK_HOURS simulated hours, a watched
 # weather file rewritten every five minutes through six weathers (clear to thunderstorm cells),

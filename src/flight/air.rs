@@ -76,6 +76,7 @@ pub struct AirLayer {
 
 /// The air at a point. Units in every name; directions in degrees true the wind blows from.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct AirData {
     /// Wind direction, degrees true it blows from.
     pub wind_from_deg: f64,

@@ -29,6 +29,7 @@ use crate::weather::{LocalFrame, Skipped, StationTable, WeatherError, WeatherInp
 
 /// Why the sky could not be built or given its weather.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum SkyError {
     /// The device or the host's targets.
     #[error(transparent)]
@@ -42,6 +43,7 @@ pub enum SkyError {
 /// settings of its own (loaded from its files, a wider cloud radius) changes the fields and hands
 /// the result to [`SkySystem::with_config`].
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct SkySystemConfig {
     /// The sky's look and the host's targets (formats, reversed Z, samples).
     pub sky: SkyConfig,
@@ -104,6 +106,7 @@ impl SkySystemConfig {
 /// # let _ = (once, downloaded, live);
 /// ```
 #[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
 pub enum Weather<'a> {
     /// A report file (the aviation weather service's `metars.cache.csv`, a NOAA cycle file,
     /// one METAR a line) or a weather theme (`.toml`), read now.
@@ -187,6 +190,7 @@ impl From<&Camera> for HostCamera {
 
 /// What the host needs to light and fog its own scene like the sky (linear RGB).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct HostLighting {
     /// Unit vector towards the sun, east-north-up.
     pub sun_direction: Vec3,

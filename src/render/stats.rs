@@ -16,10 +16,12 @@ use crate::shading::{
 /// ```
 /// use skycast::FrameStats;
 ///
-/// let stats = FrameStats { field_us: 23, cpu_update_us: 338, record_us: 31, ..FrameStats::default() };
+/// let mut stats = FrameStats::default(); // a host reads what `update` returns
+/// (stats.field_us, stats.cpu_update_us, stats.record_us) = (23, 338, 31);
 /// assert_eq!(stats.sky_cpu_us(), 392); // what the sky cost the frame thread
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
 pub struct FrameStats {
     /// Sprites drawn as sprites this frame (the impostors' not counted).
     pub sprites_drawn: u32,
@@ -279,6 +281,7 @@ pub struct Lighting {
 /// watches for growth (`tests/soak.rs`). Bytes are the sizes the buffers and textures were
 /// created with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub struct SkyMemory {
     /// The resident sprite, cloud, light, order and cloud-list buffers.
     pub resident_bytes: u64,
