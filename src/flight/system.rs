@@ -216,7 +216,8 @@ pub struct HostLighting {
     pub fog_rgb: Vec3,
 }
 
-/// The sky a simulator embeds: one per view, built once on the host's device with
+/// The sky a simulator embeds: one per simulator (a second monitor or an outside camera is a
+/// view of the same sky, [`SkySystem::add_view`]), built once on the host's device with
 /// [`SkySystem::new`] (or [`SkySystem::with_config`] for settings of the host's own), given
 /// weather with [`SkySystem::set_weather`], then every frame [`SkySystem::update`] and
 /// [`SkySystem::record`] after the host drew its scene. The crate's front page shows the frame in
