@@ -6,7 +6,14 @@
 //!   each of its `--flags` in `skycast <subcommand> --help`; `cargo test --test NAME` and
 //!   `cargo bench --bench NAME` name a file of `tests/` or `benches/`;
 //! - every subcommand has its line in the README and in `docs/src/command-line.md`;
-//! - every picture the README shows is one `make pictures` writes.
+//! - every picture the README shows is one `make pictures` writes;
+//! - every long flag of `skycast --help` and `skycast <subcommand> --help` is in
+//!   `docs/src/command-line.md`;
+//! - no link of the book leaves `docs/src/` (mdBook publishes only that folder);
+//! - the book is no lab notebook: no commit hash, no dated note (a day and month without a year
+//!   other than 2026, or an ISO date of 2026, in prose), no issue reference (`issue 31`,
+//!   `Done means`, the shared design folder). The exact rules are the doc comments of
+//!   `commit_hashes_in`, `dated_notes_in` and `outside_references_in`.
 //!
 //! Which lines count as quoted commands is the convention written in `docs/src/testing.md` ("The
 //! book's own check"): lines of a `sh` block starting with `skycast `, `cargo run ... -- ` or
@@ -486,7 +493,9 @@ fn the_readme_shows_pictures_that_make_pictures_writes() {
 }
 
 /// The checks find what they are for: a broken link, a missing picture, a bad fragment, an
-/// unknown flag, an unknown subcommand and a missing test binary, each in a made-up page.
+/// unknown flag, an unknown subcommand and a missing test binary, a commit hash, a dated note, an
+/// issue reference, a flag the command-line chapter leaves out and a link out of the book, each
+/// in a made-up page, beside look-alikes they must let through.
 #[test]
 fn the_checks_catch_what_they_are_for() {
     let page = root().join("docs/src/made-up.md");
@@ -516,4 +525,352 @@ fn the_checks_catch_what_they_are_for() {
         "{why:?}"
     );
     assert!(why[3].contains("frobnicate"), "{why:?}");
+
+    // Notebook leftovers: commit hashes, dated notes, issue references.
+    let text = "Since `5fde611` the ring is faster (main at e01c289).\n\
+        Not hashes: #ffcc00, 1234567, deadbeef, 0x1000, 128x128, `cargo test` and 2025.\n\
+        ```sh\ngit show 5fde611   # commands in fenced blocks are not prose\n```\n";
+    let hashes: Vec<String> = commit_hashes_in(text).into_iter().map(|(_, w)| w).collect();
+    assert_eq!(hashes, ["5fde611", "e01c289"], "{hashes:?}");
+
+    let text = "## Figures (3 December, afternoon)\n\
+        Measured on December 4 and on 4 December 2026, recorded 2026-12-02.\n\
+        Data, not notes: the weather of 27 January 2025, `--time 2025-01-27T19:00:00Z`,\n\
+        weather/awc-metars-2025-01-27T22Z.cache.csv, fd1us1-2026-01-31T06Z.txt, 3 km, May.\n";
+    let dates: Vec<String> = dated_notes_in(text).into_iter().map(|(_, d)| d).collect();
+    assert_eq!(
+        dates,
+        ["3 December", "December 4", "4 December", "2026-12-02"],
+        "{dates:?}"
+    );
+
+    let text = "As issue 31 asked (issue #32, issues 28 and 33, branch `issue-31`), Done means 1\n\
+        holds; see `../shared/DESIGN.md`. Not references: an issue with tissue 3, the issue's.\n";
+    let refs: Vec<String> = outside_references_in(text)
+        .into_iter()
+        .map(|(_, r)| r)
+        .collect();
+    assert_eq!(refs.len(), 6, "{refs:?}");
+    assert!(refs[0].starts_with("issue 31") && refs[5].starts_with("shared/DESIGN"));
+
+    // A command-line chapter that names only some of `skycast render`'s flags.
+    let text = "`skycast render --weather FILE --at LAT,LON --out frame.png`\n";
+    let missing = flags_missing_from(&mut help, text);
+    assert!(
+        missing.iter().any(|m| m == "skycast render --alt-ft"),
+        "{missing:?}"
+    );
+    assert!(
+        missing.iter().any(|m| m == "skycast bench --far-field"),
+        "{missing:?}"
+    );
+    assert!(
+        !missing.iter().any(|m| m == "skycast render --weather"),
+        "{missing:?}"
+    );
+    assert!(
+        !missing.iter().any(|m| m.ends_with("--help")),
+        "{missing:?}"
+    );
+
+    // Links out of the book, which mdBook does not publish.
+    let text = "[in](clouds.md), ![pic](pictures/sheet_over_sky.png), [web](https://mutants.rs),\n\
+        [here](#a-page), [code](../../src/flight/air.rs), [readme](../../README.md#skycast),\n\
+        [sneaky](pictures/../../book.toml), and the path `src/flight/air.rs` as a code span.\n";
+    let leaving = links_leaving_the_book(&page, text);
+    assert_eq!(leaving.len(), 3, "{leaving:#?}");
+    assert!(leaving[0].contains("src/flight/air.rs") && leaving[2].contains("book.toml"));
+}
+
+/// The book's own pages: every Markdown file under `docs/src/` (what mdBook publishes).
+fn book_pages() -> Vec<PathBuf> {
+    let src = root().join("docs/src");
+    markdown_files()
+        .into_iter()
+        .filter(|f| f.starts_with(&src))
+        .collect()
+}
+
+/// The words of a text (runs of ASCII letters and digits) with the byte each starts at.
+fn words(text: &str) -> Vec<(usize, &str)> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (i, c) in text.char_indices() {
+        if c.is_ascii_alphanumeric() {
+            start.get_or_insert(i);
+        } else if let Some(s) = start.take() {
+            out.push((s, &text[s..i]));
+        }
+    }
+    if let Some(s) = start {
+        out.push((s, &text[s..]));
+    }
+    out
+}
+
+/// Commit hashes in a page's prose (fenced blocks left out, code spans kept): a word of 7 to 40
+/// lower-case hex digits holding at least one digit and one of the letters a-f. Numbers (no
+/// letter), words like `deadbeef` (no digit), colours like `#ffcc00` (6 digits) and hex
+/// constants like `0x1000` (an `x`) are not hashes.
+fn commit_hashes_in(text: &str) -> Vec<(usize, String)> {
+    let prose = parse(text).prose;
+    words(&prose)
+        .into_iter()
+        .filter(|(_, w)| {
+            (7..=40).contains(&w.len())
+                && w.bytes()
+                    .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
+                && w.bytes().any(|b| b.is_ascii_digit())
+                && w.bytes().any(|b| b.is_ascii_lowercase())
+        })
+        .map(|(at, w)| (line_of(&prose, at), w.to_string()))
+        .collect()
+}
+
+const MONTHS: [&str; 12] = [
+    "January",
+    "February",
+    "March",
+    "April",
+    "May",
+    "June",
+    "July",
+    "August",
+    "September",
+    "October",
+    "November",
+    "December",
+];
+
+/// The year skycast was written in: a date in it is a note of when something was done.
+const DEVELOPMENT_YEAR: &str = "2026";
+
+/// Dated notes in a page's prose (fenced blocks and code spans left out): a day and a month
+/// (`3 December`, `December 3`) not followed by a year other than 2026, and an ISO date
+/// (`2026-12-03`) of 2026 standing as a word of its own. Dates that are data carry their year:
+/// the shipped weather of `27 January 2025`, `--time 2025-01-27T19:00:00Z`; an ISO date inside a
+/// file name (`fd1us1-2026-01-31T06Z.txt`) is the file's name, not a note.
+fn dated_notes_in(text: &str) -> Vec<(usize, String)> {
+    let (_, prose) = code_spans(&parse(text).prose);
+    let mut notes = Vec::new();
+    let words = words(&prose);
+    let day = |w: &str| {
+        let digits = w.trim_end_matches(['s', 't', 'n', 'd', 'r', 'h']);
+        !digits.is_empty()
+            && digits.len() <= 2
+            && digits.bytes().all(|b| b.is_ascii_digit())
+            && (1..=31).contains(&digits.parse::<u32>().unwrap_or(0))
+    };
+    let year = |w: Option<&str>| {
+        w.filter(|w| w.len() == 4 && w.bytes().all(|b| b.is_ascii_digit()))
+            .map(str::to_string)
+    };
+    for (i, (at, word)) in words.iter().enumerate() {
+        if !MONTHS.contains(word) {
+            continue;
+        }
+        let before = i.checked_sub(1).map(|j| words[j].1);
+        let after = words.get(i + 1).map(|(_, w)| *w);
+        let (date, year) = if before.is_some_and(day) {
+            (
+                format!("{} {word}", before.unwrap_or("")),
+                year(words.get(i + 1).map(|(_, w)| *w)),
+            )
+        } else if after.is_some_and(day) {
+            (
+                format!("{word} {}", after.unwrap_or("")),
+                year(words.get(i + 2).map(|(_, w)| *w)),
+            )
+        } else {
+            continue;
+        };
+        if year.is_none_or(|y| y == DEVELOPMENT_YEAR) {
+            notes.push((*at, date));
+        }
+    }
+    let bytes = prose.as_bytes();
+    for (at, _) in prose.match_indices(DEVELOPMENT_YEAR) {
+        let iso = prose.get(at..at + 10).unwrap_or("");
+        let shape = iso.bytes().enumerate().all(|(i, b)| match i {
+            4 | 7 => b == b'-',
+            _ => b.is_ascii_digit(),
+        });
+        let alone =
+            at == 0 || !(bytes[at - 1].is_ascii_alphanumeric() || b"-_./".contains(&bytes[at - 1]));
+        if iso.len() == 10 && shape && alone {
+            notes.push((at, iso.to_string()));
+        }
+    }
+    notes.sort();
+    notes
+        .into_iter()
+        .map(|(at, date)| (line_of(&prose, at), date))
+        .collect()
+}
+
+/// References to what a reader of the book does not have, in a page's prose (fenced blocks left
+/// out, code spans kept): issue numbers (`issue 31`, `issue #31`, `issues 28 and 33`, a branch
+/// `issue-31`), an issue's acceptance criteria (`Done means`) and the team's shared design
+/// folder (`shared/DESIGN.md`), which is not part of the repository.
+fn outside_references_in(text: &str) -> Vec<(usize, String)> {
+    let prose = parse(text).prose;
+    let lower = prose.to_ascii_lowercase();
+    let bytes = lower.as_bytes();
+    let quote = |at: usize, len: usize| {
+        let end = (at + len).min(prose.len());
+        let end = (end..=prose.len())
+            .find(|&e| prose.is_char_boundary(e))
+            .unwrap_or(prose.len());
+        (at, prose[at..end].trim_end().to_string())
+    };
+    let mut found = Vec::new();
+    for (at, _) in lower.match_indices("issue") {
+        if at > 0 && bytes[at - 1].is_ascii_alphabetic() {
+            continue; // "tissue"
+        }
+        let rest = &lower[at + 5..];
+        let rest = rest.strip_prefix('s').unwrap_or(rest);
+        if rest
+            .trim_start_matches([' ', '-', '#'])
+            .starts_with(|c: char| c.is_ascii_digit())
+        {
+            found.push(quote(at, 10));
+        }
+    }
+    for phrase in ["done means", "shared/design.md"] {
+        for (at, _) in lower.match_indices(phrase) {
+            found.push(quote(at, phrase.len()));
+        }
+    }
+    found.sort();
+    found
+        .into_iter()
+        .map(|(at, what)| (line_of(&prose, at), what))
+        .collect()
+}
+
+/// Each finding of a notebook check over the book's pages, as `file:line: what`.
+fn findings(check: fn(&str) -> Vec<(usize, String)>) -> Vec<String> {
+    book_pages()
+        .iter()
+        .flat_map(|f| {
+            check(&read(f))
+                .into_iter()
+                .map(move |(line, what)| format!("{}:{line}: {what}", f.display()))
+        })
+        .collect()
+}
+
+/// The book says what is, not when it was done: no commit hash in its prose.
+#[test]
+fn the_book_names_no_commit() {
+    let found = findings(commit_hashes_in);
+    assert!(
+        found.is_empty(),
+        "commit hashes in the book:\n{}",
+        found.join("\n")
+    );
+}
+
+/// The book says what is, not when it was done: no dated note in its prose (the rule is that of
+/// `dated_notes_in`: dates that are data carry a year other than 2026).
+#[test]
+fn the_book_has_no_dated_notes() {
+    let found = findings(dated_notes_in);
+    assert!(
+        found.is_empty(),
+        "dated notes in the book:\n{}",
+        found.join("\n")
+    );
+}
+
+/// The book points at nothing its reader does not have: no issue numbers, no `Done means`, no
+/// shared design folder.
+#[test]
+fn the_book_points_at_nothing_outside_the_repository() {
+    let found = findings(outside_references_in);
+    assert!(
+        found.is_empty(),
+        "references to what a reader does not have:\n{}",
+        found.join("\n")
+    );
+}
+
+/// Every long flag of `skycast --help` and of each `skycast <subcommand> --help` that `text`
+/// (the command-line chapter) does not name, as `skycast SUB --flag`.
+fn flags_missing_from(help: &mut Help, text: &str) -> Vec<String> {
+    let named = long_flags(text);
+    let mut subcommands = vec![String::new()];
+    subcommands.extend(help.subcommands.iter().cloned());
+    let mut missing = Vec::new();
+    for sub in subcommands {
+        for flag in help.flags_of(&sub).clone() {
+            if flag != "--help" && flag != "--version" && !named.contains(&flag) {
+                missing.push(format!("skycast {sub} {flag}").replace("  ", " "));
+            }
+        }
+    }
+    missing
+}
+
+/// Every flag the binary takes is in the book's chapter on the command line.
+#[test]
+fn every_flag_is_in_the_command_line_chapter() {
+    let mut help = Help::new();
+    let missing = flags_missing_from(&mut help, &read(&root().join("docs/src/command-line.md")));
+    assert!(
+        missing.is_empty(),
+        "flags of `--help` that docs/src/command-line.md does not name:\n{}",
+        missing.join("\n")
+    );
+}
+
+/// A path with its `.` and `..` taken out, without asking the file system.
+fn lexical(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for part in path.components() {
+        match part {
+            std::path::Component::ParentDir => {
+                out.pop();
+            }
+            std::path::Component::CurDir => {}
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+/// Every link or picture of a book page (`file`, under `docs/src/`) whose target lies outside
+/// `docs/src/`: mdBook publishes only that folder, so such a link breaks in the built book.
+fn links_leaving_the_book(file: &Path, text: &str) -> Vec<String> {
+    let src = lexical(&root().join("docs/src"));
+    let doc = parse(text);
+    let (_, prose) = code_spans(&doc.prose);
+    link_targets(&prose)
+        .into_iter()
+        .filter(|(_, t)| {
+            let external = ["http://", "https://", "mailto:", "#"];
+            !t.is_empty() && !external.iter().any(|p| t.starts_with(p))
+        })
+        .filter(|(_, t)| {
+            let path = t.split('#').next().unwrap_or("");
+            !lexical(&file.parent().unwrap_or(Path::new(".")).join(path)).starts_with(&src)
+        })
+        .map(|(line, t)| format!("{}:{line}: `{t}` leaves docs/src", file.display()))
+        .collect()
+}
+
+/// No link of the book leaves `docs/src/`: a file of the repository is named as a path in a
+/// code span (`src/flight/air.rs`), not linked.
+#[test]
+fn no_link_leaves_the_book() {
+    let found: Vec<String> = book_pages()
+        .iter()
+        .flat_map(|f| links_leaving_the_book(f, &read(f)))
+        .collect();
+    assert!(
+        found.is_empty(),
+        "links out of the book:\n{}",
+        found.join("\n")
+    );
 }
