@@ -89,6 +89,7 @@ fn cumulus(centre: DVec3) -> SkyCloud {
         flat: false,
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
+        floor_m: f32::MIN,
     }
 }
 
@@ -111,6 +112,7 @@ fn overcast(centre: DVec2, base: f64) -> SkyCloud {
         flat: false,
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
+        floor_m: f32::MIN,
     }
 }
 
@@ -456,6 +458,7 @@ fn cloud_terrain_edge_is_a_ramp() {
         flat: false,
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
+        floor_m: f32::MIN,
     };
     for scale in CLOUD_SCALES {
         soft_edge_at_scale(&slope, &sprite_cloud, scale);

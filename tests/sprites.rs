@@ -68,6 +68,7 @@ fn blocks() -> Vec<SkyBlock> {
         flat: false,
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
+        floor_m: f32::MIN,
     };
     vec![SkyBlock {
         id: 1,
@@ -87,6 +88,7 @@ fn plain_cloud(centre_m: DVec3, sprites: Vec<SkySprite>, colour_levels: ColourLe
         flat: false,
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
+        floor_m: f32::MIN,
     }
 }
 

@@ -396,7 +396,7 @@ fn sight_fan(sky: &skycast::SkySystem, at_m: glam::DVec3, heading_deg: f64) -> u
         );
         let to = at_m + dir * 10_000.0;
         hits += sky
-            .line_of_sight(HostPosition::Local(at_m), HostPosition::Local(to))
+            .first_cloud(HostPosition::Local(at_m), HostPosition::Local(to))
             .is_some() as usize;
     }
     hits

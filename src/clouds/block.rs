@@ -76,12 +76,21 @@ pub struct Cloud {
     /// A heap's shaded base, metres above its base (the type's `shaded_base_m`; 0 for none).
     #[serde(default)]
     pub shaded_base_m: f32,
+    /// The cloud's flat base, metres from its centre (negative: below it): nothing under it is
+    /// cloud to a probe ([`super::core`]), so every cloud is first met from below at its base.
+    #[serde(default = "no_floor")]
+    pub floor_m: f32,
     /// Five ambient colour levels, lowest first.
     pub colour_levels: [ColourLevel; 5],
     /// The cloud's shading groups.
     pub shading_groups: Vec<ShadingGroup>,
     /// The sprites.
     pub sprites: Vec<Sprite>,
+}
+
+/// A cloud read without a base: its cores reach as low as they do.
+fn no_floor() -> f32 {
+    f32::MIN
 }
 
 impl Cloud {

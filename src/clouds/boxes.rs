@@ -1,14 +1,16 @@
-//! A cloud as the probe's queries see it: its core box (the box of its sprite centres plus a
-//! quarter of each sprite's size, rain shafts left out, the same box the renderer's in-cloud fog
-//! uses: `render::scene::SkyCloud::core_box_m`), and the boxes of a whole generation, worked out
-//! once on the generation worker ([`super::field::Generated::boxes`]).
+//! The box around a cloud's cores ([`super::core`]: its sprites' dense cores above its base,
+//! rain shafts left out), which the probe's queries look through before they ask the cores
+//! themselves, and the boxes of a whole generation, worked out once on the generation worker
+//! ([`super::field::Generated::boxes`]).
 
 use glam::DVec3;
 
 use super::block::Cloud;
+use super::core::SpriteCore;
 use crate::weather::CloudType;
 
-/// A cloud's core box, in the field's (air) frame.
+/// The box around a cloud's cores, in the field's (air) frame: a line of sight or a point
+/// outside it is outside the cloud; inside it, the cores say.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CloudBox {
     /// Centre of the box, metres.
@@ -37,18 +39,16 @@ impl CloudBox {
         for s in &cloud.sprites {
             let o = DVec3::from_array(s.offset_m.map(f64::from));
             sphere = sphere.max(o.length() + 0.5 * f64::from(s.width_m.max(s.height_m)));
-            if s.precipitation {
+            let Some(core) = SpriteCore::of(s, cloud.flat) else {
                 continue;
-            }
-            let r = DVec3::new(
-                f64::from(s.width_m),
-                f64::from(s.width_m),
-                f64::from(s.height_m),
-            ) * 0.25;
+            };
+            let r = core.box_half_m();
             lo = lo.min(o - r);
             hi = hi.max(o + r);
             any = true;
         }
+        // Nothing below the base is cloud.
+        lo.z = lo.z.max(f64::from(cloud.floor_m)).min(hi.z);
         any.then(|| Self {
             centre_m: cloud.centre_m + (hi + lo) * 0.5,
             half_m: (hi - lo) * 0.5,
@@ -58,16 +58,6 @@ impl CloudBox {
             cloud_type: cloud.cloud_type,
             cloud: index,
         })
-    }
-
-    /// How far inside the box `p` is: 0 outside, rising to 1 over `ramp` of the half-extent.
-    pub fn inside(&self, p: DVec3, ramp: f32) -> f32 {
-        if self.half_m.min_element() <= 0.0 {
-            return 0.0;
-        }
-        let rel = (p - self.centre_m).abs() / self.half_m;
-        let inside = (1.0 - rel.max_element()) as f32;
-        (inside / ramp.max(1e-3)).clamp(0.0, 1.0)
     }
 
     /// Distance from `p` to the box, metres (0 inside).
@@ -169,14 +159,14 @@ pub(crate) mod tests {
     use super::*;
     use crate::clouds::block::{ColourLevel, Sprite};
 
-    /// A cloud of known geometry: sprites filling the box `centre ± half` (core boxes of
-    /// sprites `4 half` wide at the corners of a box of half extent 0: one sprite at the centre
-    /// whose core is exactly `half`).
+    /// A cloud of known geometry: one sprite at the centre whose core is a sphere of radius
+    /// `half` (and whose box is exactly `centre ± half`), with no base below it.
     pub(crate) fn cube_cloud(centre_m: DVec3, half_m: f32, cloud_type: CloudType) -> Cloud {
+        let size = half_m / crate::clouds::core::CORE_HALF_EXTENT as f32;
         let sprite = Sprite {
             offset_m: [0.0; 3],
-            width_m: 4.0 * half_m,
-            height_m: 4.0 * half_m,
+            width_m: size,
+            height_m: size,
             rotation_deg: 0.0,
             texture: 0,
             shading_group: 0,
@@ -193,6 +183,7 @@ pub(crate) mod tests {
             flat: false,
             sunlit_depth_m: 0.0,
             shaded_base_m: 0.0,
+            floor_m: f32::MIN,
             colour_levels: [ColourLevel {
                 height_m: 0.0,
                 rgba: [1.0; 4],
@@ -221,9 +212,7 @@ pub(crate) mod tests {
             .is_none()
         );
         assert!(b.segment(a, DVec3::new(400.0, 0.0, 2000.0)).is_none());
-        // In-cloud: 0 at the boundary, 1 in the core, and the distance outside.
-        assert_eq!(b.inside(DVec3::new(500.0, 0.0, 2000.0), 0.35), 0.0);
-        assert_eq!(b.inside(DVec3::new(1000.0, 0.0, 2000.0), 0.35), 1.0);
-        assert!((b.distance_m(DVec3::new(0.0, 0.0, 2000.0)) - 500.0).abs() < 1e-9);
+        // The distance outside.
+        assert!((b.distance_m(DVec3::new(0.0, 0.0, 2000.0)) - 500.0).abs() < 1e-3);
     }
 }

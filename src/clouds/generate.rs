@@ -30,6 +30,7 @@ use glam::{DVec2, DVec3};
 
 use super::block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};
 use super::config::{CloudTypeConfig, CloudTypes, TextureCategory};
+use super::core::CORE_HALF_EXTENT;
 use super::heap::heap_sprites;
 use super::rain::add_shafts;
 use super::rng::{SplitMix64, hash_keys};
@@ -309,10 +310,6 @@ fn scattered_layer(
     }
     (covered as f64 / (GRID * GRID) as f64, boxes)
 }
-
-/// A sprite's dense core, the part that counts as cover: within 0.7 of its half extents, i.e.
-/// this fraction of its full width (and, flat, of its height) from its centre.
-const CORE_HALF_EXTENT: f64 = 0.35;
 
 /// The sky a streak covers, m2: its flat sprites' dense cores (as [`cloud_cells`] counts them),
 /// wherever they lie.
@@ -745,6 +742,7 @@ pub(super) fn finish_cloud(
         flat: config.flat,
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
+        floor_m: (-thickness / 2.0) as f32,
         colour_levels,
         shading_groups,
         sprites,

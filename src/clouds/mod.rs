@@ -22,6 +22,7 @@
 pub mod block;
 pub mod boxes;
 pub mod config;
+pub mod core;
 pub mod far_map;
 pub mod field;
 pub mod generate;

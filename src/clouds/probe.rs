@@ -4,15 +4,16 @@
 //! a point is in a rain shaft, and the first cloud a line of sight meets with the optical depth
 //! through it.
 //!
-//! A cloud is its core box: the box of its sprite centres plus a quarter of each sprite's size
-//! (rain shafts left out), the same box the renderer's in-cloud fog uses
-//! (`render::scene::SkyCloud::core_box_m`). Inside it the in-cloud measure rises from 0 at the
-//! boundary to 1 at `ramp_fraction` of the half-extent in, times the cloud's fade where the point
-//! is ([`super::lifecycle::alpha_at`] at the point's radius fraction). A line of sight meets a
-//! cloud where it enters its box; its optical depth is the extinction inside a cloud
-//! (`3 / visibility_m`, Koschmieder) times the length inside, times the fade.
+//! A cloud is the union of its sprites' dense cores above its base ([`super::core`]), what the
+//! sprites show: a gap between them is clear air here too. Inside a core the in-cloud measure
+//! rises from 0 at its boundary to 1 at `ramp_fraction` of its radius in, times the cloud's fade
+//! where the point is ([`super::lifecycle::alpha_at`] at the point's radius fraction). A line of
+//! sight meets a cloud where it enters a core; its optical depth is the extinction inside a
+//! cloud (`3 / visibility_m`, Koschmieder) times the length inside the cores, times the fade.
 //!
-//! The boxes of a generation are worked out once, on the generation worker
+//! The walks go through the box around each cloud's cores ([`super::boxes`]) first, and ask the
+//! cores only of a cloud whose box they enter. The boxes of a generation are worked out once, on
+//! the generation worker
 //! ([`super::field::FieldBlock::boxes`]). A point query looks only at the blocks within reach of
 //! the point, and skips a block whose clouds' bounds are out of reach; a line of sight walks the
 //! field's boxes in tiles (`clouds::sight`), a tile built again when a generation joins it.
@@ -26,6 +27,7 @@ use glam::{DVec2, DVec3};
 
 use super::block::Cloud;
 use super::boxes::{CloudBox, GenerationBoxes, bounds_distance_m};
+use super::core;
 use super::field::{CloudField, FieldBlock};
 use super::lifecycle::{Phase, alpha_at};
 use super::sight::{FieldSight, Met};
@@ -139,8 +141,22 @@ pub struct CloudsAtPoint {
     pub nearest_cb_m: Option<f64>,
 }
 
-/// The first cloud a line of sight meets.
+/// One stretch of cloud along a line of sight: where it enters and leaves cloud (the cores of
+/// one cloud or of several that overlap), and the optical depth through it.
 #[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CloudCrossing {
+    /// Distance from the start to where it enters cloud, metres.
+    pub entry_m: f64,
+    /// Distance from the start to where it leaves cloud, metres.
+    pub exit_m: f64,
+    /// Optical depth through the stretch.
+    pub optical_depth: f64,
+    /// The type of the cloud that makes most of that depth.
+    pub cloud_type: CloudType,
+}
+
+/// The first cloud a line of sight meets.
+#[derive(Debug, Clone, PartialEq)]
 pub struct SightHit {
     /// Distance from the start to where it enters the cloud, metres.
     pub distance_m: f64,
@@ -152,6 +168,9 @@ pub struct SightHit {
     pub total_optical_depth: f64,
     /// The cloud's type.
     pub cloud_type: CloudType,
+    /// Every stretch of cloud along the segment, nearest first ([`CloudProbe::line_of_sight`];
+    /// empty from [`CloudProbe::first_cloud`] and [`CloudProbe::optical_depth_until`]).
+    pub crossings: Vec<CloudCrossing>,
 }
 
 /// Queries on a living [`CloudField`]. See the module docs.
@@ -268,7 +287,15 @@ impl<'a> CloudProbe<'a> {
             };
             let boxes = &listed.boxes;
             for b in &boxes.boxes {
-                let d = b.distance_m(q);
+                let box_m = b.distance_m(q);
+                let cloud = &g.block.clouds[b.cloud];
+                // Inside the box the cores say how near the cloud is; outside it the box's
+                // distance is the nearest the cores can be.
+                let d = if box_m > 0.0 {
+                    box_m
+                } else {
+                    core::distance_m(cloud, q - cloud.centre_m)
+                };
                 let in_sphere = (q - b.cloud_centre_m).length_squared() < b.sphere_m * b.sphere_m;
                 let cb = b.cloud_type == CloudType::Cumulonimbus;
                 // Only what can change an answer needs its fade.
@@ -284,7 +311,8 @@ impl<'a> CloudProbe<'a> {
                     nearest_cb = nearest_cb.min(d);
                 }
                 if d == 0.0 {
-                    let inside = b.inside(q, self.settings.ramp_fraction) * fade;
+                    let inside =
+                        core::inside(cloud, q - cloud.centre_m, self.settings.ramp_fraction) * fade;
                     if b.cloud_type == CloudType::Cumulonimbus {
                         out.in_cb = out.in_cb.max(inside);
                     }
@@ -294,7 +322,7 @@ impl<'a> CloudProbe<'a> {
                     }
                 }
                 if in_sphere {
-                    out.in_rain = out.in_rain.max(in_rain(&g.block.clouds[b.cloud], q) * fade);
+                    out.in_rain = out.in_rain.max(in_rain(cloud, q) * fade);
                 }
             }
         }
@@ -303,10 +331,15 @@ impl<'a> CloudProbe<'a> {
         out
     }
 
-    /// The first cloud met along the segment from ground point `a` to `b`, with the optical
-    /// depth through it and through every cloud along it; `None` in clear air.
+    /// Every cloud along the segment from ground point `a` to `b`: the first one met, with the
+    /// optical depth through it and through all of them, and each stretch of cloud
+    /// (`crossings`: entry, exit, optical depth); `None` in clear air.
     pub fn line_of_sight(&self, a: DVec3, b: DVec3) -> Option<SightHit> {
-        self.sight(a, b, true, f64::INFINITY)
+        let mut spans = Vec::new();
+        let length = (b - a).length();
+        let mut hit = self.sight(a, b, true, f64::INFINITY, Some(&mut spans))?;
+        hit.crossings = crossings(spans, length);
+        Some(hit)
     }
 
     /// The optical depth through the clouds along the segment from ground point `a` to `b`,
@@ -314,7 +347,7 @@ impl<'a> CloudProbe<'a> {
     /// `1 - exp(-depth)` makes 1 to within `exp(-enough)`, needs no more, and a ray up through
     /// a storm would cross hundreds of boxes beyond). 0 in clear air.
     pub fn optical_depth_until(&self, a: DVec3, b: DVec3, enough: f64) -> f64 {
-        self.sight(a, b, true, enough)
+        self.sight(a, b, true, enough, None)
             .map_or(0.0, |hit| hit.total_optical_depth)
     }
 
@@ -322,12 +355,20 @@ impl<'a> CloudProbe<'a> {
     /// `total_optical_depth` counts only the clouds looked at before the first was certain (the
     /// cheap query a host casts many of).
     pub fn first_cloud(&self, a: DVec3, b: DVec3) -> Option<SightHit> {
-        self.sight(a, b, false, f64::INFINITY)
+        self.sight(a, b, false, f64::INFINITY, None)
     }
 
     /// The walk of [`Self::line_of_sight`] (`whole`) or [`Self::first_cloud`], stopped once the
-    /// optical depth counted reaches `enough`.
-    fn sight(&self, a: DVec3, b: DVec3, whole: bool, enough: f64) -> Option<SightHit> {
+    /// optical depth counted reaches `enough`; each stretch inside a cloud's cores goes into
+    /// `spans` (t in, t out, optical depth, type) where given.
+    fn sight(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        whole: bool,
+        enough: f64,
+        mut spans: Option<&mut Vec<Span>>,
+    ) -> Option<SightHit> {
         let (qa, qb) = (self.air_point(a), self.air_point(b));
         let length = (qb - qa).length();
         let sigma = 3.0 / f64::from(self.settings.visibility_m);
@@ -355,7 +396,8 @@ impl<'a> CloudProbe<'a> {
         // The generation of the last box met and its phase now (a box's neighbours along the
         // line are mostly of the same generation).
         let mut last: Option<(u64, Option<&FieldBlock>)> = None;
-        sight.crossed(qa, qb, whole, |(index, serial), bx, t0, t1| {
+        let mut inside = Vec::new();
+        sight.crossed(qa, qb, whole, |(index, serial), bx, _, _| {
             let block = match last {
                 Some((at, block)) if at == serial => block,
                 _ => {
@@ -367,20 +409,35 @@ impl<'a> CloudProbe<'a> {
             let Some(block) = block else {
                 return Met::Passed;
             };
-            let mid = qa.lerp(qb, 0.5 * (t0 + t1));
-            let fade = f64::from(self.fade(block, bx, mid));
-            if fade <= 0.0 {
-                return Met::Passed;
+            // The box is entered: the cloud's cores say where the line is in cloud.
+            let cloud = &block.block.clouds[bx.cloud];
+            core::segment(cloud, qa - cloud.centre_m, qb - cloud.centre_m, &mut inside);
+            let mut entry: Option<f64> = None;
+            let mut depth_here = 0.0;
+            for &(t0, t1) in &inside {
+                let mid = qa.lerp(qb, 0.5 * (t0 + t1));
+                let fade = f64::from(self.fade(block, bx, mid));
+                if fade <= 0.0 {
+                    continue;
+                }
+                let depth = sigma * (t1 - t0) * length * fade;
+                depth_here += depth;
+                entry.get_or_insert(t0);
+                if let Some(spans) = spans.as_deref_mut() {
+                    spans.push((t0, t1, depth, bx.cloud_type));
+                }
             }
-            let depth = sigma * (t1 - t0) * length * fade;
-            total += depth;
+            let Some(t0) = entry else {
+                return Met::Passed;
+            };
+            total += depth_here;
             if first.is_none_or(|f| t0 < f.0) {
-                first = Some((t0, depth, bx.cloud_type));
+                first = Some((t0, depth_here, bx.cloud_type));
             }
             if total >= enough {
                 Met::Enough
             } else {
-                Met::Counted
+                Met::Counted(t0)
             }
         });
         first.map(|(t, depth, cloud_type)| SightHit {
@@ -389,8 +446,42 @@ impl<'a> CloudProbe<'a> {
             optical_depth: depth,
             total_optical_depth: total,
             cloud_type,
+            crossings: Vec::new(),
         })
     }
+}
+
+/// A stretch of one cloud's cores along a line of sight: t in, t out, optical depth, type.
+type Span = (f64, f64, f64, CloudType);
+
+/// The stretches of cloud along a segment `length_m` long: the clouds' spans, those that
+/// overlap joined (each typed by the cloud that gives it most depth).
+fn crossings(mut spans: Vec<Span>, length_m: f64) -> Vec<CloudCrossing> {
+    spans.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut out: Vec<(CloudCrossing, f64)> = Vec::new();
+    for (t0, t1, depth, cloud_type) in spans {
+        let (entry_m, exit_m) = (t0 * length_m, t1 * length_m);
+        match out.last_mut() {
+            Some((c, most)) if entry_m <= c.exit_m => {
+                c.exit_m = c.exit_m.max(exit_m);
+                c.optical_depth += depth;
+                if depth > *most {
+                    *most = depth;
+                    c.cloud_type = cloud_type;
+                }
+            }
+            _ => out.push((
+                CloudCrossing {
+                    entry_m,
+                    exit_m,
+                    optical_depth: depth,
+                    cloud_type,
+                },
+                depth,
+            )),
+        }
+    }
+    out.into_iter().map(|(c, _)| c).collect()
 }
 
 /// How opaque the rain shafts of `cloud` are at air point `q` (the renderer's rule,

@@ -432,7 +432,7 @@ impl SightBoxes {
                     let bx = &self.generations[g as usize].boxes[k as usize];
                     match hit(g as usize, bx, t0, t1) {
                         Met::Passed => {}
-                        Met::Counted => walk.best = walk.best.min(t0),
+                        Met::Counted(entry) => walk.best = walk.best.min(entry),
                         Met::Enough => {
                             walk.enough = true;
                             return false;
@@ -469,8 +469,8 @@ impl Walk {
 pub(super) enum Met {
     /// It does not count (a faded-out cloud).
     Passed,
-    /// It counts.
-    Counted,
+    /// It counts, entered at this t along the segment (at or after the box's entry).
+    Counted(f64),
     /// It counts, and the walk has what it wants: it stops.
     Enough,
 }

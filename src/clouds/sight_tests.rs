@@ -90,7 +90,7 @@ fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
                 stamp,
                 |g, bx, t0, _| {
                     met.push((t0, g, bx.cloud));
-                    Met::Counted
+                    Met::Counted(t0)
                 },
             );
             met.sort_by_key(|x| (x.1, x.2));
@@ -121,7 +121,7 @@ fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
                 stamp,
                 |_, _, t0, _| {
                     first = first.min(t0);
-                    Met::Counted
+                    Met::Counted(t0)
                 },
             );
             assert_eq!(first, nearest, "cell {cell_m} m, segment {k}");
@@ -177,7 +177,7 @@ fn check(
                 return Met::Passed;
             }
             met.push((serial, bx.cloud, t0.to_bits()));
-            Met::Counted
+            Met::Counted(t0)
         });
         met.sort_unstable();
         assert_eq!(met, every, "segment {k}: {a} to {b}");
@@ -191,7 +191,7 @@ fn check(
                 return Met::Passed;
             }
             first = first.min(t0);
-            Met::Counted
+            Met::Counted(t0)
         });
         assert_eq!(first, nearest, "segment {k}: {a} to {b}");
     }
@@ -234,7 +234,7 @@ fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
     assert_eq!(sight.tiles_built(), (0, 0));
     let middle = DVec3::new(6.0 * BLOCK_SIZE_M, 6.0 * BLOCK_SIZE_M, 1_000.0);
     sight.crossed(middle, middle + DVec3::X * 100.0, true, |_, _, _, _| {
-        Met::Counted
+        Met::Counted(0.0)
     });
     assert_eq!(sight.tiles_built(), (1, 1));
     check(&mut sight, &members, &[], &mut rand, 0);
@@ -277,7 +277,7 @@ fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
         left.push(generation(BlockIndex::new(9, 9), serial, &mut rand));
         assert_eq!(sight.update(left.iter().map(|m| (m.0, m.1, &m.2))), 1);
         sight.crossed(corner, corner + DVec3::Y * 100.0, true, |_, _, _, _| {
-            Met::Counted
+            Met::Counted(0.0)
         });
         parts.push(sight.tiles_built().1);
     }

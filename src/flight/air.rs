@@ -177,10 +177,18 @@ impl World {
         self.probe().map(|p| p.at(point_m)).unwrap_or_default()
     }
 
-    /// The first cloud the segment `from_m`..`to_m` meets, and the optical depth through it
-    /// (`total_optical_depth`: of the clouds looked at, not all along; `sun_occlusion` has
-    /// that); `None` in clear air (and before the living clouds exist).
+    /// Every cloud along the segment `from_m`..`to_m`: the first one met (where, its type, the
+    /// optical depth through it), the optical depth through them all, and each stretch of
+    /// cloud with its entry, exit and optical depth (`crossings`); `None` in clear air (and
+    /// before the living clouds exist).
     pub fn line_of_sight(&self, from_m: DVec3, to_m: DVec3) -> Option<SightHit> {
+        self.probe()?.line_of_sight(from_m, to_m)
+    }
+
+    /// The first cloud the segment `from_m`..`to_m` meets and the optical depth through it,
+    /// the cheaper query for sensors casting many lines a frame: its walk stops at the first
+    /// cloud (`total_optical_depth` counts only the clouds looked at, `crossings` is empty).
+    pub fn first_cloud(&self, from_m: DVec3, to_m: DVec3) -> Option<SightHit> {
         self.probe()?.first_cloud(from_m, to_m)
     }
 
@@ -493,8 +501,8 @@ impl super::SkySystem {
         self.world().air_at(self.local_m(position), sun)
     }
 
-    /// The first cloud met between two positions, and the optical depth through it; `None` in
-    /// clear air.
+    /// Every cloud between two positions ([`World::line_of_sight`]): the first one met, and
+    /// each stretch of cloud with its entry, exit and optical depth; `None` in clear air.
     pub fn line_of_sight(
         &self,
         from: super::HostPosition,
@@ -502,6 +510,17 @@ impl super::SkySystem {
     ) -> Option<SightHit> {
         self.world()
             .line_of_sight(self.local_m(from), self.local_m(to))
+    }
+
+    /// The first cloud met between two positions and the optical depth through it
+    /// ([`World::first_cloud`]: cheaper, for many lines a frame); `None` in clear air.
+    pub fn first_cloud(
+        &self,
+        from: super::HostPosition,
+        to: super::HostPosition,
+    ) -> Option<SightHit> {
+        self.world()
+            .first_cloud(self.local_m(from), self.local_m(to))
     }
 
     /// Uses the winds and temperatures aloft of an FB product ([`World::set_winds_aloft`]),
@@ -539,3 +558,7 @@ impl super::SkySystem {
 #[cfg(test)]
 #[path = "air_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "instrument_tests.rs"]
+mod instrument_tests;

@@ -38,18 +38,24 @@ fn world(file: &str, lat: f64, lon: f64, clouds: bool) -> World {
     w
 }
 
-/// The boxes (ground frame) of the generated clouds of a type.
-fn boxes_of(w: &World, t: CloudType) -> Vec<CloudBox> {
+/// The centres of the sprites' cores (ground frame) of the generated clouds of a type, each with
+/// its cloud's box: points in cloud, as the sprites show it.
+fn cores_of(w: &World, t: CloudType) -> Vec<(DVec3, CloudBox)> {
     let field = w.living_field().unwrap();
     let d = field.drift_m();
+    let drift = DVec3::new(d.x, d.y, 0.0);
     field
         .blocks()
         .flat_map(|(_, g)| g.block.clouds.iter().enumerate())
         .filter(|(_, c)| c.cloud_type == t)
-        .filter_map(|(i, c)| CloudBox::of(c, i))
-        .map(|mut b| {
-            b.centre_m += DVec3::new(d.x, d.y, 0.0);
-            b
+        .filter_map(|(i, c)| CloudBox::of(c, i).map(|b| (c, b)))
+        .flat_map(|(c, mut b)| {
+            b.centre_m += drift;
+            crate::clouds::core::cores(c)
+                // Above the base (a core reaching below it is cut there).
+                .filter(|k| k.centre_m.z >= f64::from(c.floor_m))
+                .map(move |k| (c.centre_m + k.centre_m + drift, b))
+                .collect::<Vec<_>>()
         })
         .collect()
 }
@@ -128,10 +134,10 @@ fn above_the_boundary_layer_the_wind_is_the_documented_profile() {
 
 /// Turbulence in and near the cumulonimbus of a world, and the icing in them.
 fn check_cbs(w: &World, what: &str) {
-    let cbs = boxes_of(w, CloudType::Cumulonimbus);
+    let cbs = cores_of(w, CloudType::Cumulonimbus);
     assert!(!cbs.is_empty(), "{what}: no cumulonimbus generated");
-    for b in cbs.iter().take(5) {
-        let inside = w.air_at(b.centre_m, UP);
+    for (core, b) in cbs.iter().step_by(97).take(5) {
+        let inside = w.air_at(*core, UP);
         assert!(inside.in_cloud > 0.9, "{what}: {inside:?}");
         assert_eq!(
             inside.turbulence_category,
@@ -184,12 +190,12 @@ fn still_clear_air_has_no_turbulence_and_no_icing() {
     assert!((-20.0..=0.0).contains(&a.temperature_c), "{a:?}");
     assert!(!a.icing, "clear air is no icing risk: {a:?}");
     // In a cumulus (warm): light turbulence at most moderate, no icing above 0 C.
-    let cu = boxes_of(&w, CloudType::CumulusMediocris)
+    let (cu, _) = cores_of(&w, CloudType::CumulusMediocris)
         .into_iter()
-        .chain(boxes_of(&w, CloudType::CumulusHumilis))
+        .chain(cores_of(&w, CloudType::CumulusHumilis))
         .next()
         .unwrap();
-    let a = w.air_at(cu.centre_m, UP);
+    let a = w.air_at(cu, UP);
     assert!(a.in_cloud > 0.9, "{a:?}");
     assert!(
         (TurbulenceCategory::Light..=TurbulenceCategory::Moderate).contains(&a.turbulence_category),
@@ -201,21 +207,15 @@ fn still_clear_air_has_no_turbulence_and_no_icing() {
 #[test]
 fn icing_only_in_cloud_or_precipitation_at_0_to_minus_20() {
     let w = world(REAL, 42.239, -8.624, true);
-    // A storm cell is drawn in parts, one a block: the part holding most of the tower's height.
-    let cb = boxes_of(&w, CloudType::Cumulonimbus)
-        .into_iter()
-        .max_by(|a, b| a.half_m.z.total_cmp(&b.half_m.z))
-        .unwrap();
+    // In the storm's sprites from its base to its top: icing exactly where it is 0 to -20 C.
+    let mut cores = cores_of(&w, CloudType::Cumulonimbus);
+    cores.sort_by(|a, b| a.0.z.total_cmp(&b.0.z));
     let ground = f64::from(w.field().weather_at(DVec2::ZERO).ground_elevation_m);
-    // Up the middle of the Cb: icing exactly where it is 0 to -20 C.
-    let (lo, hi) = (
-        cb.centre_m.z - 0.97 * cb.half_m.z,
-        cb.centre_m.z + 0.97 * cb.half_m.z,
-    );
     let (mut iced, mut warm, mut cold) = (0, 0, 0);
     for k in 0..=40 {
-        let z = lo + (hi - lo) * f64::from(k) / 40.0;
-        let a = w.air_at(DVec3::new(cb.centre_m.x, cb.centre_m.y, z), UP);
+        let (core, _) = cores[(cores.len() - 1) * k / 40];
+        let z = core.z;
+        let a = w.air_at(core, UP);
         assert!(a.in_cloud > 0.0, "{a:?}");
         let in_range = (-20.0..=0.0).contains(&a.temperature_c);
         assert_eq!(a.icing, in_range, "{z:.0} m: {a:?}");
@@ -235,20 +235,29 @@ fn icing_only_in_cloud_or_precipitation_at_0_to_minus_20() {
 #[test]
 fn a_line_of_sight_meets_the_first_cloud_at_its_near_boundary_and_clear_air_none() {
     let w = world("weather/themes/thunderstorm_cells.toml", 27.0, -81.0, true);
-    let cb = boxes_of(&w, CloudType::Cumulonimbus)[0];
-    // From 6 km west of its box to its centre, through its middle.
-    let to = cb.centre_m;
-    let from = to - DVec3::new(cb.half_m.x + 6_000.0, 0.0, 0.0);
+    let cores = cores_of(&w, CloudType::Cumulonimbus);
+    let (to, cb) = cores[cores.len() / 2];
+    // From 6 km west of its box to a point in its sprites.
+    let from = DVec3::new(cb.centre_m.x - cb.half_m.x - 6_000.0, to.y, to.z);
     let hit = w.line_of_sight(from, to).expect("a hit");
-    let boundary = 6_000.0;
-    assert!(hit.distance_m <= boundary * 1.1, "{hit:?}");
-    if hit.cloud_type == CloudType::Cumulonimbus {
-        assert!(
-            (hit.distance_m - boundary).abs() <= 0.1 * boundary,
-            "{hit:?}"
-        );
+    let length = (to - from).length();
+    assert!(
+        hit.distance_m >= 6_000.0 && hit.distance_m < length,
+        "{hit:?}"
+    );
+    // It meets cloud where the probes find it begins: clear a metre before, cloud a metre on.
+    let along = (to - from).normalize();
+    assert_eq!(w.clouds_at(hit.point_m - along).in_cloud, 0.0, "{hit:?}");
+    assert!(w.clouds_at(hit.point_m + along).in_cloud > 0.0, "{hit:?}");
+    assert!(hit.optical_depth > 0.0, "{hit:?}");
+    // Every stretch of cloud along it: the first is the hit, each ends after it begins, in order.
+    let first = hit.crossings.first().expect("a crossing");
+    assert!((first.entry_m - hit.distance_m).abs() < 1e-6, "{hit:?}");
+    for pair in hit.crossings.windows(2) {
+        assert!(pair[0].exit_m < pair[1].entry_m, "{hit:?}");
     }
-    assert!(hit.optical_depth > 1.0, "{hit:?}");
+    let summed: f64 = hit.crossings.iter().map(|c| c.optical_depth).sum();
+    assert!((summed - hit.total_optical_depth).abs() < 1e-9, "{hit:?}");
     // Far above every top: clear air.
     let high = DVec3::new(-20_000.0, 0.0, 15_000.0);
     assert_eq!(w.line_of_sight(high, high + DVec3::X * 40_000.0), None);

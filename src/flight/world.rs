@@ -105,6 +105,7 @@ impl From<&Cloud> for SkyCloud {
             flat: c.flat,
             sunlit_depth_m: c.sunlit_depth_m,
             shaded_base_m: c.shaded_base_m,
+            floor_m: c.floor_m,
         }
     }
 }

@@ -162,15 +162,23 @@ pub(super) fn used_up(
         || time_s < ordered_at.1
 }
 
-/// How far inside the cloud's core box the camera is: 0 outside, rising to 1 over `ramp` of the
-/// half-extent inside the boundary.
-fn in_cloud_factor(state: &CloudState, camera_rel_m: Vec3, ramp: f32) -> f32 {
+/// How far inside the cloud the camera is (`clouds::core::inside`, the air data's own measure):
+/// 0 outside its sprites' dense cores and below its base, rising to 1 over `ramp` of a core's
+/// radius in. The box around the cores is asked first, the cores only when the camera is in it.
+fn in_cloud_factor(state: &CloudState, cloud: &SkyCloud, camera_rel_m: Vec3, ramp: f32) -> f32 {
     if state.core_half_m.min_element() <= 0.0 {
         return 0.0;
     }
     let rel = camera_rel_m - state.core_centre_m;
-    let inside = (Vec3::ONE - rel.abs() / state.core_half_m).min_element();
-    (inside / ramp.max(1e-3)).clamp(0.0, 1.0)
+    if (rel.abs() - state.core_half_m).max_element() > 0.0 {
+        return 0.0;
+    }
+    crate::clouds::core::inside_cores(
+        cloud.cores(),
+        f64::from(cloud.floor_m),
+        camera_rel_m.as_dvec3(),
+        ramp,
+    )
 }
 
 /// The cloud's sprite indices, farthest from the camera first, with their squared distances
@@ -878,6 +886,7 @@ fn inside_clouds(
         }
         in_cloud = in_cloud.max(in_cloud_factor(
             state,
+            cloud,
             cam_local,
             settings.in_cloud.ramp_fraction,
         ));

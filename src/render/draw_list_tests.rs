@@ -105,6 +105,7 @@ pub(in crate::render) fn small_cloud() -> SkyCloud {
         flat: false,
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
+        floor_m: f32::MIN,
     }
 }
 

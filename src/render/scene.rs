@@ -8,6 +8,7 @@
 
 use glam::{DVec3, Vec3};
 
+use crate::clouds::core::SpriteCore;
 use crate::shading::ColourLevels;
 
 /// One camera-facing sprite of a cloud.
@@ -65,6 +66,10 @@ pub struct SkyCloud {
     /// A heap's shaded base, metres above its base: below it the body above hides the sun (one
     /// dark, evenly lit base), the sun coming in over it. 0: lit down to the base.
     pub shaded_base_m: f32,
+    /// Its flat base, metres from `centre_m` (negative: below it): the camera is in cloud
+    /// only above it, inside a sprite's dense core (`clouds::core`, as every probe of the
+    /// air data). `f32::MIN`: no base.
+    pub floor_m: f32,
 }
 
 /// A 4 km x 4 km block of clouds.
@@ -80,23 +85,35 @@ pub struct SkyBlock {
 }
 
 impl SkyCloud {
-    /// Half extents of the box holding the sprite centres plus half of each sprite's size,
-    /// metres, and the box centre offset from `centre_m`: the cloud itself, where the camera is
-    /// in cloud (the rain under it is not).
+    /// The dense cores of its sprites (rain and snow are not cloud), as every probe sees them.
+    pub fn cores(&self) -> impl Iterator<Item = SpriteCore> + '_ {
+        self.sprites.iter().filter(|s| !s.precipitation).map(|s| {
+            SpriteCore::new(
+                s.offset_m.to_array(),
+                s.width_m,
+                s.height_m,
+                s.rotation_deg,
+                self.flat,
+            )
+        })
+    }
+
+    /// Half extents of the box around its cores above its base, metres, and the box centre
+    /// offset from `centre_m`: outside it the camera is out of the cloud.
     pub fn core_box_m(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::splat(f32::MAX);
         let mut hi = Vec3::splat(f32::MIN);
-        let cloud = self.sprites.iter().filter(|s| !s.precipitation);
         let mut any = false;
-        for s in cloud {
-            let r = Vec3::new(s.width_m, s.width_m, s.height_m) * 0.25;
-            lo = lo.min(s.offset_m - r);
-            hi = hi.max(s.offset_m + r);
+        for core in self.cores() {
+            let r = core.box_half_m().as_vec3();
+            lo = lo.min(core.centre_m.as_vec3() - r);
+            hi = hi.max(core.centre_m.as_vec3() + r);
             any = true;
         }
         if !any {
             return (Vec3::ZERO, Vec3::ZERO);
         }
+        lo.z = lo.z.max(self.floor_m).min(hi.z);
         ((hi - lo) * 0.5, (hi + lo) * 0.5)
     }
 

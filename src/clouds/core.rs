@@ -1,0 +1,283 @@
+//! A cloud as everything that asks "is there cloud here?" sees it: the union of its sprites'
+//! dense cores, none of it below the cloud's flat base.
+//!
+//! A sprite's core is the part of its quad where the texture is dense: within 0.7 of its half
+//! extents ([`CORE_HALF_EXTENT`] of its full size) from its centre, an ellipsoid (a flat sprite's
+//! turned with it, as thick as it is narrow). It is what a person looking up counts as covered,
+//! the measure the generator places clouds by ([`super::generate`] covers a layer's oktas with
+//! it), and what the probes ([`super::probe`]: `in_cloud`, lines of sight, the sun's occlusion),
+//! so a gap the sprites show is a gap to every probe. The cloud's base
+//! ([`super::block::Cloud::floor_m`]) cuts the cores: a flat-bottomed cumulus, a deck or a storm
+//! cell is first met from below at its base, the relief of its sprites above it.
+//!
+//! Positions here are relative to the cloud's centre, metres (f64: the probes work in the air
+//! frame's metres and subtract the centre first).
+
+use glam::{DVec2, DVec3};
+
+use super::block::{Cloud, Sprite};
+
+/// A sprite's dense core reaches this fraction of its full width (and height) from its centre.
+pub const CORE_HALF_EXTENT: f64 = 0.35;
+
+/// One sprite's core, relative to its cloud's centre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpriteCore {
+    /// Centre, metres from the cloud's centre.
+    pub centre_m: DVec3,
+    /// The horizontal axis the first semi-axis lies along (unit).
+    along: DVec2,
+    /// Semi-axes, metres: along, across, up.
+    pub semi_axes_m: DVec3,
+}
+
+impl SpriteCore {
+    /// The core of `sprite` of a cloud that is `flat` (`None` for rain or snow, which is not
+    /// cloud).
+    pub fn of(sprite: &Sprite, flat: bool) -> Option<Self> {
+        (!sprite.precipitation).then(|| {
+            Self::new(
+                sprite.offset_m,
+                sprite.width_m,
+                sprite.height_m,
+                sprite.rotation_deg,
+                flat,
+            )
+        })
+    }
+
+    /// The core of a sprite `width_m` x `height_m` at `offset_m` from its cloud's centre,
+    /// turned `rotation_deg` (what matters of it for a `flat` one, a horizontal rectangle
+    /// whose height is its extent across; as thick as it is narrow).
+    pub fn new(
+        offset_m: [f32; 3],
+        width_m: f32,
+        height_m: f32,
+        rotation_deg: f32,
+        flat: bool,
+    ) -> Self {
+        let (w, h) = (f64::from(width_m), f64::from(height_m));
+        let (across, up) = if flat { (h, w.min(h)) } else { (w, h) };
+        Self {
+            centre_m: DVec3::from_array(offset_m.map(f64::from)),
+            along: DVec2::from_angle(f64::from(rotation_deg).to_radians()),
+            semi_axes_m: DVec3::new(w, across, up) * CORE_HALF_EXTENT,
+        }
+    }
+
+    /// Half the sides of the box around the core (a turned one's by its longer horizontal
+    /// axis), metres.
+    pub fn box_half_m(&self) -> DVec3 {
+        let a = &self.semi_axes_m;
+        DVec3::new(a.x.max(a.y), a.x.max(a.y), a.z)
+    }
+
+    /// `p` (from the cloud's centre) in the core's unit sphere.
+    fn unit(&self, p: DVec3) -> DVec3 {
+        let d = p - self.centre_m;
+        let flat = d.truncate();
+        DVec3::new(flat.dot(self.along), self.along.perp_dot(flat), d.z) / self.semi_axes_m
+    }
+
+    /// The core's normalised radius at `p` (below 1 inside).
+    pub fn radius(&self, p: DVec3) -> f64 {
+        self.unit(p).length()
+    }
+
+    /// Where the segment `a + t (b - a)`, t in 0..=1, is inside the core: (t in, t out).
+    pub fn segment(&self, a: DVec3, b: DVec3) -> Option<(f64, f64)> {
+        let (o, e) = (self.unit(a), self.unit(b));
+        let d = e - o;
+        let dd = d.length_squared();
+        if dd < 1e-18 {
+            return (o.length_squared() < 1.0).then_some((0.0, 1.0));
+        }
+        // |o + t d|^2 = 1.
+        let half_b = o.dot(d);
+        let c = o.length_squared() - 1.0;
+        let disc = half_b * half_b - dd * c;
+        if disc <= 0.0 {
+            return None;
+        }
+        let root = disc.sqrt();
+        let (t0, t1) = ((-half_b - root) / dd, (-half_b + root) / dd);
+        let (t0, t1) = (t0.max(0.0), t1.min(1.0));
+        (t0 < t1).then_some((t0, t1))
+    }
+}
+
+/// The cores of `cloud`'s sprites.
+pub fn cores(cloud: &Cloud) -> impl Iterator<Item = SpriteCore> + '_ {
+    cloud
+        .sprites
+        .iter()
+        .filter_map(|s| SpriteCore::of(s, cloud.flat))
+}
+
+/// How far inside `cloud` the point `p` (from the cloud's centre) is: 0 outside every core and
+/// below the base, rising to 1 over `ramp` of a core's radius in (the deepest core's).
+pub fn inside(cloud: &Cloud, p: DVec3, ramp: f32) -> f32 {
+    inside_cores(cores(cloud), f64::from(cloud.floor_m), p, ramp)
+}
+
+/// [`inside`] for any cores (the renderer's own clouds' among them) over a base at `floor_m`.
+pub fn inside_cores(
+    cores: impl Iterator<Item = SpriteCore>,
+    floor_m: f64,
+    p: DVec3,
+    ramp: f32,
+) -> f32 {
+    if p.z < floor_m {
+        return 0.0;
+    }
+    let ramp = f64::from(ramp).max(1e-3);
+    let mut deepest = 0.0f64;
+    for core in cores {
+        let r = core.radius(p);
+        if r < 1.0 {
+            deepest = deepest.max((1.0 - r) / ramp);
+            if deepest >= 1.0 {
+                return 1.0;
+            }
+        }
+    }
+    deepest.min(1.0) as f32
+}
+
+/// The distance from `p` (from the cloud's centre) to the nearest core, metres: 0 inside one,
+/// otherwise the normalised radius beyond 1 times the core's smallest semi-axis (a lower bound
+/// on the true distance, exact for a sphere).
+pub fn distance_m(cloud: &Cloud, p: DVec3) -> f64 {
+    let floor = f64::from(cloud.floor_m);
+    let below = (floor - p.z).max(0.0);
+    let mut nearest = f64::INFINITY;
+    for core in cores(cloud) {
+        let r = core.radius(p);
+        let d = ((r - 1.0).max(0.0) * core.semi_axes_m.min_element()).max(below);
+        nearest = nearest.min(d);
+        if nearest <= 0.0 {
+            return 0.0;
+        }
+    }
+    nearest
+}
+
+/// The stretches of the segment `a + t (b - a)` (from the cloud's centre), t in 0..=1, that are
+/// inside `cloud`: the union of its cores above its base, sorted and merged, into `out`
+/// (cleared first).
+pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
+    out.clear();
+    let floor = f64::from(cloud.floor_m);
+    // The part of the segment above the base.
+    let (above_from, above_to) = {
+        let dz = b.z - a.z;
+        if dz.abs() < 1e-12 {
+            if a.z < floor {
+                return;
+            }
+            (0.0, 1.0)
+        } else {
+            let t = (floor - a.z) / dz;
+            if dz > 0.0 {
+                (t.max(0.0), 1.0)
+            } else {
+                (0.0, t.min(1.0))
+            }
+        }
+    };
+    if above_from >= above_to {
+        return;
+    }
+    for core in cores(cloud) {
+        if let Some((t0, t1)) = core.segment(a, b) {
+            let (t0, t1) = (t0.max(above_from), t1.min(above_to));
+            if t0 < t1 {
+                out.push((t0, t1));
+            }
+        }
+    }
+    merge(out);
+}
+
+/// Sorts the intervals and merges those that overlap.
+fn merge(spans: &mut Vec<(f64, f64)>) {
+    spans.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut merged = 0;
+    for k in 0..spans.len() {
+        let (t0, t1) = spans[k];
+        if merged > 0 && t0 <= spans[merged - 1].1 {
+            spans[merged - 1].1 = spans[merged - 1].1.max(t1);
+        } else {
+            spans[merged] = (t0, t1);
+            merged += 1;
+        }
+    }
+    spans.truncate(merged);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::clouds::boxes::tests::cube_cloud;
+    use crate::weather::CloudType;
+
+    #[test]
+    fn a_line_up_through_a_cloud_meets_its_base_not_the_core_below_it() {
+        // One sprite 1000 m across, its centre 100 m above the cloud's base: its core reaches
+        // 350 m down, the base cuts it at 100 m below the centre.
+        let mut c = cube_cloud(
+            DVec3::ZERO,
+            1000.0 * CORE_HALF_EXTENT as f32,
+            CloudType::Stratus,
+        );
+        c.floor_m = -100.0;
+        let mut spans = Vec::new();
+        segment(
+            &c,
+            DVec3::new(0.0, 0.0, -1000.0),
+            DVec3::new(0.0, 0.0, 1000.0),
+            &mut spans,
+        );
+        assert_eq!(spans.len(), 1);
+        let (enter, exit) = (spans[0].0 * 2000.0 - 1000.0, spans[0].1 * 2000.0 - 1000.0);
+        assert!((enter + 100.0).abs() < 1e-6, "{enter}");
+        assert!((exit - 350.0).abs() < 1e-6, "{exit}");
+        assert_eq!(inside(&c, DVec3::new(0.0, 0.0, -150.0), 0.35), 0.0);
+        assert_eq!(inside(&c, DVec3::ZERO, 0.35), 1.0);
+        assert!((distance_m(&c, DVec3::new(0.0, 0.0, -300.0)) - 200.0).abs() < 1e-6);
+        // Beside the core (its corner box would hold this point): clear.
+        assert_eq!(inside(&c, DVec3::new(300.0, 300.0, 0.0), 0.35), 0.0);
+    }
+
+    #[test]
+    fn two_cores_with_a_gap_between_are_two_stretches() {
+        let mut c = cube_cloud(DVec3::ZERO, 100.0, CloudType::Stratus);
+        let mut far = c.sprites[0];
+        far.offset_m = [1000.0, 0.0, 0.0];
+        c.sprites.push(far);
+        let mut spans = Vec::new();
+        segment(
+            &c,
+            DVec3::new(-500.0, 0.0, 0.0),
+            DVec3::new(1500.0, 0.0, 0.0),
+            &mut spans,
+        );
+        let metres: Vec<(f64, f64)> = spans
+            .iter()
+            .map(|&(a, b)| (a * 2000.0 - 500.0, b * 2000.0 - 500.0))
+            .collect();
+        assert_eq!(metres.len(), 2, "{metres:?}");
+        // (The sprite's size is an f32: the core's radius is 100 m to a few micrometres.)
+        assert!((metres[0].0 + 100.0).abs() < 1e-3 && (metres[0].1 - 100.0).abs() < 1e-3);
+        assert!((metres[1].0 - 900.0).abs() < 1e-3 && (metres[1].1 - 1100.0).abs() < 1e-3);
+        // Overlapping cores merge into one stretch.
+        c.sprites[1].offset_m = [150.0, 0.0, 0.0];
+        segment(
+            &c,
+            DVec3::new(-500.0, 0.0, 0.0),
+            DVec3::new(1500.0, 0.0, 0.0),
+            &mut spans,
+        );
+        assert_eq!(spans.len(), 1);
+    }
+}
