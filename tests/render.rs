@@ -90,6 +90,7 @@ fn cumulus(centre: DVec3) -> SkyCloud {
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
+        floor_slab_m: [0.0; 2],
     }
 }
 
@@ -113,6 +114,7 @@ fn overcast(centre: DVec2, base: f64) -> SkyCloud {
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
+        floor_slab_m: [0.0; 2],
     }
 }
 
@@ -459,6 +461,7 @@ fn cloud_terrain_edge_is_a_ramp() {
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
+        floor_slab_m: [0.0; 2],
     };
     for scale in CLOUD_SCALES {
         soft_edge_at_scale(&slope, &sprite_cloud, scale);

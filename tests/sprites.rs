@@ -69,6 +69,7 @@ fn blocks() -> Vec<SkyBlock> {
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
+        floor_slab_m: [0.0; 2],
     };
     vec![SkyBlock {
         id: 1,
@@ -89,6 +90,7 @@ fn plain_cloud(centre_m: DVec3, sprites: Vec<SkySprite>, colour_levels: ColourLe
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
+        floor_slab_m: [0.0; 2],
     }
 }
 

@@ -38,6 +38,11 @@ pub struct Sprite {
     /// Falling rain or snow under the cloud (a shaft), not cloud: drawn darker and greyer.
     #[serde(default)]
     pub precipitation: bool,
+    /// Stands on the cloud's base (a heap's or a storm cell's flat underside, a deck's floor):
+    /// its dense core spans its whole width ([`super::core`]), as the overlapping undersides
+    /// close a base seen from below.
+    #[serde(default)]
+    pub base: bool,
 }
 
 /// A shading group: sprites shaded as one clump (Wang 2003 §5.2, 1 to 30 sprites).
@@ -80,6 +85,11 @@ pub struct Cloud {
     /// cloud to a probe ([`super::core`]), so every cloud is first met from below at its base.
     #[serde(default = "no_floor")]
     pub floor_m: f32,
+    /// An overcast deck's closed underside: a slab on its floor, half as wide as the first
+    /// value (metres, a square around the centre) and as deep as the second; zeros for none
+    /// ([`super::core`]).
+    #[serde(default)]
+    pub floor_slab_m: [f32; 2],
     /// Five ambient colour levels, lowest first.
     pub colour_levels: [ColourLevel; 5],
     /// The cloud's shading groups.

@@ -47,6 +47,12 @@ impl CloudBox {
             hi = hi.max(o + r);
             any = true;
         }
+        if let Some((slab_lo, slab_hi)) =
+            super::core::floor_slab(f64::from(cloud.floor_m), cloud.floor_slab_m)
+        {
+            lo = lo.min(slab_lo);
+            hi = hi.max(slab_hi);
+        }
         // Nothing below the base is cloud.
         lo.z = lo.z.max(f64::from(cloud.floor_m)).min(hi.z);
         any.then(|| Self {
@@ -79,7 +85,7 @@ impl CloudBox {
 }
 
 /// The t range of the segment `a..b` inside the box `lo..hi` (the slab method).
-pub(super) fn slab(a: DVec3, b: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64)> {
+pub(crate) fn slab(a: DVec3, b: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64)> {
     let d = b - a;
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     for k in 0..3 {
@@ -174,6 +180,7 @@ pub(crate) mod tests {
             alpha_morph: 1.0,
             upright: false,
             precipitation: false,
+            base: false,
         };
         Cloud {
             centre_m,
@@ -184,6 +191,7 @@ pub(crate) mod tests {
             sunlit_depth_m: 0.0,
             shaded_base_m: 0.0,
             floor_m: f32::MIN,
+            floor_slab_m: [0.0; 2],
             colour_levels: [ColourLevel {
                 height_m: 0.0,
                 rgba: [1.0; 4],

@@ -3,7 +3,12 @@
 //!
 //! A sprite's core is the part of its quad where the texture is dense: within 0.7 of its half
 //! extents ([`CORE_HALF_EXTENT`] of its full size) from its centre, an ellipsoid (a flat sprite's
-//! turned with it, as thick as it is narrow). It is what a person looking up counts as covered,
+//! turned with it, as thick as it is narrow). A sprite standing on the base
+//! ([`super::block::Sprite::base`]) is dense across its whole width ([`BASE_HALF_EXTENT`]) and
+//! down to the base (a flat underside: the column under its core's middle section reaches the
+//! cloud's floor): the flat undersides of a heap's base row or a deck's floor overlap into one
+//! closed, level underside, as a ceilometer under a cumulus or a pilot breaking out of an
+//! overcast sees it, where their round cores alone left the base open and undulating. It is what a person looking up counts as covered,
 //! the measure the generator places clouds by ([`super::generate`] covers a layer's oktas with
 //! it), and what the probes ([`super::probe`]: `in_cloud`, lines of sight, the sun's occlusion),
 //! so a gap the sprites show is a gap to every probe. The cloud's base
@@ -19,6 +24,8 @@ use super::block::{Cloud, Sprite};
 
 /// A sprite's dense core reaches this fraction of its full width (and height) from its centre.
 pub const CORE_HALF_EXTENT: f64 = 0.35;
+/// A base sprite's core reaches this fraction of its full width from its centre: its edge.
+pub const BASE_HALF_EXTENT: f64 = 0.5;
 
 /// One sprite's core, relative to its cloud's centre.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,6 +36,9 @@ pub struct SpriteCore {
     along: DVec2,
     /// Semi-axes, metres: along, across, up.
     pub semi_axes_m: DVec3,
+    /// A base sprite's floor, metres from the cloud's centre: the core also holds the column
+    /// under its middle section down to it (its flat underside).
+    floor_m: Option<f64>,
 }
 
 impl SpriteCore {
@@ -36,14 +46,33 @@ impl SpriteCore {
     /// cloud).
     pub fn of(sprite: &Sprite, flat: bool) -> Option<Self> {
         (!sprite.precipitation).then(|| {
-            Self::new(
+            let mut core = Self::new(
                 sprite.offset_m,
                 sprite.width_m,
                 sprite.height_m,
                 sprite.rotation_deg,
                 flat,
-            )
+            );
+            if sprite.base {
+                core.widen_to_base();
+            }
+            core
         })
+    }
+
+    /// A base sprite's core: dense across its whole width.
+    pub fn widen_to_base(&mut self) {
+        let k = BASE_HALF_EXTENT / CORE_HALF_EXTENT;
+        self.semi_axes_m.x *= k;
+        self.semi_axes_m.y *= k;
+    }
+
+    /// A base sprite's core standing on its cloud's floor (`floor_m` from the cloud's centre):
+    /// it also holds the column under its middle section down to the floor.
+    pub fn stand_on(&mut self, floor_m: f64) {
+        if floor_m < self.centre_m.z {
+            self.floor_m = Some(floor_m);
+        }
     }
 
     /// The core of a sprite `width_m` x `height_m` at `offset_m` from its cloud's centre,
@@ -62,6 +91,7 @@ impl SpriteCore {
             centre_m: DVec3::from_array(offset_m.map(f64::from)),
             along: DVec2::from_angle(f64::from(rotation_deg).to_radians()),
             semi_axes_m: DVec3::new(w, across, up) * CORE_HALF_EXTENT,
+            floor_m: None,
         }
     }
 
@@ -79,12 +109,63 @@ impl SpriteCore {
         DVec3::new(flat.dot(self.along), self.along.perp_dot(flat), d.z) / self.semi_axes_m
     }
 
-    /// The core's normalised radius at `p` (below 1 inside).
+    /// The core's normalised radius at `p` (below 1 inside): in its column, the horizontal one.
     pub fn radius(&self, p: DVec3) -> f64 {
-        self.unit(p).length()
+        let u = self.unit(p);
+        match self.floor_m {
+            Some(floor) if p.z >= floor && p.z <= self.centre_m.z => u.truncate().length(),
+            _ => u.length(),
+        }
     }
 
-    /// Where the segment `a + t (b - a)`, t in 0..=1, is inside the core: (t in, t out).
+    /// Where the segment `a + t (b - a)`, t in 0..=1, is inside the core (its column included),
+    /// pushed onto `out` as (t in, t out): none, one or two stretches.
+    pub fn segment_into(&self, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
+        if let Some(span) = self.segment(a, b) {
+            out.push(span);
+        }
+        if let Some(span) = self.column_segment(a, b) {
+            out.push(span);
+        }
+    }
+
+    /// Where the segment is inside the column under a base sprite's core.
+    fn column_segment(&self, a: DVec3, b: DVec3) -> Option<(f64, f64)> {
+        let floor = self.floor_m?;
+        let (o, e) = (self.unit(a).truncate(), self.unit(b).truncate());
+        // Between the floor and the core's middle.
+        let dz = b.z - a.z;
+        let (mut t0, mut t1) = if dz.abs() < 1e-12 {
+            if a.z < floor || a.z > self.centre_m.z {
+                return None;
+            }
+            (0.0, 1.0)
+        } else {
+            let (u, v) = ((floor - a.z) / dz, (self.centre_m.z - a.z) / dz);
+            (u.min(v).max(0.0), u.max(v).min(1.0))
+        };
+        // Inside the unit circle horizontally.
+        let d = e - o;
+        let dd = d.length_squared();
+        if dd < 1e-18 {
+            if o.length_squared() >= 1.0 {
+                return None;
+            }
+        } else {
+            let half_b = o.dot(d);
+            let disc = half_b * half_b - dd * (o.length_squared() - 1.0);
+            if disc <= 0.0 {
+                return None;
+            }
+            let root = disc.sqrt();
+            t0 = t0.max((-half_b - root) / dd);
+            t1 = t1.min((-half_b + root) / dd);
+        }
+        (t0 < t1).then_some((t0, t1))
+    }
+
+    /// Where the segment `a + t (b - a)`, t in 0..=1, is inside the core's ellipsoid: (t in,
+    /// t out).
     pub fn segment(&self, a: DVec3, b: DVec3) -> Option<(f64, f64)> {
         let (o, e) = (self.unit(a), self.unit(b));
         let d = e - o;
@@ -106,24 +187,47 @@ impl SpriteCore {
     }
 }
 
-/// The cores of `cloud`'s sprites.
+/// The cores of `cloud`'s sprites (its base sprites' standing on its floor).
 pub fn cores(cloud: &Cloud) -> impl Iterator<Item = SpriteCore> + '_ {
-    cloud
-        .sprites
-        .iter()
-        .filter_map(|s| SpriteCore::of(s, cloud.flat))
+    cloud.sprites.iter().filter_map(|s| {
+        let mut core = SpriteCore::of(s, cloud.flat)?;
+        if s.base {
+            core.stand_on(f64::from(cloud.floor_m));
+        }
+        Some(core)
+    })
+}
+
+/// An overcast's closed floor ([`Cloud::floor_slab_m`]) as a box from the cloud's centre
+/// (lowest corner, highest corner), over a floor at `floor_m`; `None` for none.
+pub fn floor_slab(floor_m: f64, slab_m: [f32; 2]) -> Option<(DVec3, DVec3)> {
+    let [half, depth] = slab_m.map(f64::from);
+    (half > 0.0 && depth > 0.0).then(|| {
+        (
+            DVec3::new(-half, -half, floor_m),
+            DVec3::new(half, half, floor_m + depth),
+        )
+    })
 }
 
 /// How far inside `cloud` the point `p` (from the cloud's centre) is: 0 outside every core and
 /// below the base, rising to 1 over `ramp` of a core's radius in (the deepest core's).
 pub fn inside(cloud: &Cloud, p: DVec3, ramp: f32) -> f32 {
-    inside_cores(cores(cloud), f64::from(cloud.floor_m), p, ramp)
+    inside_cores(
+        cores(cloud),
+        f64::from(cloud.floor_m),
+        cloud.floor_slab_m,
+        p,
+        ramp,
+    )
 }
 
-/// [`inside`] for any cores (the renderer's own clouds' among them) over a base at `floor_m`.
+/// [`inside`] for any cores (the renderer's own clouds' among them) over a base at `floor_m`,
+/// with an overcast's floor slab `slab_m` ([`Cloud::floor_slab_m`]).
 pub fn inside_cores(
     cores: impl Iterator<Item = SpriteCore>,
     floor_m: f64,
+    slab_m: [f32; 2],
     p: DVec3,
     ramp: f32,
 ) -> f32 {
@@ -132,13 +236,20 @@ pub fn inside_cores(
     }
     let ramp = f64::from(ramp).max(1e-3);
     let mut deepest = 0.0f64;
+    if let Some((lo, hi)) = floor_slab(floor_m, slab_m) {
+        let (mid, half) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+        let r = ((p - mid).abs() / half).max_element();
+        if r < 1.0 {
+            deepest = (1.0 - r) / ramp;
+        }
+    }
     for core in cores {
+        if deepest >= 1.0 {
+            return 1.0;
+        }
         let r = core.radius(p);
         if r < 1.0 {
             deepest = deepest.max((1.0 - r) / ramp);
-            if deepest >= 1.0 {
-                return 1.0;
-            }
         }
     }
     deepest.min(1.0) as f32
@@ -150,21 +261,23 @@ pub fn inside_cores(
 pub fn distance_m(cloud: &Cloud, p: DVec3) -> f64 {
     let floor = f64::from(cloud.floor_m);
     let below = (floor - p.z).max(0.0);
-    let mut nearest = f64::INFINITY;
+    let mut nearest = floor_slab(floor, cloud.floor_slab_m).map_or(f64::INFINITY, |(lo, hi)| {
+        super::boxes::bounds_distance_m(lo, hi, p)
+    });
     for core in cores(cloud) {
-        let r = core.radius(p);
-        let d = ((r - 1.0).max(0.0) * core.semi_axes_m.min_element()).max(below);
-        nearest = nearest.min(d);
         if nearest <= 0.0 {
             return 0.0;
         }
+        let r = core.radius(p);
+        let d = ((r - 1.0).max(0.0) * core.semi_axes_m.min_element()).max(below);
+        nearest = nearest.min(d);
     }
     nearest
 }
 
 /// The stretches of the segment `a + t (b - a)` (from the cloud's centre), t in 0..=1, that are
-/// inside `cloud`: the union of its cores above its base, sorted and merged, into `out`
-/// (cleared first).
+/// inside `cloud`: the union of its cores (and floor slab) above its base, sorted and merged,
+/// into `out` (cleared first).
 pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
     out.clear();
     let floor = f64::from(cloud.floor_m);
@@ -188,14 +301,26 @@ pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
     if above_from >= above_to {
         return;
     }
-    for core in cores(cloud) {
-        if let Some((t0, t1)) = core.segment(a, b) {
-            let (t0, t1) = (t0.max(above_from), t1.min(above_to));
-            if t0 < t1 {
-                out.push((t0, t1));
-            }
-        }
+    let mut spans = Vec::with_capacity(2);
+    if let Some((lo, hi)) = floor_slab(floor, cloud.floor_slab_m)
+        && let Some(span) = super::boxes::slab(a, b, lo, hi)
+    {
+        spans.push(span);
     }
+    for core in cores(cloud) {
+        core.segment_into(a, b, &mut spans);
+        out.extend(
+            spans
+                .drain(..)
+                .map(|(t0, t1)| (t0.max(above_from), t1.min(above_to))),
+        );
+    }
+    out.extend(
+        spans
+            .drain(..)
+            .map(|(t0, t1)| (t0.max(above_from), t1.min(above_to))),
+    );
+    out.retain(|(t0, t1)| t0 < t1);
     merge(out);
 }
 

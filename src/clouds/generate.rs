@@ -322,25 +322,16 @@ fn streak_footprint_m2(cloud: &Cloud) -> f64 {
         .sum()
 }
 
-/// Coverage-grid cells (of the block, 100 m) under a cloud: those whose centre lies within
-/// 0.7 half-widths of a sprite centre horizontally (the sprite's dense core); for a flat sprite,
-/// within 0.7 of its half extents (an ellipse turned with it).
+/// Coverage-grid cells (of the block, 100 m) under a cloud: those whose centre lies under a
+/// sprite's dense core ([`super::core`], what every probe asks), e.g. within 0.7 half-widths of
+/// a sprite centre horizontally; for a flat sprite, within 0.7 of its half extents (an ellipse
+/// turned with it); for one on a heap's base, within its half-width.
 fn cloud_cells(cloud: &Cloud, corner: DVec2) -> Vec<usize> {
     let cell = BLOCK_SIZE_M / GRID as f64;
     let mut cells = Vec::new();
-    for s in &cloud.sprites {
-        let p = DVec2::new(
-            cloud.centre_m.x + s.offset_m[0] as f64,
-            cloud.centre_m.y + s.offset_m[1] as f64,
-        ) - corner;
-        let a = CORE_HALF_EXTENT * s.width_m as f64;
-        let b = if cloud.flat {
-            CORE_HALF_EXTENT * s.height_m as f64
-        } else {
-            a
-        };
-        let along = DVec2::from_angle((s.rotation_deg as f64).to_radians());
-        let r = a.max(b);
+    for core in super::core::cores(cloud) {
+        let p = (cloud.centre_m + core.centre_m).truncate() - corner;
+        let r = core.box_half_m().x;
         let lo_x = ((p.x - r) / cell).floor().max(0.0) as usize;
         let hi_x = ((p.x + r) / cell).ceil().clamp(0.0, GRID as f64) as usize;
         let lo_y = ((p.y - r) / cell).floor().max(0.0) as usize;
@@ -348,8 +339,8 @@ fn cloud_cells(cloud: &Cloud, corner: DVec2) -> Vec<usize> {
         for y in lo_y..hi_y {
             for x in lo_x..hi_x {
                 let q = DVec2::new((x as f64 + 0.5) * cell, (y as f64 + 0.5) * cell) - p;
-                let (u, v) = (q.dot(along) / a, q.perp_dot(along) / b);
-                if u * u + v * v <= 1.0 {
+                // The core's horizontal section through its centre.
+                if core.radius(core.centre_m + q.extend(0.0)) <= 1.0 {
                     cells.push(y * GRID + x);
                 }
             }
@@ -413,7 +404,7 @@ fn lattice_layer(index: BlockIndex, ctx: &LayerCtx, seed: u64, out: &mut Vec<Clo
         // A round cell (below) by up to a fifth: its clearings then lie off the axes too.
         let on_lattice = DVec2::new((ci as f64 + 0.5) * s, (cj as f64 + 0.5) * s);
         let round = config.continuous && ctx.cover.oktas_at(on_lattice - lo) < OVERCAST_OKTAS;
-        let reach = if round { 0.2 } else { 0.05 };
+        let reach = if round { 0.2 } else { LATTICE_JITTER };
         let jitter = DVec2::new(rng.range_f64(-1.0, 1.0), rng.range_f64(-1.0, 1.0)) * reach * s;
         let centre = on_lattice + jitter;
         let [dmin, dmax] = config.cloud_size_m.map(f64::from);
@@ -431,6 +422,9 @@ fn lattice_layer(index: BlockIndex, ctx: &LayerCtx, seed: u64, out: &mut Vec<Clo
     }
     (keep as f64 / cells.len().max(1) as f64, boxes)
 }
+
+/// How far a square lattice cell's cloud is off its lattice point, at most, in cells.
+const LATTICE_JITTER: f64 = 0.05;
 
 /// The share of its cells a lattice layer keeps to cover `cover` of the sky, when keeping a
 /// share `p` covers `p + overhang p (1 - p)` ([`CloudTypeConfig::lattice_overhang`]): the root
@@ -526,7 +520,11 @@ fn build_cloud(
     let mut group = 0u32;
     // Continuous decks lay their boxes side by side over their lattice cell; layered clouds
     // (flat cirrus, a continuous type off the lattice) spread theirs around the centre.
-    for _ in 0..n_boxes {
+    for box_index in 0..n_boxes {
+        // A deck's first box is its floor: its sprites stand on the base (their dense cores
+        // reach it, foggy undersides where the type has them), so a deck is met from below at
+        // its base and an overcast's underside is closed, the relief of the boxes above it.
+        let floor = lattice_cell_m.is_some() && box_index == 0;
         let (half_w, offset) = if let Some(cell) = lattice_cell_m {
             // A lattice cell: every box spans the cell and no more, so that cells do not overlap
             // in strips of double density on a grid (the sprites overhang it).
@@ -588,9 +586,15 @@ fn build_cloud(
             } else {
                 (half_w - width * 0.25).max(half_w * 0.3)
             };
-            // Sprites stay inside the layer.
+            // Sprites stay inside the layer; the floor's cores reach down to its base.
             let half_h = height / 2.0;
-            let z = if config.flat {
+            let z = if floor {
+                if config.flat {
+                    0.0
+                } else {
+                    (CORE_HALF_EXTENT * height).min(thickness / 2.0)
+                }
+            } else if config.flat {
                 rng.range_f64(0.0, thickness)
             } else {
                 rng.range_f64(
@@ -605,7 +609,7 @@ fn build_cloud(
                 height,
                 group: group - 1,
                 rotation_deg: streak.map(|_| ctx.wind_axis_deg),
-                base: None,
+                base: floor.then_some(TextureCategory::Foggy),
                 category: None,
             });
         }
@@ -631,16 +635,31 @@ fn build_cloud(
     if lattice_cell_m.is_some() {
         cloud.sunlit_depth_m = config.sunlit_depth_m.unwrap_or(0.0);
     }
+    // An overcast's underside is closed, as its sprites draw it (each point of it under
+    // several of their quads): its floor a slab over the whole cell and past its sides by the
+    // cells' jitter, as deep as the floor sprites' cores reach up, so that no sight line
+    // passes between their round cores and a pilot breaking out sees the ground only below it.
+    if let Some(cell) = lattice_cell_m
+        && !round
+        && oktas >= OVERCAST_OKTAS
+    {
+        let sprite_height = 0.25 * (wmin + wmax) * (rmin + rmax);
+        cloud.floor_slab_m = [
+            (cell * (0.5 + LATTICE_JITTER)) as f32,
+            (CORE_HALF_EXTENT * sprite_height).min(thickness / 2.0) as f32,
+        ];
+    }
     (cloud, n_boxes)
 }
 
 /// Wang 2003 §3.1: traverse the list, drop a sprite closer than the cull radius to a kept one.
+/// The sprites standing on the base are all kept: they close the base seen from below.
 pub(super) fn cull(raws: Vec<Raw>, fraction: f64) -> Vec<Raw> {
     let mut kept: Vec<Raw> = Vec::with_capacity(raws.len());
     for r in raws {
         let radius = fraction * r.height;
         let r2 = radius * radius;
-        if kept.iter().all(|k| k.pos.distance_squared(r.pos) >= r2) {
+        if r.base.is_some() || kept.iter().all(|k| k.pos.distance_squared(r.pos) >= r2) {
             kept.push(r);
         }
     }
@@ -722,6 +741,7 @@ pub(super) fn finish_cloud(
             alpha_morph: 1.0,
             upright,
             precipitation: false,
+            base: r.base.is_some(),
         });
     }
     let shading_groups = sums
@@ -743,6 +763,7 @@ pub(super) fn finish_cloud(
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
         floor_m: (-thickness / 2.0) as f32,
+        floor_slab_m: [0.0; 2],
         colour_levels,
         shading_groups,
         sprites,
@@ -787,9 +808,9 @@ mod golden {
         assert_eq!(
             hashes,
             [
-                "6ea2ffa12cd8ec62",
-                "6151e0ce533d2c21",
-                "601c50867b47c891",
+                "801de14c641e0c75",
+                "8f1a8339f6abbc20",
+                "5393761c2f982975",
                 "f6cfc024a1869c4d"
             ]
         );

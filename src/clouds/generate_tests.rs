@@ -29,9 +29,9 @@ fn types() -> &'static CloudTypes {
     TYPES.get_or_init(CloudTypes::builtin)
 }
 
-/// The cells of a 50 m grid over the block (row by row, [`COVER_CELLS`] a side) within 0.7
-/// sprite half-widths (horizontally) of a sprite centre: what a person looking up would see
-/// covered, from the sprites.
+/// The cells of a 50 m grid over the block (row by row, [`COVER_CELLS`] a side) under a
+/// sprite's dense core (`clouds::core`, what every probe asks): what a person looking up would
+/// see covered, from the sprites.
 fn covered_cells(blocks: &[&CloudBlock], index: BlockIndex) -> Vec<bool> {
     let step = BLOCK_SIZE_M / COVER_CELLS as f64;
     let n = COVER_CELLS;
@@ -39,12 +39,9 @@ fn covered_cells(blocks: &[&CloudBlock], index: BlockIndex) -> Vec<bool> {
     let mut grid = vec![false; n * n];
     for block in blocks {
         for c in &block.clouds {
-            for s in &c.sprites {
-                let p = DVec2::new(
-                    c.centre_m.x + s.offset_m[0] as f64,
-                    c.centre_m.y + s.offset_m[1] as f64,
-                ) - corner;
-                let r = 0.7 * s.width_m as f64 / 2.0;
+            for core in crate::clouds::core::cores(c) {
+                let p = (c.centre_m + core.centre_m).truncate() - corner;
+                let r = core.box_half_m().x;
                 let (x0, x1) = (
                     ((p.x - r) / step).floor().max(0.0) as usize,
                     (((p.x + r) / step).ceil().max(0.0) as usize).min(n),
@@ -56,7 +53,8 @@ fn covered_cells(blocks: &[&CloudBlock], index: BlockIndex) -> Vec<bool> {
                 for y in y0..y1 {
                     for x in x0..x1 {
                         let q = DVec2::new((x as f64 + 0.5) * step, (y as f64 + 0.5) * step);
-                        if q.distance_squared(p) <= r * r {
+                        // The core's horizontal section through its centre.
+                        if core.radius(core.centre_m + (q - p).extend(0.0)) <= 1.0 {
                             grid[y * n + x] = true;
                         }
                     }
@@ -266,9 +264,10 @@ fn sprites_follow_the_paper_and_the_config() {
                 }
             }
             // The cull pass: no two sprites closer than the cull radius of the later one (of
-            // the smaller one: a deck's sprites are shuffled after the cull).
+            // the smaller one: a deck's sprites are shuffled after the cull); those standing on
+            // the base are all kept.
             for (k, s) in c.sprites.iter().enumerate() {
-                for o in &c.sprites[..k] {
+                for o in c.sprites[..k].iter().filter(|o| !(s.base || o.base)) {
                     let d2: f32 = (0..3)
                         .map(|a| (s.offset_m[a] - o.offset_m[a]).powi(2))
                         .sum();

@@ -97,6 +97,7 @@ pub fn add_shafts(
                 alpha_morph: (alpha * fade).clamp(0.0, 1.0),
                 upright: true,
                 precipitation: true,
+                base: false,
             });
             let reach_m = Vec3::new(x, y, z).length() + 0.6 * width.max(height);
             cloud.radius_m = cloud.radius_m.max(reach_m);

@@ -217,6 +217,7 @@ pub fn part_in_block(whole: &Cloud, block: BlockIndex, layer: u8) -> Option<Clou
         sunlit_depth_m: whole.sunlit_depth_m,
         shaded_base_m: whole.shaded_base_m,
         floor_m: whole.floor_m,
+        floor_slab_m: whole.floor_slab_m,
         colour_levels: whole.colour_levels,
         shading_groups: whole
             .shading_groups

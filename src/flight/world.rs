@@ -91,6 +91,7 @@ impl From<&Cloud> for SkyCloud {
                     radius_fraction: s.radius_fraction,
                     upright: s.upright,
                     precipitation: s.precipitation,
+                    base: s.base,
                 })
                 .collect(),
             group_centres_m: c
@@ -106,6 +107,7 @@ impl From<&Cloud> for SkyCloud {
             sunlit_depth_m: c.sunlit_depth_m,
             shaded_base_m: c.shaded_base_m,
             floor_m: c.floor_m,
+            floor_slab_m: c.floor_slab_m,
         }
     }
 }

@@ -176,6 +176,7 @@ fn in_cloud_factor(state: &CloudState, cloud: &SkyCloud, camera_rel_m: Vec3, ram
     crate::clouds::core::inside_cores(
         cloud.cores(),
         f64::from(cloud.floor_m),
+        cloud.floor_slab_m,
         camera_rel_m.as_dvec3(),
         ramp,
     )

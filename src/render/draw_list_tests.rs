@@ -94,6 +94,7 @@ pub(in crate::render) fn small_cloud() -> SkyCloud {
                 radius_fraction: k as f32 / 40.0,
                 upright: false,
                 precipitation: false,
+                base: false,
             }
         })
         .collect();
@@ -106,6 +107,7 @@ pub(in crate::render) fn small_cloud() -> SkyCloud {
         sunlit_depth_m: 0.0,
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
+        floor_slab_m: [0.0; 2],
     }
 }
 

@@ -40,6 +40,9 @@ pub struct SkySprite {
     pub upright: bool,
     /// Falling rain or snow (a shaft under the cloud), not cloud: drawn darker and greyer.
     pub precipitation: bool,
+    /// Stands on the cloud's base: its dense core spans its width (`clouds::core`), for the
+    /// camera's in-cloud measure.
+    pub base: bool,
 }
 
 /// One cloud: sprites around a centre, with its Wang 5 shading inputs.
@@ -70,6 +73,9 @@ pub struct SkyCloud {
     /// only above it, inside a sprite's dense core (`clouds::core`, as every probe of the
     /// air data). `f32::MIN`: no base.
     pub floor_m: f32,
+    /// An overcast deck's closed underside (`clouds::Cloud::floor_slab_m`): a slab on its
+    /// floor, half as wide as the first value and as deep as the second; zeros for none.
+    pub floor_slab_m: [f32; 2],
 }
 
 /// A 4 km x 4 km block of clouds.
@@ -88,13 +94,18 @@ impl SkyCloud {
     /// The dense cores of its sprites (rain and snow are not cloud), as every probe sees them.
     pub fn cores(&self) -> impl Iterator<Item = SpriteCore> + '_ {
         self.sprites.iter().filter(|s| !s.precipitation).map(|s| {
-            SpriteCore::new(
+            let mut core = SpriteCore::new(
                 s.offset_m.to_array(),
                 s.width_m,
                 s.height_m,
                 s.rotation_deg,
                 self.flat,
-            )
+            );
+            if s.base {
+                core.widen_to_base();
+                core.stand_on(f64::from(self.floor_m));
+            }
+            core
         })
     }
 
@@ -112,6 +123,12 @@ impl SkyCloud {
         }
         if !any {
             return (Vec3::ZERO, Vec3::ZERO);
+        }
+        if let Some((slab_lo, slab_hi)) =
+            crate::clouds::core::floor_slab(f64::from(self.floor_m), self.floor_slab_m)
+        {
+            lo = lo.min(slab_lo.as_vec3());
+            hi = hi.max(slab_hi.as_vec3());
         }
         lo.z = lo.z.max(self.floor_m).min(hi.z);
         ((hi - lo) * 0.5, (hi + lo) * 0.5)
@@ -169,6 +186,7 @@ pub fn square_sprite(offset_m: Vec3, size_m: f32, cell: u8, group: u16) -> SkySp
         radius_fraction: 0.0,
         upright: false,
         precipitation: false,
+        base: false,
     }
 }
 
