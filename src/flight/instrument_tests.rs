@@ -416,3 +416,81 @@ fn breaking_out_of_a_low_overcast_the_ground_shows_at_the_reported_base() {
     }
     assert_eq!(checked, 125);
 }
+
+/// The share of block (0, 0) where a vertical line from `from_m` to `to_m` meets cloud.
+fn covered_between(world: &World, from_m: f64, to_m: f64) -> f64 {
+    let hits = cell_centres()
+        .filter(|p| {
+            world
+                .first_cloud(p.extend(from_m), p.extend(to_m))
+                .is_some()
+        })
+        .count();
+    hits as f64 / (CELLS * CELLS) as f64
+}
+
+/// A reported upper layer a pilot sees: on real reports of two broken layers (`BKN029 BKN033`
+/// at KPKD, `BKN025 BKN046` at PAHX, `BKN022 BKN027` at LSZG, `BKN015 BKN020` at SBSJ; the
+/// shipped file has no `BKN033 BKN041`), the upper layer has at least 2 oktas of its own, its
+/// clouds cover at least a quarter of the station's block seen from between the layers, and the
+/// sky seen from the ground stays broken (5 to 7 oktas). (Where the neighbours do not report the
+/// upper layer its cover falls across the block: London's `BKN046` is 2 oktas at the station and
+/// 0.5 at the block's far side, 0.15 of the block.)
+#[test]
+fn between_two_broken_layers_the_upper_one_covers_two_oktas() {
+    let input = WeatherInput::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(REAL), None)
+        .expect("the bulk file");
+    let WeatherInput::Reports(file) = &input else {
+        panic!("a report file");
+    };
+    for station in ["KPKD", "PAHX", "LSZG", "SBSJ"] {
+        let report = file
+            .reports
+            .iter()
+            .find(|r| r.report.station == station)
+            .expect("the station's report");
+        let (lat, lon) = (report.position.latitude_deg, report.position.longitude_deg);
+        let field = input.field(
+            LocalFrame::new(lat, lon),
+            &FieldSettings::default(),
+            &CloudTypeRule::default(),
+        );
+        let weather = field.block_weather(BlockIndex::new(0, 0));
+        let [lower, upper] = [weather.layers[0], weather.layers[1]];
+        assert!(upper.coverage_oktas >= 2.0, "{station}: {upper:?}");
+        let seen =
+            crate::weather::block::cover_seen_from_below_oktas(&weather.layers, upper.base_ft_agl);
+        assert!(
+            (5.0..8.0).contains(&seen),
+            "{station}: {seen} oktas seen from below"
+        );
+        let ground_m = f64::from(weather.ground_elevation_m);
+        let mut world = World::new(
+            field,
+            &WorldSettings {
+                cloud_radius_m: 5_000.0,
+                ..WorldSettings::default()
+            },
+        );
+        world
+            .settle_clouds_around(DVec3::new(2_000.0, 2_000.0, ground_m))
+            .expect("clouds");
+        let g = world
+            .living_field()
+            .and_then(|f| f.generations(BlockIndex::new(0, 0)).first())
+            .expect("the station's block");
+        let (low, high) = (g.block.layers[0], g.block.layers[1]);
+        let between = 0.5 * (f64::from(low.top_m) + f64::from(high.base_m));
+        let top = f64::from(high.top_m) + 30.0;
+        let upper_seen = covered_between(&world, between, top);
+        let from_ground = covered_between(&world, ground_m + 1.0, top);
+        eprintln!(
+            "{station}: {lower:?} / {upper:?}: the upper layer covers {upper_seen:.3} seen from between, both {from_ground:.3} from the ground"
+        );
+        assert!(upper_seen >= 0.25 - 0.03, "{station}: {upper_seen}");
+        assert!(
+            (5.0 / 8.0 - 0.05..=7.0 / 8.0 + 0.05).contains(&from_ground),
+            "{station}: {from_ground} seen from the ground"
+        );
+    }
+}

@@ -13,7 +13,10 @@
 //!    ICAO Annex 3 reports CB and TCU with their own amount, outside the summation principle.
 //! 4. Own coverage: what the layer must add to the sky seen from below, clouds of different layers
 //!    overlapping at random ([`own_coverage_oktas`]); at least `min_added_oktas` x presence for a
-//!    layer that adds no cover (`BKN010 BKN020`); above an overcast its stations' own covers.
+//!    layer that adds little or none (`BKN033 BKN041`: 2 oktas a pilot between them sees), as
+//!    far as the sky seen from below stays in the class reported at its base (BKN: at most 7
+//!    oktas; `SCT030 SCT050` leaves the upper layer `min_coverage_oktas`); above an overcast its
+//!    stations' own covers.
 //!    A CB/TCU layer keeps its stations' own amounts, weighted (`FEW025CB` over a broken deck is
 //!    2 oktas of Cb at the station), and needs `convective.weight_min` of presence.
 //! 5. Type: CB/TCU as reported; else a type a remark or theme names (with `weight_min` of the
@@ -30,6 +33,17 @@ use crate::weather::cloud_type::CloudType;
 use super::rule::{Band, CloudTypeRule, LayerFacts};
 use super::sample::{LayerKind, StationLayer, StationSample};
 use super::settings::FieldSettings;
+
+/// The most cover, oktas, of the METAR class that `oktas` seen from below falls in: FEW up to
+/// 2, SCT up to 4, BKN up to 7 (an overcast is 8).
+fn class_top_oktas(oktas: f64) -> f64 {
+    match oktas {
+        x if x <= 2.0 => 2.0,
+        x if x <= 4.0 => 4.0,
+        x if x < 8.0 => 7.0,
+        _ => 8.0,
+    }
+}
 
 /// The surface facts the layers' types and extents depend on.
 #[derive(Debug, Clone, Copy)]
@@ -110,9 +124,15 @@ pub(super) fn blend(
                 .map(|x| x.1 * x.2.cover_below_oktas)
                 .sum::<f64>()
         } else {
+            // A layer the summation principle leaves little of its own (`BKN033 BKN041`) keeps
+            // what a pilot between the layers sees of it, as far as the sky seen from below
+            // stays in the class reported there.
+            let in_class = own_coverage_oktas(below, class_top_oktas(reported.max(below)))
+                .unwrap_or(0.0)
+                .max(l.min_coverage_oktas);
             own_coverage_oktas(below, reported.max(below))
                 .unwrap_or(0.0)
-                .max(l.min_added_oktas * presence)
+                .max((l.min_added_oktas * presence).min(in_class))
         }
         .min(8.0);
         if own < l.min_coverage_oktas || own <= 0.0 {
