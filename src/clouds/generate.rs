@@ -106,10 +106,17 @@ fn generate_layers(
         layers: Vec::with_capacity(weather.layers.len()),
         clouds: Vec::new(),
     };
-    let layers = BlockCover::layers_over_block(weather.cover.as_ref(), &weather.layers);
-    for (li, (layer, cover)) in layers.iter().enumerate() {
+    let layers = BlockCover::layers_over_block_grouped(weather.cover.as_ref(), &weather.layers);
+    for (li, (layer, cover, group)) in layers.iter().enumerate() {
         let config = types.get(layer.cloud_type);
         let frame = LayerFrame::new(layer, config, weather.ground_elevation_m as f64);
+        // The layers one layer of cloud was cut into by type, this one among them.
+        let siblings: Vec<LayerCover> = layers
+            .iter()
+            .filter(|l| l.2 == *group)
+            .map(|l| l.1)
+            .collect();
+        let sibling = layers[..li].iter().filter(|l| l.2 == *group).count();
         let ctx = LayerCtx {
             config,
             layer,
@@ -118,13 +125,21 @@ fn generate_layers(
             // The only wind reported is the surface wind; high cloud streaks along it too.
             wind_axis_deg: 90.0 - weather.wind.from_deg as f64,
             cover: *cover,
+            share: Share {
+                siblings: &siblings,
+                index: sibling,
+                group: *group as u64,
+            },
         };
+        let overcast_somewhere =
+            siblings.iter().map(LayerCover::max_oktas).sum::<f32>() >= OVERCAST_OKTAS;
         let first = block.clouds.len();
         // The field's cells are its cumulonimbus: no heaps of the block's own.
         let cells_instead = cells_decided && layer.cloud_type == CloudType::Cumulonimbus;
         let (covered, boxes) = if cover.max_oktas() <= 0.0 || cells_instead {
             (0.0, 0)
-        } else if config.continuous || layer.coverage_oktas >= OVERCAST_OKTAS {
+        } else if config.continuous || layer.coverage_oktas >= OVERCAST_OKTAS || overcast_somewhere
+        {
             lattice_layer(index, &ctx, seed, &mut block.clouds)
         } else {
             scattered_layer(index, &ctx, seed, &mut block.clouds)
@@ -387,10 +402,11 @@ fn lattice_layer(index: BlockIndex, ctx: &LayerCtx, seed: u64, out: &mut Vec<Clo
         choose_by_cover(&mut chosen, |ci, cj| {
             let centre = DVec2::new((ci as f64 + 0.5) * s, (cj as f64 + 0.5) * s);
             let oktas = ctx.cover.oktas_at(centre - lo);
-            // An overcast cell is kept whatever its neighbours.
-            match oktas >= OVERCAST_OKTAS {
-                true => oktas,
-                false => (8.0 * cells_for_cover(oktas as f64 / 8.0, overhang)) as f32,
+            // An overcast cell is kept whatever its neighbours: by this layer where the
+            // overcast's types share it to this one.
+            match ctx.share.overcast_cell(seed, ci, cj, centre - lo) {
+                Some(mine) => 8.0 * f32::from(u8::from(mine)),
+                None => (8.0 * cells_for_cover(oktas as f64 / 8.0, overhang)) as f32,
             }
         })
     };
@@ -403,14 +419,20 @@ fn lattice_layer(index: BlockIndex, ctx: &LayerCtx, seed: u64, out: &mut Vec<Clo
         // a regular grid: on it, straight down, every cell side showed alike (1 km rows).
         // A round cell (below) by up to a fifth: its clearings then lie off the axes too.
         let on_lattice = DVec2::new((ci as f64 + 0.5) * s, (cj as f64 + 0.5) * s);
-        let round = config.continuous && ctx.cover.oktas_at(on_lattice - lo) < OVERCAST_OKTAS;
+        let overcast = ctx.share.overcast_cell(seed, ci, cj, on_lattice - lo) == Some(true);
+        let round =
+            config.continuous && !overcast && ctx.cover.oktas_at(on_lattice - lo) < OVERCAST_OKTAS;
         let reach = if round { 0.2 } else { LATTICE_JITTER };
         let jitter = DVec2::new(rng.range_f64(-1.0, 1.0), rng.range_f64(-1.0, 1.0)) * reach * s;
         let centre = on_lattice + jitter;
         let [dmin, dmax] = config.cloud_size_m.map(f64::from);
         // Wide enough to cover the cell's corners.
         let d = rng.range_f64(dmin, dmax).max(s * 1.5);
-        let oktas = ctx.cover.oktas_at(centre - lo);
+        let oktas = if overcast {
+            8.0
+        } else {
+            ctx.cover.oktas_at(centre - lo)
+        };
         // A cell of a broken continuous layer is a round cloud: its gaps are then round
         // clearings, where square cells left square holes (a grid of them from FL350 over a
         // broken altostratus). (Other types take the lattice at an overcast only, and keep
@@ -455,6 +477,9 @@ pub(super) struct Raw {
     pub(super) base: Option<TextureCategory>,
     /// A set texture category, whatever the band (a storm's fibrous anvil edge).
     pub(super) category: Option<TextureCategory>,
+    /// Stands on a deck's floor, in the texture band of its height: its core reaches down to
+    /// the base as a base sprite's does ([`Sprite::base`]).
+    pub(super) floor: bool,
 }
 
 /// What every cloud of one layer shares.
@@ -467,7 +492,56 @@ pub(super) struct LayerCtx<'a> {
     pub(super) wind_axis_deg: f64,
     /// The layer's own coverage over the block.
     pub(super) cover: LayerCover,
+    /// How it shares an overcast with the other types of its layer of cloud.
+    pub(super) share: Share<'a>,
 }
+
+/// The layers of one layer of cloud cut by type ([`BlockCover::layers_over_block_grouped`]):
+/// where their covers add up to an overcast, each lattice cell goes to one of them, by a draw
+/// that all of them make alike (each type keeping its cells alone left holes where none did and
+/// doubled others: an overcast of two types was broken).
+#[derive(Clone, Copy)]
+pub(super) struct Share<'a> {
+    /// The covers of the layers of the group, in order.
+    pub(super) siblings: &'a [LayerCover],
+    /// Which of them this layer is.
+    pub(super) index: usize,
+    /// The group, keying the draw.
+    pub(super) group: u64,
+}
+
+impl Share<'_> {
+    /// A layer alone.
+    pub(super) fn alone(cover: &LayerCover) -> Share<'_> {
+        Share {
+            siblings: std::slice::from_ref(cover),
+            index: 0,
+            group: 0,
+        }
+    }
+
+    /// Whether the lattice cell (`ci`, `cj`), its point at block metres `p`, lies in the group's
+    /// overcast, and if so whether it is this layer's.
+    fn overcast_cell(&self, seed: u64, ci: i64, cj: i64, p: DVec2) -> Option<bool> {
+        let covers: Vec<f64> = self
+            .siblings
+            .iter()
+            .map(|c| f64::from(c.oktas_at(p)))
+            .collect();
+        let total: f64 = covers.iter().sum();
+        if total < f64::from(OVERCAST_OKTAS) {
+            return None;
+        }
+        let before: f64 = covers[..self.index].iter().sum();
+        let draw = hash_keys(&[seed, OVERCAST_SHARE_KEY, self.group, ci as u64, cj as u64]) as f64
+            / u64::MAX as f64
+            * total;
+        Some(draw >= before && draw < before + covers[self.index])
+    }
+}
+
+/// Keys the draw that shares an overcast's cells out among its types.
+const OVERCAST_SHARE_KEY: u64 = 0x6f76_6364;
 
 /// A lattice cell a cloud fills: its side, and whether it is a round cloud (a cell of a
 /// broken layer) rather than the whole square (an overcast's).
@@ -521,9 +595,9 @@ fn build_cloud(
     // Continuous decks lay their boxes side by side over their lattice cell; layered clouds
     // (flat cirrus, a continuous type off the lattice) spread theirs around the centre.
     for box_index in 0..n_boxes {
-        // A deck's first box is its floor: its sprites stand on the base (their dense cores
-        // reach it, foggy undersides where the type has them), so a deck is met from below at
-        // its base and an overcast's underside is closed, the relief of the boxes above it.
+        // A deck's first box holds its floor: half its sprites stand on the base (their dense
+        // cores reach it, foggy undersides where the type has them), so a deck is met from
+        // below at its base, the relief of the rest above it.
         let floor = lattice_cell_m.is_some() && box_index == 0;
         let (half_w, offset) = if let Some(cell) = lattice_cell_m {
             // A lattice cell: every box spans the cell and no more, so that cells do not overlap
@@ -586,13 +660,17 @@ fn build_cloud(
             } else {
                 (half_w - width * 0.25).max(half_w * 0.3)
             };
-            // Sprites stay inside the layer; the floor's cores reach down to its base.
+            // Sprites stay inside the layer; the floor's stand on its base (their quads' lower
+            // edges on it, their cores' columns down to it: `clouds::core`). Every other square
+            // of the floor box's grid, a checkerboard: a deck's whole first box on one level
+            // was a sheet of sprites that showed as dark blotches to a pilot just under it.
             let half_h = height / 2.0;
-            let z = if floor {
+            let on_floor = floor && grid_side.is_some_and(|m| (s % m + (s / m) % m) % 2 == 0);
+            let z = if on_floor {
                 if config.flat {
                     0.0
                 } else {
-                    (CORE_HALF_EXTENT * height).min(thickness / 2.0)
+                    half_h.min(thickness / 2.0)
                 }
             } else if config.flat {
                 rng.range_f64(0.0, thickness)
@@ -609,7 +687,8 @@ fn build_cloud(
                 height,
                 group: group - 1,
                 rotation_deg: streak.map(|_| ctx.wind_axis_deg),
-                base: floor.then_some(TextureCategory::Foggy),
+                base: None,
+                floor: on_floor,
                 category: None,
             });
         }
@@ -653,7 +732,8 @@ fn build_cloud(
 }
 
 /// Wang 2003 §3.1: traverse the list, drop a sprite closer than the cull radius to a kept one.
-/// The sprites standing on the base are all kept: they close the base seen from below.
+/// A heap's base row is all kept: it closes the base seen from below. (A deck's floor is culled
+/// as the rest: kept whole, it crowded the underside a pilot just below it sees into blotches.)
 pub(super) fn cull(raws: Vec<Raw>, fraction: f64) -> Vec<Raw> {
     let mut kept: Vec<Raw> = Vec::with_capacity(raws.len());
     for r in raws {
@@ -741,7 +821,7 @@ pub(super) fn finish_cloud(
             alpha_morph: 1.0,
             upright,
             precipitation: false,
-            base: r.base.is_some(),
+            base: r.base.is_some() || r.floor,
         });
     }
     let shading_groups = sums
@@ -809,7 +889,7 @@ mod golden {
             hashes,
             [
                 "801de14c641e0c75",
-                "8f1a8339f6abbc20",
+                "7ccbffc21b226faa",
                 "5393761c2f982975",
                 "f6cfc024a1869c4d"
             ]

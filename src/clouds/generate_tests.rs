@@ -635,13 +635,15 @@ fn lattice_cover(t: CloudType, config: &CloudTypeConfig, oktas: f32) -> f64 {
     let w = weather(t, oktas, 3000.0, 1500.0);
     let layer = &w.layers[0];
     let frame = LayerFrame::new(layer, config, w.ground_elevation_m as f64);
+    let cover = LayerCover::uniform(oktas);
     let ctx = LayerCtx {
         config,
         layer,
         li: 0,
         frame: &frame,
         wind_axis_deg: 0.0,
-        cover: LayerCover::uniform(oktas),
+        cover,
+        share: Share::alone(&cover),
     };
     let mut sum = 0.0;
     let (seeds, rows) = (6u64, 2);

@@ -79,6 +79,7 @@ pub(super) fn heap_sprites(
                 } else {
                     TextureCategory::FlatBottom
                 }),
+                floor: false,
                 category: None,
             });
         }
@@ -150,6 +151,7 @@ pub(super) fn heap_sprites(
                 group: group - 1,
                 rotation_deg: None,
                 base: None,
+                floor: false,
                 category: None,
             });
         }
@@ -190,6 +192,7 @@ pub(super) fn heap_sprites(
                 group: group - 1,
                 rotation_deg: None,
                 base: None,
+                floor: false,
                 category: None,
             });
         }

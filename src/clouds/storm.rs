@@ -21,7 +21,7 @@ use glam::{DVec2, DVec3};
 
 use super::block::Cloud;
 use super::config::{CloudTypeConfig, StormCellConfig, TextureCategory};
-use super::generate::{LayerCtx, LayerFrame, Raw, cull, finish_cloud};
+use super::generate::{LayerCtx, LayerFrame, Raw, Share, cull, finish_cloud};
 use super::heap::BASE_CENTRE_FRACTION;
 use super::rain::add_shafts;
 use super::rng::SplitMix64;
@@ -71,13 +71,15 @@ pub fn cell_cloud(cell: &StormCell, config: &CloudTypeConfig, weather: &BlockWea
         base_m,
         thickness_m: height,
     };
+    let cover = LayerCover::uniform(0.0);
     let ctx = LayerCtx {
         config,
         layer: &layer,
         li: 0,
         frame: &frame,
         wind_axis_deg: 0.0,
-        cover: LayerCover::uniform(0.0),
+        cover,
+        share: Share::alone(&cover),
     };
     let mut cloud = finish_cloud(&ctx, cell.centre(), kept, &mut rng);
     // The anvil is a veil of ice, thinner than the tower: its sprites half as opaque (two or
@@ -281,6 +283,7 @@ fn cell_raws(
                 } else {
                     TextureCategory::FlatBottom
                 }),
+                floor: false,
                 category: None,
             });
         }
@@ -395,6 +398,7 @@ fn cell_raws(
                 group: group - 1,
                 rotation_deg: None,
                 base: None,
+                floor: false,
                 category: None,
             });
         }
@@ -444,6 +448,7 @@ fn cell_raws(
                 rotation_deg: None,
                 base: None,
                 // A smooth slab (foggy sprites), not a field of puffs; fibres at the rim.
+                floor: false,
                 category: Some(if edge {
                     TextureCategory::Wispy
                 } else {

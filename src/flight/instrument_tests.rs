@@ -360,7 +360,7 @@ fn breaking_out_of_a_low_overcast_the_ground_shows_at_the_reported_base() {
     };
     let feet = |m: f64| m / crate::weather::METRES_PER_FOOT;
     let mut checked = 0;
-    for station in ["KATL", "KAHN", "KFBG", "KWRB", "UATT"] {
+    for station in ["KAHN", "KFBG", "KWRB", "UATT", "KATL"] {
         let report = file
             .reports
             .iter()

@@ -148,10 +148,25 @@ impl BlockCover {
         cover: Option<&Self>,
         layers: &[BlockLayer],
     ) -> Vec<(BlockLayer, LayerCover)> {
+        Self::layers_over_block_grouped(cover, layers)
+            .into_iter()
+            .map(|(layer, cover, _)| (layer, cover))
+            .collect()
+    }
+
+    /// [`Self::layers_over_block`] with, for each, the layer of the block's (or rim's) it was cut
+    /// from by type (an index in the order they are listed there): the layers of one group are
+    /// one layer of cloud whose types share it out, an overcast among them wherever their covers
+    /// add up to one.
+    pub fn layers_over_block_grouped(
+        cover: Option<&Self>,
+        layers: &[BlockLayer],
+    ) -> Vec<(BlockLayer, LayerCover, usize)> {
         let Some(c) = cover else {
             return layers
                 .iter()
-                .map(|l| (*l, LayerCover::uniform(l.coverage_oktas)))
+                .enumerate()
+                .map(|(i, l)| (*l, LayerCover::uniform(l.coverage_oktas), i))
                 .collect();
         };
         let own = layers.iter().enumerate().map(|(i, l)| {
@@ -167,9 +182,9 @@ impl BlockCover {
         let all: Vec<(BlockLayer, f32, RimLayer, bool)> = own.chain(only).collect();
         let mut out = Vec::with_capacity(all.len());
         let mut others = Vec::new();
-        for &(layer, at_sample, rim, has_rim) in &all {
+        for (group, &(layer, at_sample, rim, has_rim)) in all.iter().enumerate() {
             if !has_rim {
-                out.push((layer, LayerCover::uniform(at_sample)));
+                out.push((layer, LayerCover::uniform(at_sample), group));
                 continue;
             }
             let of_type = |t: CloudType| {
@@ -182,7 +197,7 @@ impl BlockCover {
                     std::array::from_fn(|k| if rim.types[k] == t { rim.oktas[k] } else { 0.0 });
                 LayerCover::new(c.sample_m, at, oktas)
             };
-            out.push((layer, of_type(layer.cloud_type)));
+            out.push((layer, of_type(layer.cloud_type), group));
             let mut seen = vec![layer.cloud_type];
             for (k, &t) in rim.types.iter().enumerate() {
                 if !seen.contains(&t) && rim.oktas[k] > 0.0 {
@@ -192,7 +207,7 @@ impl BlockCover {
                         coverage_oktas: 0.0,
                         ..layer
                     };
-                    others.push((typed, of_type(t)));
+                    others.push((typed, of_type(t), group));
                 }
             }
         }
