@@ -7,6 +7,7 @@ use clap::{Parser, Subcommand};
 
 mod bench;
 mod block;
+mod ceilometer;
 mod defaults;
 mod demo;
 mod fly;
@@ -40,6 +41,9 @@ enum Command {
     Metar(metar::MetarArgs),
     /// What a weather file holds and, with --at, the interpolated weather of the block there.
     Weather(weather::WeatherArgs),
+    /// What a ceilometer at a place reads as the clouds drift over it, and the METAR cloud
+    /// groups its readings sum up to.
+    Ceilometer(ceilometer::CeilometerArgs),
     /// The demo: the weather of the default flight area on the shipped bulk weather file.
     Demo(demo::DemoArgs),
     /// Writes the 16-texture cloud sheet (512 x 512 RGBA PNG, Wang 2003 figure 6).
@@ -90,6 +94,7 @@ pub fn main() -> ExitCode {
         }
         Command::Metar(args) => metar::run(&args),
         Command::Weather(args) => weather::run(&args),
+        Command::Ceilometer(args) => ceilometer::run(&args),
         Command::Demo(args) => demo::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Fly(args) => fly::run(&args),

@@ -293,6 +293,9 @@ pub struct CloudField {
     generator: BlockGenerator,
     time_s: f64,
     drift_m: DVec2,
+    /// The velocity the clouds drift with when the flight stage sets it (the air data's wind at
+    /// their height, [`Self::set_drift_velocity`]); else the surface wind times `wind_factor`.
+    drift_velocity_m_s: Option<DVec2>,
     wind_m_s: DVec2,
     slots: BTreeMap<BlockIndex, Slot>,
     next_serial: u64,
@@ -330,6 +333,7 @@ impl CloudField {
             generator,
             time_s: 0.0,
             drift_m: DVec2::ZERO,
+            drift_velocity_m_s: None,
             wind_m_s: DVec2::ZERO,
             slots: BTreeMap::new(),
             next_serial: 0,
@@ -407,8 +411,13 @@ impl CloudField {
         weather: &dyn Fn(BlockIndex) -> BlockWeather,
         version: Option<u64>,
     ) {
-        let here = weather(BlockIndex::containing(centre_m));
-        self.wind_m_s = here.wind.drift_m_s() * self.config.field.wind_factor;
+        self.wind_m_s = match self.drift_velocity_m_s {
+            Some(v) => v,
+            None => {
+                let here = weather(BlockIndex::containing(centre_m));
+                here.wind.drift_m_s() * self.config.field.wind_factor
+            }
+        };
         let air_centre = centre_m - self.drift_m;
         let radius = self.config.field.radius_m;
         let seed = self.config.field.seed;
@@ -656,6 +665,18 @@ impl CloudField {
     /// cloud's `centre_m` for its ground position now.
     pub fn drift_m(&self) -> DVec2 {
         self.drift_m
+    }
+
+    /// Drifts the clouds with `velocity_m_s` (east, north) from the next update on, where the
+    /// flight stage knows the wind at their height; `None`: the surface wind times
+    /// `[field] wind_factor`, the clouds stage's own guess.
+    pub fn set_drift_velocity(&mut self, velocity_m_s: Option<DVec2>) {
+        self.drift_velocity_m_s = velocity_m_s;
+    }
+
+    /// The velocity the clouds drift with now, metres a second east and north.
+    pub fn drift_velocity_m_s(&self) -> DVec2 {
+        self.wind_m_s
     }
 
     /// Field time, seconds.

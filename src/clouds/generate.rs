@@ -131,15 +131,12 @@ fn generate_layers(
                 group: *group as u64,
             },
         };
-        let overcast_somewhere =
-            siblings.iter().map(LayerCover::max_oktas).sum::<f32>() >= OVERCAST_OKTAS;
         let first = block.clouds.len();
         // The field's cells are its cumulonimbus: no heaps of the block's own.
         let cells_instead = cells_decided && layer.cloud_type == CloudType::Cumulonimbus;
         let (covered, boxes) = if cover.max_oktas() <= 0.0 || cells_instead {
             (0.0, 0)
-        } else if config.continuous || layer.coverage_oktas >= OVERCAST_OKTAS || overcast_somewhere
-        {
+        } else if config.continuous || layer.coverage_oktas >= OVERCAST_OKTAS {
             lattice_layer(index, &ctx, seed, &mut block.clouds)
         } else {
             scattered_layer(index, &ctx, seed, &mut block.clouds)

@@ -161,6 +161,38 @@ impl World {
             .map_or((0, Vec::new()), |f| (f.placed, f.unplaced.clone()))
     }
 
+    /// How the clouds at `point_m` (local metres, up above mean sea level) drift: the air
+    /// data's wind there ([`Self::air_at`]'s, the winds aloft included), as the velocity it
+    /// blows towards, metres a second east and north. The living clouds drift with it at the
+    /// lowest layer's middle over the camera ([`Self::drift_height_m`]).
+    pub fn cloud_drift_at(&self, point_m: DVec3) -> DVec2 {
+        let s = &self.air.settings;
+        let (weather, gust, qnh) =
+            self.weather_here(point_m.truncate(), s.pressure.default_qnh_hpa);
+        let lat_deg = self.field().frame().to_lat_lon_deg(point_m.truncate()).0;
+        let surface = SurfaceAir::of(&weather, gust, qnh);
+        let aloft = self
+            .air
+            .aloft
+            .as_ref()
+            .map(|f| f.column_at(point_m.truncate()));
+        let wind = air_at_aloft(&surface, point_m.z, lat_deg, s, aloft.as_ref()).wind;
+        let to = (wind.from_deg + 180.0).to_radians();
+        DVec2::new(to.sin(), to.cos()) * wind.speed_kt * crate::weather::METRES_PER_KNOT
+    }
+
+    /// The height the living clouds drift at over ground point `point_m`, metres above mean
+    /// sea level: the middle of the lowest cloud layer there (one drift moves the whole field,
+    /// every layer with it); `None` under a clear sky.
+    pub fn drift_height_m(&self, point_m: DVec2) -> Option<f64> {
+        let weather = self.field().weather_at(point_m);
+        let ground = f64::from(weather.ground_elevation_m);
+        weather.layers.first().map(|l| {
+            ground
+                + f64::from(l.base_ft_agl + 0.5 * l.thickness_ft) * crate::weather::METRES_PER_FOOT
+        })
+    }
+
     /// Uses `air` and `fog` settings for the air data.
     pub fn set_air_settings(&mut self, air: AirSettings, fog: FogSettings) {
         self.air.settings = air;

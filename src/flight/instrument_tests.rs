@@ -494,3 +494,202 @@ fn between_two_broken_layers_the_upper_one_covers_two_oktas() {
         );
     }
 }
+
+/// A METAR cover's class, 1 (FEW) to 4 (OVC).
+fn class(cover: crate::weather::metar::Cover) -> i32 {
+    use crate::weather::metar::Cover;
+    match cover {
+        Cover::Few => 1,
+        Cover::Sct => 2,
+        Cover::Bkn => 3,
+        Cover::Ovc | Cover::Vv => 4,
+    }
+}
+
+/// The ceilometer's round trip over `stations` cloudy stations of the real bulk file (reports
+/// with cloud groups and no vertical visibility; an automatic station's layers and ceiling
+/// compared below 12,000 ft or its highest reported layer, where its own ceilometer reads; the
+/// layers reported over an overcast, which no ceilometer sees, left out): the reported layers
+/// it gives back
+/// (base within max(100 ft, 10%), cover class within one) and the ceilings (both none, or within
+/// the same), as shares.
+fn ceilometer_round_trip(stations: usize) -> (f64, f64, usize) {
+    use crate::flight::ceilometer;
+    use crate::weather::metar::Cover;
+    let input = WeatherInput::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(REAL), None)
+        .expect("the bulk file");
+    let WeatherInput::Reports(file) = &input else {
+        panic!("a report file");
+    };
+    let near = |a: f64, b: f64| (a - b).abs() <= (0.1 * b).max(100.0);
+    let (mut layers, mut layers_met, mut ceilings_met, mut done) = (0, 0, 0, 0);
+    let mut seen = std::collections::HashSet::new();
+    for report in file.reports.iter().step_by(3) {
+        if done >= stations {
+            break;
+        }
+        let r = &report.report;
+        let groups: Vec<(Cover, f64)> = r
+            .clouds
+            .iter()
+            .filter_map(|g| Some((g.cover?, f64::from(g.base_ft?))))
+            .collect();
+        if groups.is_empty() || groups.iter().any(|g| g.0 == Cover::Vv) {
+            continue;
+        }
+        let (lat, lon) = (report.position.latitude_deg, report.position.longitude_deg);
+        if !seen.insert(((lat * 10.0) as i64, (lon * 10.0) as i64)) {
+            continue;
+        }
+        let (frame, at) = ceilometer::frame_centred_on(lat, lon);
+        let field = input.field(frame, &FieldSettings::default(), &CloudTypeRule::default());
+        let ground_m = f64::from(
+            field
+                .block_weather(BlockIndex::new(0, 0))
+                .ground_elevation_m,
+        );
+        let mut world = World::new(
+            field,
+            &WorldSettings {
+                cloud_radius_m: 5_000.0,
+                ..WorldSettings::default()
+            },
+        );
+        let readings = ceilometer::read(&mut world, at, ground_m, 20.0, 30.0).expect("the clouds");
+        // An automatic station's ceilometer reads to 12,000 ft (or as high as it reported).
+        let reach_ft = groups
+            .iter()
+            .map(|g| g.1 * 1.1 + 100.0)
+            .fold(12_000.0, f64::max);
+        let below = |ft: f64| !r.auto || ft < reach_ft;
+        let found: Vec<ceilometer::Layer> = ceilometer::summarize(&readings)
+            .into_iter()
+            .filter(|l| below(l.base_ft))
+            .collect();
+        // Nothing above an overcast reaches a ceilometer: the layers reported over one are
+        // the observer's, not an instrument's.
+        let first_ovc = groups
+            .iter()
+            .find(|g| g.0 == Cover::Ovc)
+            .map_or(f64::INFINITY, |g| g.1);
+        for (cover, base) in groups.iter().filter(|g| g.1 <= first_ovc) {
+            layers += 1;
+            layers_met +=
+                usize::from(found.iter().any(|l| {
+                    near(l.base_ft, *base) && (class(l.cover) - class(*cover)).abs() <= 1
+                }));
+        }
+        let reported = groups
+            .iter()
+            .find(|g| matches!(g.0, Cover::Bkn | Cover::Ovc))
+            .map(|g| g.1);
+        let ours = ceilometer::ceiling_ft(&found);
+        if std::env::var_os("SKYCAST_DEBUG_CEILOMETER").is_some() {
+            eprintln!(
+                "{} {:?} -> {:?}",
+                r.station,
+                groups,
+                found
+                    .iter()
+                    .map(|l| format!("{} {:.2}", l.group(), l.seen_share))
+                    .collect::<Vec<_>>()
+            );
+        }
+        ceilings_met += usize::from(match (reported, ours) {
+            (None, None) => true,
+            (Some(a), Some(b)) => near(b, a),
+            _ => false,
+        });
+        done += 1;
+    }
+    (
+        layers_met as f64 / layers.max(1) as f64,
+        ceilings_met as f64 / done.max(1) as f64,
+        done,
+    )
+}
+
+/// The ceilometer's round trip at 40 cloudy stations of the real bulk file: measured 0.86 of
+/// the reported layers and 0.73 of the ceilings (the 200-station figures in the book:
+/// `cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`). Held to 0.8 and
+/// 0.65 against a fall; what is missing is in the book's "What is still not right": 40 readings
+/// along a 12 km line through clouds a kilometre or two wide toss a layer's cover a class either
+/// way (a BKN read 0.55, a SCT 0.8), and a calm wind reads one spot for 20 minutes.
+#[test]
+fn a_ceilometer_under_the_drifting_clouds_reads_the_reports_back() {
+    let (layers, ceilings, stations) = ceilometer_round_trip(40);
+    eprintln!("{stations} stations: layers {layers:.3}, ceilings {ceilings:.3}");
+    assert_eq!(stations, 40);
+    assert!(layers >= 0.8 && ceilings >= 0.65, "{layers} {ceilings}");
+}
+
+/// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations (about a
+/// minute).
+#[test]
+#[ignore]
+fn ceilometer_round_trip_at_200() {
+    let (layers, ceilings, stations) = ceilometer_round_trip(200);
+    eprintln!("{stations} stations: layers {layers:.3}, ceilings {ceilings:.3}");
+    assert_eq!(stations, 200);
+    assert!(layers >= 0.8 && ceilings >= 0.65, "{layers} {ceilings}");
+}
+
+/// The clouds drift with the wind the air data reports at their height: over real reports (and
+/// with NOAA's winds aloft over the US), the field moves in a minute what `air_at`'s wind at the
+/// lowest layer's middle carries it, within 1 kt and 5 degrees.
+#[test]
+fn the_clouds_drift_with_the_air_datas_wind_at_their_height() {
+    use crate::weather::winds_aloft::WindsAloft;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let input = WeatherInput::load(&root.join(REAL), None).expect("the bulk file");
+    let aloft = WindsAloft::load(&root.join("weather/fd1us1-2026-01-31T06Z.txt")).expect("FB");
+    let table = crate::weather::StationTable::builtin();
+    let mut checked = 0;
+    for (station, lat, lon) in [
+        ("KDEN", 39.85, -104.66),
+        ("EGLL", 51.4775, -0.4614),
+        ("KORD", 41.98, -87.90),
+        ("LEVX", 42.239, -8.624),
+        ("KSAT", 29.53, -98.47),
+    ] {
+        for with_aloft in [false, true] {
+            let field = input.field(
+                LocalFrame::new(lat, lon),
+                &FieldSettings::default(),
+                &CloudTypeRule::default(),
+            );
+            let mut world = World::new(field, &WorldSettings::default());
+            if with_aloft {
+                world.set_winds_aloft(Some(&aloft), &table);
+            }
+            let Some(height) = world.drift_height_m(DVec2::ZERO) else {
+                continue;
+            };
+            let camera = DVec3::new(0.0, 0.0, height);
+            world.settle_clouds_around(camera).expect("clouds");
+            let before = world.living_field().expect("clouds").drift_m();
+            world.advance_clouds_around(camera, 60.0).expect("clouds");
+            let moved = (world.living_field().expect("clouds").drift_m() - before) / 60.0;
+            let air = world.air_at(camera, DVec3::Z);
+            let to = (air.wind_from_deg + 180.0).to_radians();
+            let wind =
+                DVec2::new(to.sin(), to.cos()) * air.wind_kt * crate::weather::METRES_PER_KNOT;
+            let knots = |v: DVec2| v.length() / crate::weather::METRES_PER_KNOT;
+            let off_deg = if wind.length() > 0.5 && moved.length() > 0.5 {
+                moved.angle_to(wind).to_degrees().abs()
+            } else {
+                0.0
+            };
+            eprintln!(
+                "{station} (aloft {with_aloft}) at {height:.0} m: drift {:.1} kt, air data {:.1} kt from {:.0}, {off_deg:.1} degrees apart",
+                knots(moved),
+                air.wind_kt,
+                air.wind_from_deg
+            );
+            assert!((knots(moved) - air.wind_kt).abs() <= 1.0, "{station}");
+            assert!(off_deg <= 5.0, "{station}: {off_deg} degrees");
+            checked += 1;
+        }
+    }
+    assert!(checked >= 8, "{checked}");
+}

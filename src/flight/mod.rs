@@ -12,6 +12,7 @@
 
 pub mod air;
 mod block_weathers;
+pub mod ceilometer;
 mod far_cells;
 mod path;
 pub mod radar;

@@ -463,6 +463,7 @@ impl World {
     /// asking about the air ([`Self::air_at`]) where nothing is drawn (the command line, tests).
     pub fn settle_clouds_around(&mut self, point_m: DVec3) -> Result<(), RenderError> {
         self.start_living()?;
+        self.set_field_drift(point_m.truncate());
         let weather_field = &self.field;
         if let Some(living) = self.living.as_mut() {
             living
@@ -470,6 +471,39 @@ impl World {
                 .update(point_m.truncate(), &|i| weather_field.block_weather(i));
             living.field.wait_for_pending();
             living.field.advance(0.0);
+        }
+        Ok(())
+    }
+
+    /// The velocity the living clouds over ground point `point_m` drift with: the air data's
+    /// wind at the lowest layer's middle there ([`Self::cloud_drift_at`]); `None` under a clear
+    /// sky (the clouds stage's own guess then).
+    fn drift_velocity(&self, point_m: DVec2) -> Option<DVec2> {
+        let height = self.drift_height_m(point_m)?;
+        Some(self.cloud_drift_at(point_m.extend(height)))
+    }
+
+    /// Sets the living clouds' drift for ground point `point_m` ([`Self::drift_velocity`]).
+    fn set_field_drift(&mut self, point_m: DVec2) {
+        let velocity = self.drift_velocity(point_m);
+        if let Some(living) = self.living.as_mut() {
+            living.field.set_drift_velocity(velocity);
+        }
+    }
+
+    /// Advances the living clouds by `dt_s` seconds around `point_m` without a sky, waiting for
+    /// the blocks that come (the clouds drift on, form and dissipate as a flight's do): for
+    /// instruments on the ground (`flight::ceilometer`) and tests.
+    pub fn advance_clouds_around(&mut self, point_m: DVec3, dt_s: f64) -> Result<(), RenderError> {
+        self.start_living()?;
+        self.set_field_drift(point_m.truncate());
+        let weather_field = &self.field;
+        if let Some(living) = self.living.as_mut() {
+            living
+                .field
+                .update(point_m.truncate(), &|i| weather_field.block_weather(i));
+            living.field.wait_for_pending();
+            living.field.advance(dt_s);
         }
         Ok(())
     }
@@ -491,18 +525,31 @@ impl World {
         if self.start_living()? {
             sky.set_lifecycle(self.clouds_config.lifecycle);
         }
+        // The blocks around are asked for again only when the camera entered another block of
+        // the moving air, the air drifted past a block, or the weather changed: then the
+        // drift's wind is looked up again too.
+        let key_of = |drift: DVec2| {
+            (
+                BlockIndex::containing(camera_m.truncate() - drift),
+                BlockIndex::containing(drift),
+                self.field_version,
+            )
+        };
+        let asking = self
+            .living
+            .as_ref()
+            .is_some_and(|l| l.asked != Some(key_of(l.field.drift_m())));
+        let drift_velocity = if asking {
+            self.drift_velocity(camera_m.truncate())
+        } else {
+            None
+        };
         let weather_field = &self.field;
         let Some(living) = self.living.as_mut() else {
             return Ok(());
         };
-        // The blocks around are asked for again only when the camera entered another block of
-        // the moving air, the air drifted past a block, or the weather changed.
         let drift = living.field.drift_m();
-        let key = (
-            BlockIndex::containing(camera_m.truncate() - drift),
-            BlockIndex::containing(drift),
-            self.field_version,
-        );
+        let key = key_of(drift);
         let version = self.field_version;
         // Where the block weathers are worked out ahead of the field (`BlockWeathers`).
         let around = (camera_m.truncate() - drift, drift, living.field.radius_m());
@@ -516,6 +563,7 @@ impl World {
                     .fill(weather_field, version, around, |job| field.spawn(job))
             };
         if living.asked != Some(key) && !filling {
+            living.field.set_drift_velocity(drift_velocity);
             let cache = std::cell::RefCell::new(std::mem::take(&mut living.weather));
             // The field's own blocks take their cover at the rim; the storm cells it decides
             // reach well beyond them (a square and an anvil's reach around the radius), and a

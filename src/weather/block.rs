@@ -16,6 +16,9 @@ pub const BLOCK_SIZE_M: f64 = 4_000.0;
 /// Metres in a foot: METAR heights (bases, thicknesses) and flight altitudes are in feet.
 pub const METRES_PER_FOOT: f64 = 0.3048;
 
+/// Metres a second in a knot.
+pub const METRES_PER_KNOT: f64 = 0.514_444;
+
 /// Integer index of a block: `i` counts blocks east, `j` blocks north of the frame origin.
 /// Block (0, 0) spans [0, 4000) m east and [0, 4000) m north.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -148,7 +151,7 @@ impl Wind {
     /// Velocity the air moves with, metres per second east/north (where clouds drift to).
     pub fn drift_m_s(self) -> DVec2 {
         let to_rad = (self.from_deg as f64 + 180.0).to_radians();
-        DVec2::new(to_rad.sin(), to_rad.cos()) * self.speed_kt as f64 * 0.514_444
+        DVec2::new(to_rad.sin(), to_rad.cos()) * self.speed_kt as f64 * METRES_PER_KNOT
     }
 }
 

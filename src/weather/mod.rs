@@ -25,7 +25,8 @@ pub mod watch;
 pub mod winds_aloft;
 
 pub use block::{
-    BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, METRES_PER_FOOT, TypeSource, Wind,
+    BLOCK_SIZE_M, BlockIndex, BlockLayer, BlockWeather, METRES_PER_FOOT, METRES_PER_KNOT,
+    TypeSource, Wind,
 };
 pub use block_cover::{BlockCover, LayerCover, RimLayer};
 pub use cloud_type::CloudType;

@@ -42,35 +42,28 @@ const MAX_STEP_OKTAS: f64 = 0.3;
 /// is left is the cover the weather asks for there, not where one seed put its clouds.
 const SEEDS: usize = 16;
 
-/// The 100 m world cells (east, north indices) under the dense cores of the clouds' sprites.
+/// The 100 m world cells (east, north indices) under the dense cores of the clouds' sprites
+/// (`skycast::clouds::core`, the geometry every probe asks).
 fn covered_cells<'a>(clouds: impl Iterator<Item = &'a Cloud>) -> HashSet<(i64, i64)> {
     let mut out = HashSet::new();
     for cloud in clouds {
-        for s in &cloud.sprites {
-            let cx = cloud.centre_m.x + s.offset_m[0] as f64;
-            let cy = cloud.centre_m.y + s.offset_m[1] as f64;
-            let a = 0.35 * s.width_m as f64;
-            let b = if cloud.flat {
-                0.35 * s.height_m as f64
-            } else {
-                a
-            };
-            let (sin, cos) = (s.rotation_deg as f64).to_radians().sin_cos();
-            let r = a.max(b);
+        for core in skycast::clouds::core::cores(cloud) {
+            let c = cloud.centre_m + core.centre_m;
+            let r = core.box_half_m().x;
             let (x0, x1) = (
-                ((cx - r) / CELL_M).floor() as i64,
-                ((cx + r) / CELL_M) as i64,
+                ((c.x - r) / CELL_M).floor() as i64,
+                ((c.x + r) / CELL_M) as i64,
             );
             let (y0, y1) = (
-                ((cy - r) / CELL_M).floor() as i64,
-                ((cy + r) / CELL_M) as i64,
+                ((c.y - r) / CELL_M).floor() as i64,
+                ((c.y + r) / CELL_M) as i64,
             );
             for y in y0..=y1 {
                 for x in x0..=x1 {
-                    let qx = (x as f64 + 0.5) * CELL_M - cx;
-                    let qy = (y as f64 + 0.5) * CELL_M - cy;
-                    let (u, v) = ((qx * cos + qy * sin) / a, (qy * cos - qx * sin) / b);
-                    if u * u + v * v <= 1.0 {
+                    let q = glam::DVec2::new((x as f64 + 0.5) * CELL_M, (y as f64 + 0.5) * CELL_M);
+                    // The core's horizontal section through its centre.
+                    let at = core.centre_m + (q - c.truncate()).extend(0.0);
+                    if core.radius(at) <= 1.0 {
                         out.insert((x, y));
                     }
                 }

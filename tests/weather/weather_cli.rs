@@ -273,3 +273,32 @@ fn the_air_at_vigo_is_its_report_at_the_ground_and_veered_above() {
     assert!(off.abs() < 1.0, "{above}");
     assert!(f(&above, "temperature_c") < 7.0);
 }
+
+/// `skycast ceilometer` under Atlanta's OVC004 (drizzle and mist): every reading finds the deck's
+/// base at 400 ft, and the readings sum up to `OVC004`, the report's own group and ceiling.
+#[test]
+fn a_ceilometer_under_atlantas_overcast_reads_ovc004() {
+    let o = skycast(&[
+        "ceilometer",
+        BULK,
+        "--at",
+        "33.6297,-84.4422",
+        "--minutes",
+        "5",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("one JSON object");
+    let readings = v["readings"].as_array().expect("readings");
+    assert_eq!(readings.len(), 10);
+    for r in readings {
+        let first = r["bases_ft"][0].as_f64().expect("a base every reading");
+        assert!((first - 400.0).abs() <= 50.0, "{r}");
+    }
+    assert_eq!(v["layers"][0]["group"], "OVC004", "{v}");
+    assert_eq!(v["ceiling_ft"], 400.0);
+    // A wrong flag value is one line and exit 2.
+    let o = skycast(&["ceilometer", BULK, "--at", "33.6,-84.4", "--every-s", "0"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--every-s"), "{}", stderr(&o));
+}

@@ -1,0 +1,271 @@
+//! A ceilometer on the ground: what one would read under the clouds skycast makes as they drift
+//! over it, and the METAR cloud groups its readings sum up to, so that the sky can be checked as
+//! an instrument checks it (`skycast ceilometer`).
+//!
+//! Each reading is a vertical line of sight from the ground up ([`World::line_of_sight`], the
+//! clouds every probe and the drawing share): the bases of the first three stretches of cloud it
+//! meets while the beam still gets through ([`BEAM_DEPTH`]), feet above the ground. Between
+//! readings the clouds advance as a flight's do.
+//!
+//! The summary ([`summarize`]), an algorithm of skycast's own after NOAA's ASOS (ASOS User's
+//! Guide, 1998, section 3.9.2), with its cover bins centred on the covers skycast draws a report
+//! with (FEW 2, SCT 4, BKN 6, OVC 8 oktas, `[oktas]` of `config/weather_field.toml`, as
+//! FlightGear maps them), where ASOS's end at them (a scattered layer drawn at its 4 oktas read
+//! SCT or BKN by the toss of 40 readings):
+//! 1. Every base of every reading, sorted, is cut into layers where one base lies more than
+//!    max(100 ft, 10%) above the one before.
+//! 2. A layer's base is the median of its bases, rounded as a METAR writes it (to 100 ft up to
+//!    5,000 ft, 500 ft to 10,000 ft, 1,000 ft above).
+//! 3. Its cover is what is seen from below up to it (the summation principle): the share of the
+//!    readings with a base at or under the layer's highest. Up to 5% is no layer (a stray
+//!    reading), to 3/8 FEW, to 5/8 SCT, to 7/8 BKN (ASOS's 87.5%), more OVC.
+//! 4. A layer that adds no cover over the one below it (the same share) is still reported when
+//!    its own readings are over 5%: a pilot between the two sees it.
+
+use glam::{DVec2, DVec3};
+use serde::Serialize;
+
+use super::World;
+use crate::render::RenderError;
+use crate::weather::metar::Cover;
+use crate::weather::{BLOCK_SIZE_M, LocalFrame, METRES_PER_FOOT};
+
+/// How high a reading looks, feet above the ground (the highest cirrus).
+pub const TOP_FT: f64 = 45_000.0;
+
+/// Bases a reading gives, at most.
+pub const BASES_PER_READING: usize = 3;
+
+/// One reading: its time from the start and the bases it found, lowest first.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Reading {
+    /// Seconds from the first reading.
+    pub time_s: f64,
+    /// The bases of the first stretches of cloud above, feet above the ground (up to
+    /// [`BASES_PER_READING`]); empty under a clear sky.
+    pub bases_ft: Vec<f64>,
+}
+
+/// One METAR cloud group the readings sum up to.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Layer {
+    /// Cover seen from below up to this layer.
+    pub cover: Cover,
+    /// Base, feet above the ground, rounded as a METAR writes it.
+    pub base_ft: f64,
+    /// The share of readings with a base at or under it.
+    pub seen_share: f64,
+}
+
+impl Layer {
+    /// The group as a METAR writes it (`BKN033`).
+    pub fn group(&self) -> String {
+        let cover = match self.cover {
+            Cover::Few => "FEW",
+            Cover::Sct => "SCT",
+            Cover::Bkn => "BKN",
+            Cover::Ovc => "OVC",
+            Cover::Vv => "VV",
+        };
+        format!("{cover}{:03.0}", self.base_ft / 100.0)
+    }
+}
+
+/// A local frame in which the point at `lat_deg`, `lon_deg` is the middle of block (0, 0), and
+/// that point in it: a station there has the block to itself (its weather is the station's
+/// report), and the air drifting over it is always that block's (at a block's corner, the
+/// frame's origin, four blocks' weathers took turns overhead).
+pub fn frame_centred_on(lat_deg: f64, lon_deg: f64) -> (LocalFrame, DVec2) {
+    let half = DVec2::splat(0.5 * BLOCK_SIZE_M);
+    let (lat, lon) = LocalFrame::new(lat_deg, lon_deg).to_lat_lon_deg(-half);
+    let frame = LocalFrame::new(lat, lon);
+    let at = frame.to_local_m(lat_deg, lon_deg);
+    (frame, at)
+}
+
+/// Reads the sky over ground point `at_m` (local metres; `ground_m` its elevation) every
+/// `every_s` seconds for `minutes`, the clouds advancing in between.
+pub fn read(
+    world: &mut World,
+    at_m: DVec2,
+    ground_m: f64,
+    minutes: f64,
+    every_s: f64,
+) -> Result<Vec<Reading>, RenderError> {
+    let count = ((minutes * 60.0 / every_s).floor() as usize).max(1);
+    let mut readings = Vec::with_capacity(count);
+    let foot = at_m.extend(ground_m + 1.0);
+    let top = at_m.extend(ground_m + TOP_FT * METRES_PER_FOOT);
+    world.settle_clouds_around(foot)?;
+    for k in 0..count {
+        if k > 0 {
+            world.advance_clouds_around(foot, every_s)?;
+        }
+        readings.push(Reading {
+            time_s: k as f64 * every_s,
+            bases_ft: bases_over(world, foot, top, ground_m),
+        });
+    }
+    Ok(readings)
+}
+
+/// The bases of the first stretches of cloud on the line from `foot` up to `top`, feet above
+/// `ground_m`: those the beam reaches, with less than [`BEAM_DEPTH`] of cloud below them (a
+/// ceilometer sees no base above a thick deck; a line of sight that came out of a deck's gap
+/// and went in again met no second layer).
+fn bases_over(world: &World, foot: DVec3, top: DVec3, ground_m: f64) -> Vec<f64> {
+    let Some(hit) = world.line_of_sight(foot, top) else {
+        return Vec::new();
+    };
+    let mut depth = 0.0;
+    let mut bases = Vec::new();
+    for c in &hit.crossings {
+        if depth >= BEAM_DEPTH || bases.len() == BASES_PER_READING {
+            break;
+        }
+        // To a tenth of a foot: the metres' rounding is no finer.
+        let feet = (foot.z + c.entry_m - ground_m) / METRES_PER_FOOT;
+        bases.push((feet * 10.0).round() / 10.0);
+        depth += c.optical_depth;
+    }
+    bases
+}
+
+/// The optical depth of cloud a ceilometer's beam goes through and still finds the base of
+/// another layer above.
+pub const BEAM_DEPTH: f64 = 3.0;
+
+/// The METAR cloud groups `readings` sum up to, lowest first (the module's algorithm).
+pub fn summarize(readings: &[Reading]) -> Vec<Layer> {
+    let n = readings.len().max(1) as f64;
+    let mut bases: Vec<f64> = readings.iter().flat_map(|r| r.bases_ft.clone()).collect();
+    bases.sort_by(f64::total_cmp);
+    // 1. Layers where the bases part.
+    let mut clusters: Vec<Vec<f64>> = Vec::new();
+    for b in bases {
+        match clusters.last_mut() {
+            Some(c) if b - c[c.len() - 1] <= gap_ft(c[c.len() - 1]) => c.push(b),
+            _ => clusters.push(vec![b]),
+        }
+    }
+    let mut layers = Vec::new();
+    for c in &clusters {
+        let highest = c[c.len() - 1];
+        // 3. Seen from below up to it, and its own share.
+        let seen = readings
+            .iter()
+            .filter(|r| r.bases_ft.first().is_some_and(|&b| b <= highest))
+            .count() as f64
+            / n;
+        let own = readings
+            .iter()
+            .filter(|r| r.bases_ft.iter().any(|&b| b >= c[0] && b <= highest))
+            .count() as f64
+            / n;
+        if own <= STRAY_SHARE {
+            continue;
+        }
+        let Some(cover) = cover_of(seen.max(own)) else {
+            continue;
+        };
+        layers.push(Layer {
+            cover,
+            base_ft: metar_rounded_ft(c[c.len() / 2]),
+            seen_share: seen,
+        });
+    }
+    layers
+}
+
+/// The share of readings up to which a layer is a stray reading, not a layer.
+const STRAY_SHARE: f64 = 0.05;
+
+/// How far above the last base of a layer the next may lie and still be the same layer, feet.
+fn gap_ft(base_ft: f64) -> f64 {
+    (0.1 * base_ft).max(100.0)
+}
+
+/// The share of the sky seen covered as a METAR cover (the module's bins).
+fn cover_of(share: f64) -> Option<Cover> {
+    match share {
+        s if s <= STRAY_SHARE => None,
+        s if s <= 3.0 / 8.0 => Some(Cover::Few),
+        s if s <= 5.0 / 8.0 => Some(Cover::Sct),
+        s if s <= 7.0 / 8.0 => Some(Cover::Bkn),
+        _ => Some(Cover::Ovc),
+    }
+}
+
+/// A base as a METAR writes it: to 100 ft up to 5,000 ft, 500 ft to 10,000 ft, 1,000 ft above.
+pub fn metar_rounded_ft(base_ft: f64) -> f64 {
+    let step = if base_ft <= 5_000.0 {
+        100.0
+    } else if base_ft <= 10_000.0 {
+        500.0
+    } else {
+        1_000.0
+    };
+    (base_ft / step).round() * step
+}
+
+/// The ceiling of `layers`, feet: the lowest base seen broken or overcast.
+pub fn ceiling_ft(layers: &[Layer]) -> Option<f64> {
+    layers
+        .iter()
+        .find(|l| matches!(l.cover, Cover::Bkn | Cover::Ovc))
+        .map(|l| l.base_ft)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn readings(bases: &[&[f64]]) -> Vec<Reading> {
+        bases
+            .iter()
+            .enumerate()
+            .map(|(k, b)| Reading {
+                time_s: 30.0 * k as f64,
+                bases_ft: b.to_vec(),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn two_broken_layers_and_a_stray_reading() {
+        // 40 readings: 28 see a base near 3,300 ft, 24 one near 4,100 ft (32 of the 40 one or
+        // both); one reading meets a wisp at 8,000 ft.
+        let mut all: Vec<Vec<f64>> = Vec::new();
+        for k in 0..40 {
+            let mut b = Vec::new();
+            if k < 28 {
+                b.push(3_280.0 + (k % 3) as f64 * 20.0);
+            }
+            if k % 4 != 0 && k < 36 {
+                b.push(4_100.0);
+            }
+            if k == 39 {
+                b.push(8_000.0);
+            }
+            all.push(b);
+        }
+        let refs: Vec<&[f64]> = all.iter().map(Vec::as_slice).collect();
+        let layers = summarize(&readings(&refs));
+        let groups: Vec<String> = layers.iter().map(Layer::group).collect();
+        assert_eq!(groups, ["BKN033", "BKN041"], "{layers:?}");
+        assert_eq!(ceiling_ft(&layers), Some(3_300.0));
+        // A clear sky is no layer and no ceiling.
+        let clear = summarize(&readings(&[&[], &[], &[]]));
+        assert!(clear.is_empty() && ceiling_ft(&clear).is_none());
+        // Every reading under one base: overcast.
+        let ovc = summarize(&readings(&[&[600.0], &[590.0], &[610.0], &[600.0]]));
+        assert_eq!(ovc.iter().map(Layer::group).collect::<Vec<_>>(), ["OVC006"]);
+    }
+
+    #[test]
+    fn bases_round_as_a_metar_writes_them() {
+        assert_eq!(metar_rounded_ft(3_349.0), 3_300.0);
+        assert_eq!(metar_rounded_ft(7_200.0), 7_000.0);
+        assert_eq!(metar_rounded_ft(23_600.0), 24_000.0);
+    }
+}
