@@ -60,11 +60,11 @@ pub mod render;
 pub mod shading;
 pub mod weather;
 
+/// The glam of the API's vectors and matrices (0.34), for the same reason.
+pub use glam;
 /// The wgpu the sky draws with (30): a host builds its device with this one, so the types agree
 /// (`skycast::wgpu::Device`), and needs no version of its own to keep in step.
 pub use wgpu;
-/// The glam of the API's vectors and matrices (0.34), for the same reason.
-pub use glam;
 
 pub use flight::{
     HostCamera, HostLighting, HostPosition, SkyError, SkySystem, SkySystemConfig, Weather,
