@@ -69,7 +69,7 @@ fn sight_fan(world: &World, at_m: DVec3, heading_deg: f64) -> usize {
                 heading.cos() * pitch.cos(),
                 pitch.sin(),
             );
-            world.line_of_sight(at_m, at_m + dir * 10_000.0).is_some()
+            world.first_cloud(at_m, at_m + dir * 10_000.0).is_some()
         })
         .count()
 }
