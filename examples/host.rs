@@ -6,8 +6,12 @@ use skycast::{HostCamera, HostPosition, HostTargets, SkySystem, ViewId, Weather}
 use wgpu::{TextureFormat, TextureUsages as Usage};
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 
-/// Under the fair-weather cumulus theme near Los Angeles, looking up a little; 320 x 180.
-pub const THEME: &str = "weather/themes/fair_weather_cumulus.toml";
+/// Under the fair-weather cumulus theme near Los Angeles, looking up a little; 320 x 180. (The
+/// theme by its path in the repository, so that the example runs from any directory.)
+pub const THEME: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/weather/themes/fair_weather_cumulus.toml"
+);
 pub const AT: (f64, f64) = (34.0, -118.4);
 pub const ALT_M: f64 = 800.0;
 pub const HEADING_DEG: f64 = 30.0;
