@@ -193,7 +193,7 @@ impl DemoHost {
             &TerrainLight {
                 sun_dir,
                 sun_rgb: light.directional_rgb,
-                ambient: light.ambient_percent * 0.35,
+                ambient: skylight(light.directional_rgb, sun_dir, light.ambient_percent),
                 fog_rgb: self.sky.fog().rgb,
                 haze: self.sky.ground_haze(visibility_m),
                 camera_radius_m: self.sky.earth().camera_radius_m(camera.position_m.z),
@@ -330,4 +330,44 @@ pub fn ground_from_field(
     HeightField::from_fn(centre_m, size_m, samples, |p| {
         coarse.height_at_m(p) + procedural_relief_m(p, relief_m, 11)
     })
+}
+
+/// How much of the clear sky's light reaches level ground besides the sun's beam, per the
+/// beam's luminance and the square root of the sun's elevation's sine: a quarter of the ground's
+/// light at 24 degrees of sun (clear-sky diffuse shares, e.g. Duffie and Beckman, "Solar
+/// Engineering of Thermal Processes", section 2.16), most of it with the sun on the horizon.
+const SKYLIGHT: f32 = 0.27;
+
+/// The light of the sky alone on the demo ground (the ground in a cloud's shadow has only it):
+/// [`SKYLIGHT`] of the sun's luminance, by the square root of its elevation's sine, and at least
+/// a twentieth of the time of day's ambient (twilight and night).
+fn skylight(sun_rgb: glam::Vec3, sun_dir: glam::Vec3, ambient_percent: f32) -> f32 {
+    let luminance = sun_rgb.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
+    (SKYLIGHT * luminance * sun_dir.z.max(0.0).sqrt()).max(0.05 * ambient_percent * 0.35)
+}
+
+
+#[cfg(test)]
+mod skylight_tests {
+    use super::*;
+
+    /// The demo ground in a thick cloud's shadow (no beam, the sky alone) against the same
+    /// ground in the sun, in the terrain shader's light (`sun_rgb * sin(elevation) + ambient`):
+    /// a quarter to a third at 24 degrees of sun, the share of clear-sky light that is diffuse;
+    /// more with the sun low, as the sky's share grows.
+    #[test]
+    fn shadowed_ground_is_lit_by_the_sky_alone() {
+        let sun_rgb = glam::Vec3::new(1.0, 0.97, 0.9);
+        let ratio = |elevation_deg: f32| {
+            let e = elevation_deg.to_radians();
+            let sun_dir = glam::Vec3::new(e.cos(), 0.0, e.sin());
+            let sky = skylight(sun_rgb, sun_dir, 1.0);
+            let beam = sun_rgb.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722)) * e.sin();
+            sky / (sky + beam)
+        };
+        let at_24 = ratio(24.0);
+        assert!((0.2..=0.4).contains(&at_24), "{at_24}");
+        assert!(ratio(60.0) < at_24 && ratio(5.0) > at_24);
+        assert!(ratio(60.0) >= 0.15, "{}", ratio(60.0));
+    }
 }
