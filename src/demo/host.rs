@@ -346,7 +346,6 @@ fn skylight(sun_rgb: glam::Vec3, sun_dir: glam::Vec3, ambient_percent: f32) -> f
     (SKYLIGHT * luminance * sun_dir.z.max(0.0).sqrt()).max(0.05 * ambient_percent * 0.35)
 }
 
-
 #[cfg(test)]
 mod skylight_tests {
     use super::*;
