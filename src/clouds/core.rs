@@ -87,11 +87,27 @@ impl SpriteCore {
     ) -> Self {
         let (w, h) = (f64::from(width_m), f64::from(height_m));
         let (across, up) = if flat { (h, w.min(h)) } else { (w, h) };
+        // A camera-facing sprite's core is round across: its turn is nothing to it (and a sine
+        // and cosine a sprite were most of a line of sight's time).
+        let along = if flat {
+            DVec2::from_angle(f64::from(rotation_deg).to_radians())
+        } else {
+            DVec2::X
+        };
         Self {
             centre_m: DVec3::from_array(offset_m.map(f64::from)),
-            along: DVec2::from_angle(f64::from(rotation_deg).to_radians()),
+            along,
             semi_axes_m: DVec3::new(w, across, up) * CORE_HALF_EXTENT,
             floor_m: None,
+        }
+    }
+
+    /// How far from its centre any of the core (its column included) reaches, metres.
+    fn reach_m(&self) -> f64 {
+        let r = self.semi_axes_m.max_element();
+        match self.floor_m {
+            Some(floor) => r.max(self.centre_m.z - floor),
+            None => r,
         }
     }
 
@@ -307,7 +323,15 @@ pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
     {
         spans.push(span);
     }
+    let d = b - a;
+    let dd = d.length_squared().max(1e-12);
     for core in cores(cloud) {
+        // Most of a cloud's cores lie off a line that crosses it: passed over on their
+        // distance from the line, before the ellipsoid is asked.
+        let reach = core.reach_m();
+        if (core.centre_m - a).cross(d).length_squared() > reach * reach * dd {
+            continue;
+        }
         core.segment_into(a, b, &mut spans);
         out.extend(
             spans
