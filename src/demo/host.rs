@@ -342,7 +342,7 @@ const SKYLIGHT: f32 = 0.27;
 /// [`SKYLIGHT`] of the sun's luminance, by the square root of its elevation's sine, and at least
 /// a twentieth of the time of day's ambient (twilight and night).
 fn skylight(sun_rgb: glam::Vec3, sun_dir: glam::Vec3, ambient_percent: f32) -> f32 {
-    let luminance = sun_rgb.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
+    let luminance = crate::shading::luminance(sun_rgb);
     (SKYLIGHT * luminance * sun_dir.z.max(0.0).sqrt()).max(0.05 * ambient_percent * 0.35)
 }
 
@@ -361,7 +361,7 @@ mod skylight_tests {
             let e = elevation_deg.to_radians();
             let sun_dir = glam::Vec3::new(e.cos(), 0.0, e.sin());
             let sky = skylight(sun_rgb, sun_dir, 1.0);
-            let beam = sun_rgb.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722)) * e.sin();
+            let beam = crate::shading::luminance(sun_rgb) * e.sin();
             sky / (sky + beam)
         };
         let at_24 = ratio(24.0);

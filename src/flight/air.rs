@@ -169,16 +169,18 @@ impl World {
         let s = &self.air.settings;
         let (weather, gust, qnh) =
             self.weather_here(point_m.truncate(), s.pressure.default_qnh_hpa);
-        let lat_deg = self.field().frame().to_lat_lon_deg(point_m.truncate()).0;
         let surface = SurfaceAir::of(&weather, gust, qnh);
-        let aloft = self
-            .air
-            .aloft
-            .as_ref()
-            .map(|f| f.column_at(point_m.truncate()));
+        let (aloft, lat_deg) = self.aloft_and_latitude(point_m.truncate());
         let wind = air_at_aloft(&surface, point_m.z, lat_deg, s, aloft.as_ref()).wind;
         let to = (wind.from_deg + 180.0).to_radians();
         DVec2::new(to.sin(), to.cos()) * wind.speed_kt * crate::weather::METRES_PER_KNOT
+    }
+
+    /// The winds aloft's column over ground point `point_m` (if an FB product is in use) and
+    /// the point's latitude, degrees: what the air's profile needs besides the surface.
+    fn aloft_and_latitude(&self, point_m: DVec2) -> (Option<AloftColumn>, f64) {
+        let aloft = self.air.aloft.as_ref().map(|f| f.column_at(point_m));
+        (aloft, self.field().frame().to_lat_lon_deg(point_m).0)
     }
 
     /// The height the living clouds drift at over ground point `point_m`, metres above mean
@@ -262,13 +264,8 @@ impl World {
                 (1.0 - (-depth).exp()) as f32
             })
         };
-        let lat_deg = self.field().frame().to_lat_lon_deg(point_m.truncate()).0;
         let surface = SurfaceAir::of(&weather, gust, qnh);
-        let aloft = self
-            .air
-            .aloft
-            .as_ref()
-            .map(|f| f.column_at(point_m.truncate()));
+        let (aloft, lat_deg) = self.aloft_and_latitude(point_m.truncate());
         air_data(
             &weather,
             &surface,

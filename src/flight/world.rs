@@ -462,17 +462,7 @@ impl World {
     /// Generates the living clouds around `point_m` and waits for them, without a sky: for
     /// asking about the air ([`Self::air_at`]) where nothing is drawn (the command line, tests).
     pub fn settle_clouds_around(&mut self, point_m: DVec3) -> Result<(), RenderError> {
-        self.start_living()?;
-        self.set_field_drift(point_m.truncate());
-        let weather_field = &self.field;
-        if let Some(living) = self.living.as_mut() {
-            living
-                .field
-                .update(point_m.truncate(), &|i| weather_field.block_weather(i));
-            living.field.wait_for_pending();
-            living.field.advance(0.0);
-        }
-        Ok(())
+        self.advance_clouds_around(point_m, 0.0)
     }
 
     /// The velocity the living clouds over ground point `point_m` drift with: the air data's
