@@ -213,6 +213,13 @@ pub struct CloudTypeConfig {
     /// absent: 0.
     #[serde(default)]
     pub lattice_overhang: f32,
+    /// Candidate centres a scattered cloud of the type is placed at the best of: the one
+    /// farthest from the clouds already placed. Cumulus fields are more even than random
+    /// (Joseph and Cahalan 1990: neighbouring cumulus lie farther apart than chance would put
+    /// them, each cloud's sinking air around it), and a sky of even clouds shows an instrument
+    /// that sees a line of it the cover it has over the block. 1..=16; absent: 1 (random).
+    #[serde(default = "one_candidate")]
+    pub placement_candidates: u32,
     /// Drawn as flat horizontal rectangles (cirrus, Wang 2003 §7.1).
     pub flat: bool,
     /// Cloud thickness range, metres; the layer's reported thickness is clamped into it.
@@ -528,6 +535,11 @@ impl Validator<'_> {
     }
 }
 
+/// [`CloudTypeConfig::placement_candidates`] when a type does not say.
+fn one_candidate() -> u32 {
+    1
+}
+
 fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<(), CloudsError> {
     let v = Validator {
         text,
@@ -546,6 +558,11 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
         "lattice_overhang",
         "must be -1..=2 (the share of the sky a lattice keeping half its cells covers beyond \
          half, times 4)",
+    )?;
+    v.check(
+        (1..=16).contains(&c.placement_candidates),
+        "placement_candidates",
+        "must be 1..=16 (1: a scattered cloud where the first random centre falls)",
     )?;
     v.range_u32(c.boxes_per_cloud, "boxes_per_cloud", 1, 50)?;
     v.check(

@@ -240,6 +240,8 @@ fn scattered_layer(
         )
     };
     let budget = config.boxes_per_block.for_oktas(mean_oktas);
+    // This layer's clouds in `out` (other layers' lie where they will: layers overlap at random).
+    let mine = out.len();
     let mut grid = vec![false; GRID * GRID];
     let mut covered = 0usize;
     let mut boxes = 0u32;
@@ -273,11 +275,13 @@ fn scattered_layer(
         };
         let mut d = size(target);
         let margin = (d / 4.0).min(BLOCK_SIZE_M / 2.0);
-        let centre = corner
-            + DVec2::new(
-                rng.range_f64(margin, BLOCK_SIZE_M - margin),
-                rng.range_f64(margin, BLOCK_SIZE_M - margin),
-            );
+        let centre = best_centre(&mut rng, config.placement_candidates, &out[mine..], |rng| {
+            corner
+                + DVec2::new(
+                    rng.range_f64(margin, BLOCK_SIZE_M - margin),
+                    rng.range_f64(margin, BLOCK_SIZE_M - margin),
+                )
+        });
         let cloud_seed = rng.next_u64();
         // Uneven cover: a centre is kept as often as the cover is there, and the cloud is as
         // big, as dense and as packed as the cover there asks.
@@ -321,6 +325,35 @@ fn scattered_layer(
         out.push(cloud);
     }
     (covered as f64 / (GRID * GRID) as f64, boxes)
+}
+
+/// The best of `candidates` random centres (`draw` makes one) for a new scattered cloud: the
+/// one farthest from the edges of the clouds already in `placed` (the first alone with none).
+fn best_centre(
+    rng: &mut SplitMix64,
+    candidates: u32,
+    placed: &[Cloud],
+    mut draw: impl FnMut(&mut SplitMix64) -> DVec2,
+) -> DVec2 {
+    let first = draw(rng);
+    if candidates <= 1 || placed.is_empty() {
+        return first;
+    }
+    let room = |p: DVec2| {
+        placed
+            .iter()
+            .map(|c| p.distance(c.centre_m.truncate()) - f64::from(c.radius_m))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut best = (room(first), first);
+    for _ in 1..candidates {
+        let p = draw(rng);
+        let r = room(p);
+        if r > best.0 {
+            best = (r, p);
+        }
+    }
+    best.1
 }
 
 /// The sky a streak covers, m2: its flat sprites' dense cores (as [`cloud_cells`] counts them),
@@ -885,7 +918,7 @@ mod golden {
         assert_eq!(
             hashes,
             [
-                "801de14c641e0c75",
+                "8162f54a59074a59",
                 "7ccbffc21b226faa",
                 "5393761c2f982975",
                 "f6cfc024a1869c4d"

@@ -632,11 +632,44 @@ fn a_deck_cell_does_not_list_its_sprites_row_by_row() {
 /// type is, and any type's overcast cells), over the middle block of 3 x 3 so that the
 /// neighbours' overhang counts, the mean of 12 blocks.
 fn lattice_cover(t: CloudType, config: &CloudTypeConfig, oktas: f32) -> f64 {
+    with_layer_ctx(t, config, oktas, |ctx| {
+        let mut sum = 0.0;
+        let (seeds, rows) = (6u64, 2);
+        for seed in 0..seeds {
+            for row in 0..rows {
+                let centre = BlockIndex::new(3 * row, 1);
+                let mut block = CloudBlock {
+                    index: centre,
+                    seed,
+                    layers: Vec::new(),
+                    clouds: Vec::new(),
+                };
+                for dj in -1..=1 {
+                    for di in -1..=1 {
+                        let b = BlockIndex::new(centre.i + di, centre.j + dj);
+                        lattice_layer(b, ctx, seed, &mut block.clouds);
+                    }
+                }
+                sum += sprite_coverage(&[&block], centre);
+            }
+        }
+        sum / (seeds as usize * rows as usize) as f64
+    })
+}
+
+/// Runs `f` with the generation context of one even layer of `t` at `oktas` (base 3,000 ft,
+/// 1,500 ft thick) drawn by `config`, alone in its block.
+fn with_layer_ctx<R>(
+    t: CloudType,
+    config: &CloudTypeConfig,
+    oktas: f32,
+    f: impl FnOnce(&LayerCtx) -> R,
+) -> R {
     let w = weather(t, oktas, 3000.0, 1500.0);
     let layer = &w.layers[0];
     let frame = LayerFrame::new(layer, config, w.ground_elevation_m as f64);
     let cover = LayerCover::uniform(oktas);
-    let ctx = LayerCtx {
+    f(&LayerCtx {
         config,
         layer,
         li: 0,
@@ -644,28 +677,7 @@ fn lattice_cover(t: CloudType, config: &CloudTypeConfig, oktas: f32) -> f64 {
         wind_axis_deg: 0.0,
         cover,
         share: Share::alone(&cover),
-    };
-    let mut sum = 0.0;
-    let (seeds, rows) = (6u64, 2);
-    for seed in 0..seeds {
-        for row in 0..rows {
-            let centre = BlockIndex::new(3 * row, 1);
-            let mut block = CloudBlock {
-                index: centre,
-                seed,
-                layers: Vec::new(),
-                clouds: Vec::new(),
-            };
-            for dj in -1..=1 {
-                for di in -1..=1 {
-                    let b = BlockIndex::new(centre.i + di, centre.j + dj);
-                    lattice_layer(b, &ctx, seed, &mut block.clouds);
-                }
-            }
-            sum += sprite_coverage(&[&block], centre);
-        }
-    }
-    sum / (seeds as usize * rows as usize) as f64
+    })
 }
 
 /// A layer on the lattice covers what the weather asks: each kept cell's clouds reach past it
@@ -790,4 +802,55 @@ fn a_broken_deck_has_no_square_gaps() {
         mean < 0.25 && all.iter().all(|&a| a < 0.35),
         "gaps along the axes: {all:.2?}, mean {mean:.2}"
     );
+}
+
+/// The clouds of a scattered layer placed at the best of several candidate centres
+/// (`placement_candidates`) lie farther from their nearest neighbour than chance would put them
+/// (Clark and Evans' ratio of the mean nearest-neighbour distance to a random pattern's), as
+/// cumulus fields do, where a single random centre left them about as clumped as chance.
+#[test]
+fn scattered_clouds_lie_more_evenly_than_chance() {
+    let t = CloudType::CumulusHumilis;
+    let shipped = types().get(t);
+    assert!(shipped.placement_candidates > 1, "{shipped:?}");
+    let mut random = shipped.clone();
+    random.placement_candidates = 1;
+    let ratio = |config: &CloudTypeConfig| {
+        with_layer_ctx(t, config, 3.0, |ctx| {
+            let (mut sum, mut n) = (0.0, 0usize);
+            for seed in 0..24u64 {
+                let mut clouds = Vec::new();
+                scattered_layer(BlockIndex::new(0, 0), ctx, seed, &mut clouds);
+                let centres: Vec<DVec2> = clouds.iter().map(|c| c.centre_m.truncate()).collect();
+                if centres.len() < 4 {
+                    continue;
+                }
+                // Clouds within 600 m of the block's sides left out of the mean (their nearest
+                // neighbour may be in the next block); every cloud is a neighbour.
+                let density = centres.len() as f64 / (BLOCK_SIZE_M * BLOCK_SIZE_M);
+                let expected = 0.5 / density.sqrt();
+                for (k, p) in centres.iter().enumerate() {
+                    if p.min_element() < 600.0 || p.max_element() > BLOCK_SIZE_M - 600.0 {
+                        continue;
+                    }
+                    let nearest = centres
+                        .iter()
+                        .enumerate()
+                        .filter(|(j, _)| *j != k)
+                        .map(|(_, q)| p.distance(*q))
+                        .fold(f64::INFINITY, f64::min);
+                    sum += nearest / expected;
+                    n += 1;
+                }
+            }
+            assert!(n >= 20, "{n} clouds measured");
+            sum / n as f64
+        })
+    };
+    let (even, chance) = (ratio(shipped), ratio(&random));
+    eprintln!(
+        "Clark-Evans ratio: {even:.2} at the best of {}, {chance:.2} at one",
+        shipped.placement_candidates
+    );
+    assert!(even > chance + 0.1, "{even} {chance}");
 }
