@@ -71,6 +71,7 @@ pictures: vulkan
 	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 3083 --heading 135 --pitch -10 --out $(PICTURES)/pilot/deck_above.png
 	$(FRAME) --weather weather/views/low_overcast_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 4000 --heading 10 --pitch -89 --out $(PICTURES)/pilot/deck_nadir.png
 	$(FRAME) --weather weather/views/high_broken_heathrow.metar --at 51.4775,-0.4614 --time 2025-01-27T12:00:00Z --alt-ft 1000 --heading 0 --pitch 45 --out $(PICTURES)/pilot/cirrocumulus_below.png
+	$(FRAME) --weather weather/gfs-2011-01-10T12Z-f120-2p5deg.grib2 --at 45,-35 --time 2011-01-15T14:30:00Z --alt-ft 35000 --heading 10 --pitch -5 --out $(PICTURES)/model/fl350_mid_atlantic.png
 	cargo test --quiet --test pilot rain_falls_out_of_a_storm && cp target/tmp/pilot/storm/rain.png $(PICTURES)/pilot/storm_20km.png
 	for m in wang harris_lastra; do \
 		$(SHADING) --shading $$m --time 2025-01-27T19:00:00Z --alt-ft 2500 --heading 90 --pitch 6 --out $(PICTURES)/shading/noon_$$m.png && \

@@ -64,6 +64,9 @@ const SPEED_M_S: f64 = 120.0;
 /// Flags of `skycast bench`.
 #[derive(Debug, Args)]
 pub struct BenchArgs {
+    /// The model under each scenario's report.
+    #[command(flatten)]
+    pub model: super::model::ModelArgs,
     /// Image size, WIDTHxHEIGHT pixels.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -212,15 +215,23 @@ fn scenario_world(
     name: &str,
     stations: &StationTable,
     settings: &WorldSettings,
+    model: Option<&std::sync::Arc<skycast::weather::model::ModelField>>,
 ) -> anyhow::Result<(World, (f64, f64))> {
     let path = dir.join(format!("{name}.metar"));
     let input = match super::defaults::shipped(&path) {
         Some(bytes) => WeatherInput::parse(&path, bytes, Some(stations))?,
         None => WeatherInput::load(&path, Some(stations))?,
     };
-    let WeatherInput::Reports(file) = &input else {
+    let input = match (model, input) {
+        (Some(model), WeatherInput::Reports(file)) => WeatherInput::Model {
+            model: model.clone(),
+            reports: Some(file),
+        },
+        (_, input) => input,
+    };
+    let Some(file) = input.reports() else {
         anyhow::bail!(
-            "{}: a scenario is a report file, not a theme",
+            "{}: a scenario is a report file, not a theme or a model",
             path.display()
         );
     };
@@ -504,13 +515,31 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         "off" => &[false],
         _ => &[true, false],
     };
+    let model = match &args.model.model {
+        Some(path) => Some(std::sync::Arc::new(
+            skycast::weather::model::ModelField::load(path)?,
+        )),
+        None => None,
+    };
+    let settings = skycast::weather::model::ModelSettings::default();
+    if let Some(warning) = model
+        .as_ref()
+        .and_then(|m| m.time_warning(unix_s, &settings.time))
+    {
+        eprintln!("warning: {warning}");
+    }
     for scenario in SCENARIOS {
         let asked = args.scenarios_only.iter().any(|s| s == scenario);
         if (!args.scenarios_only.is_empty() || scenario == ON_REQUEST) && !asked {
             continue;
         }
-        let (mut world, at) =
-            scenario_world(&args.scenarios, scenario, &stations, &world_settings)?;
+        let (mut world, at) = scenario_world(
+            &args.scenarios,
+            scenario,
+            &stations,
+            &world_settings,
+            model.as_ref(),
+        )?;
         let overdraw = mean_overdraw(&world, world_settings.seed);
         for (&impostors, &far) in rings.iter().flat_map(|r| fars.iter().map(move |f| (r, f))) {
             setup.settings.far_field.enabled = far;

@@ -65,10 +65,13 @@ pub const DEFAULT_FLIGHT: &str = "config/flights/demo_coast_under_cumulus.toml";
 
 /// Runs `skycast demo`.
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
-    let loaded = load(&args.weather, args.stations.as_deref(), None, None)?;
+    let loaded = load(&args.weather, None, args.stations.as_deref(), None, None)?;
     match &loaded.input {
         WeatherInput::Reports(file) => print!("{}", describe_file(file, &Summary::of(file), false)),
         WeatherInput::Theme(theme) => print!("{}", describe_theme(&args.weather, theme)),
+        WeatherInput::Model { model, .. } => {
+            print!("{}", super::model::ModelOut::of(model).describe())
+        }
     }
     println!(
         "\nThe default flight area, the Irish Sea: rain, low broken cloud, a CB over Belfast:"
@@ -84,6 +87,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     );
     super::fly::run(&super::fly::FlyArgs {
         weather: args.weather.clone(),
+        model: Default::default(),
         stations: args.stations.clone(),
         aloft: args.aloft.clone(),
         path: args.flight.clone(),
@@ -97,6 +101,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         settle_ms: 500,
         clouds: None,
         elevation: super::render::ElevationArgs::default(),
+        synchronous_clouds: false,
     })?;
     println!(
         "The frames are in {}/ (frame_*.png, frames.csv).",

@@ -60,9 +60,13 @@ fn ground_under_flight(field: &WeatherField, flight: &FlightPath) -> HeightField
 /// Flags of `skycast fly`.
 #[derive(Debug, Args)]
 pub struct FlyArgs {
-    /// The weather file.
+    /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, a weather
+    /// theme (`.toml`), or a weather model's GRIB2 file (told by its content).
     #[arg(long)]
     pub weather: PathBuf,
+    /// The model under the reports.
+    #[command(flatten)]
+    pub model: super::model::ModelArgs,
     /// Station table placing reports the file does not place.
     /// (default: NOAA's table built into skycast).
     #[arg(long)]
@@ -105,6 +109,10 @@ pub struct FlyArgs {
     /// The ground from an elevation file instead of the stations' elevations.
     #[command(flatten)]
     pub elevation: ElevationArgs,
+    /// Every frame waits for its clouds, as the first one does: the frames then depend on the
+    /// flight alone, not on how fast the background threads were (golden frames, tests).
+    #[arg(long)]
+    pub synchronous_clouds: bool,
 }
 
 /// Runs `skycast fly`.
@@ -122,8 +130,15 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let (lat, lon) = plan.origin_lat_lon_deg;
     let flight = plan.place(&LocalFrame::new(lat, lon));
     let (settings, table) = args.look.load()?;
-    let loaded = load(&args.weather, args.stations.as_deref(), None, None)?;
+    let loaded = load(
+        &args.weather,
+        args.model.model.as_deref(),
+        args.stations.as_deref(),
+        None,
+        None,
+    )?;
     let start_unix_s = time_or_default(args.time)?;
+    super::model::warn_if_far_in_time(&loaded.input, start_unix_s);
     let field = loaded
         .input
         .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);
@@ -173,6 +188,10 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             .schedule_weather(&event.weather, event.time_s - flight.start_s())?;
     }
     if args.watch {
+        // A `--model` stays under the watched reports.
+        if let Some(model) = loaded.input.model() {
+            host.sky.set_model(Some(model.clone()));
+        }
         host.sky.set_weather(Weather::Watch {
             path: &args.weather,
             settle: Duration::from_millis(args.settle_ms),
@@ -265,7 +284,9 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         let step_s = if k == 0 { 0.0 } else { dt_s };
         // The first frame is the warm-up: it waits for the clouds around, so the flight starts
         // under its whole sky; after it blocks arrive as they are generated.
-        host.sky.world_mut().set_synchronous_clouds(k == 0);
+        host.sky
+            .world_mut()
+            .set_synchronous_clouds(k == 0 || args.synchronous_clouds);
         let switches_before = involuntary_switches();
         let (stats, changes) = host.step(&camera, start_unix_s + time_s, step_s, write)?;
         let mut applied = String::new();

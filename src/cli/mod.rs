@@ -12,6 +12,7 @@ mod defaults;
 mod demo;
 mod fly;
 mod metar;
+mod model;
 mod preview;
 mod render;
 mod sheet;

@@ -18,10 +18,13 @@ use super::weather::{Loaded, load, parse_lat_lon};
 /// Flags of `skycast render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, or a weather
-    /// theme (`.toml`).
+    /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, a weather
+    /// theme (`.toml`), or a weather model's GRIB2 file (told by its content).
     #[arg(long)]
     pub weather: PathBuf,
+    /// The model under the reports.
+    #[command(flatten)]
+    pub model: super::model::ModelArgs,
     /// Station table placing reports the file does not place.
     /// (default: NOAA's table built into skycast).
     #[arg(long)]
@@ -313,8 +316,15 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     // lattice cell as a square from FL350 and the sorted blocks' edge as a staircase.)
     settings.vertex_cache.max_uploaded_sprites_per_frame = u32::MAX;
     settings.vertex_cache.max_sorted_sprites_per_frame = u32::MAX;
-    let loaded = load(&args.weather, args.stations.as_deref(), None, None)?;
+    let loaded = load(
+        &args.weather,
+        args.model.model.as_deref(),
+        args.stations.as_deref(),
+        None,
+        None,
+    )?;
     let unix_s = time_or_default(args.time)?;
+    super::model::warn_if_far_in_time(&loaded.input, unix_s);
     let field = loaded
         .input
         .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);

@@ -24,6 +24,7 @@ use skycast::weather::theme::{self, Theme};
 use skycast::weather::winds_aloft::WindsAloft;
 
 use super::defaults;
+use super::model::ModelOut;
 use skycast::weather::{
     BlockIndex, BlockWeather, LineWarning, LocalFrame, StationTable, WeatherInput,
 };
@@ -31,9 +32,13 @@ use skycast::weather::{
 /// Flags of `skycast weather`.
 #[derive(Debug, Args)]
 pub struct WeatherArgs {
-    /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, or a weather
-    /// theme (`.toml`, see weather/themes/).
+    /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, a weather
+    /// theme (`.toml`, see weather/themes/), or a weather model's GRIB2 file (told by its
+    /// content).
     pub file: PathBuf,
+    /// The model under the reports.
+    #[command(flatten)]
+    pub model: super::model::ModelArgs,
     /// Station table (NOAA nsd_cccc.txt format) placing reports the file does not place
     /// (default: NOAA's table built into skycast).
     #[arg(long)]
@@ -204,6 +209,8 @@ struct JsonOut<'a> {
     warnings: &'a [LineWarning],
     #[serde(flatten)]
     summary: &'a Summary,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    model: Option<&'a ModelOut>,
     at: Option<&'a AtBlock>,
     #[serde(skip_serializing_if = "Option::is_none")]
     air: Option<&'a AirData>,
@@ -221,9 +228,11 @@ pub struct Loaded {
     pub rule: CloudTypeRule,
 }
 
-/// Loads the file (with the station table), the rule and the settings.
+/// Loads the file (with the station table) and the model under it if `model` names one, the rule
+/// and the settings.
 pub fn load(
     file: &Path,
+    model: Option<&Path>,
     stations: Option<&Path>,
     rule: Option<&Path>,
     field_settings: Option<&Path>,
@@ -237,6 +246,10 @@ pub fn load(
     let input = match defaults::shipped(file) {
         Some(bytes) => WeatherInput::parse(file, bytes, table.as_deref())?,
         None => WeatherInput::load(file, table.as_deref())?,
+    };
+    let input = match model {
+        Some(path) => super::model::attach(input, path, file)?,
+        None => input,
     };
     let rule = match defaults::settings_file(rule, "cloud_type_rule.toml") {
         Some(path) => CloudTypeRule::load(&path)?,
@@ -271,6 +284,7 @@ pub fn at_block(loaded: &Loaded, lat_deg: f64, lon_deg: f64) -> AtBlock {
 pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
     let loaded = load(
         &args.file,
+        args.model.model.as_deref(),
         args.stations.as_deref(),
         args.rule.as_deref(),
         args.field_settings.as_deref(),
@@ -294,8 +308,34 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
         }
         _ => None,
     };
+    let now_s = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64());
+    super::model::warn_if_far_in_time(&loaded.input, now_s);
+    let model = loaded.input.model().map(|m| ModelOut::of(m));
     let file = match &loaded.input {
-        WeatherInput::Reports(file) => file,
+        WeatherInput::Reports(file)
+        | WeatherInput::Model {
+            reports: Some(file),
+            ..
+        } => file,
+        WeatherInput::Model { reports: None, .. } => {
+            let model = model.as_ref().context("a model input has its model")?;
+            if args.json {
+                let out = ModelJsonOut {
+                    format: "grib2",
+                    model,
+                    at: at.as_ref(),
+                    air: air.as_ref(),
+                    cells: cells.as_deref(),
+                };
+                println!("{}", serde_json::to_string(&out)?);
+            } else {
+                print!("{}", model.describe());
+                print_at(at.as_ref(), air.as_ref(), cells.as_deref());
+            }
+            return Ok(());
+        }
         WeatherInput::Theme(theme) => {
             if args.json {
                 let out = ThemeJsonOut {
@@ -333,6 +373,7 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
             located: file.reports.len(),
             warnings: &file.warnings,
             summary: &summary,
+            model: model.as_ref(),
             at: at.as_ref(),
             air: air.as_ref(),
             cells: cells.as_deref(),
@@ -341,16 +382,36 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     print!("{}", describe_file(file, &summary, true));
-    if let Some(at) = &at {
+    if let Some(model) = &model {
+        print!("{}", model.describe());
+    }
+    print_at(at.as_ref(), air.as_ref(), cells.as_deref());
+    Ok(())
+}
+
+/// Prints the block, the air data and the storm cells asked for.
+fn print_at(at: Option<&AtBlock>, air: Option<&AirData>, cells: Option<&[CellOut]>) {
+    if let Some(at) = at {
         print!("{}", describe_block(at));
     }
-    if let Some(air) = &air {
+    if let Some(air) = air {
         print!("{}", describe_air(air));
     }
-    if let Some(cells) = &cells {
+    if let Some(cells) = cells {
         print!("{}", describe_cells(cells));
     }
-    Ok(())
+}
+
+/// `skycast weather --json` of a model file alone.
+#[derive(Serialize)]
+struct ModelJsonOut<'a> {
+    format: &'static str,
+    model: &'a ModelOut,
+    at: Option<&'a AtBlock>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    air: Option<&'a AirData>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cells: Option<&'a [CellOut]>,
 }
 
 /// One storm cell as `--cells-km` lists it.
@@ -596,7 +657,8 @@ pub fn describe_block(at: &AtBlock) -> String {
         w.temperature_c,
         w.dewpoint_c,
         w.precipitation,
-        w.ground_elevation_m
+        // Rounded first: a sea a few centimetres under the geoid reads 0 m, not -0 m.
+        w.ground_elevation_m.round() + 0.0
     );
     if let Some(o) = w.obscuration {
         let name = serde_json::to_value(o)

@@ -176,11 +176,19 @@ impl World {
         DVec2::new(to.sin(), to.cos()) * wind.speed_kt * crate::weather::METRES_PER_KNOT
     }
 
-    /// The winds aloft's column over ground point `point_m` (if an FB product is in use) and
-    /// the point's latitude, degrees: what the air's profile needs besides the surface.
+    /// The winds aloft's column over ground point `point_m` (an FB product's if one is in use,
+    /// else the weather model's under the field, if any) and the point's latitude, degrees:
+    /// what the air's profile needs besides the surface.
     fn aloft_and_latitude(&self, point_m: DVec2) -> (Option<AloftColumn>, f64) {
-        let aloft = self.air.aloft.as_ref().map(|f| f.column_at(point_m));
-        (aloft, self.field().frame().to_lat_lon_deg(point_m).0)
+        let (lat, lon) = self.field().frame().to_lat_lon_deg(point_m);
+        let aloft = match &self.air.aloft {
+            Some(fb) => Some(fb.column_at(point_m)),
+            None => self
+                .field()
+                .model()
+                .map(|(model, _)| model.aloft_column_at(lat, lon)),
+        };
+        (aloft, lat)
     }
 
     /// The height the living clouds drift at over ground point `point_m`, metres above mean

@@ -609,29 +609,29 @@ fn ceilometer_round_trip(stations: usize) -> (f64, f64, usize) {
     )
 }
 
-/// The ceilometer's round trip at 40 cloudy stations of the real bulk file: measured 0.86 of
-/// the reported layers and 0.73 of the ceilings (the 200-station figures in the book:
-/// `cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`). Held to 0.8 and
-/// 0.65 against a fall; what is missing is in the book's "What is still not right": 40 readings
-/// along a 12 km line through clouds a kilometre or two wide toss a layer's cover a class either
-/// way (a BKN read 0.55, a SCT 0.8), and a calm wind reads one spot for 20 minutes.
+/// The ceilometer's round trip at 40 cloudy stations of the real bulk file: measured 0.89 of
+/// the reported layers and 0.90 of the ceilings (the 200-station figures in the book:
+/// `cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`). Held to 0.85 and
+/// 0.85 against a fall; what is missing is in the book's "What is still not right": 40 readings
+/// along a few kilometres of clouds a kilometre or two wide still toss a layer's cover a class
+/// either way now and then, and a calm wind reads one spot for 20 minutes.
 #[test]
 fn a_ceilometer_under_the_drifting_clouds_reads_the_reports_back() {
     let (layers, ceilings, stations) = ceilometer_round_trip(40);
     eprintln!("{stations} stations: layers {layers:.3}, ceilings {ceilings:.3}");
     assert_eq!(stations, 40);
-    assert!(layers >= 0.8 && ceilings >= 0.65, "{layers} {ceilings}");
+    assert!(layers >= 0.85 && ceilings >= 0.85, "{layers} {ceilings}");
 }
 
 /// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations (about a
-/// minute).
+/// minute): measured 0.86 of the layers and 0.92 of the ceilings.
 #[test]
 #[ignore]
 fn ceilometer_round_trip_at_200() {
     let (layers, ceilings, stations) = ceilometer_round_trip(200);
     eprintln!("{stations} stations: layers {layers:.3}, ceilings {ceilings:.3}");
     assert_eq!(stations, 200);
-    assert!(layers >= 0.8 && ceilings >= 0.65, "{layers} {ceilings}");
+    assert!(layers >= 0.84 && ceilings >= 0.9, "{layers} {ceilings}");
 }
 
 /// The clouds drift with the wind the air data reports at their height: over real reports (and

@@ -23,6 +23,7 @@ use crate::render::{
 use crate::shading::sun_position;
 use crate::weather::field::{CloudTypeRule, FieldSettings, WeatherField};
 use crate::weather::live::{LiveChange, LiveWeather, Prepare};
+use crate::weather::model::{ModelField, ModelSettings};
 use crate::weather::watch::{WatchUpdate, WeatherWatch};
 use crate::weather::winds_aloft::WindsAloft;
 use crate::weather::{LocalFrame, Skipped, StationTable, WeatherError, WeatherInput};
@@ -109,7 +110,9 @@ impl SkySystemConfig {
 #[non_exhaustive]
 pub enum Weather<'a> {
     /// A report file (the aviation weather service's `metars.cache.csv`, a NOAA cycle file,
-    /// one METAR a line) or a weather theme (`.toml`), read now.
+    /// one METAR a line), a weather theme (`.toml`) or a weather model's GRIB2 file (told by its
+    /// content; the model alone, see [`SkySystem::set_model`] for a model under reports), read
+    /// now.
     File(&'a Path),
     /// The same, already in memory; `name` tells a theme by its extension and names it in
     /// errors.
@@ -228,6 +231,8 @@ pub struct SkySystem {
     frame: LocalFrame,
     live: LiveWeather<(WeatherField, Skipped)>,
     prepare_field: Prepare<(WeatherField, Skipped)>,
+    /// The model under every report file ([`Self::set_model`]), shared with `prepare_field`.
+    model: Arc<std::sync::RwLock<Option<Arc<ModelField>>>>,
     /// A watched FB file of winds aloft ([`Self::watch_winds_aloft`]).
     aloft_watch: Option<WeatherWatch<WindsAloft>>,
     /// What the weather in use left out, counted.
@@ -269,7 +274,18 @@ impl SkySystem {
         let (lat, lon) = config.origin_lat_lon_deg;
         let frame = LocalFrame::new(lat, lon);
         let (settings, rule) = (config.field.clone(), config.rule.clone());
+        let model: Arc<std::sync::RwLock<Option<Arc<ModelField>>>> = Arc::default();
+        let model_under = Arc::clone(&model);
         let prepare_field: Prepare<(WeatherField, Skipped)> = Arc::new(move |input| {
+            // A report file goes over the model set; a theme or a model file stands alone.
+            let under = model_under.read().ok().and_then(|m| m.clone());
+            let input = match (under, input) {
+                (Some(model), WeatherInput::Reports(file)) => WeatherInput::Model {
+                    model,
+                    reports: Some(file),
+                },
+                (_, input) => input,
+            };
             let field = input.field(LocalFrame::new(lat, lon), &settings, &rule);
             (field, input.skipped())
         });
@@ -287,6 +303,7 @@ impl SkySystem {
             frame,
             live: LiveWeather::new(),
             prepare_field,
+            model,
             aloft_watch: None,
             skipped: Skipped::default(),
             stations: config.stations,
@@ -331,6 +348,24 @@ impl SkySystem {
     /// or of the last file a watch or schedule applied (an update's applied files).
     pub fn weather_skipped(&self) -> &Skipped {
         &self.skipped
+    }
+
+    /// Puts a numerical weather model's fields (a GRIB2 file,
+    /// [`ModelField::load`]) under the weather, or takes it away (`None`): near a station its
+    /// report rules, the model between and beyond the stations and above their reach
+    /// (`config/weather_model.toml`). It stays under every report file set, watched or
+    /// scheduled after; the weather in use now takes it at once. (A GRIB2 file given to
+    /// [`Self::set_weather`] is the model alone.) A model valid far from the simulated time is
+    /// used all the same: [`ModelField::time_warning`] says so.
+    pub fn set_model(&mut self, model: Option<Arc<ModelField>>) {
+        if let Ok(mut under) = self.model.write() {
+            under.clone_from(&model);
+        }
+        let mut field = self.world.field().clone();
+        field.set_model(model.map(|m| (m, ModelSettings::default())));
+        let skipped = self.skipped.clone();
+        self.set_weather_field(field);
+        self.skipped = skipped;
     }
 
     /// Takes a weather field the host built itself (same as [`Self::set_weather`] otherwise).

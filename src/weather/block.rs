@@ -66,6 +66,8 @@ pub enum TypeSource {
     Theme,
     /// The height/cover rule of `config/cloud_type_rule.toml`.
     HeightRule,
+    /// A numerical weather model's layer, typed by `config/weather_model.toml`.
+    Model,
 }
 
 /// One cloud layer of a block.

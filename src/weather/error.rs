@@ -59,6 +59,10 @@ pub enum WeatherError {
     /// names file, line and field.
     #[error(transparent)]
     Config(#[from] crate::config::ConfigError),
+    /// A numerical weather model's file (GRIB2) is broken or lacks a field the reader needs;
+    /// the error names file, message and field.
+    #[error(transparent)]
+    Model(#[from] super::model::ModelError),
 }
 
 /// A problem with one line of an input file that did not stop the file.

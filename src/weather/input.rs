@@ -1,13 +1,16 @@
 //! Any weather input a command takes with `--weather FILE`: a bulk report file (METAR in any of
-//! the formats of [`files`]) or a weather theme (`.toml`, see
-//! [`theme`]). Both become the same [`WeatherField`].
+//! the formats of [`files`]), a weather theme (`.toml`, see [`theme`]) or a numerical weather
+//! model's GRIB2 file ([`model`], told by its content), alone or under a report file. All become
+//! the same [`WeatherField`].
 
 use std::path::Path;
+use std::sync::Arc;
 
 use super::error::{Skipped, WeatherError};
 use super::field::{CloudTypeRule, FieldSettings, WeatherField};
 use super::files::{self, WeatherFile};
 use super::frame::LocalFrame;
+use super::model::{self, ModelField, ModelSettings};
 use super::stations::StationTable;
 use super::theme::{self, Theme};
 
@@ -18,6 +21,14 @@ pub enum WeatherInput {
     Reports(WeatherFile),
     /// A weather theme.
     Theme(Theme),
+    /// A numerical weather model's fields, with the reports of a report file over them (near a
+    /// station the report, the model beyond) or alone.
+    Model {
+        /// The model's fields.
+        model: Arc<ModelField>,
+        /// The reports blended over the model, if any.
+        reports: Option<WeatherFile>,
+    },
 }
 
 impl WeatherInput {
@@ -38,6 +49,13 @@ impl WeatherInput {
         bytes: &[u8],
         stations: Option<&StationTable>,
     ) -> Result<Self, WeatherError> {
+        if model::is_grib(bytes) {
+            let model = Arc::new(ModelField::parse(path, bytes)?);
+            return Ok(Self::Model {
+                model,
+                reports: None,
+            });
+        }
         if !theme::is_theme_path(path) {
             return Ok(Self::Reports(files::parse(path, bytes, stations)?));
         }
@@ -55,13 +73,41 @@ impl WeatherInput {
         Ok(Self::Theme(theme::parse_theme(&text, path)?))
     }
 
-    /// What the input left out and why, counted (nothing for a theme).
-    pub fn skipped(&self) -> Skipped {
+    /// This input with a model's fields under it: a report file's reports blend over the
+    /// model; a model takes the new one's place. A theme takes no model: `None`.
+    pub fn with_model(self, model: Arc<ModelField>) -> Option<Self> {
         match self {
-            Self::Reports(file) => {
-                Skipped::new(file.reports_found, file.reports.len(), &file.warnings)
-            }
-            Self::Theme(_) => Skipped::default(),
+            Self::Reports(file) => Some(Self::Model {
+                model,
+                reports: Some(file),
+            }),
+            Self::Model { reports, .. } => Some(Self::Model { model, reports }),
+            Self::Theme(_) => None,
+        }
+    }
+
+    /// The report file of this input, alone or over a model.
+    pub fn reports(&self) -> Option<&WeatherFile> {
+        match self {
+            Self::Reports(file) => Some(file),
+            Self::Model { reports, .. } => reports.as_ref(),
+            Self::Theme(_) => None,
+        }
+    }
+
+    /// The model's fields of this input, if any.
+    pub fn model(&self) -> Option<&Arc<ModelField>> {
+        match self {
+            Self::Model { model, .. } => Some(model),
+            _ => None,
+        }
+    }
+
+    /// What the input left out and why, counted (nothing for a theme or a model alone).
+    pub fn skipped(&self) -> Skipped {
+        match self.reports() {
+            Some(file) => Skipped::new(file.reports_found, file.reports.len(), &file.warnings),
+            None => Skipped::default(),
         }
     }
 
@@ -87,6 +133,11 @@ impl WeatherInput {
         match self {
             Self::Reports(file) => WeatherField::build(frame, &file.reports, settings, rule),
             Self::Theme(theme) => WeatherField::from_theme(frame, theme, settings, rule),
+            Self::Model { model, reports } => {
+                let reports = reports.as_ref().map_or(&[][..], |f| &f.reports[..]);
+                WeatherField::build(frame, reports, settings, rule)
+                    .with_model(model.clone(), ModelSettings::default())
+            }
         }
     }
 }

@@ -173,10 +173,8 @@ mod tests {
             )))
             .unwrap(),
         );
-        let count: Prepare<usize> = Arc::new(|input| match input {
-            WeatherInput::Reports(f) => f.reports.len(),
-            WeatherInput::Theme(_) => 0,
-        });
+        let count: Prepare<usize> =
+            Arc::new(|input| input.reports().map_or(0, |f| f.reports.len()));
         let mut live = LiveWeather::new();
         live.schedule(10.0, &good, Some(Arc::clone(&table)), Arc::clone(&count))
             .unwrap();

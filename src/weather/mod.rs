@@ -17,6 +17,7 @@ pub mod frame;
 pub mod input;
 pub mod live;
 pub mod metar;
+pub mod model;
 pub mod remarks;
 pub mod stations;
 pub mod storms;

@@ -225,10 +225,7 @@ mod tests {
     }
 
     fn reports_in(input: &WeatherInput) -> usize {
-        match input {
-            WeatherInput::Reports(file) => file.reports.len(),
-            WeatherInput::Theme(_) => 0,
-        }
+        input.reports().map_or(0, |f| f.reports.len())
     }
 
     /// The first `rows` rows of the real bulk file, preamble and header untouched.

@@ -22,6 +22,7 @@ use std::io::BufRead;
 use std::path::Path;
 
 use skycast::weather::block::{BlockLayer, ceiling_ft, cover_seen_from_below_oktas};
+use skycast::weather::model::{ModelField, ModelSettings};
 use skycast::weather::{
     CloudTypeRule, FieldSettings, LocalFrame, StationTable, WeatherField, files,
 };
@@ -197,6 +198,52 @@ impl Score {
 
 #[test]
 fn the_field_at_every_cloudy_station_is_its_report() {
+    let (at_station, in_block) = scores(false);
+    for (what, score) in [
+        ("at the stations", &at_station),
+        ("in their blocks", &in_block),
+    ] {
+        assert!(
+            score.layer_share() >= 0.99 && score.ceiling_share() >= 0.995,
+            "{what}: {}\nfirst misses:\n{}",
+            score.line(),
+            score.misses.join("\n")
+        );
+    }
+}
+
+/// With the GFS model under the reports ([`WeatherField::with_model`]) every station still
+/// gives its report: the round trip does not fall.
+#[test]
+fn with_a_model_under_them_every_cloudy_station_is_still_its_report() {
+    let (alone, alone_block) = scores(false);
+    let (with_model, with_model_block) = scores(true);
+    assert_eq!(
+        (with_model.layers_ok, with_model.ceilings_ok),
+        (alone.layers_ok, alone.ceilings_ok),
+        "at the stations: {} with the model, {} without",
+        with_model.line(),
+        alone.line()
+    );
+    assert_eq!(
+        (with_model_block.layers_ok, with_model_block.ceilings_ok),
+        (alone_block.layers_ok, alone_block.ceilings_ok),
+        "in their blocks: {} with the model, {} without",
+        with_model_block.line(),
+        alone_block.line()
+    );
+}
+
+/// The shipped GFS model file.
+pub(super) fn gfs() -> std::sync::Arc<ModelField> {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("weather/gfs-2011-01-10T12Z-f120-2p5deg.grib2");
+    std::sync::Arc::new(ModelField::load(&path).unwrap())
+}
+
+/// The bulk file's field (over the GFS model with `model`) scored at every cloudy station and
+/// in the station's block.
+fn scores(model: bool) -> (Score, Score) {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("weather");
     let stations = StationTable::load(&dir.join("nsd_cccc.txt")).unwrap();
     let file = files::load(Path::new(BULK_FILE), Some(&stations)).unwrap();
@@ -207,6 +254,11 @@ fn the_field_at_every_cloudy_station_is_its_report() {
         &FieldSettings::default(),
         &CloudTypeRule::default(),
     );
+    let field = if model {
+        field.with_model(gfs(), ModelSettings::default())
+    } else {
+        field
+    };
     // The stations the field holds: placed, one report per position (the latest, as the field
     // keeps it: by observation time, then by row).
     let key = |lat: f64, lon: f64| (lat.to_bits(), lon.to_bits());
@@ -243,20 +295,11 @@ fn the_field_at_every_cloudy_station_is_its_report() {
         let block = field.block_weather(frame.block_of(row.lat_deg, row.lon_deg));
         in_block.add(row, &block.layers);
     }
-    eprintln!("at the stations: {}", at_station.line());
-    eprintln!("in their blocks: {}", in_block.line());
+    let with = if model { " (model under them)" } else { "" };
+    eprintln!("at the stations{with}: {}", at_station.line());
+    eprintln!("in their blocks{with}: {}", in_block.line());
     assert!(cloudy.len() > 2_000, "{} cloudy stations", cloudy.len());
-    for (what, score) in [
-        ("at the stations", &at_station),
-        ("in their blocks", &in_block),
-    ] {
-        assert!(
-            score.layer_share() >= 0.99 && score.ceiling_share() >= 0.995,
-            "{what}: {}\nfirst misses:\n{}",
-            score.line(),
-            score.misses.join("\n")
-        );
-    }
+    (at_station, in_block)
 }
 
 /// The field of the whole bulk file and the weather at one of its stations.

@@ -8,4 +8,6 @@ mod field_bulk;
 mod fuzz_seeds;
 mod metar_bulk;
 mod metar_cli;
+mod model_blend;
+mod model_cli;
 mod weather_cli;

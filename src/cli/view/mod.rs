@@ -30,10 +30,13 @@ pub use controls::KEYS_HELP;
 /// Flags of `skycast view`.
 #[derive(Debug, Args)]
 pub struct ViewArgs {
-    /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, or a weather
-    /// theme (`.toml`).
+    /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, a weather
+    /// theme (`.toml`), or a weather model's GRIB2 file (told by its content).
     #[arg(long)]
     pub weather: PathBuf,
+    /// The model under the reports.
+    #[command(flatten)]
+    pub model: crate::cli::model::ModelArgs,
     /// Station table placing reports the file does not place.
     /// (default: NOAA's table built into skycast).
     #[arg(long)]
@@ -117,7 +120,13 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         anyhow::anyhow!(NO_DISPLAY)
     })?;
     let look = args.look.load()?;
-    let loaded = load(&args.weather, args.stations.as_deref(), None, None)?;
+    let loaded = load(
+        &args.weather,
+        args.model.model.as_deref(),
+        args.stations.as_deref(),
+        None,
+        None,
+    )?;
     let field = loaded
         .input
         .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);
@@ -139,7 +148,11 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         frames: args.frames,
         screenshots: args.screenshot_at.clone(),
         script,
-        start_unix_s: time_or_default(args.time)?,
+        start_unix_s: {
+            let unix_s = time_or_default(args.time)?;
+            crate::cli::model::warn_if_far_in_time(&loaded.input, unix_s);
+            unix_s
+        },
         aircraft: controls::Aircraft {
             position_m: glam::DVec3::new(0.0, 0.0, args.alt_ft * METRES_PER_FOOT),
             heading_deg: args.heading,

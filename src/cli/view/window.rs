@@ -82,6 +82,11 @@ impl Running {
             host.sky.set_weather_field(field);
         }
         if let Some((path, settle)) = &setup.watch {
+            // A `--model` stays under the watched reports.
+            let model = host.sky.world().field().model().map(|(m, _)| m.clone());
+            if model.is_some() {
+                host.sky.set_model(model);
+            }
             host.sky.set_weather(Weather::Watch {
                 path,
                 settle: *settle,

@@ -45,6 +45,9 @@ fn class_top_oktas(oktas: f64) -> f64 {
     }
 }
 
+/// How near an overcast (oktas short of 8) the sky seen from below is taken as one.
+const NEAR_OVERCAST_OKTAS: f64 = 0.5;
+
 /// The surface facts the layers' types and extents depend on.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Surface {
@@ -118,7 +121,10 @@ pub(super) fn blend(
             })
             .sum::<f64>()
             / total_weight;
-        let own = if below >= 8.0 - 1e-6 {
+        // Within half an okta of an overcast the summation principle cannot tell what a layer
+        // adds (it turned the last hundredth of an okta a neighbour 30 km off gave into
+        // several oktas of its own): above it, the layer's stations' own covers.
+        let own = if below >= 8.0 - NEAR_OVERCAST_OKTAS {
             m.members
                 .iter()
                 .map(|x| x.1 * x.2.cover_below_oktas)

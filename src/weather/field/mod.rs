@@ -19,6 +19,7 @@
 //! The block also carries its layers' cover at its rim ([`crate::weather::BlockCover`], `rim`),
 //! so that its clouds blend into the neighbours'. Settings: `config/weather_field.toml`.
 
+mod blend;
 mod layers;
 mod rim;
 mod rule;
@@ -29,9 +30,10 @@ mod tests;
 
 pub use rule::{Band, CloudTypeRule, LayerFacts, Reported, Rule};
 pub use sample::{LayerKind, StationLayer, StationSample};
-pub use settings::FieldSettings;
+pub use settings::{FieldSettings, StationHold};
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use glam::DVec2;
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
@@ -40,6 +42,7 @@ use super::block::{BlockIndex, BlockLayer, BlockWeather, Obscuration, Wind};
 use super::block_cover::RIM_POINTS_M;
 use super::files::PlacedReport;
 use super::frame::LocalFrame;
+use super::model::{ModelField, ModelSettings};
 use super::theme::Theme;
 
 /// A triangulation vertex: a station's local position and its index in the sample list.
@@ -58,8 +61,9 @@ impl HasPosition for Site {
 
 type Tri = DelaunayTriangulation<Site>;
 
-/// The weather everywhere, from placed reports.
-#[derive(Debug)]
+/// The weather everywhere, from placed reports (and a model under them,
+/// [`Self::with_model`]).
+#[derive(Debug, Clone)]
 pub struct WeatherField {
     frame: LocalFrame,
     settings: FieldSettings,
@@ -70,6 +74,10 @@ pub struct WeatherField {
     /// Where each block that holds a station is sampled: at that station (a sky station first,
     /// the one nearest the block centre).
     station_in_block: HashMap<BlockIndex, DVec2>,
+    /// A numerical weather model under the reports ([`Self::with_model`]).
+    model: Option<(Arc<ModelField>, ModelSettings)>,
+    /// Each sample's report age, hours behind the file's time (empty: all fresh).
+    report_ages_h: Vec<f64>,
 }
 
 /// Natural-neighbour weights of a point: (sample index, weight), weights summing to 1.
@@ -103,12 +111,40 @@ impl WeatherField {
         }
         let mut kept: Vec<&PlacedReport> = latest.into_values().collect();
         kept.sort_by_key(|p| p.line);
-        let placed = kept.into_iter().filter_map(|p| {
-            let sample = StationSample::of(p, settings)?;
-            let local = frame.to_local_m(p.position.latitude_deg, p.position.longitude_deg);
-            Some((local, sample))
-        });
-        Self::from_samples(frame, placed, settings, rule)
+        // Each report's age, hours behind the file's time (what a model under the reports fades
+        // them by, `model::BlendSettings`): the time 95 % of its reports are at or before, so
+        // that one station's clock running ahead does not age all the others.
+        let minutes = |p: &PlacedReport| {
+            p.report
+                .time
+                .map(|t| (i64::from(t.day) * 24 + i64::from(t.hour)) * 60 + i64::from(t.minute))
+        };
+        let mut times: Vec<i64> = kept.iter().filter_map(|p| minutes(p)).collect();
+        times.sort_unstable();
+        let newest = (!times.is_empty()).then(|| times[((times.len() - 1) * 95).div_ceil(100)]);
+        let mut ages_h = Vec::with_capacity(kept.len());
+        let placed: Vec<(DVec2, StationSample)> = kept
+            .into_iter()
+            .filter_map(|p| {
+                let sample = StationSample::of(p, settings)?;
+                let local = frame.to_local_m(p.position.latitude_deg, p.position.longitude_deg);
+                if !local.is_finite() {
+                    return None;
+                }
+                // A report of the month before (day 31 behind day 1) is a month's days back;
+                // one a little ahead of the file's time is fresh.
+                let age_min = match (newest, minutes(p)) {
+                    (Some(n), Some(m)) if m > n + 24 * 60 => n + 31 * 24 * 60 - m,
+                    (Some(n), Some(m)) => (n - m).max(0),
+                    _ => 0,
+                };
+                ages_h.push(age_min as f64 / 60.0);
+                Some((local, sample))
+            })
+            .collect();
+        let mut field = Self::from_samples(frame, placed, settings, rule);
+        field.report_ages_h = ages_h;
+        field
     }
 
     /// Builds the field of a weather theme in `frame`: its points, or, for a theme without
@@ -174,6 +210,57 @@ impl WeatherField {
             surface,
             clouds,
             station_in_block,
+            model: None,
+            report_ages_h: Vec::new(),
+        }
+    }
+
+    /// The field with a numerical weather model under its reports: near a station the report
+    /// rules, its weight fading with the distance to the nearest station
+    /// ([`super::model::BlendSettings::report_weight`]: the sky's stations for the layers, all
+    /// stations for the surface values) and with the reports' age
+    /// ([`super::model::BlendSettings::age_weight`]), and the model carries the rest; with no
+    /// reports, the model alone.
+    pub fn with_model(mut self, model: Arc<ModelField>, settings: ModelSettings) -> Self {
+        self.model = Some((model, settings));
+        self
+    }
+
+    /// Puts a model under the reports, or takes it away (`None`): [`Self::with_model`] on a
+    /// field already built.
+    pub fn set_model(&mut self, model: Option<(Arc<ModelField>, ModelSettings)>) {
+        self.model = model;
+    }
+
+    /// The model under the reports, if any, and its settings.
+    pub fn model(&self) -> Option<(&Arc<ModelField>, &ModelSettings)> {
+        self.model.as_ref().map(|(m, s)| (m, s))
+    }
+
+    /// The reports' weight at `point_m` against the model, 0..=1, over the stations of `tri`
+    /// whose natural-neighbour weights there are `w`: by the distance to the nearest station,
+    /// times the stations' age weights averaged by `w` (1 without a model, 0 with a model and
+    /// no station).
+    fn report_weight(&self, tri: &Tri, point_m: DVec2, w: &Weights) -> f64 {
+        let Some((_, settings)) = &self.model else {
+            return 1.0;
+        };
+        let p = Point2::new(point_m.x, point_m.y);
+        let by_distance = tri.nearest_neighbor(p).map_or(0.0, |v| {
+            let q = v.position();
+            let km = (q.x - p.x).hypot(q.y - p.y) / 1000.0;
+            settings.blend.report_weight(km)
+        });
+        let (mut by_age, mut total) = (0.0, 0.0);
+        for &(index, weight) in w {
+            let age_h = self.report_ages_h.get(index).copied().unwrap_or(0.0);
+            by_age += weight * settings.blend.age_weight(age_h);
+            total += weight;
+        }
+        if total > 0.0 {
+            by_distance * by_age / total
+        } else {
+            0.0
         }
     }
 
@@ -238,7 +325,10 @@ impl WeatherField {
 
     /// The weather at a local point (metres east/north).
     pub fn weather_at(&self, point_m: DVec2) -> BlockWeather {
-        self.weather_with(point_m, &weights(&self.surface, point_m))
+        self.weather_with(
+            point_m,
+            &weights(&self.surface, point_m, &self.settings.stations),
+        )
     }
 
     /// [`Self::weather_at`] and [`Self::gust_and_qnh_at`] at once: the stations' weights at the
@@ -248,14 +338,15 @@ impl WeatherField {
         point_m: DVec2,
         default_qnh_hpa: f64,
     ) -> (BlockWeather, f64, f64) {
-        let w = weights(&self.surface, point_m);
-        let (gust, qnh) = self.gust_and_qnh_with(&w, default_qnh_hpa);
+        let w = weights(&self.surface, point_m, &self.settings.stations);
+        let (gust, qnh) = self.gust_and_qnh_with(point_m, &w, default_qnh_hpa);
         (self.weather_with(point_m, &w), gust, qnh)
     }
 
     /// The cloud layers at a local point: the layers of [`Self::weather_at`] alone.
     fn layers_only_at(&self, point_m: DVec2) -> Vec<BlockLayer> {
-        let (surface, _) = self.surface_with(&weights(&self.surface, point_m));
+        let (surface, _) =
+            self.surface_with(&weights(&self.surface, point_m, &self.settings.stations));
         self.layers_at(point_m, surface)
     }
 
@@ -289,7 +380,7 @@ impl WeatherField {
         let east = value(&|s| s.wind_kt.map(|v| v[0]), 0.0);
         let north = value(&|s| s.wind_kt.map(|v| v[1]), 0.0);
         let wind = wind_from_velocity_kt(east, north);
-        BlockWeather {
+        let reported = BlockWeather {
             layers: self.layers_at(point_m, surface),
             visibility_m: value(&|s| s.visibility_m, d.visibility_m) as f32,
             obscuration: self.obscuration_at(w),
@@ -300,25 +391,63 @@ impl WeatherField {
             thunder: thunder as f32,
             ground_elevation_m: value(&|s| s.elevation_m, d.ground_elevation_m) as f32,
             cover: None,
+        };
+        match self.model_surface_at(point_m, w) {
+            Some((model, s)) => blend::surface(reported, s, &model),
+            None => reported,
         }
+    }
+
+    /// The model's weather at `point_m` and the surface stations' weight against it there, if
+    /// the field has a model and the stations do not rule alone.
+    fn model_surface_at(&self, point_m: DVec2, w: &Weights) -> Option<(BlockWeather, f64)> {
+        let (model, settings) = self.model.as_ref()?;
+        let s = self.report_weight(&self.surface, point_m, w);
+        let (lat, lon) = self.frame.to_lat_lon_deg(point_m);
+        (s < 1.0).then(|| (model.weather_at(lat, lon, settings), s))
     }
 
     /// The gust excess (knots above the mean wind, interpolated over the stations that report a
     /// wind) and the QNH (hPa, over those that report one; `default_qnh_hpa` where none does) at
     /// a local point: what [`crate::weather::air::SurfaceAir`] needs beyond the block weather.
     pub fn gust_and_qnh_at(&self, point_m: DVec2, default_qnh_hpa: f64) -> (f64, f64) {
-        self.gust_and_qnh_with(&weights(&self.surface, point_m), default_qnh_hpa)
+        self.gust_and_qnh_with(
+            point_m,
+            &weights(&self.surface, point_m, &self.settings.stations),
+            default_qnh_hpa,
+        )
     }
 
-    fn gust_and_qnh_with(&self, w: &Weights, default_qnh_hpa: f64) -> (f64, f64) {
+    fn gust_and_qnh_with(&self, point_m: DVec2, w: &Weights, default_qnh_hpa: f64) -> (f64, f64) {
         let gust = weighted(w, &self.samples, &|s| s.gust_excess_kt).unwrap_or(0.0);
         let qnh = weighted(w, &self.samples, &|s| s.qnh_hpa).unwrap_or(default_qnh_hpa);
-        (gust, qnh)
+        // Under a model: its sea-level pressure where the reports' weight fades.
+        let Some((model, _)) = &self.model else {
+            return (gust, qnh);
+        };
+        let s = self.report_weight(&self.surface, point_m, w);
+        let (lat, lon) = self.frame.to_lat_lon_deg(point_m);
+        // Gusts fade with the reports' weight (the model gives none here).
+        match model.qnh_hpa_at(lat, lon) {
+            Some(model_qnh) if s < 1.0 => (gust * s, qnh * s + model_qnh * (1.0 - s)),
+            _ => (gust, qnh),
+        }
     }
 
     fn layers_at(&self, point_m: DVec2, surface: layers::Surface) -> Vec<BlockLayer> {
-        let w = weights(&self.clouds, point_m);
-        layers::blend(&w, &self.samples, &self.settings, &self.rule, surface)
+        let w = weights(&self.clouds, point_m, &self.settings.stations);
+        let reported = layers::blend(&w, &self.samples, &self.settings, &self.rule, surface);
+        let Some((model, settings)) = &self.model else {
+            return reported;
+        };
+        let s = self.report_weight(&self.clouds, point_m, &w);
+        let (lat, lon) = self.frame.to_lat_lon_deg(point_m);
+        let modelled = if s < 1.0 {
+            model.layers_at(lat, lon, &settings.layers)
+        } else {
+            Vec::new()
+        };
+        blend::layers(reported, s, modelled)
     }
 
     /// The obscuration the neighbours reporting one carry the most weight for, if that weight
@@ -382,17 +511,27 @@ fn triangulate(sites: Vec<Site>) -> Tri {
     }
 }
 
-/// Natural-neighbour weights at a point; the nearest station alone outside the hull.
-fn weights(tri: &Tri, point_m: DVec2) -> Weights {
+/// Natural-neighbour weights at a point, each station's raised by its hold ([`StationHold`]:
+/// near a station its report rules); the nearest station alone outside the hull.
+fn weights(tri: &Tri, point_m: DVec2, hold: &StationHold) -> Weights {
     let p = Point2::new(point_m.x, point_m.y);
     let mut out = Vec::new();
     if tri.num_inner_faces() > 0 {
         let mut raw = Vec::new();
         tri.natural_neighbor().get_weights(p, &mut raw);
-        out.extend(
-            raw.into_iter()
-                .map(|(h, w)| (tri.vertex(h).data().index, w)),
-        );
+        let mut total = 0.0;
+        for (h, w) in raw {
+            let vertex = tri.vertex(h);
+            let at = vertex.position();
+            let raised = w * hold.raise_at((at.x - p.x).hypot(at.y - p.y));
+            total += raised;
+            out.push((vertex.data().index, raised));
+        }
+        if total > 0.0 {
+            for (_, w) in &mut out {
+                *w /= total;
+            }
+        }
     }
     if out.is_empty()
         && let Some(v) = tri.nearest_neighbor(p)

@@ -30,6 +30,10 @@ pub struct FieldSettings {
     pub convective: Convective,
     /// Which interpolated layers are kept.
     pub layers: Layers,
+    /// How far around a station its own report holds before the interpolation takes over
+    /// (absent from an older file: the shipped values).
+    #[serde(default)]
+    pub stations: StationHold,
     /// Precipitation intensity by present-weather intensity.
     pub precipitation: Precipitation,
     /// Fall-back values.
@@ -169,6 +173,42 @@ pub struct Layers {
     pub min_thickness_ft: f64,
 }
 
+/// How far around a station its own report holds. A METAR describes the sky over its station
+/// and its vicinity (the 5-10 statute miles an observer's "VC" means; an automatic station's
+/// ceilometer sees the clouds the wind carries over it in 30 minutes), not a point: within
+/// `hold_m` the station's natural-neighbour weight is raised `hold_weight` times, and from there
+/// to `hold_m + fade_m` the raise fades out. Two stations inside each other's hold blend as
+/// before (both are raised alike), so the field stays continuous.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StationHold {
+    /// Distance from a station within which its report holds, metres.
+    pub hold_m: f64,
+    /// Distance over which the hold fades to plain interpolation, metres.
+    pub fade_m: f64,
+    /// How many times a station's weight is raised within the hold (1: no hold).
+    pub hold_weight: f64,
+}
+
+impl Default for StationHold {
+    /// The shipped values (`[stations]` of `config/weather_field.toml`).
+    fn default() -> Self {
+        FieldSettings::default().stations
+    }
+}
+
+impl StationHold {
+    /// The factor a station's weight is raised by at `distance_m` from it: `hold_weight`
+    /// within `hold_m`, falling to 1 over `fade_m` evenly in its logarithm (a weight raised
+    /// 50 times hardly moves until the raise is a few times; a linear fall left the whole
+    /// change to the fade's last kilometre).
+    pub fn raise_at(&self, distance_m: f64) -> f64 {
+        let t = ((self.hold_m + self.fade_m - distance_m) / self.fade_m.max(1e-9)).clamp(0.0, 1.0);
+        // Smoothstep: the weights' slope does not step where the fade starts or ends.
+        self.hold_weight.powf(t * t * (3.0 - 2.0 * t))
+    }
+}
+
 /// Precipitation intensity 0..=1 per present-weather intensity.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -253,6 +293,24 @@ impl FieldSettings {
         if !(0.0..=8.0).contains(&l.min_added_oktas) {
             return Err(bad("layers.min_added_oktas", "must be within 0..=8"));
         }
+        let h = &self.stations;
+        for (field, ok, message) in [
+            (
+                "stations.hold_m",
+                h.hold_m >= 0.0,
+                "must be at least 0 metres",
+            ),
+            ("stations.fade_m", h.fade_m > 0.0, "must be above 0 metres"),
+            (
+                "stations.hold_weight",
+                h.hold_weight >= 1.0 && h.hold_weight.is_finite(),
+                "must be at least 1 (1: no hold)",
+            ),
+        ] {
+            if !ok {
+                return Err(bad(field, message));
+            }
+        }
         if !(0.0..=1.0).contains(&self.convective.weight_min) {
             return Err(bad("convective.weight_min", "must be within 0..=1"));
         }
@@ -309,6 +367,25 @@ mod tests {
             )),
             "{err}"
         );
+    }
+
+    #[test]
+    fn a_bad_station_hold_names_its_own_field() {
+        for (line, field) in [
+            ("fade_m = 5000.0", "stations.fade_m"),
+            ("hold_m = 5000.0", "stations.hold_m"),
+            ("hold_weight = 50.0", "stations.hold_weight"),
+        ] {
+            let key = line.split(' ').next().unwrap();
+            let text = BUILTIN.replace(line, &format!("{key} = -1.0"));
+            let err = FieldSettings::parse(&text, Path::new("f.toml")).unwrap_err();
+            let at = BUILTIN.lines().position(|l| l == line).unwrap() + 1;
+            assert!(
+                err.to_string()
+                    .starts_with(&format!("f.toml:{at}: field `{field}`")),
+                "{err}"
+            );
+        }
     }
 
     #[test]

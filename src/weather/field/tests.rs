@@ -508,3 +508,107 @@ fn cb_and_tcu_keep_their_own_amount_above_a_deck() {
         .expect("the CB layer");
     assert_eq!(cells.coverage_oktas, 2.0, "{layers:?}");
 }
+
+/// Around a station its report holds: within `[stations] hold_m` the layers are the station's
+/// (its weight raised `hold_weight` times), beyond the fade they are the plain blend, and the
+/// way from one to the other has no step (the raise fades in a smoothstep).
+#[test]
+fn a_report_holds_around_its_station_and_fades_without_a_step() {
+    let f = pair(
+        vec![layer(Cover::Ovc, 1000, None)],
+        vec![layer(Cover::Few, 4000, None)],
+    );
+    let hold = f.settings().stations;
+    assert!(hold.hold_m >= 3_000.0 && hold.hold_weight > 1.0, "{hold:?}");
+    let west = f.frame().to_local_m(LAT0, 7.5);
+    let east = f.frame().to_local_m(LAT0, 8.5);
+    let towards_east = (east - west).normalize();
+    let ovc_at = |d: f64| {
+        f.weather_at(west + towards_east * d)
+            .layers
+            .iter()
+            .find(|l| l.base_ft_agl < 2000.0)
+            .map_or(0.0, |l| l.coverage_oktas)
+    };
+    // Within the hold, 8 oktas to within a tenth: the western station's overcast, where plain
+    // natural-neighbour weights 3 km out gave the eastern station's clear sky some say.
+    for d in [1_000.0, 3_000.0, 0.9 * hold.hold_m] {
+        assert!(ovc_at(d) > 7.9, "{d} m: {}", ovc_at(d));
+    }
+    let plain = FieldSettings {
+        stations: crate::weather::field::StationHold {
+            hold_weight: 1.0,
+            ..hold
+        },
+        ..FieldSettings::default()
+    };
+    let unheld = WeatherField::build(
+        LocalFrame::new(LAT0, LON0),
+        &[
+            station(
+                LAT0,
+                7.5,
+                1,
+                report(vec![layer(Cover::Ovc, 1000, None)], 10.0, 270),
+            ),
+            station(
+                LAT0,
+                8.5,
+                2,
+                report(vec![layer(Cover::Few, 4000, None)], 10.0, 270),
+            ),
+            station(48.0, 6.0, 3, cavok(10.0)),
+            station(52.0, 10.0, 4, cavok(10.0)),
+            station(48.0, 10.0, 5, cavok(10.0)),
+            station(52.0, 6.0, 6, cavok(10.0)),
+        ],
+        &plain,
+        &CloudTypeRule::default(),
+    );
+    let beyond = hold.hold_m + hold.fade_m + 5_000.0;
+    let at = west + towards_east * beyond;
+    assert_eq!(f.weather_at(at), unheld.weather_at(at), "{beyond} m");
+    // 50 m steps through the fade: the cover changes by a few hundredths at most a step.
+    let mut last = ovc_at(hold.hold_m - 500.0);
+    let mut d = hold.hold_m - 450.0;
+    while d < hold.hold_m + hold.fade_m + 500.0 {
+        let now = ovc_at(d);
+        assert!((now - last).abs() < 0.05, "{d} m: {last} -> {now}");
+        last = now;
+        d += 50.0;
+    }
+}
+
+#[test]
+fn the_hold_raises_a_station_smoothly() {
+    let hold = FieldSettings::default().stations;
+    assert_eq!(hold.raise_at(0.0), hold.hold_weight);
+    assert_eq!(hold.raise_at(hold.hold_m), hold.hold_weight);
+    assert_eq!(hold.raise_at(hold.hold_m + hold.fade_m), 1.0);
+    let mid = hold.raise_at(hold.hold_m + 0.5 * hold.fade_m);
+    assert!((mid - hold.hold_weight.sqrt()).abs() < 1e-9, "{mid}");
+}
+
+/// Above a sky that is all but overcast from below, a layer only a distant station reports
+/// keeps that station's share of its own cover: the summation principle, asked what it adds to
+/// 7.99 oktas, made a few oktas of it out of a hundredth.
+#[test]
+fn a_far_stations_layer_over_a_near_overcast_stays_faint() {
+    let f = pair(
+        vec![layer(Cover::Ovc, 1000, None)],
+        vec![layer(Cover::Few, 1000, None), layer(Cover::Bkn, 4000, None)],
+    );
+    let west = f.frame().to_local_m(LAT0, 7.5);
+    let east = f.frame().to_local_m(LAT0, 8.5);
+    for km in [4.0, 6.0, 8.0] {
+        let at = west + (east - west).normalize() * km * 1000.0;
+        let layers = f.weather_at(at).layers;
+        let low = layers[0].coverage_oktas;
+        assert!(low > 7.5, "{km} km: {layers:?}");
+        let upper = layers
+            .iter()
+            .find(|l| l.base_ft_agl > 3000.0)
+            .map_or(0.0, |l| l.coverage_oktas);
+        assert!(upper < 1.0, "{km} km: {layers:?}");
+    }
+}
