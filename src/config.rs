@@ -1,6 +1,8 @@
 //! Loading TOML files (config, themes, flight paths) with errors a user can act on: every error
 //! names the file, the line and the field. Each stage deserialises its own types with serde; this
-//! module only turns text into them and turns failures into [`ConfigError`].
+//! module only turns text into them and turns failures into [`ConfigError`]. Every settings file
+//! type (`config/*.toml`) implements [`TomlSettings`], which reads, parses, checks and defaults
+//! it in one way.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -63,9 +65,134 @@ impl ConfigError {
 
 /// Reads and parses a TOML file.
 pub fn load_toml<T: DeserializeOwned>(path: &Path) -> Result<T, ConfigError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
+    let text = read_text(path)?;
     parse_toml(&text, path)
+}
+
+/// Reads a text file; the error names the file.
+pub fn read_text(path: &Path) -> Result<String, ConfigError> {
+    std::fs::read_to_string(path)
+        .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))
+}
+
+/// A settings file that skycast ships in `config/` and compiles in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ShippedFile {
+    /// Where it lives in the repository (`config/fog.toml`): the path its errors name.
+    pub path: &'static str,
+    /// Its text (`include_str!` of that file).
+    pub text: &'static str,
+}
+
+impl ShippedFile {
+    /// The shipped file at `path` (in the repository) whose text is `text`, in the `Some` that
+    /// [`TomlSettings::SHIPPED`] takes.
+    pub const fn at(path: &'static str, text: &'static str) -> Option<Self> {
+        Some(Self { path, text })
+    }
+}
+
+/// A TOML settings file type: how it is read, parsed, checked and defaulted, the same for every
+/// settings type of every stage.
+///
+/// A type says only what is its own: its range checks ([`check`](Self::check), which accepts
+/// everything unless overridden) and its shipped file ([`SHIPPED`](Self::SHIPPED)), when there
+/// is one. [`parse`](Self::parse) and [`load`](Self::load) then give errors that name the file,
+/// the line and the field ([`ConfigError`]), whether serde or a range check refused the text.
+/// A type with a shipped file implements [`Default`] as [`shipped`](Self::shipped).
+///
+/// ```
+/// use std::path::Path;
+///
+/// use serde::Deserialize;
+/// use skycast::config::{ConfigError, ShippedFile, TomlSettings};
+///
+/// /// `config/haze.toml`.
+/// #[derive(Debug, Deserialize)]
+/// #[serde(deny_unknown_fields)]
+/// struct HazeSettings {
+///     /// Visibility in clear air, metres.
+///     clear_visibility_m: f32,
+/// }
+///
+/// impl Default for HazeSettings {
+///     fn default() -> Self {
+///         Self::shipped()
+///     }
+/// }
+///
+/// impl TomlSettings for HazeSettings {
+///     // The text is `include_str!("../config/haze.toml")`, say.
+///     const SHIPPED: Option<ShippedFile> =
+///         ShippedFile::at("config/haze.toml", "clear_visibility_m = 40000.0\n");
+///
+///     fn check(&self, path: &Path, text: &str) -> Result<(), ConfigError> {
+///         if !(self.clear_visibility_m >= 1.0) {
+///             let message = "must be at least 1 metre";
+///             return Err(ConfigError::at_key(path, text, "clear_visibility_m", message));
+///         }
+///         Ok(())
+///     }
+/// }
+///
+/// assert_eq!(HazeSettings::default().clear_visibility_m, 40000.0);
+/// let err = HazeSettings::parse("clear_visibility_m = 0.5\n", Path::new("my_haze.toml"));
+/// assert_eq!(
+///     err.unwrap_err().to_string(),
+///     "my_haze.toml:1: field `clear_visibility_m`: must be at least 1 metre"
+/// );
+/// // No file given: the shipped defaults.
+/// assert_eq!(HazeSettings::load_or_default(None)?.clear_visibility_m, 40000.0);
+/// # Ok::<(), ConfigError>(())
+/// ```
+pub trait TomlSettings: DeserializeOwned + Default {
+    /// The shipped file of these settings, when there is one: what [`shipped`](Self::shipped)
+    /// parses.
+    const SHIPPED: Option<ShippedFile> = None;
+
+    /// Checks the ranges and the rules between fields that serde cannot, once the `text` from
+    /// `path` has parsed; an error names the field and its line ([`ConfigError::at_key`]). The
+    /// default accepts everything.
+    fn check(&self, path: &Path, text: &str) -> Result<(), ConfigError> {
+        let _ = (path, text);
+        Ok(())
+    }
+
+    /// Parses and checks settings text that came from `path` (used in messages only).
+    fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
+        let settings: Self = parse_toml(text, path)?;
+        settings.check(path, text)?;
+        Ok(settings)
+    }
+
+    /// Reads, parses and checks a settings file.
+    fn load(path: &Path) -> Result<Self, ConfigError> {
+        let text = read_text(path)?;
+        Self::parse(&text, path)
+    }
+
+    /// The settings file at `path`, or the defaults when there is none.
+    fn load_or_default(path: Option<&Path>) -> Result<Self, ConfigError> {
+        path.map_or_else(|| Ok(Self::default()), Self::load)
+    }
+
+    /// The shipped settings: [`SHIPPED`](Self::SHIPPED) parsed and checked. A type with a
+    /// shipped file implements [`Default`] as this; for one without, it is `Default::default()`
+    /// (so that type's `Default` must not call it).
+    ///
+    /// # Panics
+    ///
+    /// When the shipped file does not parse or check: a bug of the build, which
+    /// `config::tests::shipped_settings_parse_and_match_their_files` catches.
+    fn shipped() -> Self {
+        let Some(file) = Self::SHIPPED else {
+            return Self::default();
+        };
+        match Self::parse(file.text, Path::new(file.path)) {
+            Ok(settings) => settings,
+            Err(err) => panic!("the shipped {}: {err}", file.path),
+        }
+    }
 }
 
 /// Parses TOML text that came from `path` (used in messages only).
@@ -195,6 +322,30 @@ mod tests {
     #[test]
     fn syntax_error_has_a_line() {
         assert_eq!(error_of("name = \"a\"\nsize_m = \n").line, Some(2));
+    }
+
+    /// Every settings type's shipped file parses and checks, and is the file it says it is.
+    #[test]
+    fn shipped_settings_parse_and_match_their_files() {
+        fn shipped<T: TomlSettings>() {
+            let file = T::SHIPPED.expect("a shipped file");
+            let on_disk = Path::new(env!("CARGO_MANIFEST_DIR")).join(file.path);
+            let text = std::fs::read_to_string(&on_disk).unwrap_or_else(|err| panic!("{err}"));
+            assert_eq!(text, file.text, "{} is not the file built in", file.path);
+            if let Err(err) = T::parse(file.text, Path::new(file.path)) {
+                panic!("{err}");
+            }
+            if let Err(err) = T::load(&on_disk) {
+                panic!("{err}");
+            }
+        }
+        shipped::<crate::shading::FogSettings>();
+        shipped::<crate::shading::TimeOfDayTable>();
+        shipped::<crate::weather::air::AirSettings>();
+        shipped::<crate::weather::storms::StormSettings>();
+        shipped::<crate::weather::field::CloudTypeRule>();
+        shipped::<crate::weather::field::FieldSettings>();
+        shipped::<crate::weather::model::ModelSettings>();
     }
 
     #[test]

@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 
 use anyhow::{Context, bail};
+use skycast::config::{ConfigError, TomlSettings};
 use skycast::weather::StationTable;
 
 /// The environment variable `--config-dir` falls back to.
@@ -97,6 +98,12 @@ fn in_config_dir(name: &str) -> Option<PathBuf> {
 /// `None` (the built-in settings).
 pub fn settings_file(flag: Option<&Path>, name: &str) -> Option<PathBuf> {
     flag.map(Path::to_path_buf).or_else(|| in_config_dir(name))
+}
+
+/// Settings of type `T`: the file the flag names, else the config folder's `name`, else the
+/// shipped defaults.
+pub fn settings<T: TomlSettings>(flag: Option<&Path>, name: &str) -> Result<T, ConfigError> {
+    T::load_or_default(settings_file(flag, name).as_deref())
 }
 
 /// The station table: the file `--stations` names, else the config folder's `nsd_cccc.txt`,

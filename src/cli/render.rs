@@ -276,11 +276,8 @@ pub fn load_look(
     if let Some(scale) = cloud_scale {
         settings.clouds.resolution_scale = scale;
     }
-    let table = match defaults::settings_file(time_of_day.map(PathBuf::as_path), "time_of_day.toml")
-    {
-        Some(p) => TimeOfDayTable::load(&p)?,
-        None => TimeOfDayTable::default(),
-    };
+    let table: TimeOfDayTable =
+        defaults::settings(time_of_day.map(PathBuf::as_path), "time_of_day.toml")?;
     Ok((settings, table))
 }
 

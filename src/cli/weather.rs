@@ -251,14 +251,8 @@ pub fn load(
         Some(path) => super::model::attach(input, path, file)?,
         None => input,
     };
-    let rule = match defaults::settings_file(rule, "cloud_type_rule.toml") {
-        Some(path) => CloudTypeRule::load(&path)?,
-        None => CloudTypeRule::default(),
-    };
-    let settings = match defaults::settings_file(field_settings, "weather_field.toml") {
-        Some(path) => FieldSettings::load(&path)?,
-        None => FieldSettings::default(),
-    };
+    let rule: CloudTypeRule = defaults::settings(rule, "cloud_type_rule.toml")?;
+    let settings: FieldSettings = defaults::settings(field_settings, "weather_field.toml")?;
     Ok(Loaded {
         input,
         settings,
@@ -299,10 +293,8 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
     }
     let air = match (args.at, args.alt_ft) {
         (Some((lat, lon)), Some(alt_ft)) => {
-            let settings = match defaults::settings_file(args.air_settings.as_deref(), "air.toml") {
-                Some(path) => AirSettings::load(&path)?,
-                None => AirSettings::default(),
-            };
+            let settings: AirSettings =
+                defaults::settings(args.air_settings.as_deref(), "air.toml")?;
             let aloft = args.aloft.load(args.stations.as_deref())?;
             Some(air_at(&loaded, lat, lon, alt_ft, settings, aloft.as_ref())?)
         }

@@ -7,7 +7,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::spline::{self, Key};
-use crate::config::{ConfigError, parse_toml};
+use crate::config::{ConfigError, parse_toml, read_text};
 use crate::weather::METRES_PER_FOOT;
 use crate::weather::frame::LocalFrame;
 
@@ -132,8 +132,7 @@ struct PointFile {
 impl FlightPlan {
     /// Reads and validates a flight-path file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
+        let text = read_text(path)?;
         Self::parse(&text, path)
     }
 

@@ -28,7 +28,7 @@ use glam::Vec3;
 use serde::Deserialize;
 
 use super::luminance;
-use crate::config::{ConfigError, parse_toml};
+use crate::config::{ConfigError, ShippedFile, TomlSettings};
 use crate::weather::block::{BlockWeather, Obscuration};
 
 /// The shipped settings file, built in.
@@ -173,49 +173,46 @@ pub struct Fog {
     pub rgb: Vec3,
 }
 
-impl FogSettings {
-    /// Reads settings from a TOML file.
-    pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::parse(&text, path)
-    }
+impl TomlSettings for FogSettings {
+    const SHIPPED: Option<ShippedFile> = ShippedFile::at("config/fog.toml", BUILTIN);
 
-    /// Parses settings text that came from `path`.
-    pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
-        let s: Self = parse_toml(text, path)?;
+    fn check(&self, path: &Path, text: &str) -> Result<(), ConfigError> {
         let bad = |field: &str, message: &str| ConfigError::at_key(path, text, field, message);
-        if !(s.extinction_times_visibility > 0.0 && s.extinction_times_visibility.is_finite()) {
+        if !(self.extinction_times_visibility > 0.0 && self.extinction_times_visibility.is_finite())
+        {
             return Err(bad("extinction_times_visibility", "must be above 0"));
         }
-        if !(s.capped_visibility_m > 0.0 && s.clear_visibility_m >= s.capped_visibility_m) {
+        if !(self.capped_visibility_m > 0.0 && self.clear_visibility_m >= self.capped_visibility_m)
+        {
             return Err(bad(
                 "clear_visibility_m",
                 "must be at least capped_visibility_m, which must be above 0",
             ));
         }
-        if !(0.0..=1.0).contains(&s.tint) {
+        if !(0.0..=1.0).contains(&self.tint) {
             return Err(bad("tint", "must be within 0..=1"));
         }
-        if !(s.rain_visibility_m >= 1.0 && s.rain_visibility_m.is_finite()) {
+        if !(self.rain_visibility_m >= 1.0 && self.rain_visibility_m.is_finite()) {
             return Err(bad("rain_visibility_m", "must be at least 1 metre"));
         }
         let at_least_1 = [
             (
                 "boundary_layer_scale_height_m",
-                s.boundary_layer_scale_height_m,
+                self.boundary_layer_scale_height_m,
             ),
-            ("clear_air_visibility_m", s.clear_air_visibility_m),
-            ("clear_air_scale_height_m", s.clear_air_scale_height_m),
+            ("clear_air_visibility_m", self.clear_air_visibility_m),
+            ("clear_air_scale_height_m", self.clear_air_scale_height_m),
         ];
         for (field, value) in at_least_1 {
             if !(value >= 1.0 && value.is_finite()) {
                 return Err(bad(field, "must be at least 1 metre"));
             }
         }
-        Ok(s)
+        Ok(())
     }
+}
 
+impl FogSettings {
     /// The visibility a weather is drawn with, metres: the reported one, clear air for a capped
     /// report, never under 1 m.
     pub fn visibility_m(&self, weather: &BlockWeather) -> f32 {
@@ -299,10 +296,7 @@ impl FogSettings {
 impl Default for FogSettings {
     /// The shipped `config/fog.toml` (a test proves it parses).
     fn default() -> Self {
-        match Self::parse(BUILTIN, Path::new("config/fog.toml")) {
-            Ok(s) => s,
-            Err(err) => panic!("built-in config/fog.toml: {err}"),
-        }
+        Self::shipped()
     }
 }
 

@@ -8,11 +8,8 @@ use std::path::Path;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::{
-    DirectionalMapping, ForwardScattering, HarrisLastra, OvercastLight, ShadingError,
-    ShadingSettings,
-};
-use crate::config::{ConfigError, line_of, parse_toml};
+use super::{DirectionalMapping, ForwardScattering, HarrisLastra, OvercastLight, ShadingSettings};
+use crate::config::{ConfigError, ShippedFile, TomlSettings, line_of};
 
 /// The built-in table, `config/time_of_day.toml`.
 pub const DEFAULT_TIME_OF_DAY_TOML: &str = include_str!("../../config/time_of_day.toml");
@@ -70,38 +67,37 @@ pub struct TimeOfDay {
 }
 
 impl Default for TimeOfDayTable {
-    /// The shipped `config/time_of_day.toml` (built in; a test checks that it parses).
+    /// The shipped `config/time_of_day.toml` (a test proves it parses).
     fn default() -> Self {
-        Self::parse(
-            DEFAULT_TIME_OF_DAY_TOML,
-            Path::new("config/time_of_day.toml"),
-        )
-        .expect("the shipped config/time_of_day.toml is valid (tested)")
+        Self::shipped()
     }
 }
 
-impl TimeOfDayTable {
-    /// Parses and checks a table; `path` names the file in errors.
-    pub fn parse(text: &str, path: &Path) -> Result<Self, ShadingError> {
-        let table: Self = parse_toml(text, path)?;
+impl TomlSettings for TimeOfDayTable {
+    const SHIPPED: Option<ShippedFile> =
+        ShippedFile::at("config/time_of_day.toml", DEFAULT_TIME_OF_DAY_TOML);
+
+    /// At least one row, rows in increasing sun elevation, and the tables' ranges.
+    fn check(&self, path: &Path, text: &str) -> Result<(), ConfigError> {
         // Rows are checked after parsing; the line is that of the row's elevation key.
         let row_line = |row: usize| {
             text.match_indices("[[sample]]")
                 .nth(row)
                 .map(|(offset, _)| line_of(text, offset))
         };
-        let invalid = |row: usize, field: &str, message: String| {
-            ShadingError::Config(ConfigError {
-                path: path.to_path_buf(),
-                line: row_line(row),
-                field: Some(field.to_owned()),
-                message,
-            })
+        let invalid = |row: usize, field: &str, message: String| ConfigError {
+            path: path.to_path_buf(),
+            line: row_line(row),
+            field: Some(field.to_owned()),
+            message,
         };
-        if table.samples.is_empty() {
-            return Err(ConfigError::whole_file(path, "needs at least one [[sample]]").into());
+        if self.samples.is_empty() {
+            return Err(ConfigError::whole_file(
+                path,
+                "needs at least one [[sample]]",
+            ));
         }
-        for (i, pair) in table.samples.windows(2).enumerate() {
+        for (i, pair) in self.samples.windows(2).enumerate() {
             if pair[1].sun_elevation_deg <= pair[0].sun_elevation_deg {
                 return Err(invalid(
                     i + 1,
@@ -115,7 +111,7 @@ impl TimeOfDayTable {
                 ));
             }
         }
-        for (i, s) in table.samples.iter().enumerate() {
+        for (i, s) in self.samples.iter().enumerate() {
             if !(0.0..=4.0).contains(&s.ambient_percent) {
                 return Err(invalid(
                     i,
@@ -124,24 +120,19 @@ impl TimeOfDayTable {
                 ));
             }
         }
-        let invalid = table
+        let invalid = self
             .overcast
             .invalid_field()
-            .or(table.forward_scattering.invalid_field())
-            .or(table.harris_lastra.invalid_field());
+            .or(self.forward_scattering.invalid_field())
+            .or(self.harris_lastra.invalid_field());
         if let Some((field, message)) = invalid {
-            return Err(ConfigError::at_key(path, text, field, message).into());
+            return Err(ConfigError::at_key(path, text, field, message));
         }
-        Ok(table)
+        Ok(())
     }
+}
 
-    /// Reads and checks a table file.
-    pub fn load(path: &Path) -> Result<Self, ShadingError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::parse(&text, path)
-    }
-
+impl TimeOfDayTable {
     /// The light when the sun stands at `sun_elevation_deg`.
     pub fn at(&self, sun_elevation_deg: f32) -> TimeOfDay {
         let s = &self.samples;

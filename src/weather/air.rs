@@ -29,7 +29,7 @@ use serde::{Deserialize, Serialize};
 
 use super::block::{BlockWeather, Wind};
 use super::winds_aloft::AloftColumn;
-use crate::config::{ConfigError, parse_toml};
+use crate::config::{ConfigError, ShippedFile, TomlSettings};
 
 /// The shipped settings file, built in.
 const BUILTIN: &str = include_str!("../../config/air.toml");
@@ -176,27 +176,19 @@ pub struct IcingSettings {
 }
 
 impl Default for AirSettings {
-    /// The shipped `config/air.toml` (built in; a test checks that it parses).
+    /// The shipped `config/air.toml` (a test proves it parses).
     fn default() -> Self {
-        Self::parse(BUILTIN, Path::new("config/air.toml"))
-            .expect("the shipped config/air.toml is valid (tested)")
+        Self::shipped()
     }
 }
 
-impl AirSettings {
-    /// Reads settings from a TOML file.
-    pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::parse(&text, path)
-    }
+impl TomlSettings for AirSettings {
+    const SHIPPED: Option<ShippedFile> = ShippedFile::at("config/air.toml", BUILTIN);
 
-    /// Parses settings text that came from `path`, checking every range.
-    pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
-        let s: Self = parse_toml(text, path)?;
+    fn check(&self, path: &Path, text: &str) -> Result<(), ConfigError> {
         let bad = |field: &str, message: &str| ConfigError::at_key(path, text, field, message);
         let positive = |v: f64| v > 0.0 && v.is_finite();
-        let w = &s.wind;
+        let w = &self.wind;
         if !positive(w.reference_height_m) {
             return Err(bad("wind.reference_height_m", "must be above 0"));
         }
@@ -223,7 +215,7 @@ impl AirSettings {
                 return Err(bad("wind.aloft.level_m_msl", "must be a number"));
             }
         }
-        let t = &s.temperature;
+        let t = &self.temperature;
         if !(0.0..=20.0).contains(&t.lapse_c_per_km) {
             return Err(bad("temperature.lapse_c_per_km", "must be within 0..=20"));
         }
@@ -236,10 +228,10 @@ impl AirSettings {
                 "must be within 0..=20",
             ));
         }
-        if !(800.0..=1100.0).contains(&s.pressure.default_qnh_hpa) {
+        if !(800.0..=1100.0).contains(&self.pressure.default_qnh_hpa) {
             return Err(bad("pressure.default_qnh_hpa", "must be within 800..=1100"));
         }
-        let c = &s.in_cloud;
+        let c = &self.in_cloud;
         if !(c.ramp_fraction > 0.0 && c.ramp_fraction <= 1.0) {
             return Err(bad("in_cloud.ramp_fraction", "must be within (0, 1]"));
         }
@@ -252,7 +244,7 @@ impl AirSettings {
         if !(c.grid_cell_m >= 50.0 && c.grid_cell_m <= 10_000.0) {
             return Err(bad("in_cloud.grid_cell_m", "must be within 50..=10000"));
         }
-        let p = &s.precipitation;
+        let p = &self.precipitation;
         if !(0.0 <= p.light_mm_h
             && p.light_mm_h <= p.moderate_mm_h
             && p.moderate_mm_h <= p.heavy_mm_h
@@ -263,7 +255,7 @@ impl AirSettings {
                 "rates must grow: 0 <= light_mm_h <= moderate_mm_h <= heavy_mm_h",
             ));
         }
-        let u = &s.turbulence;
+        let u = &self.turbulence;
         if !(positive(u.cb_near_m) && u.cb_near_m <= c.search_radius_m) {
             return Err(bad(
                 "turbulence.cb_near_m",
@@ -293,14 +285,14 @@ impl AirSettings {
                 "must be above mechanical_from_kt, which must be at least 0",
             ));
         }
-        let i = &s.icing;
+        let i = &self.icing;
         if !(i.coldest_c < i.warmest_c && i.warmest_c.is_finite() && i.coldest_c.is_finite()) {
             return Err(bad("icing.coldest_c", "must be below icing.warmest_c"));
         }
         if !(0.0..=1.0).contains(&i.in_cloud_min) {
             return Err(bad("icing.in_cloud_min", "must be within 0..=1"));
         }
-        Ok(s)
+        Ok(())
     }
 }
 

@@ -29,7 +29,7 @@ use serde::{Deserialize, Serialize};
 use super::air::{SurfaceAir, WindSettings, wind_at};
 use super::block::{BlockWeather, METRES_PER_FOOT};
 use super::cloud_type::CloudType;
-use crate::config::{ConfigError, parse_toml};
+use crate::config::{ConfigError, ShippedFile, TomlSettings};
 
 /// The shipped settings file, built in.
 const BUILTIN: &str = include_str!("../../config/storms.toml");
@@ -110,27 +110,19 @@ pub struct LightningSettings {
 }
 
 impl Default for StormSettings {
-    /// The shipped `config/storms.toml` (built in; a test checks that it parses).
+    /// The shipped `config/storms.toml` (a test proves it parses).
     fn default() -> Self {
-        Self::parse(BUILTIN, Path::new("config/storms.toml"))
-            .expect("the shipped config/storms.toml is valid (tested)")
+        Self::shipped()
     }
 }
 
-impl StormSettings {
-    /// Reads settings from a TOML file.
-    pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::parse(&text, path)
-    }
+impl TomlSettings for StormSettings {
+    const SHIPPED: Option<ShippedFile> = ShippedFile::at("config/storms.toml", BUILTIN);
 
-    /// Parses settings text that came from `path`, checking every range.
-    pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
-        let s: Self = parse_toml(text, path)?;
+    fn check(&self, path: &Path, text: &str) -> Result<(), ConfigError> {
         let bad = |field: &str, message: &str| ConfigError::at_key(path, text, field, message);
         let range = |r: [f64; 2], lo: f64| r[0] >= lo && r[0] <= r[1] && r[1].is_finite();
-        let c = &s.cells;
+        let c = &self.cells;
         if !(c.grid_m >= 1000.0 && c.grid_m.is_finite()) {
             return Err(bad("cells.grid_m", "must be at least 1000"));
         }
@@ -170,7 +162,7 @@ impl StormSettings {
                 "must be [low, high] with 1 <= low <= high <= 12",
             ));
         }
-        let l = &s.lightning;
+        let l = &self.lightning;
         if !l
             .flashes_per_minute
             .iter()
@@ -196,7 +188,7 @@ impl StormSettings {
         if !(l.reach_m >= 10.0 && l.reach_m <= 50_000.0) {
             return Err(bad("lightning.reach_m", "must be within 10..=50000"));
         }
-        let f = &s.far;
+        let f = &self.far;
         if !(f.reach_m >= 0.0 && f.reach_m <= 2_000_000.0) {
             return Err(bad("far.reach_m", "must be within 0..=2000000"));
         }
@@ -225,9 +217,11 @@ impl StormSettings {
         if !(0.0..=600.0).contains(&f.fade_s) {
             return Err(bad("far.fade_s", "must be within 0..=600"));
         }
-        Ok(s)
+        Ok(())
     }
+}
 
+impl StormSettings {
     /// How far from its grid square's centre a cell reaches at most (jitter, base, anvil and
     /// its offset), metres: the margin around an area whose cells are asked for.
     pub fn reach_m(&self) -> f64 {

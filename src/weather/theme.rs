@@ -13,7 +13,7 @@ use toml::Spanned;
 
 use super::block::{BlockLayer, TypeSource, Wind};
 use super::cloud_type::CloudType;
-use crate::config::{ConfigError, parse_toml};
+use crate::config::{ConfigError, parse_toml, read_text};
 
 const FEET_PER_METRE: f32 = 3.280_84;
 
@@ -164,8 +164,7 @@ pub fn is_theme_path(path: &Path) -> bool {
 
 /// Reads and validates a theme file.
 pub fn load_theme(path: &Path) -> Result<Theme, ConfigError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
+    let text = read_text(path)?;
     parse_theme(&text, path)
 }
 

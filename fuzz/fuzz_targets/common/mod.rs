@@ -8,11 +8,15 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use skycast::clouds::{CloudTypes, CloudsConfig};
+use skycast::config::TomlSettings;
 use skycast::flight::FlightPlan;
 use skycast::render::RenderSettings;
 use skycast::shading::{FogSettings, TimeOfDayTable};
+use skycast::weather::air::AirSettings;
 use skycast::weather::files;
 use skycast::weather::metar::decode;
+use skycast::weather::model::ModelSettings;
+use skycast::weather::storms::StormSettings;
 use skycast::weather::{
     BlockIndex, CloudTypeRule, FieldSettings, LocalFrame, StationTable, WeatherField,
 };
@@ -145,8 +149,9 @@ pub fn check_weather_file(data: &[u8]) {
 }
 
 /// `config_files`: any bytes as each TOML config file skycast reads (renderer, time of day,
-/// clouds, cloud types, weather field, cloud-type rule, fog, themes): no panic; a rejected file's
-/// error names the file, and a line within the text where it names one.
+/// clouds, cloud types, weather field, cloud-type rule, fog, air, storms, weather model, themes):
+/// no panic; a rejected file's error names the file, and a line within the text where it names
+/// one.
 pub fn check_config_files(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     let lines = text.lines().count().max(1);
@@ -178,6 +183,15 @@ pub fn check_config_files(data: &[u8]) {
         check(e.to_string());
     }
     if let Err(e) = FogSettings::parse(&text, path) {
+        check(e.to_string());
+    }
+    if let Err(e) = AirSettings::parse(&text, path) {
+        check(e.to_string());
+    }
+    if let Err(e) = StormSettings::parse(&text, path) {
+        check(e.to_string());
+    }
+    if let Err(e) = ModelSettings::parse(&text, path) {
         check(e.to_string());
     }
     if let Err(e) = skycast::weather::theme::parse_theme(&text, path) {

@@ -8,7 +8,7 @@ use std::path::Path;
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::config::{ConfigError, parse_toml};
+use crate::config::{ConfigError, ShippedFile, TomlSettings};
 use crate::weather::cloud_type::CloudType;
 
 /// The shipped rule file, built in.
@@ -122,19 +122,13 @@ pub struct CloudTypeRule {
     pub rules: Vec<Rule>,
 }
 
-impl CloudTypeRule {
-    /// Reads a rule file.
-    pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::parse(&text, path)
-    }
+impl TomlSettings for CloudTypeRule {
+    const SHIPPED: Option<ShippedFile> = ShippedFile::at(BUILTIN_PATH, BUILTIN);
 
-    /// Parses rule text that came from `path`; checks every band has a rule without conditions.
-    pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
-        let rule: Self = parse_toml(text, path)?;
+    /// Every band has a rule without conditions.
+    fn check(&self, path: &Path, text: &str) -> Result<(), ConfigError> {
         for band in Band::ALL {
-            let of_band: Vec<&Rule> = rule
+            let of_band: Vec<&Rule> = self
                 .rules
                 .iter()
                 .filter(|r| *r.band.get_ref() == band)
@@ -157,9 +151,11 @@ impl CloudTypeRule {
                 },
             });
         }
-        Ok(rule)
+        Ok(())
     }
+}
 
+impl CloudTypeRule {
     /// The type of a layer that carries no reported CB/TCU.
     pub fn height_rule_type(&self, facts: &LayerFacts) -> CloudType {
         self.rules
@@ -174,10 +170,7 @@ impl CloudTypeRule {
 impl Default for CloudTypeRule {
     /// The shipped `config/cloud_type_rule.toml` (a test proves it parses).
     fn default() -> Self {
-        match Self::parse(BUILTIN, Path::new(BUILTIN_PATH)) {
-            Ok(rule) => rule,
-            Err(err) => panic!("built-in {BUILTIN_PATH}: {err}"),
-        }
+        Self::shipped()
     }
 }
 

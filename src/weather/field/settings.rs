@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde::Deserialize;
 
-use crate::config::{ConfigError, parse_toml};
+use crate::config::{ConfigError, ShippedFile, TomlSettings};
 use crate::weather::metar::Cover;
 
 /// The shipped settings file, built in.
@@ -237,21 +237,10 @@ pub struct Defaults {
     pub cavok_visibility_m: f64,
 }
 
-impl FieldSettings {
-    /// Reads settings from a TOML file.
-    pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::parse(&text, path)
-    }
+impl TomlSettings for FieldSettings {
+    const SHIPPED: Option<ShippedFile> = ShippedFile::at("config/weather_field.toml", BUILTIN);
 
-    /// Parses settings text that came from `path`.
-    pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
-        let settings: Self = parse_toml(text, path)?;
-        settings.validate(text, path)
-    }
-
-    fn validate(self, text: &str, path: &Path) -> Result<Self, ConfigError> {
+    fn check(&self, path: &Path, text: &str) -> Result<(), ConfigError> {
         let bad = |field: &str, message: &str| ConfigError::at_key(path, text, field, message);
         if !(self.bands.low_top_ft > 0.0 && self.bands.low_top_ft <= self.bands.high_base_ft) {
             return Err(bad(
@@ -314,17 +303,14 @@ impl FieldSettings {
         if !(0.0..=1.0).contains(&self.convective.weight_min) {
             return Err(bad("convective.weight_min", "must be within 0..=1"));
         }
-        Ok(self)
+        Ok(())
     }
 }
 
 impl Default for FieldSettings {
     /// The shipped `config/weather_field.toml` (a test proves it parses).
     fn default() -> Self {
-        match Self::parse(BUILTIN, Path::new("config/weather_field.toml")) {
-            Ok(settings) => settings,
-            Err(err) => panic!("built-in config/weather_field.toml: {err}"),
-        }
+        Self::shipped()
     }
 }
 

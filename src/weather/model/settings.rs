@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde::Deserialize;
 
-use crate::config::{ConfigError, parse_toml};
+use crate::config::{ConfigError, ShippedFile, TomlSettings};
 
 /// The shipped settings file, built in.
 const BUILTIN: &str = include_str!("../../../config/weather_model.toml");
@@ -115,19 +115,12 @@ pub struct ModelTimeSettings {
     pub warn_after_h: f64,
 }
 
-impl ModelSettings {
-    /// Reads a settings file.
-    pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::parse(&text, path)
-    }
+impl TomlSettings for ModelSettings {
+    const SHIPPED: Option<ShippedFile> = ShippedFile::at("config/weather_model.toml", BUILTIN);
 
-    /// Parses settings text that came from `path`.
-    pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
-        let s: Self = parse_toml(text, path)?;
+    fn check(&self, path: &Path, text: &str) -> Result<(), ConfigError> {
         let bad = |field: &str, message: &str| Err(ConfigError::at_key(path, text, field, message));
-        let b = s.blend;
+        let b = self.blend;
         if !(b.station_full_km >= 0.0 && b.station_fade_km > b.station_full_km) {
             return bad(
                 "blend.station_fade_km",
@@ -140,26 +133,23 @@ impl ModelSettings {
                 "must be greater than blend.report_age_full_h (which is 0 or more)",
             );
         }
-        if s.surface.heavy_mm_h.is_nan() || s.surface.heavy_mm_h <= 0.0 {
+        if self.surface.heavy_mm_h.is_nan() || self.surface.heavy_mm_h <= 0.0 {
             return bad("surface.heavy_mm_h", "must be greater than 0");
         }
-        if !(s.layers.cover_min_oktas >= 0.0 && s.layers.cover_min_oktas <= 8.0) {
+        if !(self.layers.cover_min_oktas >= 0.0 && self.layers.cover_min_oktas <= 8.0) {
             return bad("layers.cover_min_oktas", "must be within 0..=8");
         }
-        if s.time.warn_after_h.is_nan() || s.time.warn_after_h < 0.0 {
+        if self.time.warn_after_h.is_nan() || self.time.warn_after_h < 0.0 {
             return bad("time.warn_after_h", "must be 0 or more");
         }
-        Ok(s)
+        Ok(())
     }
 }
 
 impl Default for ModelSettings {
     /// The shipped `config/weather_model.toml` (a test proves it parses).
     fn default() -> Self {
-        match Self::parse(BUILTIN, Path::new("config/weather_model.toml")) {
-            Ok(settings) => settings,
-            Err(err) => panic!("built-in config/weather_model.toml: {err}"),
-        }
+        Self::shipped()
     }
 }
 
