@@ -22,7 +22,8 @@ use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, MAX_LOCKS};
 use super::id_hash::IdMap;
 use super::resident::{BlockCheck, CloudState, Resident};
 use super::scene::{Fade, SkyCloud};
-use super::settings::{RenderSettings, VertexCacheSettings};
+use super::settings::RenderSettings;
+use super::sprite_settings::VertexCacheSettings;
 use super::stats::FrameStats;
 
 /// A facing: the sprite's right and up axes and its normal towards the camera.

@@ -935,7 +935,8 @@ impl ResidentSet {
             if self.light.enabled() {
                 let light_start = std::time::Instant::now();
                 let to = (queue, &self.light_buffer, s.start);
-                let (light_bytes, lit) = self.light.written(r, to, &mut light_left);
+                let block_light = (&r.block, &mut r.light);
+                let (light_bytes, lit) = self.light.written(block_light, to, &mut light_left);
                 light_us += light_start.elapsed().as_micros() as u64;
                 bytes += light_bytes;
                 self.lit_sprites += lit;

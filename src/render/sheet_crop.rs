@@ -9,7 +9,7 @@
 //! draws what the whole square drew. A sprite small enough on screen to sample a coarser level
 //! (under about 30 pixels across) loses the faintest rim of its coarsest texels.
 
-use super::sky::SpriteSheet;
+use super::sprite_sheet::SpriteSheet;
 
 /// Cells along a side of the sheet (4 x 4 textures, Wang 2003 figure 6).
 const CELLS_PER_ROW: u32 = 4;

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, GpuSpriteView, MAX_LOCKS};
 use super::resident::storage_buffer;
-use super::settings::CloudSettings;
+use super::sprite_settings::CloudSettings;
 use super::stats::Lighting;
 use crate::clouds::LifecycleConfig;
 use crate::shading::ShadingModel;

@@ -26,7 +26,8 @@
 //! them where its scene is nearer (a mountain beyond the ring radius among far clouds). Rules
 //! and geometry: `layout`. Units: metres, degrees.
 
-mod layout;
+// The ring's settings live here, so the settings tree reads them without the ring.
+pub(super) mod layout;
 mod order_buffer;
 mod orders;
 
@@ -46,7 +47,7 @@ use super::id_hash::IdSet;
 use super::pipeline::{PassDesc, SceneDepth, frame_group, pipeline, premultiplied_over};
 use super::resident::ResidentSet;
 use super::scene::Fade;
-use super::settings::VertexCacheSettings;
+use super::sprite_settings::VertexCacheSettings;
 use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
 use order_buffer::OrderBuffer;

@@ -27,7 +27,7 @@ use crate::render::id_hash::IdMap;
 #[cfg(doc)]
 use crate::render::resident::Resident;
 use crate::render::scene::Fade;
-use crate::render::settings::VertexCacheSettings;
+use crate::render::sprite_settings::VertexCacheSettings;
 
 /// The far clouds' sprite orders as the impostor ring sees them (from its centre), kept from
 /// one ring build to the next and sorted a budget at a time: Wang's vertex cache for the ring's

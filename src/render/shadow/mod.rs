@@ -25,7 +25,8 @@
 //! (SilverLining reuses its map across frames the same way). Its last texels are faded out, so
 //! the shadows end softly at the map's edge. Geometry and rules: `layout`. Units: metres.
 
-mod layout;
+// The map's settings live here, so the settings tree reads them without the map.
+pub(super) mod layout;
 
 use std::cell::Cell;
 
