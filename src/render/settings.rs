@@ -8,7 +8,7 @@ use crate::config::{ConfigError, parse_toml};
 
 // The near sprites' own tables stand in a leaf their stages read without the whole tree;
 // their paths here stay.
-pub use super::sprite_settings::{CloudSettings, VertexCacheSettings};
+pub use super::sprites::settings::{CloudSettings, VertexCacheSettings};
 
 /// The built-in settings, `config/render.toml`.
 pub const DEFAULT_RENDER_TOML: &str = include_str!("../../config/render.toml");

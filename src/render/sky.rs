@@ -21,9 +21,7 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use super::RenderError;
-use super::build::{CHUNK, SpriteBuild, chunks};
 use super::cloud_target::can_test_against;
-use super::draw_list::{Copies, Locks, main_view};
 use super::gpu_types::{GpuFrame, GpuSpriteVertex};
 use super::impostor::RingFrame;
 use super::overhead_ease::OverheadEase;
@@ -32,11 +30,13 @@ use super::pipeline::{
     PassDesc, SceneDepth, background_test, frame_group, pipeline, pipeline_with_depth,
     premultiplied_over,
 };
-use super::resident::{ResidentSet, quad_index_buffer};
-use super::scatter::Scatter;
 use super::scene::{BlockMotion, SkyBlock};
 use super::settings::RenderSettings;
-use super::sprite_view::{self, ViewData, ViewLight};
+use super::sprites::build::{CHUNK, SpriteBuild, chunks};
+use super::sprites::draw_list::{Copies, Locks, main_view};
+use super::sprites::resident::{ResidentSet, quad_index_buffer};
+use super::sprites::scatter::Scatter;
+use super::sprites::sprite_view::{self, ViewData, ViewLight};
 use super::stats::{FrameStats, Lighting, SkyMemory, Spent, Stopwatch};
 use super::targets::{self, HostTargets, SkyView};
 use super::view::{View, ViewId, ViewShared};
@@ -45,7 +45,7 @@ use crate::shading::{SunPosition, TimeOfDay, TimeOfDayTable, hidden_above};
 use crate::weather::{BlockLayer, BlockWeather};
 
 /// The sheet lives in its own leaf module; its path under `sky` stays for hosts that name it.
-pub use super::sprite_sheet::SpriteSheet;
+pub use super::sprites::sheet::SpriteSheet;
 
 /// What the sky is created with.
 #[derive(Debug, Clone)]
@@ -274,7 +274,7 @@ impl Sky {
         let format = config.targets.colour_format;
         let resident = ResidentSet::new(device, 0);
         let view_layout = sprite_view::layout(device);
-        let crops = super::sheet_crop::cell_crops(sheet);
+        let crops = super::sprites::sheet_crop::cell_crops(sheet);
         let build = SpriteBuild::new(device, &view_layout, resident.layout(), &crops);
         let frame_only = [Some(&frame_layout)];
         let sprite_groups = [Some(&frame_layout), Some(&sheet_layout)];
@@ -1147,7 +1147,7 @@ impl Sky {
         );
         self.views[i].sprites_to_draw = stats.sprites_drawn;
         self.views[i].distant_sprites =
-            super::draw_list::distant_sprites(&self.views[i].draws, stats.sprites_drawn);
+            super::sprites::draw_list::distant_sprites(&self.views[i].draws, stats.sprites_drawn);
         let in_cloud = inside.cloud;
         self.views[i].in_cloud = in_cloud;
         self.views[i].in_rain = inside.rain;

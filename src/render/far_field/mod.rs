@@ -685,7 +685,7 @@ mod tests {
     /// the luminance of white.
     #[test]
     fn the_sheets_take_the_foggy_textures_hue() {
-        let sheet = super::super::sprite_sheet::SpriteSheet::generated();
+        let sheet = super::super::sprites::sheet::SpriteSheet::generated();
         let foggy = sheet.mean_rgb(crate::clouds::TextureCategory::Foggy.cells());
         let h = hue(foggy);
         assert!(foggy.min_element() > 0.3, "{foggy}");

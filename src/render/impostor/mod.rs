@@ -41,14 +41,14 @@ pub use layout::{
 };
 use layout::{impostor_camera, sectors_of};
 
-use super::build::{SpriteBuild, chunks};
 use super::gpu_types::{GpuDrawBlock, GpuFrame, GpuListCloud, GpuRing, GpuSpriteVertex};
 use super::id_hash::IdSet;
 use super::pipeline::{PassDesc, SceneDepth, frame_group, pipeline, premultiplied_over};
-use super::resident::ResidentSet;
 use super::scene::Fade;
-use super::sprite_settings::VertexCacheSettings;
-use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
+use super::sprites::build::{SpriteBuild, chunks};
+use super::sprites::resident::ResidentSet;
+use super::sprites::settings::VertexCacheSettings;
+use super::sprites::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
 use order_buffer::OrderBuffer;
 use orders::{RingOrders, RingSort};

@@ -35,12 +35,12 @@ use glam::{DVec3, Mat4, Vec3};
 pub use layout::{EYE_DISTANCE_M, MAX_SIZE_PX, ShadowFrame, ShadowSettings, needs_redraw};
 
 use super::RenderError;
-use super::build::{SpriteBuild, chunks};
-use super::draw_list::{Blocks, fade_code};
 use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuSpriteVertex};
 use super::id_hash::{IdMap, IdSet};
-use super::resident::{ResidentSet, storage_buffer};
-use super::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
+use super::sprites::build::{SpriteBuild, chunks};
+use super::sprites::draw_list::{Blocks, fade_code};
+use super::sprites::resident::{ResidentSet, storage_buffer};
+use super::sprites::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
 
 const WGSL: &str = include_str!("../../../shaders/cloud_shadow.wgsl");
@@ -639,7 +639,7 @@ impl CloudShadows {
         // Blocks added to a map are a few of the thousands held: looked up, not searched for.
         // Sorted on keys copied out of the blocks (a comparison that reads two blocks costs two
         // cache misses).
-        let mut order: Vec<(f64, f64, u64, &super::resident::Resident)> = match only {
+        let mut order: Vec<(f64, f64, u64, &super::sprites::resident::Resident)> = match only {
             Some(ids) => ids
                 .iter()
                 .filter_map(|id| blocks.get(id))
@@ -827,7 +827,7 @@ impl CloudShadows {
 
 /// Whether a block (placed on the GPU) may cast a shadow into the map: its sphere's shadow
 /// reaches the square across the rays.
-fn is_covered(r: &super::resident::Resident, frame: &ShadowFrame) -> bool {
+fn is_covered(r: &super::sprites::resident::Resident, frame: &ShadowFrame) -> bool {
     if r.place.is_none() || !r.uploaded {
         return false;
     }

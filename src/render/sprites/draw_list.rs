@@ -17,14 +17,14 @@ use std::collections::HashMap;
 use bytemuck::Zeroable;
 use glam::{DVec3, Vec3};
 
-use super::camera::Frustum;
-use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, MAX_LOCKS};
-use super::id_hash::IdMap;
 use super::resident::{BlockCheck, CloudState, Resident};
-use super::scene::{Fade, SkyCloud};
-use super::settings::RenderSettings;
-use super::sprite_settings::VertexCacheSettings;
-use super::stats::FrameStats;
+use super::settings::VertexCacheSettings;
+use crate::render::camera::Frustum;
+use crate::render::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, MAX_LOCKS};
+use crate::render::id_hash::IdMap;
+use crate::render::scene::{Fade, SkyCloud};
+use crate::render::settings::RenderSettings;
+use crate::render::stats::FrameStats;
 
 /// A facing: the sprite's right and up axes and its normal towards the camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -66,7 +66,7 @@ pub fn upright_facing(to_cam: Vec3) -> Facing {
 /// comes within `lock_radius_fraction` of its radius and is released when it leaves. Only the
 /// clouds the camera is inside of are looked at.
 #[derive(Debug, Default)]
-pub(super) struct Locks {
+pub(in crate::render) struct Locks {
     map: HashMap<u32, (Facing, bool)>,
     changed: bool,
 }
@@ -148,7 +148,7 @@ fn thresholds(fading: bool, near_edge_m: f64, cache: &VertexCacheSettings) -> (f
 
 /// Whether more than `share` of a cloud's movement or age threshold is used up since its order
 /// was computed (or time ran backwards): with `share` 1 Wang's rule that the order is stale.
-pub(super) fn used_up(
+pub(in crate::render) fn used_up(
     (ordered_at, fading): ((DVec3, f64), bool),
     camera_rel_m: DVec3,
     time_s: f64,
@@ -201,7 +201,7 @@ pub fn sprites_back_to_front(cloud: &SkyCloud, cam_local_m: Vec3) -> Vec<(usize,
 /// sprite's index, so that one ascending sort of plain integers puts the farthest first and
 /// equally far sprites by index), and scratch to check a previous order with.
 #[derive(Debug, Default)]
-pub(super) struct SortKeys {
+pub(in crate::render) struct SortKeys {
     keys: Vec<u64>,
     /// One bit a sprite: seen in the previous order.
     seen: Vec<u64>,
@@ -209,7 +209,7 @@ pub(super) struct SortKeys {
 
 impl SortKeys {
     /// Empty buffers.
-    pub(super) fn new() -> Self {
+    pub(in crate::render) fn new() -> Self {
         Self::default()
     }
 }
@@ -226,7 +226,7 @@ impl SortKeys {
 /// insertion sort puts right the few sprites that changed places: a handful of moves a sprite
 /// instead of a sort from scratch. Anything else in `slots` (a new cloud, another block's
 /// leftovers) is sorted from scratch; the result is the same either way.
-pub(super) fn order_into(
+pub(in crate::render) fn order_into(
     offsets: &[Vec3],
     cam_local_m: Vec3,
     base: u32,
@@ -302,7 +302,7 @@ fn fade_opacity(fade: Fade) -> f32 {
 /// beyond the draw distance (`far_fade` in `shaders/sprite_build.wgsl`, keep in sync).
 const DISTANT_BLOCK: u32 = 4;
 
-pub(super) fn fade_code(fade: Fade) -> (u32, f32) {
+pub(in crate::render) fn fade_code(fade: Fade) -> (u32, f32) {
     match fade {
         Fade::Steady => (0, 1.0),
         Fade::Forming(p) => (1, p.clamp(0.0, 1.0)),
@@ -311,11 +311,15 @@ pub(super) fn fade_code(fade: Fade) -> (u32, f32) {
 }
 
 /// The blocks the sky holds, by id.
-pub(super) type Blocks = IdMap<Resident>;
+pub(in crate::render) type Blocks = IdMap<Resident>;
 
 /// Blocks' ids, farthest centre (with its drift) from `from_m` first (the impostor views; the
 /// sky camera's sorts the near blocks themselves).
-pub(super) fn blocks_back_to_front(blocks: &Blocks, ids: &[u64], from_m: DVec3) -> Vec<(f64, u64)> {
+pub(in crate::render) fn blocks_back_to_front(
+    blocks: &Blocks,
+    ids: &[u64],
+    from_m: DVec3,
+) -> Vec<(f64, u64)> {
     let mut order: Vec<(f64, &Resident)> = ids
         .iter()
         .filter_map(|id| blocks.get(id))
@@ -333,7 +337,7 @@ fn farthest_first(a: (f64, &Resident), b: (f64, &Resident)) -> std::cmp::Orderin
 
 /// The sprites of a frame's distant blocks, which its draw list puts first: they are drawn
 /// behind the impostor ring, which holds nearer clouds.
-pub(super) fn distant_sprites(draws: &[GpuDrawBlock], total: u32) -> u32 {
+pub(in crate::render) fn distant_sprites(draws: &[GpuDrawBlock], total: u32) -> u32 {
     draws
         .iter()
         .find(|d| d.fade_kind & DISTANT_BLOCK == 0)
@@ -342,7 +346,7 @@ pub(super) fn distant_sprites(draws: &[GpuDrawBlock], total: u32) -> u32 {
 
 /// Where the sky camera's sprite orders and cloud lists go: CPU copies of the order and list
 /// buffers and the spans of them changed this frame.
-pub(super) struct Copies<'a> {
+pub(in crate::render) struct Copies<'a> {
     pub orders: &'a mut [u32],
     pub dirty_orders: &'a mut Vec<std::ops::Range<u32>>,
     pub lists: &'a mut [GpuListCloud],
@@ -356,7 +360,7 @@ pub(super) struct Copies<'a> {
 /// marked dirty, at most `budget` sprites), updates `locks` and `seams`, and counts into
 /// `stats`. Returns how far inside a cloud, and how deep in rain, the camera is.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn main_view(
+pub(in crate::render) fn main_view(
     (blocks, near): (&mut Blocks, &[u64]),
     copies: Copies,
     (camera_m, frustum): (DVec3, &Frustum),
@@ -464,7 +468,7 @@ const MAX_INTERLEAVED: usize = 8;
 /// that long is as good, and a frame whose groups' lists all stand touches none of their
 /// clouds.
 #[derive(Debug, Default)]
-pub(super) struct Seams {
+pub(in crate::render) struct Seams {
     kept: Vec<Merged>,
     /// Scratch: the squared distances of the clouds of the group being merged.
     d2: Vec<f64>,
@@ -762,7 +766,7 @@ fn interleave(members: &[Listed], eye_m: DVec3, d2: &mut Vec<f64>) -> Vec<Run> {
 
 /// Where the camera is among the clouds of a frame.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(super) struct Inside {
+pub(in crate::render) struct Inside {
     /// How far inside a cloud, 0 (outside) ..= 1 (deep in its core).
     pub cloud: f32,
     /// How opaque the rain or snow shaft the camera is in is there: the shaft's opacity, less
@@ -928,4 +932,4 @@ fn inside_clouds(
 
 #[cfg(test)]
 #[path = "draw_list_tests.rs"]
-pub(super) mod tests;
+pub(in crate::render) mod tests;

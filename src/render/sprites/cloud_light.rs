@@ -12,7 +12,7 @@
 
 use glam::Vec3;
 
-use super::scene::{SkyBlock, SkyCloud};
+use crate::render::scene::{SkyBlock, SkyCloud};
 use crate::shading::{
     HarrisLastra, LightScratch, Particle, ParticleLight, RelightTrigger, ShadingModel,
     harris_lastra,
@@ -21,7 +21,7 @@ use crate::shading::{
 /// The light state of the resident set: the model's settings while it is on, the sun
 /// direction the sprites are lit for, scratch space.
 #[derive(Debug, Clone)]
-pub(super) struct CloudLight {
+pub(in crate::render) struct CloudLight {
     /// The model's constants, `None` under Wang's model (nothing computed).
     settings: Option<HarrisLastra>,
     trigger: RelightTrigger,
@@ -35,7 +35,7 @@ pub(super) struct CloudLight {
 
 /// A block's light: its packed lights (its sprites' order) and how far they are.
 #[derive(Debug, Clone, Default)]
-pub(super) struct BlockLight {
+pub(in crate::render) struct BlockLight {
     /// Packed per sprite (empty until first lit).
     pub lights: Vec<u32>,
     /// The sun direction every cloud of it is lit for (none while provisional).
@@ -61,7 +61,7 @@ impl Default for CloudLight {
 }
 
 /// Where a block's lights go: the queue, the light buffer and the block's first sprite slot.
-pub(super) type LightTarget<'a> = (&'a wgpu::Queue, &'a wgpu::Buffer, u32);
+pub(in crate::render) type LightTarget<'a> = (&'a wgpu::Queue, &'a wgpu::Buffer, u32);
 
 impl CloudLight {
     /// Sets the model and the sun of this frame; the lit direction follows the sun only when it

@@ -15,11 +15,13 @@ use std::ops::Range;
 use glam::{DVec3, Vec3};
 
 use super::cloud_light::{BlockLight, CloudLight};
-use super::gpu_types::{GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT};
-use super::id_hash::{IdMap, IdSet};
-use super::scene::{BlockMotion, SkyBlock, SkyCloud};
 use super::slots::{SlotRanges, copy_runs, pack};
-use super::stats::{Spent, Stopwatch};
+use crate::render::gpu_types::{
+    GpuCloud, GpuListCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT,
+};
+use crate::render::id_hash::{IdMap, IdSet};
+use crate::render::scene::{BlockMotion, SkyBlock, SkyCloud};
+use crate::render::stats::{Spent, Stopwatch};
 
 /// Bytes of GPU memory each sprite slot costs: its record, its order entry and its Harris and
 /// Lastra light (a cloud's record and list entry come on top, about a twentieth of it for
@@ -28,7 +30,7 @@ pub const BYTES_PER_SPRITE: u64 = std::mem::size_of::<GpuSprite>() as u64 + 4 + 
 
 /// A cloud's bounds (computed once when its block arrives) and its order cache.
 #[derive(Debug, Clone)]
-pub(super) struct CloudState {
+pub(in crate::render) struct CloudState {
     /// Its centre, metres (a copy of the cloud's: what a frame reads of every cloud, together).
     pub centre_m: DVec3,
     /// Its sprites.
@@ -58,7 +60,7 @@ pub(super) struct CloudState {
 /// block then, how far it may move from there and until when, before any of its clouds passes
 /// its cache thresholds or the draw distance.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct BlockCheck {
+pub(in crate::render) struct BlockCheck {
     pub camera_rel_m: DVec3,
     pub move_budget_m: f64,
     pub checked_s: f64,
@@ -67,7 +69,7 @@ pub(super) struct BlockCheck {
 
 /// A block the sky holds.
 #[derive(Debug, Clone)]
-pub(super) struct Resident {
+pub(in crate::render) struct Resident {
     pub block: SkyBlock,
     pub motion: BlockMotion,
     /// Radius of a sphere around the block's centre holding all its clouds, metres.
@@ -97,7 +99,7 @@ pub(super) struct Resident {
     /// Its Harris and Lastra light (empty under Wang's model).
     pub light: BlockLight,
     /// Drawn as sprites at any distance and never in the ring: a storm cell beyond the cloud
-    /// field ([`super::Sky::insert_distant_block`]).
+    /// field ([`crate::render::Sky::insert_distant_block`]).
     pub distant: bool,
     pub clouds: Vec<CloudState>,
     /// Every sprite's offset from its cloud's centre, metres, cloud after cloud
@@ -111,7 +113,7 @@ pub(super) struct Resident {
 }
 
 impl Resident {
-    pub(super) fn new(block: SkyBlock, motion: BlockMotion) -> Self {
+    pub(in crate::render) fn new(block: SkyBlock, motion: BlockMotion) -> Self {
         let mut first_offset = 0u32;
         let clouds: Vec<CloudState> = block
             .clouds
@@ -212,7 +214,7 @@ impl Resident {
     /// background generation finishes, in an order that differs from run to run, and the
     /// frame must not (equally far blocks' overlapping sprites blend differently in either
     /// order, and the upload and relight budgets would take either first).
-    pub(super) fn tie_order(&self, other: &Resident) -> std::cmp::Ordering {
+    pub(in crate::render) fn tie_order(&self, other: &Resident) -> std::cmp::Ordering {
         let (a, b) = (self.block.centre_m, other.block.centre_m);
         a.x.total_cmp(&b.x)
             .then(a.y.total_cmp(&b.y))
@@ -249,7 +251,7 @@ fn fractions(low: f32, high: f32) -> u32 {
 }
 
 /// The GPU record of a sprite.
-pub fn gpu_sprite(cloud: &SkyCloud, s: &super::scene::SkySprite) -> GpuSprite {
+pub fn gpu_sprite(cloud: &SkyCloud, s: &crate::render::scene::SkySprite) -> GpuSprite {
     let group = cloud
         .group_centres_m
         .get(s.group as usize)
@@ -298,7 +300,7 @@ pub fn gpu_cloud(cloud: &SkyCloud, block_m: DVec3) -> GpuCloud {
 }
 
 /// The blocks the sky holds and their GPU buffers.
-pub(super) struct ResidentSet {
+pub(in crate::render) struct ResidentSet {
     device: wgpu::Device,
     pub blocks: IdMap<Resident>,
     sprite_slots: SlotRanges,
@@ -345,15 +347,15 @@ pub(super) struct ResidentSet {
     /// place): while it stays the same, so do they.
     pub changes: u64,
     /// Counts changes of a block's kind of fade (steady, forming, dissipating;
-    /// [`super::Sky::set_block_fade`] and its kin), not of its progress: what the shadow map's
+    /// [`crate::render::Sky::set_block_fade`] and its kin), not of its progress: what the shadow map's
     /// cover check watches, which a sky of forming clouds would otherwise trip every frame.
     pub fades: u64,
-    /// The drift [`super::Sky::set_drift`] last moved every block to.
+    /// The drift [`crate::render::Sky::set_drift`] last moved every block to.
     pub drift_m: DVec3,
     /// Placings of blocks so far ([`Resident::place_serial`]).
     placings: u64,
     /// Sprites and clouds of blocks the caller will insert in the next frames
-    /// ([`super::Sky::expect_blocks`]): a buffer that grows grows for them too, once.
+    /// ([`crate::render::Sky::expect_blocks`]): a buffer that grows grows for them too, once.
     pub expected: (u64, u64),
 }
 
@@ -948,7 +950,11 @@ impl ResidentSet {
 }
 
 /// A storage buffer the queue writes into, of at least 16 bytes.
-pub(super) fn storage_buffer(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
+pub(in crate::render) fn storage_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    bytes: u64,
+) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: bytes.max(16),
@@ -1058,7 +1064,7 @@ mod tests {
     /// unit where a value falls on a half), for any angle a block holds, negative or past a turn.
     #[test]
     fn a_sprite_record_packs_rotation_and_fractions_as_rounded() {
-        let cloud = crate::render::draw_list::tests::small_cloud();
+        let cloud = crate::render::sprites::draw_list::tests::small_cloud();
         let near = |a: u32, b: u32, modulo: u32| {
             let d = a.abs_diff(b) % modulo;
             d.min(modulo - d) <= 1

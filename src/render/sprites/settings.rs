@@ -1,6 +1,6 @@
 //! The near sprites' settings: the `[clouds]` and `[vertex_cache]` tables of
 //! `config/render.toml`, read by the sprite stages (the draw list, the sprite views, the
-//! impostor ring's orders). A leaf of the settings tree: [`RenderSettings`](super::RenderSettings)
+//! impostor ring's orders). A leaf of the settings tree: [`RenderSettings`](crate::render::RenderSettings)
 //! holds them, and nothing here reads it.
 
 use serde::{Deserialize, Serialize};
@@ -48,7 +48,7 @@ pub struct CloudSettings {
     pub haze_distance_m: f32,
     /// Resolution of the off-screen target the clouds (sprites, impostor ring, in-cloud fog) are
     /// drawn into, as a fraction of the host's: 1, 0.5 or 0.25 (1: straight into the host's
-    /// colour). See [`super::cloud_target`].
+    /// colour). See [`crate::render::cloud_target`].
     #[serde(default = "default_resolution_scale")]
     pub resolution_scale: f32,
     /// Clouds seen above the horizon fade out over this last fraction of the farthest distance a
