@@ -2,7 +2,8 @@
 //! resident on the GPU to the corners the sprite draw reads. The impostor ring and the shadow
 //! map draw the same resident sprites through the same lists and build.
 //!
-//! - `resident`, `slots`: the sprites and clouds on the GPU, each block in slots it keeps.
+//! - `resident`, `slots`: the sprites and clouds on the GPU, each block in slots it keeps;
+//!   `records`: a sprite's and a cloud's GPU record.
 //! - `cloud_light`: under Harris and Lastra's model, the light each resident sprite gets through
 //!   its cloud (computed on the CPU when a block arrives and after the sun turned, a budget a
 //!   frame), in a buffer beside the sprites; `resident_light` runs it over the resident set.
@@ -20,6 +21,7 @@
 pub(super) mod build;
 pub(super) mod cloud_light;
 pub mod draw_list;
+pub(super) mod records;
 pub(super) mod resident;
 mod resident_light;
 pub(super) mod scatter;
