@@ -9,7 +9,8 @@
 //!   frame), in a buffer beside the sprites; `resident_light` runs it over the resident set.
 //! - `draw_list`: per frame on the CPU: the near blocks back to front, each block's cloud list
 //!   and each cloud's sprite order recomputed only when Wang's cache thresholds say (6.1), the
-//!   facing locks (3.3), the draw list. `sprite_view`: a view's uniform, draw list, lists and
+//!   facing locks (3.3), the draw list (its entries, seams between deck blocks included, in
+//!   `draw_entries`). `sprite_view`: a view's uniform, draw list, lists and
 //!   orders on the GPU. `scatter`: the changed lists and orders sent as one patch. `build`: the
 //!   compute pass that makes the sprites' corners (facing, Wang 5 shading, fades) for the draw;
 //!   `sheet_crop`: the part of each sheet cell its texture covers, for the build.
@@ -20,6 +21,7 @@
 
 pub(super) mod build;
 pub(super) mod cloud_light;
+mod draw_entries;
 pub mod draw_list;
 pub(super) mod records;
 pub(super) mod resident;
