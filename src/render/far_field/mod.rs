@@ -230,7 +230,8 @@ pub(super) struct FarFieldShared<'a> {
     /// resolution.
     pub cloud_targets: Option<&'a [(wgpu::TextureFormat, Option<wgpu::BlendState>)]>,
     /// The mean colour of the sheet's foggy textures, which the near decks' sprites are drawn
-    /// with ([`SpriteSheet::mean_rgb`](super::SpriteSheet::mean_rgb)): its hue tints the far field's sheets.
+    /// with ([`SpriteSheet::mean_rgb`](super::SpriteSheet::mean_rgb)): its hue tints the far
+    /// field's sheets.
     pub sheet_rgb: Vec3,
 }
 

@@ -1,5 +1,5 @@
 //! The shadow map's view of the resident sprites: the draw list of the blocks a drawing covers,
-//! each with every cloud of its in its list (kept between drawings, [`KeptLists`]), and their
+//! each with every cloud of its in its list (kept between drawings, `KeptLists`), and their
 //! upload with the view's uniform ([`CloudShadows::write_view`]). What
 //! [`CloudShadows::prepare`] writes once it has decided to draw.
 

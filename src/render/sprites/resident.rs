@@ -287,8 +287,9 @@ pub(in crate::render) struct ResidentSet {
     /// place): while it stays the same, so do they.
     pub changes: u64,
     /// Counts changes of a block's kind of fade (steady, forming, dissipating;
-    /// [`crate::render::Sky::set_block_fade`] and its kin), not of its progress: what the shadow map's
-    /// cover check watches, which a sky of forming clouds would otherwise trip every frame.
+    /// [`crate::render::Sky::set_block_fade`] and its kin), not of its progress: what the
+    /// shadow map's cover check watches, which a sky of forming clouds would otherwise trip
+    /// every frame.
     pub fades: u64,
     /// The drift [`crate::render::Sky::set_drift`] last moved every block to.
     pub drift_m: DVec3,

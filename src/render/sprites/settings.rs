@@ -1,7 +1,7 @@
 //! The near sprites' settings: the `[clouds]` and `[vertex_cache]` tables of
 //! `config/render.toml`, read by the sprite stages (the draw list, the sprite views, the
-//! impostor ring's orders). A leaf of the settings tree: [`RenderSettings`](crate::render::RenderSettings)
-//! holds them, and nothing here reads it.
+//! impostor ring's orders). A leaf of the settings tree:
+//! [`RenderSettings`](crate::render::RenderSettings) holds them, and nothing here reads it.
 
 use serde::{Deserialize, Serialize};
 

@@ -1,7 +1,7 @@
 //! The sprite texture sheet the sky draws its cloud sprites with: what a host hands
-//! [`Sky::new`](crate::render::Sky::new) in its [`SkyConfig`](crate::render::SkyConfig) (the clouds stage's
-//! procedural sheet by default). A leaf: the sky, the sprite build's crops and the far field
-//! read it, and it reads none of them.
+//! [`Sky::new`](crate::render::Sky::new) in its [`SkyConfig`](crate::render::SkyConfig) (the
+//! clouds stage's procedural sheet by default). A leaf: the sky, the sprite build's crops and
+//! the far field read it, and it reads none of them.
 
 use glam::Vec3;
 

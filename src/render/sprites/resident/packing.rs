@@ -1,7 +1,10 @@
-//! Where the resident set puts a block: in free slots ([`SlotRanges`](super::super::slots::SlotRanges)), else in buffers grown
+//! Where the resident set puts a block: in free slots ([`SlotRanges`]), else in buffers grown
 //! for it, else in place of farther blocks; packing the slots in place on the device when they
 //! are too scattered; and the upload of the records of the blocks placed, nearest first,
-//! within the frame's budget (with their light, [`CloudLight::written`](super::super::cloud_light::CloudLight::written)).
+//! within the frame's budget (with their light, [`CloudLight::written`]).
+//!
+//! [`SlotRanges`]: super::super::slots::SlotRanges
+//! [`CloudLight::written`]: super::super::cloud_light::CloudLight::written
 
 use std::ops::Range;
 
@@ -99,6 +102,8 @@ impl ResidentSet {
     /// CPU writes the orders and lists again, as when growing. Growing it instead (the cloud
     /// buffer went from 256 slots to 4,096 when a block's clouds found no range) made the size
     /// depend on how a long flight's changes had cut up the slots.
+    ///
+    /// [`SlotRanges::capacity_for`]: super::super::slots::SlotRanges::capacity_for
     pub(super) fn grow_for(&mut self, queue: &wgpu::Queue, id: u64) -> bool {
         let Some(r) = self.blocks.get(&id) else {
             return false;
