@@ -109,7 +109,7 @@ fuzz:
 # not caught). Results in mutants.out/ (caught.txt, missed.txt, unviable.txt, timeout.txt); missed
 # mutants (cargo-mutants' status 2) are listed, not failed on: docs/src/testing.md says which are
 # accepted and why.
-MUTANTS_FILES ?= src/clouds/lifecycle.rs src/render/slots.rs src/weather/metar/sky.rs \
+MUTANTS_FILES ?= src/clouds/lifecycle.rs src/render/sprites/slots.rs src/weather/metar/sky.rs \
 	src/shading/directional.rs
 mutants:
 	@command -v cargo-mutants >/dev/null || { echo "installing cargo-mutants"; cargo install --locked cargo-mutants; }

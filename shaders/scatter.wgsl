@@ -3,7 +3,7 @@
 // cloud). One workgroup per span; a span copies `count` words of the patch to `dst` of its
 // target (0: orders, 1: cloud lists, as words).
 
-// Keep in sync with the spans built in src/render/scatter.rs.
+// Keep in sync with the spans built in src/render/sprites/scatter.rs.
 struct Span {
     dst: u32,
     src: u32,

@@ -89,7 +89,7 @@ struct Draws {
 @group(0) @binding(3) var<storage, read> orders: array<u32>;
 @group(1) @binding(0) var<storage, read> sprites: array<Sprite>;
 @group(1) @binding(1) var<storage, read> clouds: array<Cloud>;
-// Per sprite slot its Harris and Lastra light (src/render/cloud_light.rs): bytes 0, 1, 2 the
+// Per sprite slot its Harris and Lastra light (src/render/sprites/cloud_light.rs): bytes 0, 1, 2 the
 // sun's direct and total light and the skylight that reach it, fractions.
 @group(1) @binding(2) var<storage, read> lights: array<u32>;
 
@@ -107,7 +107,7 @@ struct BuiltCorner {
 // x: the chunk's first sprite (a chunk of at most CHUNK sprites is built, then drawn).
 @group(2) @binding(1) var<uniform> chunk: vec4<u32>;
 
-// Keep in sync with `CHUNK` in src/render/build.rs.
+// Keep in sync with `CHUNK` in src/render/sprites/build.rs.
 const CHUNK: u32 = 32768u;
 
 struct Facing {
@@ -122,7 +122,7 @@ fn normalize_or(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
 }
 
 // Right/up axes facing a viewer along `normal`, world up kept up (east when straight above).
-// Same as `facing_towards` in src/render/draw_list.rs (the CPU's copy starts a lock).
+// Same as `facing_towards` in src/render/sprites/draw_list.rs (the CPU's copy starts a lock).
 fn facing_towards(normal: vec3<f32>) -> Facing {
     let r = cross(vec3<f32>(0.0, 0.0, 1.0), normal);
     let right = select(vec3<f32>(1.0, 0.0, 0.0), normalize(r), dot(r, r) > 1e-6);
@@ -300,7 +300,7 @@ fn cell_uv(cell: u32, corner: vec2<f32>) -> vec2<f32> {
 }
 
 // The part of cell `cell`'s quad its texture covers (x: left, y: top, z: right, w: bottom, 0..1
-// across the quad, v down): `CELL_CROP` (src/render/sheet_crop.rs, put in front of this file
+// across the quad, v down): `CELL_CROP` (src/render/sprites/sheet_crop.rs, put in front of this file
 // when the pipeline is built) holds it as fractions of the cell, which the inset maps onto the
 // quad. The quad is cut to it: its transparent margins cost fragments and show nothing.
 fn cell_crop(cell: u32) -> vec4<f32> {
@@ -354,7 +354,7 @@ fn locked_facing(slot: u32, fallback: Facing) -> Facing {
 fn build_sprite(k: u32, at: u32) {
     let b = draws.blocks[block_of(k)];
     // An entry may be a part of its block's cloud list (the clouds of two blocks the camera
-    // stands between are drawn interleaved, `draw_entries` in src/render/draw_list.rs): its
+    // stands between are drawn interleaved, `draw_entries` in src/render/sprites/draw_list.rs): its
     // list's sprite counts run on from the part's first cloud's.
     let in_block = k - b.first + lists[b.list_base].first;
     let entry = lists[cloud_of(b, in_block)];
@@ -401,7 +401,7 @@ fn build_sprite(k: u32, at: u32) {
         alpha *= clamp((cos_angle - lock.w) / max(lock.z - lock.w, 1e-4), 0.0, 1.0);
     }
     // Bit 4 of `fade_kind`: a distant block (a storm cell beyond the cloud field,
-    // `DISTANT_BLOCK` in src/render/draw_list.rs), drawn however far; while the far field is
+    // `DISTANT_BLOCK` in src/render/sprites/draw_list.rs), drawn however far; while the far field is
     // drawn (`hl_deck.z`) it fades in over the hand-over band as the near sprites fade out.
     let morph = morph_radius.x * lifecycle_alpha(b.fade_kind & 3u, b.fade_progress, morph_radius.y);
     let faded = far_fade(to_cam);

@@ -59,11 +59,6 @@ impl Camera {
     pub fn frustum_relative(&self) -> Frustum {
         Frustum::from_view_proj(self.view_proj_relative())
     }
-
-    /// The camera as the sky takes a host's view: position and matrices.
-    pub fn sky_view(&self) -> super::targets::SkyView {
-        self.into()
-    }
 }
 
 /// The four side planes of a view volume (camera-relative metres), each `n . p + d >= 0`

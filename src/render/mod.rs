@@ -5,15 +5,9 @@
 //! [`Sky::record`] (its passes into the host's encoder, reading the host's depth, never writing
 //! it).
 //!
-//! - `resident`, `slots`: the sprites and clouds on the GPU, each block in slots it keeps.
-//! - `cloud_light`: under Harris and Lastra's model, the light each resident sprite gets through
-//!   its cloud (computed on the CPU when a block arrives and after the sun turned, a budget a
-//!   frame), in a buffer beside the sprites.
-//! - `draw_list`: per frame on the CPU: the near blocks back to front, each block's cloud list
-//!   and each cloud's sprite order recomputed only when Wang's cache thresholds say (6.1), the
-//!   facing locks (3.3), the draw list. `sprite_view`: a view's uniform, draw list, lists and
-//!   orders on the GPU. `scatter`: the changed lists and orders sent as one patch. `build`: the
-//!   compute pass that makes the sprites' corners (facing, Wang 5 shading, fades) for the draw.
+//! - `sprites`: the near sprites' pipeline, from the blocks resident on the GPU to the built
+//!   corners a draw reads (its own page lists the parts); the impostor ring and the shadow map
+//!   draw with its lists and its build too.
 //! - `sky`: pipelines and passes: sky gradient and sun, sprites with soft depth fades
 //!   (Bahnassi), in-cloud fog (Wang 7.1). Shaders in `shaders/*.wgsl`, structs with twins in
 //!   `gpu_types`. `readback`: the built corners read back for tests and tools.
@@ -33,12 +27,9 @@
 //! Positions are f64 on the CPU and camera-relative f32 on the GPU. Units: metres, degrees,
 //! linear RGB.
 
-mod build;
 pub mod camera;
 pub mod capabilities;
-mod cloud_light;
 pub mod cloud_target;
-pub mod draw_list;
 pub mod earth;
 pub mod far_field;
 pub mod gpu_types;
@@ -48,27 +39,26 @@ mod overhead_ease;
 mod pass_timing;
 mod pipeline;
 mod readback;
-mod resident;
-mod scatter;
 pub mod scene;
 pub mod settings;
 pub mod shadow;
-mod sheet_crop;
 pub mod sky;
-mod slots;
-mod sprite_view;
+mod sprites;
 pub mod stats;
 pub mod targets;
 mod view;
 
 pub use camera::{Camera, Frustum};
+// The draw list's module stays public under its old path (benches sort with it).
 pub use pass_timing::{PassTimes, Timestamps};
 pub use readback::SpriteCorner;
-pub use resident::{BYTES_PER_SPRITE, resident_slots_bound};
 pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};
 pub use settings::RenderSettings;
 pub use shadow::{CloudShadowMap, ShadowImage, ShadowSettings};
-pub use sky::{Sky, SkyConfig, SkyFlash, SpriteSheet};
+pub use sky::{Sky, SkyConfig, SkyFlash};
+pub use sprites::draw_list;
+pub use sprites::resident::{BYTES_PER_SPRITE, resident_slots_bound};
+pub use sprites::sheet::SpriteSheet;
 pub use stats::{FrameStats, Lighting, SkyMemory, Spent, Stopwatch, ThreadCpu};
 pub use targets::{HostTargets, SkyView};
 pub use view::ViewId;

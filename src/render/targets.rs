@@ -245,6 +245,14 @@ impl SkyView {
     }
 }
 
+// Here rather than in `camera`, which stays a leaf that knows nothing of the host's view.
+impl Camera {
+    /// The camera as the sky takes a host's view: position and matrices.
+    pub fn sky_view(&self) -> SkyView {
+        self.into()
+    }
+}
+
 impl From<&Camera> for SkyView {
     fn from(camera: &Camera) -> Self {
         Self {

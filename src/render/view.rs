@@ -9,11 +9,11 @@ use std::cell::{Cell, RefCell};
 use glam::Mat4;
 
 use super::cloud_target::{CloudShared, CloudTarget, cloud_targets, divisor_of};
-use super::draw_list::{Locks, Seams};
 use super::gpu_types::{GpuDrawBlock, GpuFrame};
 use super::impostor::{ImpostorRing, RingShared};
 use super::settings::RenderSettings;
-use super::sprite_view::ViewBuffers;
+use super::sprites::draw_list::{Locks, Seams};
+use super::sprites::sprite_view::ViewBuffers;
 use super::stats::Spent;
 use super::targets::HostTargets;
 

@@ -230,7 +230,8 @@ pub(super) struct FarFieldShared<'a> {
     /// resolution.
     pub cloud_targets: Option<&'a [(wgpu::TextureFormat, Option<wgpu::BlendState>)]>,
     /// The mean colour of the sheet's foggy textures, which the near decks' sprites are drawn
-    /// with ([`super::sky::SpriteSheet::mean_rgb`]): its hue tints the far field's sheets.
+    /// with ([`SpriteSheet::mean_rgb`](super::SpriteSheet::mean_rgb)): its hue tints the far
+    /// field's sheets.
     pub sheet_rgb: Vec3,
 }
 
@@ -685,7 +686,7 @@ mod tests {
     /// the luminance of white.
     #[test]
     fn the_sheets_take_the_foggy_textures_hue() {
-        let sheet = super::super::sky::SpriteSheet::generated();
+        let sheet = super::super::sprites::sheet::SpriteSheet::generated();
         let foggy = sheet.mean_rgb(crate::clouds::TextureCategory::Foggy.cells());
         let h = hue(foggy);
         assert!(foggy.min_element() > 0.3, "{foggy}");

@@ -5,8 +5,8 @@
 use std::ops::Range;
 
 use super::orders::RingOrders;
-use crate::render::resident::storage_buffer;
-use crate::render::scatter::Scatter;
+use crate::render::sprites::resident::storage_buffer;
+use crate::render::sprites::scatter::Scatter;
 
 /// The buffer, its patch and how many times it was made again.
 pub(super) struct OrderBuffer {

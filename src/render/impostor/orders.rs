@@ -19,15 +19,15 @@ use std::ops::Range;
 
 use glam::DVec3;
 
-use crate::render::draw_list::{
-    Blocks, SortKeys, blocks_back_to_front, fade_code, order_into, used_up,
-};
 use crate::render::gpu_types::{GpuDrawBlock, GpuListCloud};
 use crate::render::id_hash::IdMap;
-#[cfg(doc)]
-use crate::render::resident::Resident;
 use crate::render::scene::Fade;
-use crate::render::settings::VertexCacheSettings;
+use crate::render::sprites::draw_list::{
+    Blocks, SortKeys, blocks_back_to_front, fade_code, order_into, used_up,
+};
+#[cfg(doc)]
+use crate::render::sprites::resident::Resident;
+use crate::render::sprites::settings::VertexCacheSettings;
 
 /// The far clouds' sprite orders as the impostor ring sees them (from its centre), kept from
 /// one ring build to the next and sorted a budget at a time: Wang's vertex cache for the ring's

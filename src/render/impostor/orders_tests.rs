@@ -4,10 +4,10 @@
 use glam::DVec3;
 
 use super::*;
-use crate::render::draw_list::sprites_back_to_front;
-use crate::render::draw_list::tests::{cache, small_cloud};
-use crate::render::resident::Resident;
 use crate::render::scene::SkyCloud;
+use crate::render::sprites::draw_list::sprites_back_to_front;
+use crate::render::sprites::draw_list::tests::{cache, small_cloud};
+use crate::render::sprites::resident::Resident;
 
 /// `blocks` blocks of `clouds` small clouds each, 30 km north of the origin in a row, placed
 /// (slots given as the sky would) so that the ring's views can be read.

@@ -9,7 +9,7 @@
 //! draws what the whole square drew. A sprite small enough on screen to sample a coarser level
 //! (under about 30 pixels across) loses the faintest rim of its coarsest texels.
 
-use super::sky::SpriteSheet;
+use super::sheet::SpriteSheet;
 
 /// Cells along a side of the sheet (4 x 4 textures, Wang 2003 figure 6).
 const CELLS_PER_ROW: u32 = 4;
@@ -21,7 +21,7 @@ const EXACT_LEVELS: usize = 2;
 /// Per cell (row-major, as the shader's `cell` numbers them) the part of the cell its texture
 /// covers: `[u_min, v_min, u_max, v_max]`, fractions of the cell, v down. The whole cell where
 /// a cell's pixels are missing or all transparent.
-pub(super) fn cell_crops(sheet: &SpriteSheet) -> [[f32; 4]; 16] {
+pub(in crate::render) fn cell_crops(sheet: &SpriteSheet) -> [[f32; 4]; 16] {
     std::array::from_fn(|cell| {
         let mut crop: Option<[f32; 4]> = None;
         for (level, data) in sheet.mips.iter().enumerate().take(EXACT_LEVELS + 1) {
@@ -80,7 +80,7 @@ fn level_crop(data: &[u8], side: u32, cell: u32) -> Option<[f32; 4]> {
 
 /// The crops as WGSL (`CELL_CROP` in `shaders/sprite_build.wgsl`), put in front of the shader
 /// when its pipeline is built: constants for the sky's life, no uniform to write each frame.
-pub(super) fn crops_wgsl(crops: &[[f32; 4]; 16]) -> String {
+pub(in crate::render) fn crops_wgsl(crops: &[[f32; 4]; 16]) -> String {
     let cells: Vec<String> = crops
         .iter()
         .map(|c| format!("vec4<f32>({:?}, {:?}, {:?}, {:?})", c[0], c[1], c[2], c[3]))

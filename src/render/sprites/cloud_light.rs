@@ -10,10 +10,9 @@
 //! nor for decks (lit as one slab in the shader; their sprites cost the budget nothing).
 //! Its time is part of the frame's `cpu_update_us` and shown as `light_us`.
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 
-use super::resident::{Resident, ResidentSet};
-use super::scene::{SkyBlock, SkyCloud};
+use crate::render::scene::{SkyBlock, SkyCloud};
 use crate::shading::{
     HarrisLastra, LightScratch, Particle, ParticleLight, RelightTrigger, ShadingModel,
     harris_lastra,
@@ -22,7 +21,7 @@ use crate::shading::{
 /// The light state of the resident set: the model's settings while it is on, the sun
 /// direction the sprites are lit for, scratch space.
 #[derive(Debug, Clone)]
-pub(super) struct CloudLight {
+pub(in crate::render) struct CloudLight {
     /// The model's constants, `None` under Wang's model (nothing computed).
     settings: Option<HarrisLastra>,
     trigger: RelightTrigger,
@@ -36,7 +35,7 @@ pub(super) struct CloudLight {
 
 /// A block's light: its packed lights (its sprites' order) and how far they are.
 #[derive(Debug, Clone, Default)]
-pub(super) struct BlockLight {
+pub(in crate::render) struct BlockLight {
     /// Packed per sprite (empty until first lit).
     pub lights: Vec<u32>,
     /// The sun direction every cloud of it is lit for (none while provisional).
@@ -44,7 +43,7 @@ pub(super) struct BlockLight {
     /// Whether the skylight bytes are computed (not provisional).
     pub sky_exact: bool,
     /// A relight under way: the sun it is for, the next cloud, whether it computes the skylight.
-    pass: Option<(Vec3, usize, bool)>,
+    pub(super) pass: Option<(Vec3, usize, bool)>,
 }
 
 impl Default for CloudLight {
@@ -62,7 +61,7 @@ impl Default for CloudLight {
 }
 
 /// Where a block's lights go: the queue, the light buffer and the block's first sprite slot.
-pub(super) type LightTarget<'a> = (&'a wgpu::Queue, &'a wgpu::Buffer, u32);
+pub(in crate::render) type LightTarget<'a> = (&'a wgpu::Queue, &'a wgpu::Buffer, u32);
 
 impl CloudLight {
     /// Sets the model and the sun of this frame; the lit direction follows the sun only when it
@@ -97,7 +96,7 @@ impl CloudLight {
 
     /// The packed light of the sprites of `cloud` into `out` (one per sprite): the sun's always,
     /// the skylight when `with_sky`, else `out`'s sky bytes are kept.
-    fn cloud(&mut self, cloud: &SkyCloud, with_sky: bool, out: &mut [u32]) {
+    pub(super) fn cloud(&mut self, cloud: &SkyCloud, with_sky: bool, out: &mut [u32]) {
         let Some(settings) = self.settings else {
             return;
         };
@@ -175,20 +174,24 @@ impl CloudLight {
     /// (written again after the buffers grew; a stale one is relit later), else its own when
     /// `budget` (sprites, taken from) allows, else a provisional one. Returns the bytes written
     /// and the sprites lit.
-    pub fn written(&mut self, r: &mut Resident, to: LightTarget, budget: &mut u32) -> (u64, u32) {
-        let n = r.sprite_count();
-        let cost = sprites_to_light(&r.block.clouds);
-        let light = &mut r.light;
+    pub fn written(
+        &mut self,
+        (block, light): (&SkyBlock, &mut BlockLight),
+        to: LightTarget,
+        budget: &mut u32,
+    ) -> (u64, u32) {
+        let n: u32 = block.clouds.iter().map(|c| c.sprites.len() as u32).sum();
+        let cost = sprites_to_light(&block.clouds);
         let mut lit = 0;
         if light.lights.len() != n as usize {
             if cost <= *budget {
-                self.block(&r.block, &mut light.lights);
+                self.block(block, &mut light.lights);
                 light.lit_for = Some(self.sun_dir);
                 light.sky_exact = true;
                 *budget -= cost;
                 lit = cost;
             } else {
-                self.provisional(&r.block, &mut light.lights);
+                self.provisional(block, &mut light.lights);
                 (light.lit_for, light.sky_exact) = (None, false);
             }
             light.pass = None;
@@ -201,7 +204,7 @@ impl CloudLight {
 /// the shader (`deck_harris_lastra` in shaders/sprite_build.wgsl): each cell lit alone here
 /// would take the sun on its sunward side, a grid seen from above. Its sprites cost the light
 /// budget nothing.
-fn lit_in_shader(cloud: &SkyCloud) -> bool {
+pub(super) fn lit_in_shader(cloud: &SkyCloud) -> bool {
     cloud.sunlit_depth_m > 0.0
 }
 
@@ -215,106 +218,15 @@ fn sprites_to_light<'a>(clouds: impl IntoIterator<Item = &'a SkyCloud>) -> u32 {
 }
 
 /// Writes packed lights at the block's slot `to.2` plus `offset`; returns the bytes.
-fn write_lights((queue, buffer, first): LightTarget, offset: u32, lights: &[u32]) -> u64 {
+pub(super) fn write_lights(
+    (queue, buffer, first): LightTarget,
+    offset: u32,
+    lights: &[u32],
+) -> u64 {
     if lights.is_empty() {
         return 0;
     }
     let at = (first + offset) as u64 * 4;
     queue.write_buffer(buffer, at, bytemuck::cast_slice(lights));
     lights.len() as u64 * 4
-}
-
-impl ResidentSet {
-    /// Gives every written block a provisional light (the model was just switched on;
-    /// [`Self::relight`] gives them their own, a budget a frame); returns the bytes.
-    pub fn provisional_all(&mut self, queue: &wgpu::Queue) -> u64 {
-        let start = std::time::Instant::now();
-        let mut bytes = 0;
-        for r in self.blocks.values_mut() {
-            let Some((s, _)) = r.place.clone() else {
-                continue;
-            };
-            if !r.uploaded {
-                continue;
-            }
-            self.light.provisional(&r.block, &mut r.light.lights);
-            (r.light.lit_for, r.light.sky_exact, r.light.pass) = (None, false, None);
-            bytes += write_lights((queue, &self.light_buffer, s.start), 0, &r.light.lights);
-        }
-        self.light_us += start.elapsed().as_micros() as u64;
-        bytes
-    }
-
-    /// Computes again the light of written blocks not lit for the current lit direction,
-    /// nearest to `camera_m` first, a cloud at a time, until what this frame's arrivals left of
-    /// the budget is spent (at least one cloud a frame); returns the bytes written.
-    pub fn relight(&mut self, queue: &wgpu::Queue, camera_m: DVec3) -> u64 {
-        if !self.light.enabled() {
-            return 0;
-        }
-        let start = std::time::Instant::now();
-        let target = self.light.sun_dir;
-        let mut stale: Vec<(f64, &mut Resident)> = self
-            .blocks
-            .values_mut()
-            .filter(|r| r.place.is_some() && r.uploaded && r.light.lit_for != Some(target))
-            .map(|r| ((r.centre_m() - camera_m).length_squared(), r))
-            .collect();
-        if stale.is_empty() {
-            return 0;
-        }
-        stale.sort_by(|a, b| a.0.total_cmp(&b.0).then_with(|| a.1.tie_order(b.1)));
-        let budget = self.light.budget().saturating_sub(self.lit_sprites);
-        let (mut lit, mut bytes) = (0u32, 0u64);
-        for (_, r) in stale {
-            let Some((s, _)) = r.place.clone() else {
-                continue;
-            };
-            let n = r.sprite_count() as usize;
-            let light = &mut r.light;
-            if light.lights.len() != n {
-                self.light.provisional(&r.block, &mut light.lights);
-                light.sky_exact = false;
-            }
-            let (mut next, with_sky) = match light.pass {
-                Some((sun, next, with_sky)) if sun == target => (next, with_sky),
-                _ => (0, !light.sky_exact),
-            };
-            // The clouds lit this frame are next to each other: one write a run of them (a deck,
-            // lit in the shader, ends a run and is neither lit nor written).
-            let at = (queue, &self.light_buffer, s.start);
-            let mut from = r.clouds.get(next).map_or(0, |c| c.sprite_base - s.start) as usize;
-            let mut to = from;
-            let mut done = true;
-            while next < r.block.clouds.len() {
-                if lit > 0 && lit >= budget {
-                    light.pass = Some((target, next, with_sky));
-                    done = false;
-                    break;
-                }
-                let cloud = &r.block.clouds[next];
-                let first = (r.clouds[next].sprite_base - s.start) as usize;
-                let end = first + cloud.sprites.len();
-                next += 1;
-                if lit_in_shader(cloud) {
-                    bytes += write_lights(at, from as u32, &light.lights[from..to]);
-                    (from, to) = (end, end);
-                    continue;
-                }
-                self.light
-                    .cloud(cloud, with_sky, &mut light.lights[first..end]);
-                lit += cloud.sprites.len() as u32;
-                to = end;
-            }
-            bytes += write_lights(at, from as u32, &light.lights[from..to]);
-            if !done {
-                break;
-            }
-            (light.lit_for, light.pass) = (Some(target), None);
-            light.sky_exact |= with_sky;
-        }
-        self.lit_sprites += lit;
-        self.light_us += start.elapsed().as_micros() as u64;
-        bytes
-    }
 }

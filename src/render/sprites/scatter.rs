@@ -11,11 +11,11 @@
 use std::cell::Cell;
 use std::ops::Range;
 
-use super::gpu_types::GpuListCloud;
-use super::id_hash::IdMap;
 use super::resident::storage_buffer;
+use crate::render::gpu_types::GpuListCloud;
+use crate::render::id_hash::IdMap;
 
-const WGSL: &str = include_str!("../../shaders/scatter.wgsl");
+const WGSL: &str = include_str!("../../../shaders/scatter.wgsl");
 /// Workgroups per dispatch row.
 const ROW: u32 = 65_535;
 
@@ -23,7 +23,7 @@ const ROW: u32 = 65_535;
 type Target<'a, T> = (&'a [T], &'a wgpu::Buffer, &'a mut Vec<Range<u32>>);
 
 /// The patch being gathered and its GPU side.
-pub(super) struct Scatter {
+pub(in crate::render) struct Scatter {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     values: Vec<u32>,

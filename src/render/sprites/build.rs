@@ -5,12 +5,12 @@
 //! drawing order, so its memory stays bounded whatever is in view. One buffer serves every view
 //! of a frame: each build is followed by its draw before the next.
 
-use super::gpu_types::GpuSpriteVertex;
+use crate::render::gpu_types::GpuSpriteVertex;
 
-const WGSL: &str = include_str!("../../shaders/sprite_build.wgsl");
+const WGSL: &str = include_str!("../../../shaders/sprite_build.wgsl");
 /// Most sprites built and drawn at once (6.3 MB of corners). Keep in sync with `CHUNK` in
 /// `shaders/sprite_build.wgsl`.
-pub(super) const CHUNK: u32 = 32_768;
+pub(in crate::render) const CHUNK: u32 = 32_768;
 /// Most chunks of one view (8.4 million sprites).
 const MAX_CHUNKS: u32 = 256;
 /// Bytes between the chunks' uniforms (the dynamic offset alignment every device accepts).
@@ -20,7 +20,7 @@ const GROUP: u32 = 64;
 const ROW: u32 = 65_535;
 
 /// The pipeline, and the vertex buffer with its bind group.
-pub(super) struct SpriteBuild {
+pub(in crate::render) struct SpriteBuild {
     pipeline: wgpu::ComputePipeline,
     out_layout: wgpu::BindGroupLayout,
     vertices: wgpu::Buffer,
@@ -32,7 +32,7 @@ pub(super) struct SpriteBuild {
 }
 
 /// The chunks of `sprites` sprites: (index, first sprite, sprites).
-pub(super) fn chunks(sprites: u32) -> impl Iterator<Item = (u32, u32, u32)> {
+pub(in crate::render) fn chunks(sprites: u32) -> impl Iterator<Item = (u32, u32, u32)> {
     (0..sprites.div_ceil(CHUNK).min(MAX_CHUNKS))
         .map(move |c| (c, c * CHUNK, (sprites - c * CHUNK).min(CHUNK)))
 }

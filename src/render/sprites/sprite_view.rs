@@ -6,18 +6,18 @@
 
 use glam::Vec3;
 
-use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, GpuSpriteView, MAX_LOCKS};
 use super::resident::storage_buffer;
 use super::settings::CloudSettings;
-use super::stats::Lighting;
 use crate::clouds::LifecycleConfig;
+use crate::render::gpu_types::{GpuDrawBlock, GpuListCloud, GpuLock, GpuSpriteView, MAX_LOCKS};
+use crate::render::stats::Lighting;
 use crate::shading::ShadingModel;
 
 /// Bytes of the view uniform before its lock table.
 const HEADER_BYTES: usize = std::mem::size_of::<GpuSpriteView>() - MAX_LOCKS * 48;
 
 /// The layout of group 3: view uniform, draw list, cloud lists, orders.
-pub(super) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+pub(in crate::render) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
@@ -41,7 +41,7 @@ pub(super) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 }
 
 /// What a view's uniform says besides the locks.
-pub(super) struct ViewLight<'a> {
+pub(in crate::render) struct ViewLight<'a> {
     pub lighting: &'a Lighting,
     pub clouds: &'a CloudSettings,
     pub lifecycle: &'a LifecycleConfig,
@@ -56,7 +56,7 @@ pub(super) struct ViewLight<'a> {
 }
 
 /// The uniform of a view (its lock table written apart).
-pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
+pub(in crate::render) fn header(light: &ViewLight) -> GpuSpriteView {
     let ViewLight {
         lighting,
         clouds,
@@ -120,7 +120,7 @@ pub(super) fn header(light: &ViewLight) -> GpuSpriteView {
 }
 
 /// A view's buffers and bind group.
-pub(super) struct ViewBuffers {
+pub(in crate::render) struct ViewBuffers {
     uniform: wgpu::Buffer,
     draws: Grown,
     /// An impostor view's own cloud lists (the sky's camera uses the resident ones).
@@ -177,7 +177,7 @@ impl Grown {
 /// What a view writes besides its uniform: its draw list (after a header of its counts: blocks,
 /// locks, sprites), and an impostor's own cloud lists with the ring's order buffer or, for the
 /// sky's camera, the resident list and order buffers (with their generation).
-pub(super) enum ViewData<'a> {
+pub(in crate::render) enum ViewData<'a> {
     Own {
         counts: [u32; 4],
         draws: &'a [GpuDrawBlock],

@@ -1,0 +1,161 @@
+//! The blocks a host hands the sky ([`Sky::set_clouds`], [`Sky::insert_block`] and their
+//! kin): into the resident set, out of it, their motion, drift and fade. What a frame uploads of
+//! them is the resident set's; here they are only taken in and let go.
+
+use std::collections::HashSet;
+
+use super::Sky;
+use crate::render::scene::BlockMotion;
+use crate::render::scene::SkyBlock;
+use crate::render::stats::Stopwatch;
+
+impl Sky {
+    /// Replaces the clouds with `blocks` (none drifting, all steady). A block the sky already
+    /// holds with the same id and content stays on the GPU as it is, with its cached orders;
+    /// the others are uploaded by the next [`Self::prepare`]. For a whole new scene; a living
+    /// field hands over its changes with [`Self::insert_block`], [`Self::remove_block`] and
+    /// [`Self::set_block_motion`] instead.
+    pub fn set_clouds(&mut self, blocks: Vec<SkyBlock>) {
+        let start = Stopwatch::start();
+        let ids: HashSet<u64> = blocks.iter().map(|b| b.id).collect();
+        let gone: Vec<u64> = self
+            .resident
+            .blocks
+            .keys()
+            .filter(|id| !ids.contains(id))
+            .copied()
+            .collect();
+        for id in gone {
+            self.retire(id);
+        }
+        for block in blocks {
+            match self.resident.blocks.get_mut(&block.id) {
+                Some(r) if r.block == block => {
+                    if r.motion != BlockMotion::default() {
+                        let steady = BlockMotion::default();
+                        self.resident.fades += r.motion.fade.kind_changes(steady.fade) as u64;
+                        r.motion = steady;
+                        self.resident.changes += 1;
+                    }
+                }
+                _ => self.resident.insert(block, BlockMotion::default()),
+            }
+        }
+        self.pending += start.spent();
+    }
+
+    /// Adds a block (or replaces the one with its id); it is uploaded to the GPU once, by the
+    /// next [`Self::prepare`]. Many at once: [`Self::insert_blocks`].
+    pub fn insert_block(&mut self, block: SkyBlock, motion: BlockMotion) {
+        self.insert_blocks([(block, motion)]);
+    }
+
+    /// [`Self::insert_block`] for each of `blocks`, timed once (reading the thread's CPU clock
+    /// costs about a microsecond, more than inserting a block).
+    pub fn insert_blocks(&mut self, blocks: impl IntoIterator<Item = (SkyBlock, BlockMotion)>) {
+        let start = Stopwatch::start();
+        for (block, motion) in blocks {
+            self.retire(block.id);
+            self.resident.insert(block, motion);
+        }
+        self.pending += start.spent();
+    }
+
+    /// Says that blocks of `sprites` sprites and `clouds` clouds in all will be inserted in
+    /// the next frames (a weather change handed over a part a frame): when the buffers next
+    /// grow, they grow for those as well, once. Each call replaces the last; 0, 0 when none
+    /// wait.
+    pub fn expect_blocks(&mut self, sprites: u64, clouds: u64) {
+        self.resident.expected = (sprites, clouds);
+    }
+
+    /// Adds a block drawn as sprites however far it is, never into the impostor ring nor cut at
+    /// the draw distance: what the ring and the far field cannot draw beyond the cloud field,
+    /// a storm cell's tower seen from 100-450 km (`flight::far_cells`). While the far field is
+    /// drawn, its sprites fade in over the hand-over band as the near sprites and the ring fade
+    /// out there ([`Self::far_field_hand_over_m`]). Replaces the block with
+    /// its id; uploaded once, by the next [`Self::prepare`].
+    pub fn insert_distant_block(&mut self, block: SkyBlock, motion: BlockMotion) {
+        let start = Stopwatch::start();
+        let id = block.id;
+        self.retire(id);
+        self.resident.insert(block, motion);
+        if let Some(r) = self.resident.blocks.get_mut(&id) {
+            r.distant = true;
+        }
+        self.pending += start.spent();
+    }
+
+    /// Retires a block; false if the sky did not hold it. Many at once:
+    /// [`Self::remove_blocks`].
+    pub fn remove_block(&mut self, id: u64) -> bool {
+        self.remove_blocks([id]) == 1
+    }
+
+    /// [`Self::remove_block`] for each of `ids`, timed once; returns how many the sky held.
+    pub fn remove_blocks(&mut self, ids: impl IntoIterator<Item = u64>) -> usize {
+        let start = Stopwatch::start();
+        let held = ids.into_iter().filter(|&id| self.retire(id)).count();
+        self.pending += start.spent();
+        held
+    }
+
+    fn retire(&mut self, id: u64) -> bool {
+        match self.resident.remove(id) {
+            Some(slots) => {
+                for view in &mut self.views {
+                    view.locks.release(slots.clone());
+                }
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Moves a block (its drift) and sets where it is in its life; nothing is uploaded but the
+    /// frame's draw list. False if the sky does not hold it.
+    pub fn set_block_motion(&mut self, id: u64, motion: BlockMotion) -> bool {
+        match self.resident.blocks.get_mut(&id) {
+            Some(r) => {
+                // What the shadow map watches for (a block moved by other means than the drift).
+                self.resident.changes += (r.motion.offset_m != motion.offset_m) as u64;
+                self.resident.fades += r.motion.fade.kind_changes(motion.fade) as u64;
+                r.motion = motion;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Moves every block the sky holds to the same drift offset (a field drifting with the air as
+    /// one): one write a block, no lookups, nothing uploaded.
+    pub fn set_drift(&mut self, offset_m: glam::DVec3) {
+        for r in self.resident.blocks.values_mut() {
+            r.motion.offset_m = offset_m;
+        }
+        self.resident.drift_m = offset_m;
+        self.shadows.set_drift(offset_m);
+    }
+
+    /// Sets where a block is in its life, keeping its drift; false if the sky does not hold it.
+    pub fn set_block_fade(&mut self, id: u64, fade: crate::render::Fade) -> bool {
+        match self.resident.blocks.get_mut(&id) {
+            Some(r) => {
+                self.resident.fades += r.motion.fade.kind_changes(fade) as u64;
+                r.motion.fade = fade;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The ids of the blocks the sky holds.
+    pub fn block_ids(&self) -> impl Iterator<Item = u64> + '_ {
+        self.resident.blocks.keys().copied()
+    }
+
+    /// A block the sky holds.
+    pub fn block(&self, id: u64) -> Option<&SkyBlock> {
+        self.resident.blocks.get(&id).map(|r| &r.block)
+    }
+}
