@@ -346,6 +346,7 @@ mod tests {
         shipped::<crate::weather::field::CloudTypeRule>();
         shipped::<crate::weather::field::FieldSettings>();
         shipped::<crate::weather::model::ModelSettings>();
+        shipped::<crate::render::RenderSettings>();
     }
 
     #[test]

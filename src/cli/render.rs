@@ -269,10 +269,8 @@ pub fn load_look(
     time_of_day: Option<&PathBuf>,
     cloud_scale: Option<f32>,
 ) -> anyhow::Result<(RenderSettings, TimeOfDayTable)> {
-    let mut settings = match defaults::settings_file(render.map(PathBuf::as_path), "render.toml") {
-        Some(p) => RenderSettings::load(&p)?,
-        None => RenderSettings::default(),
-    };
+    let mut settings: RenderSettings =
+        defaults::settings(render.map(PathBuf::as_path), "render.toml")?;
     if let Some(scale) = cloud_scale {
         settings.clouds.resolution_scale = scale;
     }

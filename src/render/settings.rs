@@ -4,7 +4,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::config::{ConfigError, parse_toml};
+use crate::config::{ConfigError, ShippedFile, TomlSettings};
 
 // The near sprites' own tables stand in a leaf their stages read without the whole tree;
 // their paths here stay.
@@ -76,15 +76,15 @@ pub struct RenderSettings {
 impl Default for RenderSettings {
     /// The shipped `config/render.toml` (built in; a test checks that it parses).
     fn default() -> Self {
-        Self::parse(DEFAULT_RENDER_TOML, Path::new("config/render.toml"))
-            .expect("the shipped config/render.toml is valid (tested)")
+        Self::shipped()
     }
 }
 
-impl RenderSettings {
-    /// Parses and checks settings; `path` names the file in errors.
-    pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
-        let s: Self = parse_toml(text, path)?;
+impl TomlSettings for RenderSettings {
+    const SHIPPED: Option<ShippedFile> = ShippedFile::at("config/render.toml", DEFAULT_RENDER_TOML);
+
+    fn check(&self, path: &Path, text: &str) -> Result<(), ConfigError> {
+        let s = self;
         let positive = [
             ("camera.near_m", s.camera.near_m),
             ("camera.fov_y_deg", s.camera.fov_y_deg),
@@ -187,14 +187,7 @@ impl RenderSettings {
                 "must be greater than camera.near_m",
             ));
         }
-        Ok(s)
-    }
-
-    /// Reads and checks a settings file.
-    pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|err| ConfigError::whole_file(path, format!("cannot read: {err}")))?;
-        Self::parse(&text, path)
+        Ok(())
     }
 }
 
