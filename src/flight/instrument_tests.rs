@@ -513,7 +513,7 @@ fn class(cover: crate::weather::metar::Cover) -> i32 {
 /// it gives back
 /// (base within max(100 ft, 10%), cover class within one) and the ceilings (both none, or within
 /// the same), as shares.
-fn ceilometer_round_trip(stations: usize) -> (f64, f64, usize) {
+fn ceilometer_round_trip(stations: usize) -> RoundTrip {
     use crate::flight::ceilometer;
     use crate::weather::metar::Cover;
     let input = WeatherInput::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(REAL), None)
@@ -523,6 +523,7 @@ fn ceilometer_round_trip(stations: usize) -> (f64, f64, usize) {
     };
     let near = |a: f64, b: f64| (a - b).abs() <= (0.1 * b).max(100.0);
     let (mut layers, mut layers_met, mut ceilings_met, mut done) = (0, 0, 0, 0);
+    let mut calm = (0, 0);
     let mut seen = std::collections::HashSet::new();
     for report in file.reports.iter().step_by(3) {
         if done >= stations {
@@ -572,12 +573,21 @@ fn ceilometer_round_trip(stations: usize) -> (f64, f64, usize) {
             .iter()
             .find(|g| g.0 == Cover::Ovc)
             .map_or(f64::INFINITY, |g| g.1);
+        // A calm or variable wind (up to 3 kt, or no direction) drifts the clouds over the
+        // station hardly at all: its readings are of one spot.
+        let is_calm = r
+            .wind
+            .is_none_or(|w| w.speed_kt.unwrap_or(0.0) <= 3.0 || w.dir_deg.is_none());
         for (cover, base) in groups.iter().filter(|g| g.1 <= first_ovc) {
+            let met = found
+                .iter()
+                .any(|l| near(l.base_ft, *base) && (class(l.cover) - class(*cover)).abs() <= 1);
             layers += 1;
-            layers_met +=
-                usize::from(found.iter().any(|l| {
-                    near(l.base_ft, *base) && (class(l.cover) - class(*cover)).abs() <= 1
-                }));
+            layers_met += usize::from(met);
+            if is_calm {
+                calm.0 += 1;
+                calm.1 += usize::from(met);
+            }
         }
         let reported = groups
             .iter()
@@ -602,11 +612,43 @@ fn ceilometer_round_trip(stations: usize) -> (f64, f64, usize) {
         });
         done += 1;
     }
-    (
-        layers_met as f64 / layers.max(1) as f64,
-        ceilings_met as f64 / done.max(1) as f64,
-        done,
-    )
+    RoundTrip {
+        layers: layers_met as f64 / layers.max(1) as f64,
+        ceilings: ceilings_met as f64 / done.max(1) as f64,
+        stations: done,
+        calm_layers: calm,
+        windy_layers: (layers - calm.0, layers_met - calm.1),
+    }
+}
+
+/// What [`ceilometer_round_trip`] gives back.
+struct RoundTrip {
+    /// The share of the reported layers given back.
+    layers: f64,
+    /// The share of the ceilings given back.
+    ceilings: f64,
+    /// Stations read.
+    stations: usize,
+    /// Reported layers and those given back at stations with a calm or variable wind.
+    calm_layers: (usize, usize),
+    /// The same at the other stations.
+    windy_layers: (usize, usize),
+}
+
+impl RoundTrip {
+    fn print(&self) {
+        eprintln!(
+            "{} stations: layers {:.3}, ceilings {:.3}; calm or variable wind: {} of {} layers, \
+             the others: {} of {}",
+            self.stations,
+            self.layers,
+            self.ceilings,
+            self.calm_layers.1,
+            self.calm_layers.0,
+            self.windy_layers.1,
+            self.windy_layers.0
+        );
+    }
 }
 
 /// The ceilometer's round trip at 40 cloudy stations of the real bulk file: measured 0.89 of
@@ -617,21 +659,22 @@ fn ceilometer_round_trip(stations: usize) -> (f64, f64, usize) {
 /// either way now and then, and a calm wind reads one spot for 20 minutes.
 #[test]
 fn a_ceilometer_under_the_drifting_clouds_reads_the_reports_back() {
-    let (layers, ceilings, stations) = ceilometer_round_trip(40);
-    eprintln!("{stations} stations: layers {layers:.3}, ceilings {ceilings:.3}");
-    assert_eq!(stations, 40);
-    assert!(layers >= 0.85 && ceilings >= 0.85, "{layers} {ceilings}");
+    let trip = ceilometer_round_trip(40);
+    trip.print();
+    assert_eq!(trip.stations, 40);
+    assert!(trip.layers >= 0.85 && trip.ceilings >= 0.85);
 }
 
 /// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations (about a
-/// minute): measured 0.86 of the layers and 0.92 of the ceilings.
+/// minute): measured 0.86 of the layers and 0.92 of the ceilings; at the stations with a calm or
+/// variable wind 42 of 69 layers (0.61), at the others 227 of 243 (0.93).
 #[test]
 #[ignore]
 fn ceilometer_round_trip_at_200() {
-    let (layers, ceilings, stations) = ceilometer_round_trip(200);
-    eprintln!("{stations} stations: layers {layers:.3}, ceilings {ceilings:.3}");
-    assert_eq!(stations, 200);
-    assert!(layers >= 0.84 && ceilings >= 0.9, "{layers} {ceilings}");
+    let trip = ceilometer_round_trip(200);
+    trip.print();
+    assert_eq!(trip.stations, 200);
+    assert!(trip.layers >= 0.84 && trip.ceilings >= 0.9);
 }
 
 /// The clouds drift with the wind the air data reports at their height: over real reports (and
