@@ -1,7 +1,8 @@
 //! Storm cells beyond the cloud field: the cells of the weather field between the field's rim
 //! (`config/clouds.toml` `radius_m`) and `[far] reach_m` of `config/storms.toml`, each drawn
 //! whole as one cloud of few large sprites ([`crate::clouds::storm::far_cell_cloud`]) that the
-//! sky draws however far it is ([`Sky::insert_distant_block`]). The ring and the far field stop
+//! sky draws however far it is ([`crate::render::Sky::insert_distant_block`]), handed over as
+//! [`DistantChange`]s of the frame's [`crate::render::SkyUpdate`]. The ring and the far field stop
 //! a storm at the field's rim: the far field would draw its area as a grey layer from base to
 //! top (it leaves cumulonimbus out for this), and pilots see storms 50-160 km off.
 //!
@@ -19,8 +20,8 @@ use glam::{DVec2, DVec3};
 
 use crate::clouds::CloudTypes;
 use crate::clouds::storm::far_cell_cloud;
-use crate::render::Sky;
 use crate::render::scene::{BlockMotion, Fade, SkyBlock, SkyCloud};
+use crate::render::update::DistantChange;
 use crate::weather::field::WeatherField;
 use crate::weather::storms::{FarCellSettings, StormCell, StormContext, cell_of_square};
 use crate::weather::{BlockIndex, BlockWeather, CloudType};
@@ -125,11 +126,12 @@ impl FarCells {
         self.settings.enabled
     }
 
-    /// One frame: looks further for cells, and hands `sky` the ones that join or leave.
-    pub(super) fn update(&mut self, sky: &mut Sky, f: &FarCellFrame) {
+    /// One frame: looks further for cells, and adds to `changes` the ones that join or leave
+    /// and the fades that moved on, in order, for the sky.
+    pub(super) fn update(&mut self, changes: &mut Vec<DistantChange>, f: &FarCellFrame) {
         if !self.settings.enabled {
             for (_, s) in self.shown.drain() {
-                sky.remove_block(s.id);
+                changes.push(DistantChange::Went(s.id));
             }
             return;
         }
@@ -141,15 +143,15 @@ impl FarCells {
         });
         if decide {
             self.decided = Some((self.searches, f.camera_air_m, f.band_start_m));
-            self.decide(sky, f);
+            self.decide(changes, f);
         }
         if self.fading > 0 {
-            self.fade_on(sky, f);
+            self.fade_on(changes, f);
         }
     }
 
-    /// Hands `sky` the cells that join the shown set (forming) and marks those that leave it.
-    fn decide(&mut self, sky: &mut Sky, f: &FarCellFrame) {
+    /// Hands over the cells that join the shown set (forming) and marks those that leave it.
+    fn decide(&mut self, changes: &mut Vec<DistantChange>, f: &FarCellFrame) {
         let wanted = self.wanted(f);
         let by_key: HashMap<u64, &StormCell> = wanted.iter().map(|c| (c.key, c)).collect();
         let offset_m = DVec3::new(f.drift_m.x, f.drift_m.y, 0.0);
@@ -187,11 +189,11 @@ impl FarCells {
             }
             joins -= 1;
             if let Some(old) = self.shown.remove(key) {
-                sky.remove_block(old.id);
+                changes.push(DistantChange::Went(old.id));
             }
             let id = self.next_id;
             self.next_id += 1;
-            sky.insert_distant_block(
+            changes.push(DistantChange::Came(
                 far_block(id, cell, f, &self.settings),
                 BlockMotion {
                     offset_m,
@@ -201,7 +203,7 @@ impl FarCells {
                         Fade::Forming(0.0)
                     },
                 },
-            );
+            ));
             self.shown.insert(
                 *key,
                 Shown {
@@ -215,7 +217,7 @@ impl FarCells {
     }
 
     /// The fades go on; those done are steady, or gone.
-    fn fade_on(&mut self, sky: &mut Sky, f: &FarCellFrame) {
+    fn fade_on(&mut self, changes: &mut Vec<DistantChange>, f: &FarCellFrame) {
         let fade_s = self.settings.fade_s;
         self.shown.retain(|_, s| {
             let Some((leaving, since)) = s.fade else {
@@ -228,18 +230,18 @@ impl FarCells {
             };
             match (leaving, p >= 1.0) {
                 (true, true) => {
-                    sky.remove_block(s.id);
+                    changes.push(DistantChange::Went(s.id));
                     return false;
                 }
                 (false, true) => {
                     s.fade = None;
-                    sky.set_block_fade(s.id, Fade::Steady);
+                    changes.push(DistantChange::Fade(s.id, Fade::Steady));
                 }
                 (true, false) => {
-                    sky.set_block_fade(s.id, Fade::Dissipating(p));
+                    changes.push(DistantChange::Fade(s.id, Fade::Dissipating(p)));
                 }
                 (false, false) => {
-                    sky.set_block_fade(s.id, Fade::Forming(p));
+                    changes.push(DistantChange::Fade(s.id, Fade::Forming(p)));
                 }
             }
             true

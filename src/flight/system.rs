@@ -507,8 +507,15 @@ impl SkySystem {
         let sun = sun_position(utc_unix_s, lat, lon);
         self.sun_direction = sun.direction_enu().as_vec3();
         self.sun = Some(sun);
-        self.sky.add_field_cpu(start.spent());
-        self.world.update_sky(&mut self.sky, position_m, dt_s)?;
+        let own = start.spent();
+        // Read after the far map above: the far field's band holds from its first map on. A
+        // host may switch the ring or the far field between frames (through `DerefMut`).
+        self.world.set_sky_reach(self.sky.reach());
+        let update = self.world.advance_sky(position_m, dt_s)?;
+        // The field's time is the weather, the far map, the sun and the world's own; the
+        // sky's applying goes into its update time.
+        let field = own + update.field_cpu;
+        self.sky.apply(update);
         self.sky.set_flash(self.world.flash_now());
         let view = SkyView {
             position_m,
@@ -516,6 +523,7 @@ impl SkySystem {
             projection: camera.projection,
         };
         let mut stats = self.sky.prepare(queue, view, &sun, dt_s);
+        stats.add_field(field);
         stats.weather_us = weather_us;
         // This frame is not recorded yet: the last recording is the previous frame's.
         stats.set_record(self.sky.last_record());

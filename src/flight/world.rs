@@ -3,8 +3,11 @@
 //!
 //! Blocks are generated on demand (a pure function of block index, block weather and seed) and
 //! kept, so a flight regenerates nothing it has seen. A living world hands the sky its changes
-//! only ([`World::update_sky`]): a generation that appears is uploaded once, one that goes is
-//! retired, and every frame the rest only move with the wind and fade.
+//! only, as plain data ([`World::advance_sky`] returns a [`SkyUpdate`] that
+//! [`Sky::apply`] applies): a generation that appears is uploaded once, one that goes is
+//! retired, and every frame the rest only move with the wind and fade. What it needs to know of
+//! the sky (where the impostor ring and the far field take over) it is given as values
+//! ([`World::set_sky_reach`]).
 
 use std::collections::{HashMap, HashSet};
 
@@ -17,8 +20,11 @@ use crate::clouds::{
     Cloud, CloudField, CloudTypes, CloudsConfig, field::FieldBlock, field::weather_changed,
     generate_block,
 };
+#[cfg(doc)]
+use crate::render::Sky;
 use crate::render::scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite};
-use crate::render::{RenderError, Sky, SpriteSheet, Stopwatch};
+use crate::render::update::{SkyReach, SkyUpdate};
+use crate::render::{RenderError, SpriteSheet, Stopwatch};
 use crate::shading::{ColourLevel, ColourLevels};
 use crate::weather::field::WeatherField;
 use crate::weather::storms::{Flash, FlashKind, flashes_between};
@@ -157,6 +163,9 @@ pub struct World {
     flashes: std::collections::VecDeque<Flash>,
     /// The latest in-cloud flash, lighting its cell while it lasts.
     lit: Option<Flash>,
+    /// Where the sky hands its clouds over to the ring and the far field
+    /// ([`World::set_sky_reach`]).
+    sky_reach: SkyReach,
 }
 
 /// Flashes kept for a host that does not drain them, at most (the oldest go first).
@@ -177,7 +186,22 @@ impl World {
             air: Default::default(),
             flashes: std::collections::VecDeque::new(),
             lit: None,
+            sky_reach: SkyReach::default(),
         }
+    }
+
+    /// Tells the world where the sky it feeds hands its clouds over ([`Sky::reach`]: the
+    /// impostor ring's radius, the far field's band), before [`Self::advance_sky`]: arrivals
+    /// fade in within the ring, far storm cells are drawn whole past the band's start. A plain
+    /// copy, so [`crate::SkySystem::update`] gives it every frame (a host may switch the ring
+    /// or the far field at any time). Until given: neither is drawn.
+    pub fn set_sky_reach(&mut self, reach: SkyReach) {
+        self.sky_reach = reach;
+    }
+
+    /// What [`Self::set_sky_reach`] last gave.
+    pub fn sky_reach(&self) -> SkyReach {
+        self.sky_reach
     }
 
     /// The in-cloud flash lighting its cell now, as the sky draws it: its light fades from the
@@ -231,13 +255,13 @@ impl World {
     }
 
     /// Uses `config` (lifecycle durations: how long a changed block's clouds take to form and
-    /// dissipate) for the living clouds; call before the first [`Self::update_sky`]. The
+    /// dissipate) for the living clouds; call before the first [`Self::advance_sky`]. The
     /// field radius and seed stay the world's.
     pub fn set_clouds_config(&mut self, config: CloudsConfig) {
         self.clouds_config = config;
     }
 
-    /// When `on`, every frame of [`Self::update_sky`] waits for the blocks it queued, so what
+    /// When `on`, every frame of [`Self::advance_sky`] waits for the blocks it queued, so what
     /// a frame shows does not depend on thread timing, and they show whole at once: the warm-up
     /// for tests and offline rendering (turned on for the first frame, it gives that frame
     /// every cloud), never for a simulator's frame loop. Off by default: no frame waits, not
@@ -273,7 +297,7 @@ impl World {
         });
     }
 
-    /// The clouds stage's living field, once [`Self::update_sky`] has run.
+    /// The clouds stage's living field, once [`Self::advance_sky`] has run.
     pub fn living_field(&self) -> Option<&CloudField> {
         self.living.as_ref().map(|l| &l.field)
     }
@@ -501,19 +525,18 @@ impl World {
     /// Advances the clouds stage's [`CloudField`] around `camera_m` by `dt_s` seconds (blocks
     /// generated in the background, no call waits for them unless clouds are synchronous;
     /// arriving into an empty sky, they fade in; drifting with the wind;
-    /// forming and dissipating when the weather changes) and hands `sky` what changed: new
-    /// generations are inserted (uploaded once), gone ones removed, and every block's drift and
-    /// fade set. Its own CPU time goes into the sky's next [`crate::render::FrameStats::field_us`].
-    /// Hand it the same sky every frame.
-    pub fn update_sky(
-        &mut self,
-        sky: &mut Sky,
-        camera_m: DVec3,
-        dt_s: f64,
-    ) -> Result<(), RenderError> {
+    /// forming and dissipating when the weather changes) and returns what changed for the sky,
+    /// as plain data for [`Sky::apply`]: the new generations (moved in, uploaded once), the gone
+    /// ones, the fades that moved on, the drift, the far storm cells' changes, and the CPU time
+    /// this took ([`SkyUpdate::field_cpu`], for the frame's
+    /// [`crate::render::FrameStats::field_us`]). Apply every update, in order, to the same sky:
+    /// each says only what changed since the last. Give it the sky's reach first
+    /// ([`Self::set_sky_reach`]).
+    pub fn advance_sky(&mut self, camera_m: DVec3, dt_s: f64) -> Result<SkyUpdate, RenderError> {
         let start = Stopwatch::start();
+        let mut update = SkyUpdate::default();
         if self.start_living()? {
-            sky.set_lifecycle(self.clouds_config.lifecycle);
+            update.lifecycle = Some(self.clouds_config.lifecycle);
         }
         // The blocks around are asked for again only when the camera entered another block of
         // the moving air, the air drifted past a block, or the weather changed: then the
@@ -536,7 +559,7 @@ impl World {
         };
         let weather_field = &self.field;
         let Some(living) = self.living.as_mut() else {
-            return Ok(());
+            return Ok(update);
         };
         let drift = living.field.drift_m();
         let key = key_of(drift);
@@ -587,11 +610,11 @@ impl World {
         living.field.advance(dt_s);
         self.queue_flashes(dt_s);
         let Some(living) = self.living.as_mut() else {
-            return Ok(());
+            return Ok(update);
         };
         let drift = living.field.drift_m();
         living.far_cells.update(
-            sky,
+            &mut update.distant,
             &super::far_cells::FarCellFrame {
                 weather: &self.field,
                 version: self.field_version,
@@ -600,9 +623,7 @@ impl World {
                 camera_air_m: camera_m.truncate() - drift,
                 drift_m: drift,
                 field_radius_m: self.clouds_config.field.radius_m,
-                band_start_m: sky
-                    .far_field_hand_over_m()
-                    .map(|(start, _)| f64::from(start)),
+                band_start_m: (self.sky_reach.hand_over_m).map(|(start, _)| f64::from(start)),
                 now_s: living.field.time_s(),
                 whole: self.synchronous_clouds,
             },
@@ -610,15 +631,14 @@ impl World {
         let offset_m = DVec3::new(drift.x, drift.y, 0.0);
         let now = living.field.time_s();
         let lifecycle = *living.field.lifecycle();
-        let sky_before = sky.pending_cpu();
+        update.drift_m = Some(offset_m);
         // (Generations still waiting to be handed over are looked for every frame.)
         let same_members =
             living.membership == Some(living.field.membership()) && living.waiting.is_empty();
         // Nothing came, went, forms, dissipates or arrives: only the drift changed.
         if same_members && living.was_fading.is_empty() && living.arriving.is_empty() {
-            sky.set_drift(offset_m);
-            sky.add_field_cpu(start.spent());
-            return Ok(());
+            update.field_cpu = start.spent();
+            return Ok(update);
         }
         // Nothing came or went: only the generations that were fading can be fading now (a
         // steady one starts to dissipate only beside a new one), so only they are looked at,
@@ -635,17 +655,15 @@ impl World {
                 // generations were a thousand look-ups of the sky's blocks every frame.
                 let step = fade_step(serial, fade);
                 if step != shown {
-                    sky.set_block_fade(serial, fade);
+                    update.fades.push((serial, fade));
                 }
                 if fade != Fade::Steady {
                     living.fading.push((serial, phase, step));
                 }
             }
             std::mem::swap(&mut living.was_fading, &mut living.fading);
-            sky.set_drift(offset_m);
-            let sky_spent = sky.pending_cpu().saturating_sub(sky_before);
-            sky.add_field_cpu(start.spent().saturating_sub(sky_spent));
-            return Ok(());
+            update.field_cpu = start.spent();
+            return Ok(update);
         }
         living.membership = Some(living.field.membership());
         // Generations are handed over when they appear (serials only grow; those a frame's
@@ -660,8 +678,7 @@ impl World {
         // clouds around (the first frames, a jump) has arrivals to fade.
         let fade_in_s = self.settings.arrival_fade_s;
         let fade_in = fade_in_s > 0.0 && !self.synchronous_clouds;
-        let impostors = &sky.settings().impostors;
-        let ring_m = impostors.enabled.then_some(impostors.ring_radius_m);
+        let ring_m = self.sky_reach.ring_radius_m;
         let ground_m = camera_m.truncate();
         // The new generations, nearest first after the walk: (distance squared, serial,
         // index, generation).
@@ -696,7 +713,7 @@ impl World {
                     .ok()
                     .map(|k| living.was_fading[k].2);
                 if !is_new && shown != Some(step) {
-                    sky.set_block_fade(fb.serial, fade);
+                    update.fades.push((fb.serial, fade));
                 }
                 living.fading.push((fb.serial, fb.phase, step));
             }
@@ -707,7 +724,8 @@ impl World {
             true => u64::MAX,
             false => u64::from(self.settings.joined_sprites_per_frame),
         };
-        let (mut spent, mut joined, mut waiting_sprites) = (0u64, Vec::new(), 0u64);
+        let (mut spent, mut waiting_sprites) = (0u64, 0u64);
+        let joined = &mut update.came;
         let mut waiting_clouds = 0u64;
         for &(d2, serial, index, fb) in &new {
             let sprites: u64 = fb.block.clouds.iter().map(|c| c.sprites.len() as u64).sum();
@@ -735,17 +753,16 @@ impl World {
             joined.push((living_block(index, fb), BlockMotion { offset_m, fade }));
         }
         // What still waits, so that the sky grows its buffers once for all of it.
-        sky.expect_blocks(waiting_sprites, waiting_clouds);
-        sky.insert_blocks(joined);
-        // The ones that finished forming since the last frame.
+        update.expected = Some((waiting_sprites, waiting_clouds));
+        // The ones that finished forming since the last frame (told after the new ones come,
+        // which they may be).
         living.fading.sort_unstable_by_key(|f| f.0);
         for &(id, _, _) in &living.was_fading {
             if living.fading.binary_search_by_key(&id, |f| f.0).is_err() {
-                sky.set_block_fade(id, Fade::Steady);
+                update.fades.push((id, Fade::Steady));
             }
         }
         std::mem::swap(&mut living.was_fading, &mut living.fading);
-        sky.set_drift(offset_m);
         // Every block of the field is in the sky or waits; more there means some went.
         if living.in_sky.len() + living.waiting.len() != count {
             living.seen.clear();
@@ -759,12 +776,11 @@ impl World {
             }
             let seen = &living.seen;
             living.waiting.retain(|id| seen.contains(id));
-            sky.remove_blocks(gone);
+            update.went = gone;
         }
-        // The sky counts its own share (the blocks inserted and removed) in its update.
-        let sky_spent = sky.pending_cpu().saturating_sub(sky_before);
-        sky.add_field_cpu(start.spent().saturating_sub(sky_spent));
-        Ok(())
+        // The field's own time: the sky counts its applying in its own update.
+        update.field_cpu = start.spent();
+        Ok(update)
     }
 }
 
@@ -824,6 +840,46 @@ fn fade_of(phase: Phase, arrival: Option<f32>, now_s: f64, lifecycle: &Lifecycle
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The flight side hands the sky plain data, without a device: a synchronous world's first
+    /// update brings every block of its field and the lifecycle; the next, with nothing changed
+    /// but time, only the drift.
+    #[test]
+    fn a_world_hands_the_sky_its_changes_as_plain_data() {
+        use crate::weather::field::{CloudTypeRule, FieldSettings};
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("weather/themes/fair_weather_cumulus.toml");
+        let input = crate::weather::WeatherInput::load(&path, None).expect("the shipped theme");
+        let field = input.field(
+            crate::weather::LocalFrame::new(47.0, 8.0),
+            &FieldSettings::default(),
+            &CloudTypeRule::default(),
+        );
+        let settings = WorldSettings {
+            cloud_radius_m: 6_000.0,
+            ..WorldSettings::default()
+        };
+        let mut world = World::new(field, &settings);
+        world.set_synchronous_clouds(true);
+        world.set_sky_reach(SkyReach {
+            ring_radius_m: Some(20_000.0),
+            hand_over_m: None,
+        });
+        let camera_m = DVec3::new(0.0, 0.0, 1_500.0);
+        let first = world.advance_sky(camera_m, 0.0).expect("first update");
+        let blocks = world.living_field().expect("living").blocks().count();
+        assert!(first.lifecycle.is_some());
+        assert!(blocks > 0);
+        assert_eq!(first.came.len(), blocks);
+        assert!(first.went.is_empty());
+        assert!(first.drift_m.is_some());
+        let next = world
+            .advance_sky(camera_m, 1.0 / 60.0)
+            .expect("next update");
+        assert_eq!(next.lifecycle, None);
+        assert!(next.came.is_empty() && next.went.is_empty() && next.fades.is_empty());
+        assert!(next.drift_m.is_some());
+    }
 
     /// How opaque a block with `fade` is drawn as a whole (the renderer's own measure).
     fn opacity(fade: Fade) -> f32 {

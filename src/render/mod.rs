@@ -46,6 +46,7 @@ pub mod sky;
 mod sprites;
 pub mod stats;
 pub mod targets;
+pub mod update;
 mod view;
 
 pub use camera::{Camera, Frustum};
@@ -61,6 +62,7 @@ pub use sprites::resident::{BYTES_PER_SPRITE, resident_slots_bound};
 pub use sprites::sheet::SpriteSheet;
 pub use stats::{FrameStats, Lighting, SkyMemory, Spent, Stopwatch, ThreadCpu};
 pub use targets::{HostTargets, SkyView};
+pub use update::{DistantChange, SkyReach, SkyUpdate};
 pub use view::ViewId;
 
 /// How to install a software Vulkan driver where there is no GPU (Debian, Ubuntu).

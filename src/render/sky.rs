@@ -253,8 +253,9 @@ impl Sky {
     }
 
     /// Counts what the host's cloud field work for this frame `spent` (time it with a
-    /// [`Stopwatch`]) into the next prepared frame's [`FrameStats::field_us`] and its thread
-    /// figure.
+    /// [`Stopwatch`], or a [`super::SkyUpdate`]'s `field_cpu`) into the next prepared frame's
+    /// [`FrameStats::field_us`] and its thread figure: for a host that drives the sky itself
+    /// ([`crate::SkySystem::update`] adds its own to the stats it returns).
     pub fn add_field_cpu(&mut self, spent: Spent) {
         self.field += spent;
     }
@@ -265,13 +266,6 @@ impl Sky {
     /// span with [`Self::add_field_cpu`] as well.
     pub fn add_far_field_us(&mut self, us: u64) {
         self.far_field_us += us;
-    }
-
-    /// Time spent on the block changes handed over since the last [`Self::prepare`] (inserts,
-    /// removals, [`Self::set_clouds`]): part of the next frame's
-    /// [`FrameStats::cpu_update_us`] and its thread figure.
-    pub fn pending_cpu(&self) -> Spent {
-        self.pending
     }
 
     /// The corners of the last prepared frame's sprites, four per sprite in drawing order, as

@@ -44,16 +44,20 @@ pub struct FrameStats {
     /// Fraction of drawn clouds served from the cache, 0..=1 (1 when nothing was drawn).
     pub cache_hit_rate: f32,
     /// CPU time of [`crate::render::Sky::prepare`] (less `gpu_wait_us`) plus the block changes
-    /// handed to the sky since the last one (inserts, removals, motions), microseconds.
+    /// handed to the sky since the last one (inserts and removals, by hand or in a
+    /// [`crate::render::Sky::apply`] that brings or takes blocks), microseconds.
     pub cpu_update_us: u64,
     /// Time [`crate::render::Sky::prepare`] spent waiting for the device, microseconds: the
     /// submit that flushes the writes of a frame that was prepared and never recorded, which a
     /// busy device can hold (lavapipe waits in it for the submission before to finish). Not part
     /// of `cpu_update_us` or [`Self::sky_cpu_us`]; 0 on frames after a recorded one.
     pub gpu_wait_us: u64,
-    /// CPU time the host's cloud field spent on the frame thread for this frame (drift,
-    /// lifecycle, the blocks handed over), microseconds, as reported to the sky with
-    /// [`crate::render::Sky::add_field_cpu`].
+    /// CPU time the host's cloud field spent on the frame thread for this frame (the weather
+    /// step, the clouds advanced, drift, lifecycle, the blocks looked through for the sky; not
+    /// the sky's applying them, which is `cpu_update_us`), microseconds: a
+    /// [`crate::render::SkyUpdate`]'s `field_cpu` and the host's own, as
+    /// [`crate::SkySystem::update`] adds them ([`Self::add_field`]), or as reported to the sky
+    /// with [`crate::render::Sky::add_field_cpu`].
     pub field_us: u64,
     /// The host's weather step this frame (polling a watched file, switching in a new field;
     /// never reading one), microseconds; part of `field_us`.
@@ -139,6 +143,13 @@ impl FrameStats {
     pub fn set_record(&mut self, spent: Spent) {
         self.record_us = spent.wall_us;
         self.thread.record_us = spent.thread_us;
+    }
+
+    /// Adds what the host's cloud field `spent` on this frame to `field_us` and its thread
+    /// figure (a [`crate::render::SkyUpdate`]'s `field_cpu` and the host's weather step).
+    pub fn add_field(&mut self, spent: Spent) {
+        self.field_us += spent.wall_us;
+        self.thread.field_us += spent.thread_us;
     }
 
     /// Sets `air_us` and its thread figure from what the host's air-data queries spent.

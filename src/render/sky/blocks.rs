@@ -1,6 +1,7 @@
 //! The blocks a host hands the sky ([`Sky::set_clouds`], [`Sky::insert_block`] and their
-//! kin): into the resident set, out of it, their motion, drift and fade. What a frame uploads of
-//! them is the resident set's; here they are only taken in and let go.
+//! kin, or a living field's [`SkyUpdate`] through [`Sky::apply`]): into the resident set, out
+//! of it, their motion, drift and fade. What a frame uploads of them is the resident set's; here
+//! they are only taken in and let go.
 
 use std::collections::HashSet;
 
@@ -8,6 +9,7 @@ use super::Sky;
 use crate::render::scene::BlockMotion;
 use crate::render::scene::SkyBlock;
 use crate::render::stats::Stopwatch;
+use crate::render::update::{DistantChange, SkyReach, SkyUpdate};
 
 impl Sky {
     /// Replaces the clouds with `blocks` (none drifting, all steady). A block the sky already
@@ -44,6 +46,71 @@ impl Sky {
         self.pending += start.spent();
     }
 
+    /// Applies what a living field changed this frame (`flight::World::advance_sky` makes it),
+    /// in the order [`SkyUpdate`] gives: the blocks that came are moved in (uploaded once, by
+    /// the next [`Self::prepare`]), those that went are retired, the fades and the drift set.
+    /// Applying is counted in the next frame's [`crate::render::FrameStats::cpu_update_us`]
+    /// when blocks come or go (timed once); a drift and fades alone are one write a block and
+    /// go untimed, as a clock read would cost more. `update.field_cpu` is the host's to count
+    /// ([`Self::add_field_cpu`], or the frame's stats).
+    pub fn apply(&mut self, update: SkyUpdate) {
+        let start = update.moves_blocks().then(Stopwatch::start);
+        let SkyUpdate {
+            lifecycle,
+            distant,
+            expected,
+            came,
+            fades,
+            drift_m,
+            went,
+            field_cpu: _,
+        } = update;
+        if let Some(lifecycle) = lifecycle {
+            self.set_lifecycle(lifecycle);
+        }
+        for change in distant {
+            match change {
+                DistantChange::Came(block, motion) => self.insert_distant(block, motion),
+                DistantChange::Went(id) => {
+                    self.retire(id);
+                }
+                DistantChange::Fade(id, fade) => {
+                    self.set_block_fade(id, fade);
+                }
+            }
+        }
+        if let Some((sprites, clouds)) = expected {
+            self.expect_blocks(sprites, clouds);
+        }
+        for (block, motion) in came {
+            self.retire(block.id);
+            self.resident.insert(block, motion);
+        }
+        for (id, fade) in fades {
+            self.set_block_fade(id, fade);
+        }
+        if let Some(offset_m) = drift_m {
+            self.set_drift(offset_m);
+        }
+        for id in went {
+            self.retire(id);
+        }
+        if let Some(start) = start {
+            self.pending += start.spent();
+        }
+    }
+
+    /// Where this sky hands its clouds over from one way of drawing them to the next (the
+    /// impostor ring, the far field's band), as a living field needs to know it: read again
+    /// after the ring or the far field is switched, or the far field's first map arrived.
+    pub fn reach(&self) -> SkyReach {
+        let impostors = &self.settings.impostors;
+        SkyReach {
+            ring_radius_m: impostors.enabled.then_some(impostors.ring_radius_m),
+            hand_over_m: self.far_field_hand_over_m(),
+        }
+    }
+
     /// Adds a block (or replaces the one with its id); it is uploaded to the GPU once, by the
     /// next [`Self::prepare`]. Many at once: [`Self::insert_blocks`].
     pub fn insert_block(&mut self, block: SkyBlock, motion: BlockMotion) {
@@ -77,13 +144,18 @@ impl Sky {
     /// its id; uploaded once, by the next [`Self::prepare`].
     pub fn insert_distant_block(&mut self, block: SkyBlock, motion: BlockMotion) {
         let start = Stopwatch::start();
+        self.insert_distant(block, motion);
+        self.pending += start.spent();
+    }
+
+    /// [`Self::insert_distant_block`], untimed.
+    fn insert_distant(&mut self, block: SkyBlock, motion: BlockMotion) {
         let id = block.id;
         self.retire(id);
         self.resident.insert(block, motion);
         if let Some(r) = self.resident.blocks.get_mut(&id) {
             r.distant = true;
         }
-        self.pending += start.spent();
     }
 
     /// Retires a block; false if the sky did not hold it. Many at once:
