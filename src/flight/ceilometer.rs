@@ -13,7 +13,9 @@
 //! FlightGear maps them), where ASOS's end at them (a scattered layer drawn at its 4 oktas read
 //! SCT or BKN by the toss of 40 readings):
 //! 1. Every base of every reading, sorted, is cut into layers where one base lies more than
-//!    max(100 ft, 10%) above the one before.
+//!    max(100 ft, 10%) above the one before; a layer so found is cut again where a few bases
+//!    chained two layers into one ([`split_chained`]: both sides more than a stray reading's
+//!    share, their medians more than max(100 ft, 10%) apart).
 //! 2. A layer's base is the median of its bases, rounded as a METAR writes it (to 100 ft up to
 //!    5,000 ft, 500 ft to 10,000 ft, 1,000 ft above).
 //! 3. Its cover is what is seen from below up to it (the summation principle): the share of the
@@ -148,6 +150,17 @@ pub fn summarize(readings: &[Reading]) -> Vec<Layer> {
             _ => clusters.push(vec![b]),
         }
     }
+    let own_share = |low: f64, high: f64| {
+        readings
+            .iter()
+            .filter(|r| r.bases_ft.iter().any(|&b| b >= low && b <= high))
+            .count() as f64
+            / n
+    };
+    let clusters: Vec<Vec<f64>> = clusters
+        .into_iter()
+        .flat_map(|c| split_chained(c, &own_share))
+        .collect();
     let mut layers = Vec::new();
     for c in &clusters {
         let highest = c[c.len() - 1];
@@ -157,11 +170,7 @@ pub fn summarize(readings: &[Reading]) -> Vec<Layer> {
             .filter(|r| r.bases_ft.first().is_some_and(|&b| b <= highest))
             .count() as f64
             / n;
-        let own = readings
-            .iter()
-            .filter(|r| r.bases_ft.iter().any(|&b| b >= c[0] && b <= highest))
-            .count() as f64
-            / n;
+        let own = own_share(c[0], highest);
         if own <= STRAY_SHARE {
             continue;
         }
@@ -175,6 +184,35 @@ pub fn summarize(readings: &[Reading]) -> Vec<Layer> {
         });
     }
     layers
+}
+
+/// Step 1b of the module's algorithm: `cluster` (sorted bases) cut in two where a few bases
+/// between two layers chained them into one (the upper puffs of a cumulus, met again above a
+/// gap, lie between its base and the deck above). Of its gaps, widest first, the first that
+/// leaves more than a stray reading's share on both sides and their medians more than
+/// max(100 ft, 10%) apart; each side then again. `own_share(low, high)` is the share of the
+/// readings with a base in `low..=high`.
+fn split_chained(cluster: Vec<f64>, own_share: &impl Fn(f64, f64) -> f64) -> Vec<Vec<f64>> {
+    let median = |c: &[f64]| c[c.len() / 2];
+    let mut gaps: Vec<usize> = (1..cluster.len()).collect();
+    gaps.sort_by(|&a, &b| {
+        let width = |k: usize| cluster[k] - cluster[k - 1];
+        width(b).total_cmp(&width(a))
+    });
+    for k in gaps {
+        let (low, high) = cluster.split_at(k);
+        let apart = median(high) - median(low) > gap_ft(median(low));
+        if apart
+            && own_share(low[0], low[low.len() - 1]) > STRAY_SHARE
+            && own_share(high[0], high[high.len() - 1]) > STRAY_SHARE
+        {
+            let (low, high) = (low.to_vec(), high.to_vec());
+            let mut parts = split_chained(low, own_share);
+            parts.extend(split_chained(high, own_share));
+            return parts;
+        }
+    }
+    vec![cluster]
 }
 
 /// The share of readings up to which a layer is a stray reading, not a layer.
@@ -260,6 +298,31 @@ mod tests {
         // Every reading under one base: overcast.
         let ovc = summarize(&readings(&[&[600.0], &[590.0], &[610.0], &[600.0]]));
         assert_eq!(ovc.iter().map(Layer::group).collect::<Vec<_>>(), ["OVC006"]);
+    }
+
+    #[test]
+    fn a_base_between_two_layers_does_not_chain_them_into_one() {
+        // KVTI's SCT080 OVC090 as read under skycast's clouds: the scattered layer over 24 of
+        // 40 readings, the deck over the rest, and one reading meeting a cumulus's upper puff
+        // at 8,564 ft, which bridges the 1,000 ft between the two.
+        let mut all: Vec<Vec<f64>> = Vec::new();
+        for k in 0..40 {
+            all.push(match k {
+                3 => vec![8_000.0, 8_564.0],
+                _ if k % 5 < 3 => vec![8_000.0],
+                _ => vec![9_000.0],
+            });
+        }
+        let refs: Vec<&[f64]> = all.iter().map(Vec::as_slice).collect();
+        let groups: Vec<String> = summarize(&readings(&refs))
+            .iter()
+            .map(Layer::group)
+            .collect();
+        assert_eq!(groups, ["SCT080", "OVC090"]);
+        // One layer whose bases spread evenly over 10% is not cut.
+        let spread: Vec<Vec<f64>> = (0..40).map(|k| vec![3_000.0 + 10.0 * k as f64]).collect();
+        let refs: Vec<&[f64]> = spread.iter().map(Vec::as_slice).collect();
+        assert_eq!(summarize(&readings(&refs)).len(), 1);
     }
 
     #[test]
