@@ -169,11 +169,26 @@ impl World {
         let s = &self.air.settings;
         let (weather, gust, qnh) =
             self.weather_here(point_m.truncate(), s.pressure.default_qnh_hpa);
-        let surface = SurfaceAir::of(&weather, gust, qnh);
+        let surface = self.surface_air(point_m.truncate(), &weather, gust, qnh);
         let (aloft, lat_deg) = self.aloft_and_latitude(point_m.truncate());
         let wind = air_at_aloft(&surface, point_m.z, lat_deg, s, aloft.as_ref()).wind;
         let to = (wind.from_deg + 180.0).to_radians();
         DVec2::new(to.sin(), to.cos()) * wind.speed_kt * crate::weather::METRES_PER_KNOT
+    }
+
+    /// The surface air at ground point `point_m` from its weather, gust excess and QNH, with
+    /// the regional surface wind around it the profile reaches at the top of the boundary
+    /// layer (`[wind] regional_radius_m` of the air settings).
+    fn surface_air(
+        &self,
+        point_m: DVec2,
+        weather: &BlockWeather,
+        gust: f64,
+        qnh: f64,
+    ) -> SurfaceAir {
+        let radius = self.air.settings.wind.regional_radius_m;
+        SurfaceAir::of(weather, gust, qnh)
+            .with_regional_wind_kt(self.field().regional_wind_kt(point_m, radius))
     }
 
     /// The winds aloft's column over ground point `point_m` (an FB product's if one is in use,
@@ -272,7 +287,7 @@ impl World {
                 (1.0 - (-depth).exp()) as f32
             })
         };
-        let surface = SurfaceAir::of(&weather, gust, qnh);
+        let surface = self.surface_air(point_m.truncate(), &weather, gust, qnh);
         let (aloft, lat_deg) = self.aloft_and_latitude(point_m.truncate());
         air_data(
             &weather,

@@ -118,17 +118,43 @@ fn above_the_boundary_layer_the_wind_is_the_documented_profile() {
         (42.239, -8.624, 330.0f64, 16.0, 30.0),
         (-29.994, -51.171, 290.0, 6.0, -30.0),
     ] {
-        let w = world(REAL, lat, lon, false);
+        let mut w = world(REAL, lat, lon, false);
         let ground = f64::from(w.field().weather_at(DVec2::ZERO).ground_elevation_m);
-        let s = w.air_settings().wind;
+        let shipped = *w.air_settings();
+        let s = shipped.wind;
         let growth = (s.boundary_layer_top_m / s.reference_height_m).powf(s.power_law_exponent);
+        let wind_from = |velocity: DVec2| velocity.x.atan2(velocity.y).to_degrees() + 180.0;
+        // With the regional wind: the surface winds within its radius, grown and turned.
+        let regional = w
+            .field()
+            .regional_wind_kt(DVec2::ZERO, s.regional_radius_m)
+            .expect("stations around");
+        for above_m in [s.boundary_layer_top_m, 2000.0, 6000.0] {
+            let a = w.air_at(DVec3::new(0.0, 0.0, ground + above_m), UP);
+            let want = (wind_from(regional) + turn).rem_euclid(360.0);
+            assert!((a.wind_from_deg - want).abs() < 0.5, "{lat}: {a:?}");
+            assert!(
+                (a.wind_kt - regional.length() * growth).abs() < 0.05,
+                "{lat}: {a:?}"
+            );
+            assert_eq!(a.gust_kt, a.wind_kt, "no gusts above the boundary layer");
+        }
+        // Without it: the station's own wind, grown and turned.
+        let mut own = shipped;
+        own.wind.regional_radius_m = 0.0;
+        w.set_air_settings(own, crate::shading::FogSettings::default());
         for above_m in [s.boundary_layer_top_m, 2000.0, 6000.0] {
             let a = w.air_at(DVec3::new(0.0, 0.0, ground + above_m), UP);
             let want = (dir + turn).rem_euclid(360.0);
             assert!((a.wind_from_deg - want).abs() < 0.5, "{lat}: {a:?}");
             assert!((a.wind_kt - speed * growth).abs() < 0.05, "{lat}: {a:?}");
-            assert_eq!(a.gust_kt, a.wind_kt, "no gusts above the boundary layer");
         }
+        // At the anemometer, the station's own wind either way.
+        let a = w.air_at(DVec3::new(0.0, 0.0, ground + s.reference_height_m), UP);
+        w.set_air_settings(shipped, crate::shading::FogSettings::default());
+        let b = w.air_at(DVec3::new(0.0, 0.0, ground + s.reference_height_m), UP);
+        assert!((a.wind_kt - speed).abs() < 0.05 && (b.wind_kt - speed).abs() < 0.05);
+        assert!((a.wind_from_deg - b.wind_from_deg).abs() < 1e-6);
     }
 }
 

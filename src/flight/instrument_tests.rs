@@ -513,7 +513,7 @@ fn class(cover: crate::weather::metar::Cover) -> i32 {
 /// it gives back
 /// (base within max(100 ft, 10%), cover class within one) and the ceilings (both none, or within
 /// the same), as shares.
-fn ceilometer_round_trip(stations: usize) -> RoundTrip {
+fn ceilometer_round_trip(stations: usize, seed: u64) -> RoundTrip {
     use crate::flight::ceilometer;
     use crate::weather::metar::Cover;
     let input = WeatherInput::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(REAL), None)
@@ -553,6 +553,7 @@ fn ceilometer_round_trip(stations: usize) -> RoundTrip {
             field,
             &WorldSettings {
                 cloud_radius_m: 5_000.0,
+                seed,
                 ..WorldSettings::default()
             },
         );
@@ -651,30 +652,42 @@ impl RoundTrip {
     }
 }
 
-/// The ceilometer's round trip at 40 cloudy stations of the real bulk file: measured 0.89 of
-/// the reported layers and 0.90 of the ceilings (the 200-station figures in the book:
+/// The ceilometer's round trip at 40 cloudy stations of the real bulk file: measured 0.94 of
+/// the reported layers and 0.875 of the ceilings (the 200-station figures in the book:
 /// `cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`). Held to 0.85 and
 /// 0.85 against a fall; what is missing is in the book's "What is still not right": 40 readings
 /// along a few kilometres of clouds a kilometre or two wide still toss a layer's cover a class
-/// either way now and then, and a calm wind reads one spot for 20 minutes.
+/// either way now and then.
 #[test]
 fn a_ceilometer_under_the_drifting_clouds_reads_the_reports_back() {
-    let trip = ceilometer_round_trip(40);
+    let trip = ceilometer_round_trip(40, WorldSettings::default().seed);
     trip.print();
     assert_eq!(trip.stations, 40);
     assert!(trip.layers >= 0.85 && trip.ceilings >= 0.85);
 }
 
-/// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations (about a
-/// minute): measured 0.86 of the layers and 0.92 of the ceilings; at the stations with a calm or
-/// variable wind 42 of 69 layers (0.61), at the others 227 of 243 (0.93).
+/// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations, with the
+/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.93-0.95 of the layers and
+/// 0.90-0.94 of the ceilings; at the stations with a calm or variable wind about 57 of 69 layers,
+/// at the others about 235 of 243 (`cargo test --lib ceilometer_round_trip_at_200 -- --ignored
+/// --nocapture`).
 #[test]
 #[ignore]
 fn ceilometer_round_trip_at_200() {
-    let trip = ceilometer_round_trip(200);
-    trip.print();
-    assert_eq!(trip.stations, 200);
-    assert!(trip.layers >= 0.84 && trip.ceilings >= 0.9);
+    let trips: Vec<RoundTrip> = [WorldSettings::default().seed, 1, 2, 3]
+        .into_iter()
+        .map(|seed| {
+            let trip = ceilometer_round_trip(200, seed);
+            eprint!("seed {seed}: ");
+            trip.print();
+            assert_eq!(trip.stations, 200);
+            trip
+        })
+        .collect();
+    let mean = |f: fn(&RoundTrip) -> f64| trips.iter().map(f).sum::<f64>() / trips.len() as f64;
+    let (layers, ceilings) = (mean(|t| t.layers), mean(|t| t.ceilings));
+    eprintln!("mean over the seeds: layers {layers:.3}, ceilings {ceilings:.3}");
+    assert!(layers >= 0.92 && ceilings >= 0.9);
 }
 
 /// The clouds drift with the wind the air data reports at their height: over real reports (and

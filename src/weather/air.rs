@@ -73,6 +73,16 @@ pub struct WindSettings {
     /// A wind aloft the profile goes over to above the boundary layer.
     #[serde(default)]
     pub aloft: Option<WindAloft>,
+    /// Radius of the regional surface wind the profile reaches at the top of the boundary
+    /// layer, metres (the surface winds within it averaged, `WeatherField::regional_wind_kt`);
+    /// 0: each point's own surface wind all the way up.
+    #[serde(default = "default_regional_radius_m")]
+    pub regional_radius_m: f64,
+}
+
+/// [`WindSettings::regional_radius_m`] where a settings file does not set it.
+fn default_regional_radius_m() -> f64 {
+    150_000.0
 }
 
 /// A wind aloft from the settings (`[wind.aloft]`).
@@ -204,6 +214,12 @@ impl TomlSettings for AirSettings {
         if !(-90.0..=90.0).contains(&w.turn_deg) {
             return Err(bad("wind.turn_deg", "must be within -90..=90"));
         }
+        if !(w.regional_radius_m >= 0.0 && w.regional_radius_m <= 2_000_000.0) {
+            return Err(bad(
+                "wind.regional_radius_m",
+                "must be within 0..=2000000 (metres; 0 switches the regional wind off)",
+            ));
+        }
         if let Some(a) = w.aloft {
             if !(0.0..=360.0).contains(&a.from_deg) {
                 return Err(bad("wind.aloft.from_deg", "must be within 0..=360"));
@@ -311,6 +327,11 @@ pub struct SurfaceAir {
     pub qnh_hpa: f64,
     /// Ground elevation, metres MSL.
     pub ground_m_msl: f64,
+    /// The regional surface wind around the point (knots east, north;
+    /// [`crate::weather::WeatherField::regional_wind_kt`]): the wind goes over from
+    /// [`Self::wind`] at the anemometer to this one's gradient wind at the top of the boundary
+    /// layer. `None`: the point's own wind all the way up.
+    pub regional_wind_kt: Option<DVec2>,
 }
 
 impl SurfaceAir {
@@ -324,6 +345,16 @@ impl SurfaceAir {
             dewpoint_c: f64::from(weather.dewpoint_c),
             qnh_hpa,
             ground_m_msl: f64::from(weather.ground_elevation_m),
+            regional_wind_kt: None,
+        }
+    }
+
+    /// This surface air with the regional surface wind around it
+    /// ([`Self::regional_wind_kt`]).
+    pub fn with_regional_wind_kt(self, regional_wind_kt: Option<DVec2>) -> Self {
+        Self {
+            regional_wind_kt,
+            ..self
         }
     }
 }
@@ -482,8 +513,27 @@ pub fn wind_at(
     let share = (z / zr).ln() / (top / zr).ln();
     let hemisphere = if lat_deg < 0.0 { -1.0 } else { 1.0 };
     let turn = hemisphere * w.turn_deg * share;
-    let speed = f64::from(surface.wind.speed_kt) * growth;
-    let from = f64::from(surface.wind.from_deg) + turn;
+    // The surface wind the profile grows from: the point's own at the anemometer, the
+    // regional one's at the top of the boundary layer (over evenly in the logarithm of
+    // height, as the turn).
+    let own = velocity_kt(
+        f64::from(surface.wind.from_deg),
+        f64::from(surface.wind.speed_kt),
+    );
+    let base = match surface.regional_wind_kt {
+        Some(regional) => own.lerp(regional, share),
+        None => own,
+    };
+    let (base_from, base_speed) = if surface.regional_wind_kt.is_some() {
+        from_velocity_kt(base)
+    } else {
+        (
+            f64::from(surface.wind.from_deg),
+            f64::from(surface.wind.speed_kt),
+        )
+    };
+    let speed = base_speed * growth;
+    let from = base_from + turn;
     let gust_excess = surface.gust_excess_kt * (1.0 - height_agl_m / top).max(0.0);
     if height_agl_m <= top {
         return sample(from, speed, gust_excess);
@@ -566,6 +616,40 @@ mod tests {
             dewpoint_c: 5.0,
             qnh_hpa: 1013.25,
             ground_m_msl: 200.0,
+            regional_wind_kt: None,
+        }
+    }
+
+    #[test]
+    fn a_calm_surface_under_a_regional_wind_reaches_its_gradient_wind() {
+        let s = AirSettings::default().wind;
+        let calm = surface(0.0, 0.0, 0.0).with_regional_wind_kt(Some(velocity_kt(270.0, 10.0)));
+        let at = |h: f64| wind_at(&calm, h, 200.0 + h, 45.0, &s);
+        // The anemometer reads the station's calm...
+        assert_eq!(at(10.0).speed_kt, 0.0);
+        // ...the top of the boundary layer the region's gradient wind: 1.8 times its 10 kt,
+        // veered 30 degrees.
+        let top = at(s.boundary_layer_top_m);
+        let growth = (s.boundary_layer_top_m / s.reference_height_m).powf(s.power_law_exponent);
+        assert!((top.speed_kt - 10.0 * growth).abs() < 1e-9, "{top:?}");
+        assert!((top.from_deg - 300.0).abs() < 1e-9, "{top:?}");
+        // Between, the wind grows steadily, and above it holds.
+        let speeds: Vec<f64> = [10.0, 50.0, 150.0, 400.0, 610.0, 2000.0]
+            .map(|h| at(h).speed_kt)
+            .to_vec();
+        assert!(speeds.windows(2).all(|p| p[1] >= p[0]), "{speeds:?}");
+        assert_eq!(at(2000.0), top);
+        // Where the region's wind is the station's, the profile is the station's alone.
+        let windy = surface(200.0, 12.0, 0.0);
+        let same = windy.with_regional_wind_kt(Some(velocity_kt(200.0, 12.0)));
+        for h in [10.0, 100.0, 610.0, 3000.0] {
+            let (a, b) = (
+                wind_at(&windy, h, 200.0 + h, 45.0, &s),
+                wind_at(&same, h, 200.0 + h, 45.0, &s),
+            );
+            assert!(
+                (a.speed_kt - b.speed_kt).abs() < 1e-9 && (a.from_deg - b.from_deg).abs() < 1e-6
+            );
         }
     }
 

@@ -223,9 +223,25 @@ fn themes_and_remarks_show_where_each_type_came_from() {
 
 /// `--at` with `--alt-ft`: the air data under `"air"` with every field the issue names; at Vigo's
 /// elevation (830 ft in the field) the wind and temperature are LEVX's report (33016G27KT 07/05
-/// Q1011).
+/// Q1011); 2,000 ft above it, with the regional wind switched off (`--config-dir` with
+/// `regional_radius_m = 0`), LEVX's own gradient wind.
 #[test]
 fn the_air_at_vigo_is_its_report_at_the_ground_and_veered_above() {
+    let shipped = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/air.toml"),
+    )
+    .expect("the shipped air settings");
+    assert!(shipped.contains("regional_radius_m = 150000.0"));
+    let own_wind = temp_file("regional-off", "")
+        .with_extension("d")
+        .join("air.toml");
+    std::fs::create_dir_all(own_wind.parent().expect("its folder")).expect("a config folder");
+    std::fs::write(
+        &own_wind,
+        shipped.replace("regional_radius_m = 150000.0", "regional_radius_m = 0.0"),
+    )
+    .expect("air.toml");
+    let config_dir = own_wind.parent().expect("its folder").to_string_lossy();
     let air = |ft: &str| {
         let o = skycast(&[
             "weather",
@@ -235,6 +251,8 @@ fn the_air_at_vigo_is_its_report_at_the_ground_and_veered_above() {
             "--alt-ft",
             ft,
             "--json",
+            "--config-dir",
+            &config_dir,
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
         let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("JSON");

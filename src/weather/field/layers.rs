@@ -12,10 +12,12 @@
 //!    station has fades out with that station's weight. Only fog and plain layers take part:
 //!    ICAO Annex 3 reports CB and TCU with their own amount, outside the summation principle.
 //! 4. Own coverage: what the layer must add to the sky seen from below, clouds of different layers
-//!    overlapping at random ([`own_coverage_oktas`]); at least `min_added_oktas` x presence for a
-//!    layer that adds little or none (`BKN033 BKN041`: 2 oktas a pilot between them sees), as
-//!    far as the sky seen from below stays in the class reported at its base (BKN: at most 7
-//!    oktas; `SCT030 SCT050` leaves the upper layer `min_coverage_oktas`); above an overcast its
+//!    overlapping at random ([`own_coverage_oktas`]); a layer that adds little or none
+//!    (`BKN033 BKN041`) adds at least `min_seen_added_oktas` to the sky seen from below (what
+//!    a ceilometer meets through the gaps of the one below) and has at least `min_added_oktas`
+//!    of its own (2 oktas a pilot between them sees), times its presence, as far as the sky
+//!    seen from below stays in the class reported at its base (BKN: at most 7 oktas;
+//!    `SCT030 SCT050` leaves the upper layer `min_coverage_oktas`); above an overcast its
 //!    stations' own covers.
 //!    A CB/TCU layer keeps its stations' own amounts, weighted (`FEW025CB` over a broken deck is
 //!    2 oktas of Cb at the station), and needs `convective.weight_min` of presence.
@@ -133,12 +135,15 @@ pub(super) fn blend(
             // A layer the summation principle leaves little of its own (`BKN033 BKN041`) keeps
             // what a pilot between the layers sees of it, as far as the sky seen from below
             // stays in the class reported there.
-            let in_class = own_coverage_oktas(below, class_top_oktas(reported.max(below)))
+            let top = class_top_oktas(reported.max(below));
+            let in_class = own_coverage_oktas(below, top)
                 .unwrap_or(0.0)
                 .max(l.min_coverage_oktas);
+            let seen =
+                own_coverage_oktas(below, below + l.min_seen_added_oktas * presence).unwrap_or(0.0);
             own_coverage_oktas(below, reported.max(below))
                 .unwrap_or(0.0)
-                .max((l.min_added_oktas * presence).min(in_class))
+                .max((l.min_added_oktas * presence).max(seen).min(in_class))
         }
         .min(8.0);
         if own < l.min_coverage_oktas || own <= 0.0 {

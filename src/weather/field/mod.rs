@@ -21,6 +21,7 @@
 
 mod blend;
 mod layers;
+mod regional;
 mod rim;
 mod rule;
 mod sample;
@@ -78,6 +79,8 @@ pub struct WeatherField {
     model: Option<(Arc<ModelField>, ModelSettings)>,
     /// Each sample's report age, hours behind the file's time (empty: all fresh).
     report_ages_h: Vec<f64>,
+    /// The stations' surface winds binned for [`Self::regional_wind_kt`].
+    regional: regional::RegionalWinds,
 }
 
 /// Natural-neighbour weights of a point: (sample index, weight), weights summing to 1.
@@ -200,6 +203,12 @@ impl WeatherField {
         }
         // The two triangulations are independent: build them side by side.
         let station_in_block = stations_in_blocks(&cloud_sites, &surface_sites);
+        let regional = regional::RegionalWinds::new(surface_sites.iter().map(|s| {
+            (
+                DVec2::new(s.position.x, s.position.y),
+                samples[s.index].wind_kt,
+            )
+        }));
         let (surface, clouds) =
             rayon::join(|| triangulate(surface_sites), || triangulate(cloud_sites));
         Self {
@@ -212,6 +221,7 @@ impl WeatherField {
             station_in_block,
             model: None,
             report_ages_h: Vec::new(),
+            regional,
         }
     }
 
@@ -405,6 +415,14 @@ impl WeatherField {
         let s = self.report_weight(&self.surface, point_m, w);
         let (lat, lon) = self.frame.to_lat_lon_deg(point_m);
         (s < 1.0).then(|| (model.weather_at(lat, lon, settings), s))
+    }
+
+    /// The regional surface wind at a local point: the reported surface winds within
+    /// `radius_m` averaged as vectors (knots east, north; `regional`); `None` where no station
+    /// within the radius reports a wind. What the air's profile reaches at the top of the
+    /// boundary layer ([`crate::weather::air::SurfaceAir::regional_wind_kt`]).
+    pub fn regional_wind_kt(&self, point_m: DVec2, radius_m: f64) -> Option<DVec2> {
+        self.regional.at(point_m, radius_m)
     }
 
     /// The gust excess (knots above the mean wind, interpolated over the stations that report a

@@ -284,12 +284,74 @@ fn sky_layers(r: &Report, settings: &FieldSettings) -> Option<Vec<StationLayer>>
         });
     }
     layers.sort_by(|a, b| a.base_ft.total_cmp(&b.base_ft));
+    spread_within_class(&mut layers, settings);
     Some(layers)
+}
+
+/// A run of plain layers reported with the same FEW or SCT cover (`SCT033 SCT040 SCT047`):
+/// a METAR's cover is the sky seen from below at each base, and the class's drawn cover
+/// (`[oktas]`, the top of FEW and SCT) leaves nothing for the upper ones to add, yet the
+/// station's ceilometer met each of their bases. Going down the run, each lower layer is seen
+/// `[layers] min_seen_added_oktas` less than the one above, never below halfway to the class
+/// under it, so that each adds what a ceilometer meets through the gaps. (A BKN run has room
+/// up to 7 oktas above its 6: the layers' own rule adds it there.)
+fn spread_within_class(layers: &mut [StationLayer], settings: &FieldSettings) {
+    let o = &settings.oktas;
+    let step = settings.layers.min_seen_added_oktas;
+    let reported: Vec<f64> = layers.iter().map(|l| l.cover_below_oktas).collect();
+    for i in (0..layers.len().saturating_sub(1)).rev() {
+        let floor = if reported[i] == o.few {
+            0.5 * o.few
+        } else if reported[i] == o.sct {
+            0.5 * (o.few + o.sct)
+        } else {
+            continue;
+        };
+        let plain = |l: &StationLayer| l.kind == LayerKind::Plain;
+        if !plain(&layers[i]) || !plain(&layers[i + 1]) || reported[i + 1] != reported[i] {
+            continue;
+        }
+        let below_next = layers[i + 1].cover_below_oktas - step;
+        layers[i].cover_below_oktas = below_next.max(floor).min(reported[i]);
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_run_of_one_class_steps_down_from_its_top() {
+        let settings = FieldSettings::default();
+        let layer = |kind, base_ft, cover_below_oktas| StationLayer {
+            kind,
+            base_ft,
+            cover_below_oktas,
+            thickness_ft: None,
+            named: None,
+        };
+        let plain = LayerKind::Plain;
+        // KA39's SCT033 SCT040 SCT047: 3, 3.25 and 4 oktas seen from below.
+        let mut three = [
+            layer(plain, 3300.0, 4.0),
+            layer(plain, 4000.0, 4.0),
+            layer(plain, 4700.0, 4.0),
+        ];
+        spread_within_class(&mut three, &settings);
+        let seen: Vec<f64> = three.iter().map(|l| l.cover_below_oktas).collect();
+        assert_eq!(seen, [3.0, 3.25, 4.0]);
+        // BKN has room above; a CB stands apart; other classes stay.
+        let mut mixed = [
+            layer(plain, 1000.0, 2.0),
+            layer(plain, 2000.0, 4.0),
+            layer(LayerKind::Cb, 2500.0, 4.0),
+            layer(plain, 3000.0, 6.0),
+            layer(plain, 4000.0, 6.0),
+        ];
+        let before = mixed;
+        spread_within_class(&mut mixed, &settings);
+        assert_eq!(mixed, before);
+    }
     use crate::weather::files::Position;
     use crate::weather::metar::{CloudGroup, PresentWeather, WindGroup};
 

@@ -169,8 +169,19 @@ pub struct Layers {
     /// Least own coverage of a reported layer that adds no cover seen from below (`BKN010
     /// BKN020`), oktas: it is still drawn, seen through the gaps of the one below.
     pub min_added_oktas: f64,
+    /// Least cover a reported layer adds to the sky seen from below, oktas (times its
+    /// presence), as far as the class reported at its base allows (`BKN033 BKN041` over 6
+    /// oktas: 0.75 of the 1 okta left to BKN's 7), so that a ceilometer meets its base through
+    /// the gaps below, as its station's did when it reported it.
+    #[serde(default = "default_min_seen_added_oktas")]
+    pub min_seen_added_oktas: f64,
     /// Least thickness of a layer squeezed under the next base, feet.
     pub min_thickness_ft: f64,
+}
+
+/// [`Layers::min_seen_added_oktas`] where a settings file does not set it.
+fn default_min_seen_added_oktas() -> f64 {
+    0.75
 }
 
 /// How far around a station its own report holds. A METAR describes the sky over its station
@@ -281,6 +292,9 @@ impl TomlSettings for FieldSettings {
         }
         if !(0.0..=8.0).contains(&l.min_added_oktas) {
             return Err(bad("layers.min_added_oktas", "must be within 0..=8"));
+        }
+        if !(0.0..=8.0).contains(&l.min_seen_added_oktas) {
+            return Err(bad("layers.min_seen_added_oktas", "must be within 0..=8"));
         }
         let h = &self.stations;
         for (field, ok, message) in [
