@@ -667,7 +667,7 @@ fn a_ceilometer_under_the_drifting_clouds_reads_the_reports_back() {
 }
 
 /// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations, with the
-/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.93-0.95 of the layers and
+/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.92-0.95 of the layers and
 /// 0.90-0.94 of the ceilings; at the stations with a calm or variable wind about 57 of 69 layers,
 /// at the others about 235 of 243 (`cargo test --lib ceilometer_round_trip_at_200 -- --ignored
 /// --nocapture`).
