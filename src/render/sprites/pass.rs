@@ -138,8 +138,7 @@ impl SpritePass {
         if resident.light.set(model, harris_lastra, sun_dir) {
             bytes += resident.provisional_all(queue);
         }
-        let (placed, left_out) = resident.place_and_upload(queue, camera_m, budget_sprites);
-        stats.blocks_left_out = left_out;
+        stats.blocks_left_out = resident.place(queue, camera_m);
         if resident.packed() {
             // Blocks moved to other slots: what holds sprite slots from frame to frame follows
             // them, and a patch of orders kept for the old slots goes (the new buffers were
@@ -149,7 +148,7 @@ impl SpritePass {
                 l.follow(|slot| resident.moved_slot(slot));
             }
         }
-        bytes += placed;
+        bytes += resident.write_placed(queue, camera_m, budget_sprites);
         bytes += resident.relight(queue, camera_m);
         (stats.sprites_lit, stats.light_us) = (resident.lit_sprites, resident.light_us);
         (bytes, resident.grow_wait)
