@@ -159,7 +159,7 @@ impl DemoHost {
 
     /// Draws one frame (ground, then sky) without reading it back, the sky prepared by hand
     /// (the clouds given to the renderer directly, no frame step); returns the sky's stats, or
-    /// why the sky refused the frame ([`Sky::record`]'s checks).
+    /// why the sky refused the frame ([`Sky::record`](crate::render::Sky::record)'s checks).
     pub fn draw(
         &mut self,
         camera: &Camera,

@@ -38,7 +38,7 @@ impl Sky {
 
     /// Caps the GPU memory of the sprites (records, orders, quad indices) at `bytes` (0: only
     /// the device's limits). Past it the farthest blocks are left out and counted in
-    /// [`FrameStats::blocks_left_out`]. Every block is uploaded again.
+    /// [`FrameStats::blocks_left_out`](crate::render::FrameStats::blocks_left_out). Every block is uploaded again.
     pub fn set_sprite_budget_bytes(&mut self, bytes: u64) {
         let mut old = ResidentSet::new(&self.device, bytes);
         std::mem::swap(&mut old, &mut self.sprites.resident);
@@ -51,8 +51,8 @@ impl Sky {
     }
 
     /// Counts what the host's cloud field work for this frame `spent` (time it with a
-    /// [`Stopwatch`], or a [`crate::render::SkyUpdate`]'s `field_cpu`) into the next prepared frame's
-    /// [`FrameStats::field_us`] and its thread figure: for a host that drives the sky itself
+    /// [`Stopwatch`](crate::render::Stopwatch), or a [`crate::render::SkyUpdate`]'s `field_cpu`) into the next prepared frame's
+    /// [`FrameStats::field_us`](crate::render::FrameStats::field_us) and its thread figure: for a host that drives the sky itself
     /// ([`crate::SkySystem::update`] adds its own to the stats it returns).
     pub fn add_field_cpu(&mut self, spent: Spent) {
         self.field += spent;
@@ -60,7 +60,7 @@ impl Sky {
 
     /// Counts the wall-clock microseconds the host's work on the far field's map took this frame
     /// (sampling the weather into its rows, [`Self::set_far_map`]) into the next prepared
-    /// frame's [`FrameStats::far_field_us`]. They are part of the field's time too: count that
+    /// frame's [`FrameStats::far_field_us`](crate::render::FrameStats::far_field_us). They are part of the field's time too: count that
     /// span with [`Self::add_field_cpu`] as well.
     pub fn add_far_field_us(&mut self, us: u64) {
         self.far_field_us += us;
