@@ -79,7 +79,7 @@ fn cruise() -> Cruise {
         })
         .collect();
     let blocks = world.sky_blocks_around(cameras[0].position_m);
-    host.sky.set_clouds(blocks.clone());
+    host.sky.sky_mut().set_clouds(blocks.clone());
     Cruise {
         host,
         blocks,
@@ -91,12 +91,13 @@ fn cruise() -> Cruise {
 /// Prepares and records every frame of the stretch (nothing submitted; the writes are flushed
 /// at the end); returns the sprites recomputed, the sprites drawn and the bytes uploaded.
 fn run(c: &mut Cruise, cache: bool) -> (u64, u64, u64) {
-    c.host.sky.set_vertex_cache(cache);
+    c.host.sky.sky_mut().set_vertex_cache(cache);
     let (mut recomputed, mut drawn, mut uploaded) = (0u64, 0u64, 0u64);
     for camera in &c.cameras {
         let stats = c
             .host
             .sky
+            .sky_mut()
             .prepare(&c.host.gpu.queue, camera, &c.sun, 1.0 / FPS);
         let mut encoder = c
             .host

@@ -481,12 +481,12 @@ fn main() -> Result<()> {
     let first_ms = start.elapsed().as_secs_f64() * 1e3;
     // Four seconds of 60 Hz frame steps (drawn or not, it is the same step), by which the
     // clouds have arrived and faded in: the blocks the sky holds after some of them.
-    let mut arrived = vec![(1, host.sky.block_ids().count())];
+    let mut arrived = vec![(1, host.sky.sky().block_ids().count())];
     for frame in 2..=240 {
         std::thread::sleep(std::time::Duration::from_secs_f64(dt_s));
         host.sky.update(&host.queue, &host.camera, UNIX_S, dt_s)?;
         if [2, 5, 10, 30, 60, 240].contains(&frame) {
-            arrived.push((frame, host.sky.block_ids().count()));
+            arrived.push((frame, host.sky.sky().block_ids().count()));
         }
     }
     println!(
@@ -521,7 +521,7 @@ fn main() -> Result<()> {
     )?;
     println!(
         "second view: {back_out}; it adds {:.1} MB of GPU memory",
-        host.sky.view_gpu_bytes(back.id) as f64 / 1e6
+        host.sky.sky().view_gpu_bytes(back.id) as f64 / 1e6
     );
     println!(
         "{mode}: {out}; light for the host's own scene: {:?}",

@@ -39,10 +39,14 @@ fn reference_frames() -> [Vec<u8>; 2] {
         near_m: 1.0,
         far_m: 300_000.0,
     };
-    demo.sky.set_weather_overhead(&world.weather_over(position));
+    demo.sky
+        .sky_mut()
+        .set_weather_overhead(&world.weather_over(position));
     let sun = sun_position(host::UNIX_S, host::AT.0, host::AT.1);
     let (clear, _) = demo.frame(&camera, &sun, 0.0, 40_000.0).expect("frame");
-    demo.sky.set_clouds(world.sky_blocks_around(position));
+    demo.sky
+        .sky_mut()
+        .set_clouds(world.sky_blocks_around(position));
     let (clouds, _) = demo.frame(&camera, &sun, 0.0, 40_000.0).expect("frame");
     [clouds.to_srgb8(), clear.to_srgb8()]
 }
@@ -503,14 +507,14 @@ fn the_first_frames_do_not_wait_and_clouds_fade_in_as_they_arrive() {
     let host_without_ring = |theme: bool| {
         let weather = theme.then(|| Path::new(host::THEME));
         let mut h = host::Host::new("standard", weather).expect("host");
-        h.sky.set_impostors(false);
+        h.sky.sky_mut().set_impostors(false);
         h
     };
     let clear = host_without_ring(false).frame().expect("clear");
     // The warm-up (synchronous clouds): every block there in the first frame, whole.
     let mut warm = host_without_ring(true);
     let whole = warm.frame().expect("warm frame");
-    let blocks = warm.sky.block_ids().count();
+    let blocks = warm.sky.sky().block_ids().count();
     assert!(cover(&whole, &clear) > 0.2);
 
     // The default: the first update queues the blocks and returns; they come in over the next
@@ -518,7 +522,7 @@ fn the_first_frames_do_not_wait_and_clouds_fade_in_as_they_arrive() {
     let mut h = host_without_ring(true);
     h.sky.world_mut().set_synchronous_clouds(false);
     let mut updates = 0;
-    while h.sky.block_ids().count() < blocks {
+    while h.sky.sky().block_ids().count() < blocks {
         h.sky
             .update(&h.queue, &h.camera, host::UNIX_S, 0.0)
             .expect("update");
@@ -526,7 +530,7 @@ fn the_first_frames_do_not_wait_and_clouds_fade_in_as_they_arrive() {
         assert!(
             updates < 3_000,
             "{} of {blocks} blocks came",
-            h.sky.block_ids().count()
+            h.sky.sky().block_ids().count()
         );
         std::thread::sleep(std::time::Duration::from_millis(10));
     }
@@ -573,7 +577,7 @@ fn mean_difference(a: &[u8], b: &[u8]) -> f64 {
 fn two_views_recorded_into_one_encoder_each_show_their_own_clouds() {
     let mut h = host::Host::new("standard", Some(Path::new(host::THEME))).expect("host");
     let front_alone = h.frame().expect("front");
-    let sky_bytes = h.sky.gpu_buffer_bytes();
+    let sky_bytes = h.sky.sky().gpu_buffer_bytes();
     // A second monitor from the same seat, looking back over the tail.
     let back = h.add_view(host::HEADING_DEG + 180.0, 8.0);
     let read = |h: &host::Host, encoder, texture: &wgpu::Texture| {
@@ -605,8 +609,8 @@ fn two_views_recorded_into_one_encoder_each_show_their_own_clouds() {
     }
     // What a view adds: its frame uniform, draw list, ring and cloud target, no more (the
     // resident sprites are the sky's: its buffers grew by the view's own at most).
-    let bytes = h.sky.view_gpu_bytes(back.id);
-    let grown = h.sky.gpu_buffer_bytes() - sky_bytes;
+    let bytes = h.sky.sky().view_gpu_bytes(back.id);
+    let grown = h.sky.sky().gpu_buffer_bytes() - sky_bytes;
     eprintln!("a view adds {bytes} bytes of GPU memory; the sky's buffers grew by {grown}");
     assert!(bytes > 0 && grown <= bytes, "{grown} > {bytes}");
 }

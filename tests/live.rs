@@ -633,7 +633,7 @@ fn a_weather_change_reaches_the_sky_a_budget_of_sprites_a_frame() {
     let camera = host.camera(DVec3::new(0.0, 0.0, 900.0), 90.0, 8.0);
     let step = |host: &mut DemoHost| {
         host.step(&camera, UTC_S, 0.05, false).unwrap();
-        let m = host.sky.memory();
+        let m = host.sky.sky().memory();
         (m.blocks, m.sprites)
     };
     // Until the field is generated and handed over whole (the first frames are budgeted too).

@@ -60,7 +60,9 @@ fn fly(model: ShadingModel, warm_up: u32, frames: u32) -> (u64, u64) {
     let far_map = FarMapFeed::new(far.texels, far.texel_m, far.move_texels, 1)
         .update(DVec2::ZERO, true, world.far_map_cell())
         .expect("a first far map");
-    demo.sky.set_far_map(&demo.gpu.queue, &far_map, None);
+    demo.sky
+        .sky_mut()
+        .set_far_map(&demo.gpu.queue, &far_map, None);
     let sun = sun_position(UNIX_S, AT.0, AT.1);
     let (mut settled, mut late) = (Vec::new(), Vec::new());
     for k in 0..warm_up + frames {
@@ -81,12 +83,16 @@ fn fly(model: ShadingModel, warm_up: u32, frames: u32) -> (u64, u64) {
             near_m: 1.0,
             far_m: 160_000.0,
         };
-        demo.sky.set_weather_overhead(&world.weather_over(position));
-        demo.sky.set_clouds(world.sky_blocks_around(position));
+        demo.sky
+            .sky_mut()
+            .set_weather_overhead(&world.weather_over(position));
+        demo.sky
+            .sky_mut()
+            .set_clouds(world.sky_blocks_around(position));
         let (_, stats) = demo.frame(&camera, &sun, 0.1, 40_000.0).expect("frame");
         assert!(stats.sprites_drawn > 0, "frame {k} drew no cloud");
         assert!(
-            demo.sky.memory().far_field_bytes > 100_000,
+            demo.sky.sky().memory().far_field_bytes > 100_000,
             "frame {k} drew no far field"
         );
         if (warm_up - SAMPLES..warm_up).contains(&k) {

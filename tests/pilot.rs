@@ -432,7 +432,7 @@ fn rain_falls_out_of_a_storm_seen_from_20_km() {
     for (name, precipitation) in [("rain", 1.0), ("dry", 0.0)] {
         let (cell, base_radius_m) = storm_cell(precipitation, DISTANCE_M);
         let centre = cell.centre_m;
-        host.sky.set_clouds(vec![SkyBlock {
+        host.sky.sky_mut().set_clouds(vec![SkyBlock {
             id: 1 + precipitation as u64,
             centre_m: centre,
             clouds: vec![SkyCloud::from(&cell)],
@@ -441,14 +441,14 @@ fn rain_falls_out_of_a_storm_seen_from_20_km() {
         looks.push((storm_picture(&mut host, &camera, &sun, &png), base_radius_m));
         // Flown into the heart of a shaft (its upper sprite's axis, 100 m up), the visibility
         // drops to the rain's; 20 km away it is the air's.
-        let air = host.sky.fog().distance_m;
+        let air = host.sky.sky().fog().distance_m;
         let shaft = cell.sprites.iter().find(|s| s.precipitation);
         assert_eq!(shaft.is_some(), precipitation > 0.0, "{name}: shafts");
         if let Some(s) = shaft {
             let at = centre + DVec3::new(s.offset_m[0] as f64, s.offset_m[1] as f64, 0.0);
             let inside = host.camera(DVec3::new(at.x, at.y, 100.0), 0.0, 0.0);
             host.frame(&inside, &sun, 0.0, 50_000.0).unwrap();
-            let in_rain = host.sky.fog().distance_m;
+            let in_rain = host.sky.sky().fog().distance_m;
             println!("{name}: visibility {air} m 20 km away, {in_rain} m in a shaft");
             assert!(
                 in_rain < 3_000.0 && air > 10_000.0,
@@ -536,7 +536,7 @@ fn a_storm_base_lies_in_the_shadow_of_its_tower() {
     let body_rows = row(BASE_M + 3500.0)..row(BASE_M + 2500.0);
     let mut looks = Vec::new();
     for (id, (name, cloud)) in [("shaded", shaded), ("lit", lit)].into_iter().enumerate() {
-        host.sky.set_clouds(vec![SkyBlock {
+        host.sky.sky_mut().set_clouds(vec![SkyBlock {
             id: id as u64 + 1,
             centre_m: cell.centre_m,
             clouds: vec![cloud],

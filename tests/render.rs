@@ -155,7 +155,7 @@ impl Rig {
     }
 
     fn set_clouds(&mut self, blocks: Vec<SkyBlock>) {
-        self.host.sky.set_clouds(blocks);
+        self.host.sky.sky_mut().set_clouds(blocks);
     }
 
     fn frame(&mut self, name: &str, camera: &Camera) -> (Frame, skycast::render::FrameStats) {
@@ -263,7 +263,7 @@ fn clear_overcast_and_in_cloud_frames() {
     // overhead, the sky turns grey (nothing blue left) and the ground loses its sun.
     let level = rig.camera(DVec3::new(0.0, 0.0, 300.0), 0.0, 0.0);
     let (blue_band, _) = rig.frame("under_stratus_clear_light", &level);
-    rig.host.sky.set_weather_overhead(&weather);
+    rig.host.sky.sky_mut().set_weather_overhead(&weather);
     let (grey_band, _) = rig.frame("under_stratus", &level);
     let blue = |f: &Frame| fraction(f, |i| f.depth[i] >= 1.0 && !cloud_like(f.rgba[i]));
     let ground_lum = |f: &Frame| {
@@ -285,7 +285,10 @@ fn clear_overcast_and_in_cloud_frames() {
         ground_lum(&grey_band),
         ground_lum(&blue_band)
     );
-    rig.host.sky.set_weather_overhead(&BlockWeather::default());
+    rig.host
+        .sky
+        .sky_mut()
+        .set_weather_overhead(&BlockWeather::default());
 
     rig.set_clouds(vec![SkyBlock {
         id: 7,
@@ -963,12 +966,12 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
 
     // Switched off at run time (`skycast view`'s key): every block sprites, as in a sky made
     // without the ring; on again: built afresh at once.
-    assert!(rig.host.sky.set_impostors(false));
+    assert!(rig.host.sky.sky_mut().set_impostors(false));
     let (off, stats) = rig.frame("ring_switched_off", &cam);
     assert_eq!((stats.blocks_near, stats.blocks_far), (3, 0), "{stats:?}");
     assert_eq!(stats.sprites_drawn, 180, "{stats:?}");
     assert_eq!(changed_pixels(&off, &sprites_only).0, 0);
-    assert!(rig.host.sky.set_impostors(true));
+    assert!(rig.host.sky.sky_mut().set_impostors(true));
     let (_, stats) = rig.frame("ring_switched_on", &cam);
     assert_eq!(stats.impostors_rebuilt, 8, "{stats:?}");
     assert_eq!((stats.blocks_near, stats.blocks_far), (2, 1), "{stats:?}");
@@ -990,7 +993,7 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
         offset_m: DVec3::ZERO,
         fade: Fade::Forming(0.0),
     };
-    assert!(rig.host.sky.set_block_motion(4, forming));
+    assert!(rig.host.sky.sky_mut().set_block_motion(4, forming));
     let waiting: Vec<_> = (0..3)
         .map(|k| rig.frame(&format!("ring_forming_far_block_{k}"), &cam).1)
         .map(|s| (s.impostors_rebuilt, s.blocks_near, s.blocks_far))
@@ -1025,7 +1028,7 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
         "the whole far block waited for a rebuild: {whole:?}"
     );
     // A sky made without the ring has no textures to turn it on with.
-    assert!(!plain.host.sky.set_impostors(true));
+    assert!(!plain.host.sky.sky_mut().set_impostors(true));
 }
 
 /// Each view draws its own near blocks, also while its ring stands and its split no longer
@@ -1053,10 +1056,11 @@ fn each_view_draws_its_own_near_blocks() {
     // Half-second frames: any crossfade is over within the first few.
     let frames: Vec<_> = (0..8)
         .map(|_| {
-            let a = rig.host.sky.prepare(&queue, main, &sun(), 0.5);
+            let a = rig.host.sky.sky_mut().prepare(&queue, main, &sun(), 0.5);
             let b = rig
                 .host
                 .sky
+                .sky_mut()
                 .prepare_view(second, &queue, north, &sun(), 0.5);
             (a.sprites_drawn, b.sprites_drawn, b.impostors_rebuilt)
         })
@@ -1117,14 +1121,14 @@ fn clouds_already_on_the_gpu_stay_drawn_when_the_buffers_grow() {
     let mut growing = Rig::with_settings(flat_ground(0.0), settings);
     growing.set_clouds(vec![near]);
     let (before, _) = growing.frame("grow_before", &camera);
-    let bytes_before = growing.host.sky.gpu_buffer_bytes();
+    let bytes_before = growing.host.sky.sky().gpu_buffer_bytes();
     growing.set_clouds(every);
     // The blocks behind arrive within the frames' upload budget.
     let mut after = before.clone();
     for k in 0..4 {
         after = growing.frame(&format!("grow_after_{k}"), &camera).0;
     }
-    let bytes_after = growing.host.sky.gpu_buffer_bytes();
+    let bytes_after = growing.host.sky.sky().gpu_buffer_bytes();
     assert!(
         bytes_after > bytes_before,
         "the buffers grew: {bytes_before} -> {bytes_after}"
@@ -1810,9 +1814,12 @@ fn harris_lastra_darkens_a_cumulus_body_against_a_low_sun() {
         centre_m: DVec3::new(-1600.0, 0.0, base),
         clouds: vec![thick_cumulus(DVec3::new(-1600.0, 0.0, base))],
     }]);
-    assert_eq!(rig.host.sky.shading_model(), ShadingModel::Wang);
+    assert_eq!(rig.host.sky.sky().shading_model(), ShadingModel::Wang);
     let wang = frame(&mut rig, "low_sun_wang");
-    rig.host.sky.set_shading_model(ShadingModel::HarrisLastra);
+    rig.host
+        .sky
+        .sky_mut()
+        .set_shading_model(ShadingModel::HarrisLastra);
     let hl = frame(&mut rig, "low_sun_harris_lastra");
     // The cloud: where either frame differs from the empty one.
     let differs = |f: &Frame, i: usize| {
@@ -1912,7 +1919,7 @@ fn from_fl350_near_cumulus_stand_out_from_the_ground_below() {
         let mut rig = Rig::new(ground);
         // A report of 10 km is capped (9999): clear air; `literal_10_km` takes it as it is.
         let shipped = FogSettings::default();
-        rig.host.sky.set_fog_settings(FogSettings {
+        rig.host.sky.sky_mut().set_fog_settings(FogSettings {
             altitude_haze,
             capped_visibility_m: if literal_10_km {
                 20_000.0
@@ -1921,7 +1928,7 @@ fn from_fl350_near_cumulus_stand_out_from_the_ground_below() {
             },
             ..shipped
         });
-        rig.host.sky.set_weather_overhead(&BlockWeather {
+        rig.host.sky.sky_mut().set_weather_overhead(&BlockWeather {
             visibility_m: 10_000.0,
             ground_elevation_m: 200.0,
             ..BlockWeather::default()
@@ -2155,8 +2162,9 @@ fn from_fl350_the_clouds_reach_the_horizon() {
     let mut frame = |name: &str, cover: f32, on: bool| {
         rig.host
             .sky
+            .sky_mut()
             .set_far_map(&rig.host.gpu.queue, &uniform_far_map(cover), None);
-        rig.host.sky.set_far_field_enabled(on);
+        rig.host.sky.sky_mut().set_far_field_enabled(on);
         rig.frame(name, &cam).0
     };
     let cloudy = frame("far-field", 0.5, true);
@@ -2214,7 +2222,10 @@ fn the_far_fields_sheets_cover_what_the_map_asks() {
         for cell in &mut map.cells {
             cell[3] = 0.0;
         }
-        rig.host.sky.set_far_map(&rig.host.gpu.queue, &map, None);
+        rig.host
+            .sky
+            .sky_mut()
+            .set_far_map(&rig.host.gpu.queue, &map, None);
         rig.frame(name, &cam).0
     };
     let clear = frame("far-sheet-clear", 0.0);
@@ -2295,7 +2306,10 @@ fn a_new_weather_crossfades_the_far_field() {
         ..uniform_far_map(cover)
     };
     let set = |rig: &mut Rig, m: &skycast::clouds::far_map::FarMap| {
-        rig.host.sky.set_far_map(&rig.host.gpu.queue, m, Some(3.0));
+        rig.host
+            .sky
+            .sky_mut()
+            .set_far_map(&rig.host.gpu.queue, m, Some(3.0));
     };
     set(&mut rig, &map(0.5, 0, 0.0));
     let cloudy = frame(&mut rig, "crossfade-before", 10.0);
@@ -2338,6 +2352,7 @@ fn from_fl350_the_sky_brightens_down_to_the_earths_rim() {
     let cam = rig.camera(DVec3::new(0.0, 0.0, height_m), 0.0, pitch_deg);
     rig.host
         .sky
+        .sky_mut()
         .set_far_map(&rig.host.gpu.queue, &uniform_far_map(0.0), None);
     let clear = rig.frame("fl350-horizon", &cam).0;
     let row_at = |elevation_deg: f64| -> u32 {
@@ -2404,6 +2419,7 @@ fn hand_over_run(band_m: f32, ring: Option<f64>) -> Vec<f32> {
     let cover = if ring.is_some() { 0.15 } else { 0.05 };
     rig.host
         .sky
+        .sky_mut()
         .set_far_map(&rig.host.gpu.queue, &uniform_far_map(cover), None);
     let mut blocks = Vec::new();
     // Sixteen along a diagonal 58 to 61.75 km ahead: as the camera flies 1 km, the end of the
@@ -2529,6 +2545,7 @@ fn with_the_far_field_on_the_ring_stops_at_the_hand_over() {
         let mut rig = Rig::with_settings(ground, settings);
         rig.host
             .sky
+            .sky_mut()
             .set_far_map(&rig.host.gpu.queue, &uniform_far_map(0.15), None);
         let blocks = [(1, 30_000.0), (2, 80_000.0)]
             .into_iter()
@@ -2580,18 +2597,18 @@ fn a_block_arriving_adds_its_shadow_to_the_map() {
     let (_, steady) = rig.frame("shadow_add_steady", &camera);
     assert!(!steady.shadow_redrawn, "{steady:?}");
     let queue = rig.host.gpu.queue.clone();
-    let before = rig.host.sky.read_back_cloud_shadows(&queue).unwrap();
+    let before = rig.host.sky.sky().read_back_cloud_shadows(&queue).unwrap();
     rig.set_clouds(vec![first, block(2, 2000.0, 1)]);
     let (_, added) = rig.frame("shadow_add_second", &camera);
     assert!(
         added.shadow_redrawn && added.shadow_sprites == 60,
         "only the new block's 60 sprites drawn: {added:?}"
     );
-    let grown = rig.host.sky.read_back_cloud_shadows(&queue).unwrap();
-    rig.host.sky.redraw_cloud_shadows();
+    let grown = rig.host.sky.sky().read_back_cloud_shadows(&queue).unwrap();
+    rig.host.sky.sky_mut().redraw_cloud_shadows();
     let (_, again) = rig.frame("shadow_add_whole", &camera);
     assert_eq!(again.shadow_sprites, 240, "{again:?}");
-    let redrawn = rig.host.sky.read_back_cloud_shadows(&queue).unwrap();
+    let redrawn = rig.host.sky.sky().read_back_cloud_shadows(&queue).unwrap();
     let new_shadow = grown
         .tau
         .iter()
@@ -2700,7 +2717,10 @@ fn the_far_fields_cumulus_have_the_sprites_grain() {
         settings.far_field.fade_end_m = 25_000.0;
         let ground = HeightField::from_fn(DVec2::ZERO, 200_000.0, 16, |_| 0.0);
         let mut rig = Rig::with_settings(ground, settings);
-        rig.host.sky.set_far_map(&rig.host.gpu.queue, &map, None);
+        rig.host
+            .sky
+            .sky_mut()
+            .set_far_map(&rig.host.gpu.queue, &map, None);
         if !far {
             rig.set_clouds(blocks.clone());
         }

@@ -189,9 +189,13 @@ fn shadows_darken_the_ground_under_clouds_and_only_there() {
     ];
     for (name, alt_ft, heading_deg, pitch_deg) in views {
         let camera = host.camera(DVec3::new(0.0, 0.0, alt_ft * FEET), heading_deg, pitch_deg);
-        host.sky.set_cloud_shadows(true);
+        host.sky.sky_mut().set_cloud_shadows(true);
         let (on, stats) = host.step_frame(&camera, UNIX_S, 0.0).unwrap();
-        let map = host.sky.read_back_cloud_shadows(&host.gpu.queue).unwrap();
+        let map = host
+            .sky
+            .sky()
+            .read_back_cloud_shadows(&host.gpu.queue)
+            .unwrap();
         let lookup = host.sky.cloud_shadows().uv_from_camera_relative;
         save_map(&map, &format!("{name}_map"));
         on.write_png(&out_dir().join(format!("{name}_on.png")))
@@ -206,7 +210,7 @@ fn shadows_darken_the_ground_under_clouds_and_only_there() {
             stats.shadow_gpu_bytes
         );
         let light_on = host.sky.lighting();
-        host.sky.set_cloud_shadows(false);
+        host.sky.sky_mut().set_cloud_shadows(false);
         let (off, _) = host.step_frame(&camera, UNIX_S, 0.0).unwrap();
         off.write_png(&out_dir().join(format!("{name}_off.png")))
             .unwrap();
@@ -274,10 +278,14 @@ fn shadows_move_with_the_clouds_drift() {
     for (t, dt) in [(0.0, 0.0), (60.0, 60.0)] {
         // Drawn anew each time (steady clouds would keep the first drawing, moved by the
         // lookup: this checks the drawing too).
-        host.sky.redraw_cloud_shadows();
+        host.sky.sky_mut().redraw_cloud_shadows();
         let (stats, _) = host.step(&camera, UNIX_S + t, dt, false).unwrap();
         assert!(stats.shadow_redrawn, "{stats:?}");
-        let map = host.sky.read_back_cloud_shadows(&host.gpu.queue).unwrap();
+        let map = host
+            .sky
+            .sky()
+            .read_back_cloud_shadows(&host.gpu.queue)
+            .unwrap();
         save_map(&map, &format!("drift_{t}"));
         frames.push((
             map,
@@ -371,10 +379,14 @@ fn sub_texel_camera_moves_leave_the_shadows_unchanged() {
     let mut seen = Vec::new();
     for offset in [DVec3::ZERO, (frame.right * 0.4 - frame.up * 0.3) * texel] {
         let camera = host.camera(on_texel + offset, 135.0, -8.0);
-        host.sky.redraw_cloud_shadows();
+        host.sky.sky_mut().redraw_cloud_shadows();
         let (on, stats) = host.step_frame(&camera, UNIX_S, 0.0).unwrap();
         assert!(stats.shadow_redrawn, "{stats:?}");
-        let map = host.sky.read_back_cloud_shadows(&host.gpu.queue).unwrap();
+        let map = host
+            .sky
+            .sky()
+            .read_back_cloud_shadows(&host.gpu.queue)
+            .unwrap();
         let lookup = host.sky.cloud_shadows().uv_from_camera_relative;
         let taus = taus_at(&map, lookup, camera.position_m, &points);
         seen.push((map, taus, on));

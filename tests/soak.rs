@@ -213,7 +213,7 @@ fn soak(hours: u64) -> Soak {
                 let (_, changes) = host.step(&camera, UTC_S + time_s, 0.0, false).unwrap();
                 arrived.extend(changes);
                 // The new generations are placed in this frame: its slots count.
-                let (m, q) = (host.sky.memory(), queues(&host));
+                let (m, q) = (host.sky.sky().memory(), queues(&host));
                 hour.add(&m, rss_bytes(), q);
                 cycle.add(&m, rss_bytes(), q);
                 if !arrived.is_empty() {
@@ -236,7 +236,7 @@ fn soak(hours: u64) -> Soak {
             soak.drawn[w] = soak.drawn[w].max(stats.sprites_drawn);
         }
         time_s += 1.0;
-        let (m, q, rss) = (host.sky.memory(), queues(&host), rss_bytes());
+        let (m, q, rss) = (host.sky.sky().memory(), queues(&host), rss_bytes());
         if (s + 1) % WEATHER_S == 0 {
             let w = k % weathers.len();
             soak.settled[w] = soak.settled[w].max(m.sprites);

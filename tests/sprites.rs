@@ -114,8 +114,9 @@ fn corners(host: &mut DemoHost, at: DVec3, dt_s: f64) -> Vec<SpriteCorner> {
 /// [`corners`] with the camera looking north `pitch_deg` above the horizon.
 fn corners_looking(host: &mut DemoHost, at: DVec3, pitch_deg: f64, dt_s: f64) -> Vec<SpriteCorner> {
     let cam = host.camera(at, 0.0, pitch_deg);
-    host.sky.prepare(&host.gpu.queue, cam, &SUN, dt_s);
+    host.sky.sky_mut().prepare(&host.gpu.queue, cam, &SUN, dt_s);
     host.sky
+        .sky()
         .read_back_corners(&host.gpu.queue)
         .expect("corners read back")
 }
@@ -135,11 +136,11 @@ fn centre(quad: &[SpriteCorner]) -> Vec3 {
 #[test]
 fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
     let mut host = host(TimeOfDayTable::default());
-    host.sky.set_clouds(blocks());
+    host.sky.sky_mut().set_clouds(blocks());
     let cam = DVec3::new(0.0, 0.0, 1000.0);
     let at = |host: &DemoHost, p: DVec3| camera(host, p);
     let c0 = at(&host, cam);
-    let first = host.sky.prepare(&host.gpu.queue, c0, &SUN, 0.0);
+    let first = host.sky.sky_mut().prepare(&host.gpu.queue, c0, &SUN, 0.0);
     assert_eq!(
         (
             first.clouds_drawn,
@@ -148,24 +149,27 @@ fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
         ),
         (10, 10, 200)
     );
-    let first_corners = host.sky.read_back_corners(&host.gpu.queue).unwrap();
+    let first_corners = host.sky.sky().read_back_corners(&host.gpu.queue).unwrap();
     for frame in 1..30 {
-        let still = host.sky.prepare(&host.gpu.queue, c0, &SUN, 1.0 / 30.0);
+        let still = host
+            .sky
+            .sky_mut()
+            .prepare(&host.gpu.queue, c0, &SUN, 1.0 / 30.0);
         assert_eq!(still.clouds_recomputed, 0, "frame {frame}");
         assert_eq!(still.cache_hit_rate, 1.0);
     }
     assert_eq!(
-        host.sky.read_back_corners(&host.gpu.queue).unwrap(),
+        host.sky.sky().read_back_corners(&host.gpu.queue).unwrap(),
         first_corners
     );
     // Handing the same blocks again (as a host does when the block set changes) keeps them.
-    host.sky.set_clouds(blocks());
-    let again = host.sky.prepare(&host.gpu.queue, c0, &SUN, 0.0);
+    host.sky.sky_mut().set_clouds(blocks());
+    let again = host.sky.sky_mut().prepare(&host.gpu.queue, c0, &SUN, 0.0);
     assert_eq!(again.clouds_recomputed, 0);
     // Clouds drifting with the wind and a camera flying along with them: nothing moved
     // relative to each other, nothing re-sorts.
     let drift = DVec3::new(400.0, -250.0, 0.0);
-    host.sky.set_block_motion(
+    host.sky.sky_mut().set_block_motion(
         1,
         BlockMotion {
             offset_m: drift,
@@ -175,15 +179,19 @@ fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
     let along = at(&host, cam + drift);
     assert_eq!(
         host.sky
+            .sky_mut()
             .prepare(&host.gpu.queue, along, &SUN, 0.0)
             .clouds_recomputed,
         0
     );
-    host.sky.set_block_motion(1, BlockMotion::default());
+    host.sky
+        .sky_mut()
+        .set_block_motion(1, BlockMotion::default());
     // 300 m is past the threshold of every cloud (at most 5 m + 2% of ~19 km).
     let moved = at(&host, cam + DVec3::new(0.0, 300.0, 0.0));
     assert_eq!(
         host.sky
+            .sky_mut()
             .prepare(&host.gpu.queue, moved, &SUN, 0.0)
             .clouds_recomputed,
         10
@@ -191,14 +199,20 @@ fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
     // 150 m more: past the threshold of the near clouds (about 90 m at 4 km) only, not of
     // the far ones (about 280 m at 14 km).
     let nudged = at(&host, cam + DVec3::new(0.0, 450.0, 0.0));
-    let stats = host.sky.prepare(&host.gpu.queue, nudged, &SUN, 0.0);
+    let stats = host
+        .sky
+        .sky_mut()
+        .prepare(&host.gpu.queue, nudged, &SUN, 0.0);
     assert!(
         stats.clouds_recomputed > 0 && stats.clouds_recomputed < 10,
         "{stats:?}"
     );
     // Uncached, every frame re-sorts everything.
-    host.sky.set_vertex_cache(false);
-    let stats = host.sky.prepare(&host.gpu.queue, nudged, &SUN, 0.0);
+    host.sky.sky_mut().set_vertex_cache(false);
+    let stats = host
+        .sky
+        .sky_mut()
+        .prepare(&host.gpu.queue, nudged, &SUN, 0.0);
     assert_eq!(stats.clouds_recomputed, 10);
 }
 
@@ -207,7 +221,7 @@ fn still_camera_resorts_nothing_after_the_first_frame_and_a_moved_one_does() {
 #[test]
 fn sprites_are_sorted_back_to_front_and_face_the_camera() {
     let mut host = host(TimeOfDayTable::default());
-    host.sky.set_clouds(blocks());
+    host.sky.sky_mut().set_clouds(blocks());
     let quads = corners(&mut host, DVec3::new(0.0, 0.0, 1000.0), 0.0);
     assert_eq!(quads.len(), 200 * 4);
     let dists: Vec<f32> = quads.chunks(4).map(|q| centre(q).length()).collect();
@@ -246,7 +260,7 @@ fn sprites_are_sorted_back_to_front_and_face_the_camera() {
 fn orders_outgrowing_the_patch_buffer_still_reach_the_gpu() {
     let start = DVec3::new(0.0, 0.0, 1000.0);
     let mut piled = host(TimeOfDayTable::default());
-    piled.sky.set_clouds(blocks());
+    piled.sky.sky_mut().set_clouds(blocks());
     corners(&mut piled, start, 0.0);
     // Every frame moves 300 m, past every cloud's threshold: its 200 orders sorted again. Twenty
     // frames make 4,000 orders and their lists: more than the 16 kB the patch starts with, less
@@ -255,15 +269,19 @@ fn orders_outgrowing_the_patch_buffer_still_reach_the_gpu() {
     for _ in 0..20 {
         at.x += 300.0;
         let cam = camera(&piled, at);
-        let stats = piled.sky.prepare(&piled.gpu.queue, cam, &SUN, 1.0 / 30.0);
+        let stats = piled
+            .sky
+            .sky_mut()
+            .prepare(&piled.gpu.queue, cam, &SUN, 1.0 / 30.0);
         assert_eq!(stats.sprites_recomputed, 200);
     }
     let after_pile = piled
         .sky
+        .sky()
         .read_back_corners(&piled.gpu.queue)
         .expect("corners read back");
     let mut fresh = host(TimeOfDayTable::default());
-    fresh.sky.set_clouds(blocks());
+    fresh.sky.sky_mut().set_clouds(blocks());
     let from_the_start = corners(&mut fresh, at, 0.0);
     assert_eq!(after_pile.len(), 200 * 4);
     let differing = quads_differing(&after_pile, &from_the_start);
@@ -288,7 +306,7 @@ fn a_quad_is_cut_to_the_visible_part_of_its_cell() {
         mips: vec![pixels],
     };
     let mut host = host_with_sheet(TimeOfDayTable::default(), sheet);
-    host.sky.set_clouds(one_cloud(plain_cloud(
+    host.sky.sky_mut().set_clouds(one_cloud(plain_cloud(
         DVec3::new(0.0, 3000.0, 1000.0),
         vec![
             square_sprite(Vec3::ZERO, 200.0, 0, 0),
@@ -337,8 +355,8 @@ fn a_quad_is_cut_to_the_visible_part_of_its_cell() {
 #[test]
 fn facing_locks_inside_half_the_radius_and_fades_with_the_angle() {
     let mut host = host(TimeOfDayTable::default());
-    host.sky.set_vertex_cache(false);
-    host.sky.set_clouds(one_cloud(plain_cloud(
+    host.sky.sky_mut().set_vertex_cache(false);
+    host.sky.sky_mut().set_clouds(one_cloud(plain_cloud(
         DVec3::new(0.0, 0.0, 1000.0),
         vec![square_sprite(Vec3::ZERO, 200.0, 0, 0)],
         ColourLevels::even(900.0, 1100.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
@@ -386,7 +404,7 @@ fn upright_sprites_stay_level_and_fade_seen_from_below() {
     let mut host = host(TimeOfDayTable::default());
     let mut upright = square_sprite(Vec3::ZERO, 200.0, 3, 0);
     upright.upright = true;
-    host.sky.set_clouds(one_cloud(plain_cloud(
+    host.sky.sky_mut().set_clouds(one_cloud(plain_cloud(
         DVec3::new(0.0, 3000.0, 1500.0),
         vec![upright, square_sprite(Vec3::X * 600.0, 200.0, 3, 0)],
         ColourLevels::even(1400.0, 1700.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
@@ -452,7 +470,7 @@ fn layer_sprites_seen_from_above_are_round_and_lie_their_own_way() {
             )
         })
         .collect();
-    host.sky.set_clouds(one_cloud(plain_cloud(
+    host.sky.sky_mut().set_clouds(one_cloud(plain_cloud(
         centre_m,
         puffs,
         ColourLevels::even(1400.0, 1600.0, [[0.5, 0.5, 0.5, 1.0]; 5]),
@@ -512,15 +530,16 @@ fn the_rim_of_a_cloud_against_the_sun_glows() {
             forward_scattering: forward,
             ..TimeOfDayTable::default()
         });
-        host.sky.set_clouds(blocks());
+        host.sky.sky_mut().set_clouds(blocks());
         let sun = SunPosition {
             elevation_deg: 2.86,
             azimuth_deg,
             declination_deg: 0.0,
         };
         let c = camera(&host, cam);
-        host.sky.prepare(&host.gpu.queue, c, &sun, 0.0);
+        host.sky.sky_mut().prepare(&host.gpu.queue, c, &sun, 0.0);
         host.sky
+            .sky()
             .read_back_corners(&host.gpu.queue)
             .unwrap()
             .iter()
@@ -551,7 +570,7 @@ fn far_from_the_origin_the_corners_are_as_precise_as_near_it() {
                 c.centre_m += offset;
             }
         }
-        host.sky.set_clouds(b);
+        host.sky.sky_mut().set_clouds(b);
         corners(&mut host, DVec3::new(0.0, 0.0, 1000.0) + offset, 0.0)
     };
     let near = shifted(DVec3::ZERO);
@@ -579,17 +598,19 @@ fn past_the_sprite_budget_the_farthest_blocks_are_left_out() {
     };
     // Room for two of the three 200-sprite blocks.
     host.sky
+        .sky_mut()
         .set_sprite_budget_bytes(500 * skycast::render::BYTES_PER_SPRITE);
-    host.sky.set_clouds(vec![
+    host.sky.sky_mut().set_clouds(vec![
         block(1, 3_000.0),
         block(2, 6_000.0),
         block(3, -12_000.0),
     ]);
     let drawn_from = |host: &mut DemoHost, at: DVec3| {
         let c = camera(host, at);
-        let stats = host.sky.prepare(&host.gpu.queue, c, &SUN, 0.1);
+        let stats = host.sky.sky_mut().prepare(&host.gpu.queue, c, &SUN, 0.1);
         let norths: Vec<f32> = host
             .sky
+            .sky()
             .read_back_corners(&host.gpu.queue)
             .unwrap()
             .chunks(4)
@@ -639,7 +660,7 @@ fn a_layer_seen_above_the_horizon_fades_out_where_the_clouds_end() {
         )],
     };
     let camera_z = 9000.0;
-    host.sky.set_clouds(vec![
+    host.sky.sky_mut().set_clouds(vec![
         block(1, DVec3::new(0.0, 55_000.0, camera_z + 8000.0)),
         block(2, DVec3::new(4000.0, 30_000.0, camera_z + 8000.0)),
         block(3, DVec3::new(-4000.0, 55_000.0, camera_z - 8000.0)),
@@ -694,17 +715,19 @@ fn a_far_cloud_fades_into_the_horizon_haze() {
             },
         )
         .unwrap_or_else(|e| panic!("sprite tests need an adapter: {e}"));
-        host.sky.set_fog_settings(skycast::shading::FogSettings {
-            altitude_haze: false,
-            ..Default::default()
-        });
-        host.sky.set_weather_overhead(&BlockWeather {
+        host.sky
+            .sky_mut()
+            .set_fog_settings(skycast::shading::FogSettings {
+                altitude_haze: false,
+                ..Default::default()
+            });
+        host.sky.sky_mut().set_weather_overhead(&BlockWeather {
             visibility_m: 1e9,
             ..BlockWeather::default()
         });
         let camera = host.camera(DVec3::new(0.0, 0.0, 1500.0), 0.0, 2.0);
         let (bare, _) = host.frame(&camera, &SUN, 0.0, 1e9).unwrap();
-        host.sky.set_clouds(one_cloud(plain_cloud(
+        host.sky.sky_mut().set_clouds(one_cloud(plain_cloud(
             DVec3::new(0.0, 8000.0, 1800.0),
             vec![square_sprite(Vec3::ZERO, 1500.0, 0, 0)],
             ColourLevels::even(0.0, 4000.0, [[0.05, 0.05, 0.05, 1.0]; 5]),
@@ -782,9 +805,9 @@ fn fill_slots(host: &mut DemoHost, n: u64, at: DVec3) -> Vec<SkyBlock> {
     let all: Vec<SkyBlock> = (1..=n)
         .map(|id| row_block(id, 3750.0 + 250.0 * id as f64, 10))
         .collect();
-    host.sky.set_clouds(all.clone());
+    host.sky.sky_mut().set_clouds(all.clone());
     let c = camera(host, at);
-    let first = host.sky.prepare(&host.gpu.queue, c, &SUN, 0.0);
+    let first = host.sky.sky_mut().prepare(&host.gpu.queue, c, &SUN, 0.0);
     assert_eq!(first.sprites_drawn, 200 * n as u32, "{first:?}");
     all
 }
@@ -793,7 +816,7 @@ fn fill_slots(host: &mut DemoHost, n: u64, at: DVec3) -> Vec<SkyBlock> {
 /// 800 slots are free in holes of 200.
 fn cut_up_slots(host: &mut DemoHost, all: Vec<SkyBlock>) -> Vec<SkyBlock> {
     let taken = [3, 7, 11, 15];
-    assert_eq!(host.sky.remove_blocks(taken), 4);
+    assert_eq!(host.sky.sky_mut().remove_blocks(taken), 4);
     all.into_iter().filter(|b| !taken.contains(&b.id)).collect()
 }
 
@@ -814,20 +837,29 @@ fn a_packing_moves_the_blocks_on_the_device_and_draws_the_same_sprites() {
     // 600 m on, past every cloud's threshold: all 160 clouds sorted again, their orders in a
     // patch that no frame applies before the packing.
     let c = camera(&packed, at);
-    let undrawn = packed.sky.prepare(&packed.gpu.queue, c, &SUN, 0.0);
+    let undrawn = packed
+        .sky
+        .sky_mut()
+        .prepare(&packed.gpu.queue, c, &SUN, 0.0);
     assert_eq!(undrawn.clouds_recomputed, 160, "{undrawn:?}");
-    let memory = packed.sky.memory();
+    let memory = packed.sky.sky().memory();
     assert_eq!(
         (memory.sprite_slots, memory.sprite_slots_used),
         (4096, 3200)
     );
     // 300 sprites in 15 clouds: no hole holds them (the last is 96), the 896 free in all do.
     let new = row_block(21, 6100.0, 15);
-    packed.sky.insert_block(new.clone(), BlockMotion::default());
+    packed
+        .sky
+        .sky_mut()
+        .insert_block(new.clone(), BlockMotion::default());
     kept.push(new);
     let c = camera(&packed, at);
-    let stats = packed.sky.prepare(&packed.gpu.queue, c, &SUN, 0.0);
-    let memory = packed.sky.memory();
+    let stats = packed
+        .sky
+        .sky_mut()
+        .prepare(&packed.gpu.queue, c, &SUN, 0.0);
+    let memory = packed.sky.sky().memory();
     // Packed at the same size (not grown), and the new block placed.
     assert_eq!(
         (memory.sprite_slots, memory.sprite_slots_used),
@@ -845,10 +877,11 @@ fn a_packing_moves_the_blocks_on_the_device_and_draws_the_same_sprites() {
     assert_eq!(stats.clouds_recomputed, 15, "{stats:?}");
     let after = packed
         .sky
+        .sky()
         .read_back_corners(&packed.gpu.queue)
         .expect("corners read back");
     let mut fresh = host(TimeOfDayTable::default());
-    fresh.sky.set_clouds(kept);
+    fresh.sky.sky_mut().set_clouds(kept);
     let expected = corners(&mut fresh, at, 0.0);
     assert_eq!((after.len(), expected.len()), (3500 * 4, 3500 * 4));
     let differing = quads_differing(&after, &expected);
@@ -866,7 +899,7 @@ fn a_locked_facing_follows_its_sprite_when_the_buffers_pack() {
     // 19 blocks in slots 0..3,800, then the sprite's block after them.
     let all = fill_slots(&mut host, 19, locked_at);
     let sprite_m = DVec3::new(0.0, 0.0, 1000.0);
-    host.sky.insert_block(
+    host.sky.sky_mut().insert_block(
         SkyBlock {
             id: 40,
             centre_m: sprite_m,
@@ -891,12 +924,13 @@ fn a_locked_facing_follows_its_sprite_when_the_buffers_pack() {
     // The holes of 200 and the 295 at the end hold no 300 sprites: the buffers pack, and the
     // sprite moves from slot 3,800 to 3,000.
     cut_up_slots(&mut host, all);
-    assert_eq!(host.sky.memory().sprite_slots_used, 3001);
+    assert_eq!(host.sky.sky().memory().sprite_slots_used, 3001);
     host.sky
+        .sky_mut()
         .insert_block(row_block(41, 6100.0, 15), BlockMotion::default());
     let stepped_to = DVec3::new(30.0, -20.0, 1000.0);
     let quads = corners(&mut host, stepped_to, 0.1);
-    let memory = host.sky.memory();
+    let memory = host.sky.sky().memory();
     assert_eq!(
         (memory.sprite_slots, memory.sprite_slots_used),
         (4096, 3301)

@@ -104,23 +104,23 @@ fn a_10_km_cell_from_20_km_spans_25_degrees_on_a_dark_base_and_a_flash_lights_it
     let mut host = host();
     // The cell's shadow darkens the ground below it between the frame without it and the one
     // with it, which the mask would take for the cell: the cell is measured without it.
-    host.sky.set_cloud_shadows(false);
+    host.sky.sky_mut().set_cloud_shadows(false);
     // A report's 9999 (10 km or more) under the cell, drawn in clear air of 100 km visual
     // range: storms are seen 50-80 km off (../shared/DESIGN.md), which the shipped 40 km of
     // `clear_visibility_m` (config/fog.toml) hides; the figure under it is printed below.
-    host.sky.set_weather_overhead(&BlockWeather {
+    host.sky.sky_mut().set_weather_overhead(&BlockWeather {
         visibility_m: 9_999.0,
         ..weather.clone()
     });
     let shipped = FogSettings::default();
-    host.sky.set_fog_settings(FogSettings {
+    host.sky.sky_mut().set_fog_settings(FogSettings {
         clear_visibility_m: 100_000.0,
         ..shipped
     });
     // Looking north at it, the view tilted up to hold base and top.
     let camera = host.camera(DVec3::new(0.0, 0.0, EYE_M), 0.0, 15.0);
     let clear = frame(&mut host, "clear", &camera);
-    host.sky.set_clouds(vec![block]);
+    host.sky.sky_mut().set_clouds(vec![block]);
     let storm = frame(&mut host, "cell_from_20_km", &camera);
     let mask = cell_mask(&storm, &clear);
     let at = |x: u32, y: u32| (y * W + x) as usize;
@@ -184,7 +184,7 @@ fn a_10_km_cell_from_20_km_spans_25_degrees_on_a_dark_base_and_a_flash_lights_it
     assert!(ratio <= 0.65, "the base is {ratio:.2} of the sky beside it");
 
     // The same view in the shipped clear air (40 km): printed, for the book.
-    host.sky.set_fog_settings(shipped);
+    host.sky.sky_mut().set_fog_settings(shipped);
     let hazed = frame(&mut host, "cell_from_20_km_shipped_fog", &camera);
     eprintln!(
         "base / sky beside in the shipped 40 km clear air: {:.2}",
@@ -202,7 +202,7 @@ fn a_10_km_cell_from_20_km_spans_25_degrees_on_a_dark_base_and_a_flash_lights_it
         "horizon sky / sky beside the base: {:.2}",
         horizon / sky_beside
     );
-    host.sky.set_fog_settings(FogSettings {
+    host.sky.sky_mut().set_fog_settings(FogSettings {
         clear_visibility_m: 100_000.0,
         ..shipped
     });
@@ -210,13 +210,13 @@ fn a_10_km_cell_from_20_km_spans_25_degrees_on_a_dark_base_and_a_flash_lights_it
     // An in-cloud flash in the middle of the tower: the cell brighter from inside, the sky
     // around the same.
     let lightning = StormSettings::default().lightning;
-    host.sky.set_flash(Some(SkyFlash {
+    host.sky.sky_mut().set_flash(Some(SkyFlash {
         position_m: DVec3::new(c.centre_m[0], c.centre_m[1], 4_500.0),
         reach_m: lightning.reach_m as f32,
         light: lightning.brightness as f32,
     }));
     let lit = frame(&mut host, "cell_flash", &camera);
-    host.sky.set_flash(None);
+    host.sky.sky_mut().set_flash(None);
     // The tower: the cell's pixels over the body's columns, base to mid-height.
     let tower: Vec<usize> = ((top + bottom) / 2..=bottom)
         .flat_map(|y| (lo..=hi).map(move |x| at(x, y)))
@@ -274,13 +274,13 @@ fn a_cell_200_km_off_stands_over_the_horizon_as_a_distant_block() {
 fn far_cell_frames(scale: Option<f32>, block: &SkyBlock) {
     let weather = BlockWeather::default();
     let mut host = host_at(scale);
-    host.sky.set_cloud_shadows(false);
-    host.sky.set_weather_overhead(&BlockWeather {
+    host.sky.sky_mut().set_cloud_shadows(false);
+    host.sky.sky_mut().set_weather_overhead(&BlockWeather {
         visibility_m: 9_999.0,
         ..weather.clone()
     });
     // In clear air of 100 km (the other test's): in the shipped 40 km only its top shows.
-    host.sky.set_fog_settings(FogSettings {
+    host.sky.sky_mut().set_fog_settings(FogSettings {
         clear_visibility_m: 100_000.0,
         ..FogSettings::default()
     });
@@ -290,10 +290,13 @@ fn far_cell_frames(scale: Option<f32>, block: &SkyBlock) {
         ..host.camera(DVec3::new(0.0, 0.0, 3_048.0), 0.0, 0.0)
     };
     let clear = frame(&mut host, "far_clear", &camera);
-    host.sky.insert_block(block.clone(), BlockMotion::default());
-    let near = frame(&mut host, "far_cell_as_near_block", &camera);
-    host.sky.remove_block(block.id);
     host.sky
+        .sky_mut()
+        .insert_block(block.clone(), BlockMotion::default());
+    let near = frame(&mut host, "far_cell_as_near_block", &camera);
+    host.sky.sky_mut().remove_block(block.id);
+    host.sky
+        .sky_mut()
         .insert_distant_block(block.clone(), BlockMotion::default());
     let distant = frame(&mut host, "far_cell_200_km", &camera);
     let changed = |f: &Frame| cell_mask(f, &clear).iter().filter(|&&m| m).count();
@@ -359,12 +362,12 @@ fn the_impostor_ring_holds_a_cells_anvil_high_above_the_horizon() {
         }
     }
     let mut host = host();
-    host.sky.set_cloud_shadows(false);
+    host.sky.sky_mut().set_cloud_shadows(false);
     // Looking up at 30 degrees: the rows of the frame from 0 (60 degrees up) down.
     let camera = host.camera(DVec3::new(0.0, 0.0, EYE_M), 0.0, 30.0);
     // The first ring is built at once, with the cell in it.
     let parts = blocks.len() as u32;
-    host.sky.set_clouds(blocks);
+    host.sky.sky_mut().set_clouds(blocks);
     let (ring, stats) = host.frame(&camera, &sun(), 0.0, 60_000.0).unwrap();
     eprintln!(
         "{parts} parts: {} near, {} in the ring",
@@ -373,9 +376,9 @@ fn the_impostor_ring_holds_a_cells_anvil_high_above_the_horizon() {
     assert!(stats.blocks_far > 0, "{stats:?}");
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("storm-tests");
     ring.write_png(&dir.join("anvil_in_the_ring.png")).unwrap();
-    host.sky.set_impostors(false);
+    host.sky.sky_mut().set_impostors(false);
     let sprites = frame(&mut host, "anvil_as_sprites", &camera);
-    host.sky.set_clouds(Vec::new());
+    host.sky.sky_mut().set_clouds(Vec::new());
     let clear = frame(&mut host, "anvil_clear", &camera);
     // The rows more than 24 degrees up: the top 36 of the frame's 60 degrees (rows 0..108).
     let high = |f: &Frame| {

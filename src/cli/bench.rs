@@ -320,12 +320,12 @@ fn fly(
     }
     if let Some(Some(map)) = &far_map {
         for host in &mut hosts {
-            host.sky.set_far_map(&host.gpu.queue, map, None);
+            host.sky.sky_mut().set_far_map(&host.gpu.queue, map, None);
         }
     }
     if setup.passes {
         for host in &mut hosts {
-            if !host.sky.set_pass_timing(true) {
+            if !host.sky.sky_mut().set_pass_timing(true) {
                 eprintln!("bench: --passes: this device has no GPU timestamps between passes");
             }
         }
@@ -371,9 +371,10 @@ fn fly(
                     .collect());
             }
             for host in &mut hosts {
-                host.sky.set_clouds(blocks.clone());
+                host.sky.sky_mut().set_clouds(blocks.clone());
                 for block in &distant {
                     host.sky
+                        .sky_mut()
                         .insert_distant_block(block.clone(), BlockMotion::default());
                 }
             }
@@ -384,7 +385,7 @@ fn fly(
             if n == 1 {
                 *warm_up = records.len();
             }
-            host.sky.set_weather_overhead(&overhead);
+            host.sky.sky_mut().set_weather_overhead(&overhead);
             let distance_m = k as f64 * step_m;
             timestamps &=
                 draw_to_steady(host, (p, distance_m), (&sun, dt_s, visibility_m), records)?;
@@ -445,7 +446,7 @@ fn draw_to_steady(
             blocks_far: stats.blocks_far,
             impostors_rebuilt: stats.impostors_rebuilt,
             cloud_target_bytes: stats.cloud_target_bytes,
-            passes: host.sky.pass_times(),
+            passes: host.sky.sky().pass_times(),
         });
         if steady {
             break;

@@ -354,6 +354,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     // `cloud_distance`, and its largest value printed.
     let cloud_distance = host
         .sky
+        .sky()
         .read_cloud_distance_m(&host.gpu.queue)
         .map(|(w, h, d)| stretch(&d, (w, h), (frame.width, frame.height)));
     if let Some(exr) = &args.exr {

@@ -13,7 +13,7 @@ use super::headless::{self, Frame, HeadlessGpu, OffscreenTarget};
 use super::terrain::{HeightField, Terrain, TerrainLight, procedural_relief_m};
 use crate::flight::{HostCamera, SkyError, SkySystem, SkySystemConfig};
 use crate::render::gpu_types::GpuSprite;
-use crate::render::{Camera, FrameStats, RenderError, Sky, Timestamps};
+use crate::render::{Camera, FrameStats, RenderError, Timestamps};
 use crate::shading::SunPosition;
 use crate::weather::field::WeatherField;
 
@@ -159,7 +159,7 @@ impl DemoHost {
 
     /// Draws one frame (ground, then sky) without reading it back, the sky prepared by hand
     /// (the clouds given to the renderer directly, no frame step); returns the sky's stats, or
-    /// why the sky refused the frame ([`Sky::record`]'s checks).
+    /// why the sky refused the frame ([`Sky::record`](crate::render::Sky::record)'s checks).
     pub fn draw(
         &mut self,
         camera: &Camera,
@@ -170,7 +170,7 @@ impl DemoHost {
         if let Some(t) = &self.timer {
             t.stamp(&self.gpu, 0);
         }
-        let stats = self.sky.prepare(&self.gpu.queue, camera, sun, dt_s);
+        let stats = (self.sky.sky_mut()).prepare(&self.gpu.queue, camera, sun, dt_s);
         if let Some(t) = &self.timer {
             t.stamp(&self.gpu, 1);
         }
@@ -185,7 +185,7 @@ impl DemoHost {
         visibility_m: f32,
         mut stats: FrameStats,
     ) -> Result<FrameStats, RenderError> {
-        let light = self.sky.light();
+        let light = self.sky.sky().light();
         let shadows = self.sky.cloud_shadows();
         self.terrain.prepare(
             (&self.gpu.device, &self.gpu.queue),
@@ -194,7 +194,7 @@ impl DemoHost {
                 sun_dir,
                 sun_rgb: light.directional_rgb,
                 ambient: skylight(light.directional_rgb, sun_dir, light.ambient_percent),
-                fog_rgb: self.sky.fog().rgb,
+                fog_rgb: self.sky.sky().fog().rgb,
                 haze: self.sky.ground_haze(visibility_m),
                 camera_radius_m: self.sky.earth().camera_radius_m(camera.position_m.z),
             },
@@ -218,8 +218,7 @@ impl DemoHost {
             t.stamps.write(&mut encoder, 3);
         }
         // The renderer's own record: `draw` prepares it by hand, without the frame step.
-        Sky::record(
-            &self.sky,
+        self.sky.sky().record(
             &mut encoder,
             &self.target.colour_view,
             &self.target.depth_view,

@@ -509,7 +509,7 @@ impl SkySystem {
         self.sun = Some(sun);
         let own = start.spent();
         // Read after the far map above: the far field's band holds from its first map on. A
-        // host may switch the ring or the far field between frames (through `DerefMut`).
+        // host may switch the ring or the far field between frames (through `sky_mut`).
         self.world.set_sky_reach(self.sky.reach());
         let update = self.world.advance_sky(position_m, dt_s)?;
         // The field's time is the weather, the far map, the sun and the world's own; the
@@ -622,6 +622,50 @@ impl SkySystem {
         }
     }
 
+    /// The clouds' shadow map of the last [`Self::update`] and the matrix the host looks it up
+    /// with ([`Sky::cloud_shadows`]): the host multiplies its ground's direct sunlight by
+    /// `exp(-tau)`. Take it every frame.
+    pub fn cloud_shadows(&self) -> crate::render::CloudShadowMap<'_> {
+        self.sky.cloud_shadows()
+    }
+
+    /// The haze the host fogs its ground with along a view ray, its visibility at most
+    /// `visibility_m` ([`Sky::ground_haze`]): the clouds fade into the same haze.
+    pub fn ground_haze(&self, visibility_m: f32) -> crate::shading::AltitudeHaze {
+        self.sky.ground_haze(visibility_m)
+    }
+
+    /// The round Earth the sky draws on; the host draws its far ground on the same
+    /// ([`Sky::earth`]).
+    pub fn earth(&self) -> crate::render::earth::EarthSettings {
+        self.sky.earth()
+    }
+
+    /// The renderer settings the sky was made with (its camera's projection, the clouds' reach,
+    /// what is switched on).
+    pub fn settings(&self) -> &crate::render::RenderSettings {
+        self.sky.settings()
+    }
+
+    /// Time the last [`Self::record`] spent.
+    pub fn last_record(&self) -> crate::render::Spent {
+        self.sky.last_record()
+    }
+
+    /// The renderer under the frame step, to read: its memory, pass times, blocks and the
+    /// state of its switches.
+    pub fn sky(&self) -> &Sky {
+        &self.sky
+    }
+
+    /// The renderer under the frame step, for its lower-level controls between frames
+    /// (switching the ring, the far field, the shadows or pass timing; fades and blocks given
+    /// by hand for tests and tools). The frame step reads the ring and the far field's reach
+    /// back from it every [`Self::update`], so a switch holds from the next frame on.
+    pub fn sky_mut(&mut self) -> &mut Sky {
+        &mut self.sky
+    }
+
     /// The local frame: latitude/longitude to the metres positions are given in.
     pub fn frame(&self) -> &LocalFrame {
         &self.frame
@@ -636,22 +680,6 @@ impl SkySystem {
     /// frames).
     pub fn world_mut(&mut self) -> &mut World {
         &mut self.world
-    }
-}
-
-/// A `SkySystem` is the [`Sky`] with the frame step around it: the renderer's lower-level
-/// controls (its settings, stats, fades, blocks given by hand) are reached through it.
-impl std::ops::Deref for SkySystem {
-    type Target = Sky;
-
-    fn deref(&self) -> &Sky {
-        &self.sky
-    }
-}
-
-impl std::ops::DerefMut for SkySystem {
-    fn deref_mut(&mut self) -> &mut Sky {
-        &mut self.sky
     }
 }
 

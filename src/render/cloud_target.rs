@@ -20,6 +20,10 @@
 //!    runs both sides of a branch for every pixel, so one draw paid for the sky gradient and the
 //!    fix-up everywhere (the composite took half the time it takes now).
 //!
+//! As every pass of the sky: `new` builds the pipelines, `plan` sizes the target from the
+//! host's (plain data), `frame` makes its textures when that size changed, and `downsample`,
+//! `pass` and `composite` record.
+//!
 //! At scale 1 nothing here runs: the cloud passes draw straight into the host's colour as
 //! before, and cost nothing more. The target follows the host's frame size (checked each
 //! record, rebuilt when it changed); the host's API does not change.
@@ -87,7 +91,6 @@ pub(super) struct CloudTarget {
 
 /// Pipelines of the off-screen path, and the size-dependent textures.
 struct Offscreen {
-    divisor: u32,
     downsample: wgpu::RenderPipeline,
     composite: wgpu::RenderPipeline,
     /// The composite split by the host's depth as a read-only attachment: the sky's pixels,
@@ -214,8 +217,15 @@ impl CloudTarget {
         Some((w, h, out))
     }
 
+    /// The plan of a frame whose host targets are `host_size` pixels: the target's size,
+    /// `None` at scale 1 (the clouds go straight into the host's colour). CPU only.
+    pub fn plan(&self, host_size: (u32, u32)) -> Option<(u32, u32)> {
+        (self.offscreen.is_some()).then(|| target_size(host_size, self.divisor))
+    }
+
     /// The target for a frame of the host's `depth_view`'s size (made or remade if the size
-    /// changed); `None` at scale 1.
+    /// changed: the pass's upload); `None` at scale 1. Its `downsample`, `pass` and
+    /// `composite` record.
     pub fn frame(
         &self,
         device: &wgpu::Device,
@@ -227,7 +237,8 @@ impl CloudTarget {
         let host_size = (size.width, size.height);
         let current = offscreen.textures.borrow().as_ref().map(|t| t.host_size);
         if current != Some(host_size) {
-            let textures = offscreen.textures_for(device, frame_buffer, host_size);
+            let size = self.plan(host_size)?;
+            let textures = offscreen.textures_for(device, frame_buffer, (host_size, size));
             *offscreen.textures.borrow_mut() = Some(textures);
         }
         let textures =
@@ -352,7 +363,6 @@ impl Offscreen {
             ..Default::default()
         });
         Self {
-            divisor,
             downsample,
             composite,
             split_composite,
@@ -370,11 +380,11 @@ impl Offscreen {
         &self,
         device: &wgpu::Device,
         frame_buffer: &wgpu::Buffer,
-        host_size: (u32, u32),
+        (host_size, (width, height)): ((u32, u32), (u32, u32)),
     ) -> SizedTextures {
         let size = wgpu::Extent3d {
-            width: host_size.0.div_ceil(self.divisor).max(1),
-            height: host_size.1.div_ceil(self.divisor).max(1),
+            width,
+            height,
             depth_or_array_layers: 1,
         };
         let mut bytes = 0;
@@ -589,9 +599,26 @@ pub(super) fn begin_with_depth<'e>(
     })
 }
 
+/// The cloud target's size for host targets of `host_size` pixels drawn at 1 / `divisor`:
+/// rounded up, so the last block of host pixels has a texel.
+fn target_size(host_size: (u32, u32), divisor: u32) -> (u32, u32) {
+    (
+        host_size.0.div_ceil(divisor).max(1),
+        host_size.1.div_ceil(divisor).max(1),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_target_covers_every_block_of_host_pixels() {
+        assert_eq!(target_size((160, 90), 2), (80, 45));
+        assert_eq!(target_size((161, 91), 2), (81, 46));
+        assert_eq!(target_size((321, 180), 4), (81, 45));
+        assert_eq!(target_size((0, 0), 4), (1, 1));
+    }
 
     #[test]
     fn scales_map_to_divisors() {

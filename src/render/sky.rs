@@ -15,20 +15,14 @@
 //! read-only attachment: a software rasteriser then shades only those pixels, while a shader's
 //! own test runs the whole shader on every pixel.
 
-use glam::Vec3;
-
 use super::RenderError;
-use super::gpu_types::{GpuFrame, GpuSpriteVertex};
+use super::gpu_types::GpuFrame;
 use super::impostor::RingFrame;
 use super::overhead_ease::OverheadEase;
-use super::pass_timing::STAMPS;
 use super::settings::RenderSettings;
-use super::sprites::build::{CHUNK, SpriteBuild, chunks};
-use super::sprites::draw_list::{Copies, Locks, main_view};
-use super::sprites::resident::{ResidentSet, quad_index_buffer};
-use super::sprites::scatter::Scatter;
-use super::sprites::sprite_view::{self, ViewData, ViewLight};
-use super::stats::{FrameStats, Lighting, Spent, Stopwatch};
+use super::sprites::pass::{SpriteFrame, SpritePass, SpriteViewState};
+use super::sprites::sprite_view::{self, ViewLight};
+use super::stats::{FrameStats, Spent, Stopwatch};
 use super::targets::{HostTargets, SkyView};
 use super::view::{View, ViewId, ViewShared};
 use crate::clouds::LifecycleConfig;
@@ -38,6 +32,9 @@ use crate::weather::{BlockLayer, BlockWeather};
 // What the sky does apart from conducting a frame, one file each.
 mod blocks;
 mod build;
+mod controls;
+// The sky pass's plan: the frame uniform every pass into the host's targets reads.
+mod frame;
 mod light;
 mod memory;
 mod record;
@@ -93,13 +90,9 @@ pub struct Sky {
     /// attachment (in a pass of its own); `None` where the host's depth format has a stencil
     /// aspect.
     sky_tested_pipeline: Option<wgpu::RenderPipeline>,
-    sprite_pipeline: wgpu::RenderPipeline,
-    in_cloud_pipeline: wgpu::RenderPipeline,
-    resident: ResidentSet,
-    /// Quad indices for this many sprites (the most one draw needs so far).
-    quads: (wgpu::Buffer, u32),
-    scatter: Scatter,
-    build: SpriteBuild,
+    /// The near sprites' pass, with the resident sprites, the corner build and the quads the
+    /// ring and the shadow map draw through too.
+    sprites: SpritePass,
     view_layout: wgpu::BindGroupLayout,
     /// Each camera's own state, [`ViewId::MAIN`] first: the blocks, weather and resident
     /// sprites above are shared by all.
@@ -150,8 +143,6 @@ pub struct SkyFlash {
 }
 
 const SKY_WGSL: &str = include_str!("../../shaders/sky.wgsl");
-const SPRITES_WGSL: &str = include_str!("../../shaders/sprites.wgsl");
-const IN_CLOUD_WGSL: &str = include_str!("../../shaders/in_cloud.wgsl");
 
 impl Sky {
     /// Creates pipelines, the sheet texture and buffers on the host's device. The device is
@@ -220,227 +211,6 @@ impl Sky {
         self.views.get(id.0).map_or(0, View::gpu_bytes)
     }
 
-    /// Switches the cloud shading model (`[shading] model` of the time-of-day table). Switched
-    /// to Harris and Lastra's, the clouds held get a provisional light at the next
-    /// [`Self::prepare`] and their own within the model's budget of sprites a frame.
-    pub fn set_shading_model(&mut self, model: crate::shading::ShadingModel) {
-        self.time_of_day.shading.model = model;
-    }
-
-    /// The cloud shading model in use.
-    pub fn shading_model(&self) -> crate::shading::ShadingModel {
-        self.time_of_day.shading.model
-    }
-
-    /// How clouds form and dissipate (the clouds stage's `[lifecycle]`): which sprites of a
-    /// forming or dissipating block show at a given progress.
-    pub fn set_lifecycle(&mut self, lifecycle: LifecycleConfig) {
-        self.lifecycle = lifecycle;
-    }
-
-    /// Caps the GPU memory of the sprites (records, orders, quad indices) at `bytes` (0: only
-    /// the device's limits). Past it the farthest blocks are left out and counted in
-    /// [`FrameStats::blocks_left_out`]. Every block is uploaded again.
-    pub fn set_sprite_budget_bytes(&mut self, bytes: u64) {
-        let mut old = ResidentSet::new(&self.device, bytes);
-        std::mem::swap(&mut old, &mut self.resident);
-        for (_, r) in old.blocks {
-            self.resident.insert(r.block, r.motion);
-        }
-        for view in &mut self.views {
-            view.locks = Locks::default();
-        }
-    }
-
-    /// Counts what the host's cloud field work for this frame `spent` (time it with a
-    /// [`Stopwatch`], or a [`super::SkyUpdate`]'s `field_cpu`) into the next prepared frame's
-    /// [`FrameStats::field_us`] and its thread figure: for a host that drives the sky itself
-    /// ([`crate::SkySystem::update`] adds its own to the stats it returns).
-    pub fn add_field_cpu(&mut self, spent: Spent) {
-        self.field += spent;
-    }
-
-    /// Counts the wall-clock microseconds the host's work on the far field's map took this frame
-    /// (sampling the weather into its rows, [`Self::set_far_map`]) into the next prepared
-    /// frame's [`FrameStats::far_field_us`]. They are part of the field's time too: count that
-    /// span with [`Self::add_field_cpu`] as well.
-    pub fn add_far_field_us(&mut self, us: u64) {
-        self.far_field_us += us;
-    }
-
-    /// The corners of the last prepared frame's sprites, four per sprite in drawing order, as
-    /// the build pass makes them for the draw (position relative to the camera, colour, drawn or
-    /// not): for tests and tools. Runs the frame's patch and build passes and waits.
-    pub fn read_back_corners(
-        &self,
-        queue: &wgpu::Queue,
-    ) -> Result<Vec<super::SpriteCorner>, RenderError> {
-        let main = &self.views[0];
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        self.scatter.record(&mut encoder);
-        let read = super::readback::read_buffer(&self.device, main.sprites_to_draw);
-        let corner_bytes = 4 * std::mem::size_of::<GpuSpriteVertex>() as u64;
-        if let Some(view_group) = main.view.group() {
-            for (chunk, first, sprites) in chunks(main.sprites_to_draw) {
-                let group = &self.resident.group;
-                self.build
-                    .record(&mut encoder, view_group, group, (chunk, sprites));
-                encoder.copy_buffer_to_buffer(
-                    self.build.vertices(),
-                    0,
-                    &read,
-                    first as u64 * corner_bytes,
-                    sprites as u64 * corner_bytes,
-                );
-            }
-        }
-        super::readback::read_corners(&self.device, queue, encoder, &read, main.sprites_to_draw)
-    }
-
-    /// Times each group of the sky's passes on the GPU from the next [`Self::record`] on (a
-    /// profiling aid: the far field, the ring and the sprites then go in passes of their own),
-    /// or stops.
-    /// Returns whether timing is on: the device needs timestamp queries inside encoders
-    /// (`wgpu::Features::TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS`).
-    pub fn set_pass_timing(&mut self, on: bool) -> bool {
-        self.pass_timer = if on {
-            super::Timestamps::new(&self.device, &self.queue, "sky.pass_times", STAMPS)
-        } else {
-            None
-        };
-        self.shadows
-            .set_timing(&self.queue, self.pass_timer.is_some());
-        self.pass_timer.is_some()
-    }
-
-    /// GPU time of each group of passes of the last recorded frame, once it was submitted:
-    /// waits for the device. `None` while pass timing is off or if the times cannot be read.
-    pub fn pass_times(&self) -> Option<super::PassTimes> {
-        let times =
-            super::pass_timing::pass_times(&self.pass_timer.as_ref()?.read_ms(&self.device)?);
-        let shadow_ms = self.shadows.last_ms().unwrap_or(0.0);
-        times.map(|t| super::PassTimes { shadow_ms, ..t })
-    }
-
-    /// The clouds' shadow map of the last prepared frame and the matrix a host looks it up with
-    /// ([`super::CloudShadowMap`]): the host multiplies its ground's direct sunlight by
-    /// `exp(-tau)`. Take it every frame (after [`Self::prepare`]): the lookup follows the camera
-    /// and the clouds' drift, and the texture is replaced when the shadows are switched.
-    pub fn cloud_shadows(&self) -> super::CloudShadowMap<'_> {
-        self.shadows.map()
-    }
-
-    /// Switches the cloud shadows on (drawn from the next [`Self::prepare`]) or off (the map a
-    /// single texel of open sun).
-    pub fn set_cloud_shadows(&mut self, on: bool) {
-        self.shadows.set_enabled(&self.queue, on);
-        self.settings.cloud_shadows.enabled = on;
-    }
-
-    /// Draws the cloud shadow map at the next [`Self::prepare`] whatever changed (it is drawn
-    /// again by itself when the camera has gone far, the sun turned, a block near went (one
-    /// that arrives is added to it), or, while clouds form or dissipate, after
-    /// `update_interval_s`).
-    pub fn redraw_cloud_shadows(&mut self) {
-        self.shadows.redraw();
-    }
-
-    /// The shadow map's optical depth read back (tests and tools); waits for the device.
-    pub fn read_back_cloud_shadows(
-        &self,
-        queue: &wgpu::Queue,
-    ) -> Result<super::ShadowImage, RenderError> {
-        self.shadows.read_back(queue)
-    }
-
-    /// Time the last [`Self::record`] spent.
-    pub fn last_record(&self) -> Spent {
-        self.views[0].record.get()
-    }
-
-    /// Time the last [`Self::record_view`] of `id` spent (0 for an unknown view).
-    pub fn view_record(&self, id: ViewId) -> Spent {
-        self.views
-            .get(id.0)
-            .map_or_else(Spent::default, |v| v.record.get())
-    }
-
-    /// The host's targets the sky was made for.
-    pub fn targets(&self) -> &HostTargets {
-        &self.targets
-    }
-
-    /// The settings the sky was made with.
-    pub fn settings(&self) -> &RenderSettings {
-        &self.settings
-    }
-
-    /// Turns the far-cloud impostor ring off (every block drawn as sprites) or back on (built
-    /// afresh). Returns false and changes nothing when turning it on in a sky made with
-    /// `impostors.enabled = false`: the ring's textures are made at start-up only.
-    pub fn set_impostors(&mut self, enabled: bool) -> bool {
-        let mut switched = true;
-        for view in &mut self.views {
-            switched &= view.ring.set_enabled(enabled);
-        }
-        if switched {
-            self.settings.impostors.enabled = enabled;
-        }
-        switched
-    }
-
-    /// Turns the vertex cache on or off (off: every cloud recomputed every frame).
-    pub fn set_vertex_cache(&mut self, enabled: bool) {
-        self.settings.vertex_cache.enabled = enabled;
-    }
-
-    /// Hands the far field a new cloud map ([`crate::clouds::far_map::FarMapFeed`] makes them
-    /// from the weather field as the camera moves); uploaded now. The first map fades in over
-    /// `fade_in_s` when given (as arriving clouds do); a map of another weather
-    /// ([`crate::clouds::far_map::FarMap::weather_epoch`]) crossfades from the one shown over
-    /// the lifecycle's formation time, as the blocks' clouds form and dissipate; a map moved
-    /// with the camera shows at once (its cells keep their weather).
-    pub fn set_far_map(
-        &mut self,
-        queue: &wgpu::Queue,
-        map: &crate::clouds::far_map::FarMap,
-        fade_in_s: Option<f64>,
-    ) {
-        let crossfade_s = f64::from(self.lifecycle.formation_s);
-        self.far_field.set_map(
-            &self.device,
-            queue,
-            map,
-            (self.elapsed_s, fade_in_s, crossfade_s),
-        );
-    }
-
-    /// Where the far field takes over from the sprites and the ring while it is drawn: the band
-    /// over which they fade out and it fades in (metres from the camera), and the distant
-    /// blocks fade in ([`Self::insert_distant_block`]). `None` while it is not drawn.
-    pub fn far_field_hand_over_m(&self) -> Option<(f32, f32)> {
-        self.far_field.hand_over_m()
-    }
-
-    /// Switches the far field on or off at run time (for comparisons; the sprites and the ring
-    /// fade out as before without it).
-    pub fn set_far_field_enabled(&mut self, enabled: bool) {
-        self.far_field.set_enabled(enabled);
-    }
-
-    /// The far field's settings (the map's size, the hand-over band).
-    pub fn far_field_settings(&self) -> super::far_field::FarFieldSettings {
-        *self.far_field.settings()
-    }
-
-    /// The clouds' distance in the main view's last recorded frame (metres from the camera
-    /// plane, weighted by what each cloud shows; 0 where none shows) at the cloud target's
-    /// resolution: width, height and the texels row by row. `None` with the clouds drawn at full
-    /// resolution (no cloud target). Waits for the GPU: for tools and tests.
-    pub fn read_cloud_distance_m(&self, queue: &wgpu::Queue) -> Option<(u32, u32, Vec<f32>)> {
-        self.views[0].clouds.read_distance_m(&self.device, queue)
-    }
-
     /// CPU work of a frame: advances time by `dt_s`, uploads blocks that arrived, sorts blocks
     /// and clouds, recomputes the sprite orders Wang's cache says are stale, and writes the draw
     /// list and this frame's uniforms (only what changed goes to the GPU). It submits nothing of
@@ -472,6 +242,7 @@ impl Sky {
     ) -> FrameStats {
         let start = Stopwatch::start();
         let i = if id.0 < self.views.len() { id.0 } else { 0 };
+        let main = i == ViewId::MAIN.0;
         let camera: SkyView = view.into();
         self.views[i].projection = Some(camera.projection);
         let mut gpu_wait = Spent::default();
@@ -485,265 +256,175 @@ impl Sky {
         }
         // The frame's clock is the main view's; the others use `dt_s` for their ring's
         // crossfade only.
-        if i == ViewId::MAIN.0 {
+        if main {
             self.elapsed_s += dt_s.max(0.0);
         }
-        self.clear_light = self.time_of_day.at(sun.elevation_deg as f32);
-        let (hidden, _) = self.overhead_ease.show(
-            self.sky_hidden_at(camera.position_m.z),
-            self.fog.0.visibility_m(&self.fog.1),
-            self.elapsed_s,
-        );
-        self.seen_light = self
-            .clear_light
-            .under_cover(hidden, &self.time_of_day.overcast);
-        // The host's sun is the clear sun, on or off: the shadow map dims it where the clouds
-        // stop it, and with the shadows off nothing does (off casts no shadows; it does not
-        // dim the ground evenly). The cover's mean dimming is kept apart for a host without
-        // the map.
-        self.cover_transmittance = 1.0 - hidden.clamp(0.0, 1.0);
-        self.seen_light.directional_rgb = self.clear_light.directional_rgb;
-        let sun_dir = sun.direction_enu().as_vec3();
-        let lighting = Lighting {
-            sun_dir,
-            time_of_day: self.clear_light,
-            mapping: self.time_of_day.directional_mapping,
-            forward: self.time_of_day.forward_scattering,
-            model: self.time_of_day.shading.model,
-            harris_lastra: self.time_of_day.harris_lastra,
-        };
+        let lighting = self.light_frame(sun, camera.position_m.z);
+        let sun_dir = lighting.sun_dir;
         let mut stats = FrameStats::default();
-        (self.resident.lit_sprites, self.resident.light_us) = (0, 0);
-        let switched_on = self.resident.light.set(
-            self.time_of_day.shading.model,
-            &self.time_of_day.harris_lastra,
-            sun_dir,
-        );
-        let mut upload_bytes = 0;
-        if switched_on {
-            upload_bytes += self.resident.provisional_all(queue);
-        }
-        let (placed_bytes, left_out) = self.resident.place_and_upload(
+
+        // The resident sprites every pass draws from: arrived blocks placed and written.
+        let ts = &self.time_of_day;
+        let (mut upload_bytes, grow_wait) = self.sprites.place(
             queue,
-            camera.position_m,
-            self.settings.vertex_cache.max_uploaded_sprites_per_frame,
+            (
+                camera.position_m,
+                self.settings.vertex_cache.max_uploaded_sprites_per_frame,
+            ),
+            (ts.shading.model, &ts.harris_lastra, sun_dir),
+            self.views.iter_mut().map(|v| &mut v.locks),
+            &mut stats,
         );
-        stats.blocks_left_out = left_out;
-        gpu_wait += self.resident.grow_wait;
-        if self.resident.packed() {
-            // Blocks moved to other slots: what holds sprite slots from frame to frame follows
-            // them, and a patch of orders kept for the old slots goes (the new buffers were
-            // written whole from the CPU's copies, which hold its values).
-            self.scatter.forget_kept();
-            let resident = &self.resident;
-            for view in &mut self.views {
-                view.locks.follow(|slot| resident.moved_slot(slot));
-            }
-        }
-        upload_bytes += placed_bytes;
-        upload_bytes += self.resident.relight(queue, camera.position_m);
-        (stats.sprites_lit, stats.light_us) = (self.resident.lit_sprites, self.resident.light_us);
-        // While the far field is drawn every sprite has faded out by the end of its hand-over
-        // band (a twentieth more: the band is horizontal, the draw distance along the ray):
-        // neither the ring nor the sprites go farther.
-        let band_m = (self.far_field.hand_over_m()).map(|(start, end)| (start, 1.05 * end));
+        gpu_wait += grow_wait;
+
+        // Plans, on the CPU. The ring first: which blocks it holds and which it leaves to the
+        // sprites. While the far field is drawn every sprite has faded out by the end of its
+        // hand-over band (a twentieth more: the band is horizontal, the draw distance along
+        // the ray): neither the ring nor the sprites go farther.
+        let hand_over_m = self.far_field.hand_over_m();
+        let band_m = hand_over_m.map(|(start, end)| (start, 1.05 * end));
         let mut drawn = self.settings;
         if let Some((_, end)) = band_m {
             drawn.clouds.draw_distance_m = drawn.clouds.draw_distance_m.min(end);
         }
-        (self.views[i].ring)
-            .set_reach_limit(band_m.map(|(start, end)| (f64::from(start), f64::from(end))));
-        self.views[i]
-            .ring
-            .split(&mut self.resident, camera.position_m, sun_dir, dt_s);
-        // The frame's sorting budget, shared with a ring that is being rebuilt.
-        let sort_budget = self.settings.vertex_cache.max_sorted_sprites_per_frame;
-        let sort_budget = sort_budget - self.views[i].ring.sort_reserve(sort_budget);
-        let resident = &mut self.resident;
         let v = &mut self.views[i];
-        let inside = main_view(
-            (&mut resident.blocks, v.ring.near()),
-            Copies {
-                orders: &mut resident.orders_cpu,
-                dirty_orders: &mut resident.dirty_orders,
-                lists: &mut resident.lists_cpu,
-                dirty_lists: &mut resident.dirty_lists,
+        (v.ring).set_reach_limit(band_m.map(|(start, end)| (f64::from(start), f64::from(end))));
+        (v.ring).plan(&self.sprites.resident, camera.position_m, sun_dir, dt_s);
+        // The near sprites and the far storm cells: the view's draw list, within the frame's
+        // sorting budget (shared with a ring that is being rebuilt).
+        let sort_budget = self.settings.vertex_cache.max_sorted_sprites_per_frame;
+        let sprite_plan = self.sprites.plan(
+            SpriteViewState {
+                near: v.ring.near(),
+                locks: &mut v.locks,
+                seams: &mut v.seams,
+                draws: &mut v.draws,
             },
-            (camera.position_m, &camera.frustum()),
-            self.elapsed_s,
-            (&drawn, sort_budget),
-            (&mut v.locks, &mut v.seams),
-            &mut v.draws,
+            &SpriteFrame {
+                camera_m: camera.position_m,
+                frustum: &camera.frustum(),
+                time_s: self.elapsed_s,
+                drawn: &drawn,
+                sort_budget: sort_budget - v.ring.sort_reserve(sort_budget),
+            },
             &mut stats,
         );
-        let resident = &mut self.resident;
-        upload_bytes += self.scatter.prepare(
-            &self.device,
-            queue,
-            (&resident.orders_cpu, &resident.order_buffer),
-            &mut resident.dirty_orders,
-            (&resident.lists_cpu, &resident.list_buffer),
-            &mut resident.dirty_lists,
+        (v.sprites_to_draw, v.distant_sprites) = (sprite_plan.sprites, sprite_plan.distant);
+        (v.in_cloud, v.in_rain) = (sprite_plan.inside.cloud, sprite_plan.inside.rain);
+        stats.in_cloud = sprite_plan.inside.cloud;
+        // The sky pass's frame uniform, which every pass into the host's targets reads.
+        let haze = self.fog.0.cloud_haze(
+            &self.fog_for(sprite_plan.inside.rain),
+            self.settings.clouds.haze_distance_m,
+            self.fog.1.ground_elevation_m,
         );
-        let locks = self.views[i].locks.gpu();
+        let frame = frame::plan(&frame::FrameParts {
+            camera: &camera,
+            sun_dir,
+            settings: &self.settings,
+            clear_light: &self.clear_light,
+            seen_light: &self.seen_light,
+            cover_transmittance: self.cover_transmittance,
+            haze: &haze,
+            in_cloud: sprite_plan.inside.cloud,
+            background_depth: self.targets.background_depth(),
+            flash: self.flash,
+        });
+
+        // Uploads: the sprites' patch and view, the frame uniform, the far field's uniform,
+        // the ring's impostor renders, the shadow map (the main view's).
         let light = ViewLight {
             lighting: &lighting,
             clouds: &self.settings.clouds,
             lifecycle: &self.lifecycle,
             camera_z_m: camera.position_m.z as f32,
             farthest_m: self.settings.clouds.draw_distance_m,
-            hand_over_m: self.far_field.hand_over_m(),
+            hand_over_m,
         };
-        let header = sprite_view::header(&light);
         let v = &mut self.views[i];
-        let changed_locks = v.locks.take_changed().then_some(&locks[..]);
-        upload_bytes += v.view.write(
-            &self.device,
-            queue,
+        upload_bytes += self.sprites.upload(
+            (&self.device, queue),
             &self.view_layout,
-            &header,
-            changed_locks,
-            ViewData::Resident {
-                counts: [
-                    v.draws.len() as u32,
-                    locks.len() as u32,
-                    stats.sprites_drawn,
-                    0,
-                ],
-                draws: &v.draws,
-                lists: &self.resident.list_buffer,
-                orders: &self.resident.order_buffer,
-                generation: self.resident.generation,
-            },
+            &sprite_plan,
+            &sprite_view::header(&light),
+            (&mut v.locks, &v.draws),
+            &mut v.view,
         );
-        self.views[i].sprites_to_draw = stats.sprites_drawn;
-        self.views[i].distant_sprites =
-            super::sprites::draw_list::distant_sprites(&self.views[i].draws, stats.sprites_drawn);
-        let in_cloud = inside.cloud;
-        self.views[i].in_cloud = in_cloud;
-        self.views[i].in_rain = inside.rain;
-        stats.in_cloud = in_cloud;
-
-        let view_proj = camera.view_proj();
-        let sun_cfg = &self.settings.sun;
-        // In-cloud fog: the ambient of a mid-grey cloud at this time of day plus some sun.
-        let fog_rgb = Vec3::splat(0.8) * self.clear_light.ambient_percent
-            + self.clear_light.directional_rgb * 0.25;
-        let cloud_haze = self.fog.0.cloud_haze(
-            &self.fog_for(self.views[i].in_rain),
-            self.settings.clouds.haze_distance_m,
-            self.fog.1.ground_elevation_m,
-        );
-        let frame = GpuFrame {
-            view_proj: view_proj.to_cols_array_2d(),
-            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-            sun_dir: sun_dir
-                .extend(sun_cfg.disc_radius_deg.to_radians().cos())
-                .to_array(),
-            // The sky's own sun glow and disc behind the clouds: dimmed by the cover as a
-            // whole, the same with the shadows on or off.
-            sun_rgb: (self.seen_light.directional_rgb * self.cover_transmittance)
-                .extend(sun_cfg.glow_radius_deg.to_radians().cos())
-                .to_array(),
-            // w: the camera's height above the haze's base; its distance from the Earth's
-            // centre (0: flat).
-            sky_zenith_rgb: self
-                .seen_light
-                .sky_zenith_rgb
-                .extend(camera.position_m.z as f32 - cloud_haze.base_msl_m)
-                .to_array(),
-            sky_horizon_rgb: self
-                .seen_light
-                .sky_horizon_rgb
-                .extend(self.settings.earth.camera_radius_m(camera.position_m.z))
-                .to_array(),
-            in_cloud_rgba: fog_rgb.extend(in_cloud).to_array(),
-            params: [
-                self.targets.background_depth(),
-                self.settings.clouds.soft_depth_fade_m.recip(),
-                self.settings.clouds.soft_depth_fade_m,
-                self.settings.in_cloud.visibility_m,
-            ],
-            haze: cloud_haze.to_gpu(),
-            flash_reach: [self.flash.map_or(0.0, |f| f.reach_m), 0.0, 0.0, 0.0],
-            depth_to_view: camera.depth_to_view(),
-            flash: self.flash.map_or([0.0; 4], |f| {
-                (f.position_m - camera.position_m)
-                    .as_vec3()
-                    .extend(f.light)
-                    .to_array()
-            }),
-        };
-        queue.write_buffer(&self.views[i].frame_buffer, 0, bytemuck::bytes_of(&frame));
-        let far_field = std::time::Instant::now();
-        self.far_field.prepare(
-            queue,
-            (camera.position_m, frame.sky_horizon_rgb[3]),
-            &self.clear_light,
-            self.elapsed_s,
-        );
-        self.far_field_us += far_field.elapsed().as_micros() as u64;
+        queue.write_buffer(&v.frame_buffer, 0, bytemuck::bytes_of(&frame));
         upload_bytes += std::mem::size_of::<GpuFrame>() as u64;
+        let far_field = std::time::Instant::now();
+        let far = (camera.position_m, frame.sky_horizon_rgb[3]);
+        if let Some(plan) = self.far_field.plan(far, &self.clear_light, self.elapsed_s) {
+            self.far_field.upload(queue, &plan);
+        }
+        self.far_field_us += far_field.elapsed().as_micros() as u64;
         let ring_frame = RingFrame {
-            resident: &self.resident,
+            resident: &self.sprites.resident,
             template: &frame,
             view: &light,
             camera_m: camera.position_m,
             cache: &self.settings.vertex_cache,
         };
-        upload_bytes += self.views[i]
-            .ring
-            .prepare_builds(queue, &ring_frame, &mut stats);
-        if i == ViewId::MAIN.0 {
+        upload_bytes += (v.ring).prepare_builds(queue, &ring_frame, &mut stats);
+        if main {
             // One map for all views (the sun is shared), around the main view's camera.
             let at = (camera.position_m, sun_dir, self.elapsed_s);
-            upload_bytes += (self.shadows).prepare(queue, &self.resident, &light, at, &mut stats);
+            let resident = &self.sprites.resident;
+            upload_bytes += (self.shadows).prepare(queue, resident, &light, at, &mut stats);
         }
         // Quad indices and built corners for the largest draw of the frame (the sprites, an
         // impostor's sector, the shadow map's chunk).
-        let most = stats
-            .sprites_drawn
+        let most = (stats.sprites_drawn)
             .max(self.views[i].ring.most_sprites_pending())
-            .max(self.shadows.pending_sprites())
-            .min(CHUNK);
-        if most > self.quads.1 {
-            let sprites = most.next_power_of_two();
-            self.quads = (quad_index_buffer(&self.device, sprites), sprites);
-        }
-        self.build.reserve(&self.device, most);
+            .max(self.shadows.pending_sprites());
+        self.sprites.reserve(&self.device, most);
         stats.upload_bytes = upload_bytes;
-        // The shadow map, when due (rarely: see `shadow`), goes in a submission of its own with
-        // the patch of changed orders it reads, applied but kept for the host's frame. The
-        // ring's impostor renders go in the host's encoder (`record_view`).
-        if self.shadows.has_pending() {
-            let mut encoder = self
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("sky.cloud_shadows"),
-                });
-            self.scatter.record_kept(&mut encoder);
-            let resident = &self.resident.group;
-            (self.shadows).record(
-                &mut encoder,
-                &self.sheet_group,
-                &self.build,
-                resident,
-                &self.quads.0,
-            );
-            // lavapipe runs the submission on the frame thread: counted as a wait, as the
-            // flush above is.
-            let wait = Stopwatch::start();
-            queue.submit([encoder.finish()]);
-            gpu_wait += wait.spent();
+        gpu_wait += self.record_shadows(queue);
+        self.count_costs(i, start.spent().saturating_sub(gpu_wait), gpu_wait, stats)
+    }
+
+    /// The shadow map, when due (rarely: see `shadow`), in a submission of its own with the
+    /// patch of changed orders it reads, applied but kept for the host's frame (the ring's
+    /// impostor renders go in the host's encoder, `record_view`). Returns the time the submit
+    /// held the frame thread: lavapipe runs the submission there, counted as a wait.
+    fn record_shadows(&self, queue: &wgpu::Queue) -> Spent {
+        if !self.shadows.has_pending() {
+            return Spent::default();
         }
-        stats.cloud_scale = self.views[i].clouds.scale();
-        stats.cloud_target_bytes = self.views[i].clouds.gpu_bytes();
-        stats.sprite_gpu_bytes = self.resident.gpu_bytes()
-            + self.quads.0.size()
-            + self.build.gpu_bytes()
-            + self.views[i].view.gpu_bytes();
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("sky.cloud_shadows"),
+            });
+        self.sprites.scatter.record_kept(&mut encoder);
+        let sprites = &self.sprites;
+        (self.shadows).record(
+            &mut encoder,
+            &self.sheet_group,
+            &sprites.build,
+            &sprites.resident.group,
+            &sprites.quads.0,
+        );
+        let wait = Stopwatch::start();
+        queue.submit([encoder.finish()]);
+        wait.spent()
+    }
+
+    /// The frame's costs added up: the view's memory, the CPU time of the prepare (`own`,
+    /// waits apart), of the block changes and of the host's field since the last prepare.
+    fn count_costs(
+        &mut self,
+        i: usize,
+        own: Spent,
+        gpu_wait: Spent,
+        mut stats: FrameStats,
+    ) -> FrameStats {
+        let v = &self.views[i];
+        stats.cloud_scale = v.clouds.scale();
+        stats.cloud_target_bytes = v.clouds.gpu_bytes();
+        stats.sprite_gpu_bytes = self.sprites.gpu_bytes() + v.view.gpu_bytes();
         let field = std::mem::take(&mut self.field);
-        let update = start.spent().saturating_sub(gpu_wait) + std::mem::take(&mut self.pending);
+        let update = own + std::mem::take(&mut self.pending);
         stats.far_field_us = std::mem::take(&mut self.far_field_us);
         stats.far_field_gpu_bytes = self.far_field.gpu_bytes();
         stats.field_us = field.wall_us;

@@ -128,7 +128,7 @@ impl Viewer {
             Key::I => {
                 if let Some(running) = self.running.as_mut() {
                     let enabled = running.host.sky.settings().impostors.enabled;
-                    if !running.host.sky.set_impostors(!enabled) {
+                    if !running.host.sky.sky_mut().set_impostors(!enabled) {
                         eprintln!(
                             "the impostor ring cannot be turned on: the render settings say impostors.enabled = false"
                         );
@@ -138,7 +138,7 @@ impl Viewer {
             Key::V => {
                 if let Some(running) = self.running.as_mut() {
                     let enabled = running.host.sky.settings().vertex_cache.enabled;
-                    running.host.sky.set_vertex_cache(!enabled);
+                    running.host.sky.sky_mut().set_vertex_cache(!enabled);
                 }
             }
             Key::H => {

@@ -11,13 +11,17 @@
 //! crossfades in: 96 x 96 cells of 10 km are 442 KB). Settings: `[far_field]` of
 //! `config/render.toml`.
 
-use glam::{DVec2, DVec3, Vec3};
+use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::clouds::far_map::FarMap;
 use crate::shading::TimeOfDay;
 
 use super::pipeline::{PassDesc, SceneDepth, premultiplied_over};
+use plan::{FarFrame, MapPlace, crossfade_progress};
+
+// The frame's uniform from the map's place, the camera and the light: plain data.
+mod plan;
 
 /// The far field's shader.
 const WGSL: &str = include_str!("../../../shaders/far_field.wgsl");
@@ -245,18 +249,11 @@ fn hue(rgb: Vec3) -> Vec3 {
     }
 }
 
-/// The map on the GPU.
+/// The map on the GPU, and where it lies.
 struct MapOnGpu {
     texture: wgpu::Texture,
     group: wgpu::BindGroup,
-    centre_m: DVec2,
-    side_m: f64,
-    texels: u32,
-    /// Mean middle heights of the low and high layers, metres above sea level.
-    heights: [f32; 2],
-    /// The lowest base and highest top of the cells with cloud of each layer that has any,
-    /// metres above sea level.
-    extents: Vec<(f32, f32)>,
+    place: MapPlace,
 }
 
 /// The far field's pipelines, map and uniform (module docs).
@@ -277,14 +274,6 @@ pub struct FarField {
     crossfade: Option<(FarMap, f64, f64)>,
     /// The hue of the near decks' textures ([`FarFieldShared::sheet_rgb`]).
     sheet_hue: Vec3,
-}
-
-/// How far a crossfade begun at `start_s` over `over_s` has come at `now_s`, 0..=1.
-fn crossfade_progress(now_s: f64, start_s: f64, over_s: f64) -> f32 {
-    if over_s <= 0.0 {
-        return 1.0;
-    }
-    ((now_s - start_s) / over_s).clamp(0.0, 1.0) as f32
 }
 
 impl FarField {
@@ -560,88 +549,39 @@ impl FarField {
         self.map = Some(MapOnGpu {
             texture,
             group,
-            centre_m: map.centre_m,
-            side_m: f64::from(n) * map.texel_m,
-            texels: n,
-            heights: [mean(sums[0], 1500.0), mean(sums[1], 9000.0)],
-            extents,
+            place: MapPlace {
+                centre_m: map.centre_m,
+                side_m: f64::from(n) * map.texel_m,
+                texels: n,
+                heights: [mean(sums[0], 1500.0), mean(sums[1], 9000.0)],
+                extents,
+            },
         });
     }
 
-    /// Writes this frame's uniform for a camera at `camera_m` (`camera_radius_m` from the
-    /// Earth's centre, 0 for the flat frame) under the light `light`, at `now_s` of the sky's
-    /// clock.
-    pub(super) fn prepare(
+    /// This frame's uniform for a camera at `camera_m` (`camera_radius_m` from the Earth's
+    /// centre, 0 for the flat frame) under the light `light`, at `now_s` of the sky's clock;
+    /// `None` before the first map. CPU only ([`plan::plan`]): [`Self::upload`] writes it.
+    pub(super) fn plan(
         &self,
-        queue: &wgpu::Queue,
-        (camera_m, camera_radius_m): (DVec3, f32),
+        camera: (DVec3, f32),
         light: &TimeOfDay,
         now_s: f64,
-    ) {
-        let Some(map) = &self.map else {
-            return;
+    ) -> Option<GpuFarField> {
+        let map = self.map.as_ref()?;
+        let frame = FarFrame {
+            settings: &self.settings,
+            map: &map.place,
+            fade: self.fade,
+            crossfade: (self.crossfade.as_ref()).map(|(_, start, over)| (*start, *over)),
+            sheet_hue: self.sheet_hue,
         };
-        let s = &self.settings;
-        let period = s.noise_period_m();
-        let centre_rel = (map.centre_m - camera_m.truncate()).as_vec2();
-        let noise = DVec2::new(
-            map.centre_m.x.rem_euclid(period),
-            map.centre_m.y.rem_euclid(period),
-        )
-        .as_vec2();
-        // A far cloud's colours: Wang's mid-grey-to-white levels in the ambient light, with the
-        // sun's share of its median directional shading on the top.
-        let ambient = light.ambient_percent;
-        let lit: Vec3 = Vec3::splat(0.9) * ambient + light.directional_rgb * 0.6;
-        // A sheet's, in the hue of the textures the near decks are drawn with (the foggy ones are
-        // blue-grey); the shader multiplies its type's top level into the ambient part.
-        let sheet_ambient = Vec3::splat(ambient) * self.sheet_hue;
-        let sheet_sun = light.directional_rgb * 0.6 * self.sheet_hue;
-        let shade: Vec3 = Vec3::splat(0.62) * ambient + light.directional_rgb * 0.12;
-        // The shader leaves out rays that meet a layer nearer than sqrt(0.8) of the band's
-        // start, or off the map.
-        let reach = (
-            0.8f32.sqrt() * s.fade_start_m,
-            centre_rel.length() + (map.side_m * std::f64::consts::FRAC_1_SQRT_2) as f32,
-        );
-        let band = band_elevations(camera_m.z as f32, camera_radius_m, &map.extents, reach)
-            .unwrap_or((0.0, 0.0));
-        let gpu = GpuFarField {
-            centre_rel_size: [
-                centre_rel.x,
-                centre_rel.y,
-                map.side_m as f32,
-                map.texels as f32,
-            ],
-            noise_fade: [noise.x, noise.y, s.fade_start_m, s.fade_end_m],
-            lit_rgb: lit.extend(camera_m.z as f32).to_array(),
-            shade_rgb: shade.extend(s.heaped_scale_m).to_array(),
-            heights: [
-                map.heights[0],
-                map.heights[1],
-                s.heaped_scale_m * 8.0,
-                period as f32,
-            ],
-            fade: [
-                self.fade.map_or(1.0, |(start, over)| {
-                    ((now_s - start) / over.max(1e-3)).clamp(0.0, 1.0) as f32
-                }),
-                band.0,
-                band.1,
-                self.crossfade.as_ref().map_or(1.0, |(_, start, over)| {
-                    crossfade_progress(now_s, *start, *over)
-                }),
-            ],
-            puffs: [
-                s.heaped_cloud_size_m[0],
-                s.heaped_cloud_size_m[1],
-                s.heaped_height_over_size,
-                s.puff_share(),
-            ],
-            sheet_ambient_rgb: sheet_ambient.extend(0.0).to_array(),
-            sheet_sun_rgb: sheet_sun.extend(0.0).to_array(),
-        };
-        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&gpu));
+        Some(plan::plan(&frame, camera, light, now_s))
+    }
+
+    /// Writes a planned uniform ([`Self::plan`]).
+    pub(super) fn upload(&self, queue: &wgpu::Queue, plan: &GpuFarField) {
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(plan));
     }
 
     /// Draws the far field into `pass` (the sky pass, or the off-screen cloud pass when

@@ -33,6 +33,8 @@ mod orders;
 // Which blocks the ring draws and when it rebuilds: the CPU's decision, apart from the GPU work.
 mod split;
 
+use split::RingPlan;
+
 use std::cell::Cell;
 
 use glam::{DVec3, Vec3};
@@ -108,64 +110,23 @@ pub struct ImpostorRing {
     lists: Vec<GpuListCloud>,
     /// The ring pass's uniform (`GpuRing`).
     ring_uniform: wgpu::Buffer,
-    shown: Option<(usize, RingState)>,
-    build: Option<Build>,
-    /// The ring fading in and the fade so far, 0..=1.
-    fade: Option<(usize, RingState, f64)>,
-    /// The impostor renders prepared since the last recorded frame: (ring, impostor, sprites).
-    pending: Vec<(usize, usize, u32)>,
-    /// Whether `pending` went into a recorded frame (then the next prepare starts afresh).
-    recorded: Cell<bool>,
+    /// Which blocks the ring holds, the rings shown, built and fading, the renders pending:
+    /// the CPU's decisions, plain data ([`RingPlan::split`]).
+    plan: RingPlan,
     /// This frame's ring pass: (old ring, new ring), if any ring is shown.
     quads: Option<(usize, usize)>,
-    /// Blocks drawn into the ring this frame.
-    blocks_far: u32,
+    /// Whether the plan's pending renders went into a recorded frame (then the next plan
+    /// starts afresh).
+    recorded: Cell<bool>,
     /// How far the ring reaches at most, metres, below its view radius (`None`: the view
     /// radius): while the far field is drawn, the end of its hand-over band, beyond which the
     /// ring's blocks would be built faded out to nothing.
     reach_limit_m: Option<f64>,
-    /// Where the hand-over band has faded the ring halfway, metres (`None`: no band): a far
-    /// block that arrives whole beyond it (joining the field at its rim) is no reason to
-    /// rebuild at once.
-    half_faded_m: Option<f64>,
     bytes: u64,
     /// The far clouds' orders from the ring centre, kept between builds, and their GPU copy.
     sorts: RingOrders,
     /// `None` for a ring made without impostors.
     order_buffer: Option<OrderBuffer>,
-    /// Time the ring has seen pass (the sum of the frames' steps), seconds.
-    clock_s: f64,
-    /// Builds started.
-    builds: u64,
-    /// The last pass over every block while the ring was steady.
-    last_split: Option<SplitCheck>,
-    /// The ids of the blocks this view draws as sprites (held, not in the ring), as of the last
-    /// pass over every block: what the view's draw list looks at, not the thousands held.
-    near: Vec<u64>,
-    /// What `near` was found with: the blocks' changes and the build of the ring whose blocks
-    /// it leaves out. While both stand it stands, through builds and crossfades.
-    near_of: Option<(u64, Option<u64>)>,
-}
-
-/// What a pass over every block found while the ring was steady (shown, no build, no fade),
-/// and what with: while no block came, went or was written, the same ring is shown and the
-/// camera's height and the drift moved less than a tenth of the ring's own rebuild distances
-/// (which blocks are far from the ring centre does not depend on where the camera is across
-/// the ground), the blocks' near marks and the crossings stand, and the thousands of blocks
-/// are not walked again (a block that drifted across the ring radius starts a rebuild that
-/// little later).
-#[derive(Debug, Clone, Copy)]
-struct SplitCheck {
-    changes: u64,
-    builds: u64,
-    view_radius_m: f64,
-    camera_z_m: f64,
-    drift_m: DVec3,
-    far_now: usize,
-    same: bool,
-    /// Whether a far block not in the shown ring is drawn whole
-    /// ([`Fade::Steady`](crate::render::Fade::Steady)).
-    whole_new: bool,
 }
 
 const SPRITES_WGSL: &str = include_str!("../../../shaders/sprites.wgsl");
@@ -447,23 +408,13 @@ impl ImpostorRing {
             draws: Vec::new(),
             lists: Vec::new(),
             ring_uniform,
-            shown: None,
-            build: None,
-            fade: None,
-            reach_limit_m: None,
-            half_faded_m: None,
-            pending: Vec::new(),
-            recorded: Cell::new(false),
+            plan: RingPlan::default(),
             quads: None,
-            blocks_far: 0,
+            recorded: Cell::new(false),
+            reach_limit_m: None,
             bytes,
             sorts: RingOrders::default(),
             order_buffer: (slots > 0).then(|| OrderBuffer::new(device)),
-            clock_s: 0.0,
-            builds: 0,
-            last_split: None,
-            near_of: None,
-            near: Vec::new(),
         }
     }
 
@@ -475,10 +426,10 @@ impl ImpostorRing {
             return false;
         }
         self.settings.enabled = enabled;
-        self.shown = None;
-        self.fade = None;
-        self.build = None;
-        self.pending.clear();
+        self.plan.shown = None;
+        self.plan.fade = None;
+        self.plan.build = None;
+        self.plan.pending.clear();
         true
     }
 
@@ -505,7 +456,7 @@ impl ImpostorRing {
     /// the ring is rebuilt.
     pub(super) fn set_reach_limit(&mut self, band_m: Option<(f64, f64)>) {
         self.reach_limit_m = band_m.map(|(_, end)| end);
-        self.half_faded_m = band_m.map(|(start, end)| 0.5 * (start + end));
+        self.plan.half_faded_m = band_m.map(|(start, end)| 0.5 * (start + end));
     }
 
     /// The settings with the view radius cut to the reach limit (kept beyond the ring radius).
@@ -519,7 +470,7 @@ impl ImpostorRing {
 
     /// The ids of the blocks this view draws as sprites this frame (decided by [`Self::split`]).
     pub(super) fn near(&self) -> &[u64] {
-        &self.near
+        &self.plan.near
     }
 
     /// Writes this frame's impostor builds (all 8 for a first ring, else the next one whose
@@ -549,11 +500,11 @@ impl ImpostorRing {
             return 0;
         }
         let mut bytes = 0;
-        let first = self.shown.is_none() && self.fade.is_none();
+        let first = self.plan.shown.is_none() && self.plan.fade.is_none();
         let view_radius_m = self.reach_settings().view_radius_m;
         // (A ring with a build has impostors, and so an order buffer.)
         if let Some(order_buffer) = self.order_buffer.as_mut()
-            && let Some(mut build) = self.build.take()
+            && let Some(mut build) = self.plan.build.take()
         {
             let slots = resident.orders_cpu.len() as u32;
             bytes += order_buffer.fit(&self.device, queue, &mut self.sorts, slots);
@@ -574,7 +525,7 @@ impl ImpostorRing {
             let mut when = RingSort {
                 gather: 0,
                 since_s: build.state.begun_s,
-                time_s: self.clock_s,
+                time_s: self.plan.clock_s,
                 cache: &ring_cache,
                 largest,
             };
@@ -584,7 +535,7 @@ impl ImpostorRing {
                 let i = build.next;
                 let centre = build.state.centre_m;
                 let sector = &build.sectors[i];
-                when.gather = self.builds * IMPOSTORS as u64 + i as u64;
+                when.gather = self.plan.builds * IMPOSTORS as u64 + i as u64;
                 let (sorted_all, sorted) =
                     self.sorts.sort(blocks, sector, reach, &when, &mut budget);
                 stats.ring_sprites_sorted += sorted;
@@ -632,19 +583,19 @@ impl ImpostorRing {
                 };
                 queue.write_buffer(&self.slot_frames[slot], 0, bytemuck::bytes_of(&frame));
                 bytes += std::mem::size_of::<GpuFrame>() as u64;
-                self.pending.push((build.ring, i, sprites));
+                self.plan.pending.push((build.ring, i, sprites));
                 build.next += 1;
                 rendered += 1;
             }
             stats.impostors_rebuilt = rendered;
             if build.next >= IMPOSTORS {
                 if first {
-                    self.shown = Some((build.ring, build.state));
+                    self.plan.shown = Some((build.ring, build.state));
                 } else {
-                    self.fade = Some((build.ring, build.state, 0.0));
+                    self.plan.fade = Some((build.ring, build.state, 0.0));
                 }
             } else {
-                self.build = Some(build);
+                self.plan.build = Some(build);
             }
         }
         // The orders this frame's sorts and views wrote, as a patch; sent on frames with none
@@ -655,13 +606,11 @@ impl ImpostorRing {
             stats.ring_orders_rewritten = rewritten;
         }
         // The ring pass: the shown ring, mixed with the one fading in by the crossfade weight.
-        let w = self.fade.as_ref().map_or(0.0, |f| f.2);
+        let w = self.plan.fade.as_ref().map_or(0.0, |f| f.2);
         stats.crossfade_weight = w as f32;
-        if let Some((old, old_state)) = &self.shown {
-            let (new, new_state) = self
-                .fade
-                .as_ref()
-                .map_or((*old, old_state), |(r, st, _)| (*r, st));
+        if let Some((old, old_state)) = &self.plan.shown {
+            let (new, new_state) =
+                (self.plan.fade.as_ref()).map_or((*old, old_state), |(r, st, _)| (*r, st));
             let half = self.settings.ring_radius_m * (IMPOSTOR_FOV_DEG * 0.5).to_radians().tan();
             let uniform = GpuRing {
                 old_centre_weight: (old_state.centre_m - camera_m)
@@ -683,8 +632,8 @@ impl ImpostorRing {
             bytes += std::mem::size_of::<GpuRing>() as u64;
             self.quads = Some((*old, new));
         }
-        stats.blocks_far = self.blocks_far;
-        stats.blocks_near = blocks.len() as u32 - self.blocks_far;
+        stats.blocks_far = self.plan.blocks_far;
+        stats.blocks_near = blocks.len() as u32 - self.plan.blocks_far;
         bytes
     }
 
@@ -693,8 +642,8 @@ impl ImpostorRing {
     /// than the budget for a long while (blocks forming all around) cannot hold the rebuild up;
     /// else nothing. The ring also sorts whatever the camera leaves of its share.
     pub(super) fn sort_reserve(&self, whole: u32) -> u32 {
-        let shown = self.shown.is_some() || self.fade.is_some();
-        if self.settings.enabled && shown && self.build.is_some() {
+        let shown = self.plan.shown.is_some() || self.plan.fade.is_some();
+        if self.settings.enabled && shown && self.plan.build.is_some() {
             whole / 2
         } else {
             0
@@ -703,7 +652,7 @@ impl ImpostorRing {
 
     /// The most sprites one of the impostor renders to record draws.
     pub(super) fn most_sprites_pending(&self) -> u32 {
-        self.pending.iter().map(|p| p.2).max().unwrap_or(0)
+        self.plan.pending.iter().map(|p| p.2).max().unwrap_or(0)
     }
 
     /// Records the impostor renders prepared since the last recorded frame (their own passes,
@@ -723,7 +672,7 @@ impl ImpostorRing {
         if let Some(order_buffer) = &self.order_buffer {
             order_buffer.record(encoder);
         }
-        for &(r, i, sprites) in &self.pending {
+        for &(r, i, sprites) in &self.plan.pending {
             let slot = r * IMPOSTORS + i;
             let view = self.slot_views[slot].group().filter(|_| sprites > 0);
             let parts: Vec<(u32, u32, u32)> = chunks(sprites).collect();

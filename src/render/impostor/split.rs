@@ -1,41 +1,115 @@
-//! The ring's split of each frame ([`ImpostorRing::split`]): which blocks the camera draws as
+//! The ring's plan of each frame ([`RingPlan::split`]): which blocks the camera draws as
 //! sprites and which the ring holds, from the camera's height and the blocks' distances from
 //! the ring centre (`layout::is_far`), and when the ring starts or advances a rebuild
-//! (`layout::needs_rebuild`). Plain data over the resident blocks; the GPU work of a rebuild is
-//! [`ImpostorRing::prepare_builds`]'s and [`ImpostorRing::record_builds`]'s.
+//! (`layout::needs_rebuild`). Plain data over the resident blocks, tested without a device; the
+//! GPU work of a rebuild is [`ImpostorRing::prepare_builds`]'s and
+//! [`ImpostorRing::record_builds`]'s.
 
 use glam::{DVec3, Vec3};
 
-use super::layout::{IMPOSTORS, is_far, needs_rebuild, sectors_of};
-use super::{Build, ImpostorRing, RingState, SplitCheck};
+use super::layout::{IMPOSTORS, ImpostorSettings, is_far, needs_rebuild, sectors_of};
+use super::{Build, ImpostorRing, RingState};
 use crate::render::id_hash::IdSet;
 use crate::render::scene::Fade;
+use crate::render::sprites::draw_list::Blocks;
 use crate::render::sprites::resident::ResidentSet;
 
+/// The ring's CPU state from frame to frame: the rings shown, built and fading in, the renders
+/// planned and not recorded yet, and which blocks the view draws as sprites.
+#[derive(Default)]
+pub(super) struct RingPlan {
+    pub shown: Option<(usize, RingState)>,
+    pub build: Option<Build>,
+    /// The ring fading in and the fade so far, 0..=1.
+    pub fade: Option<(usize, RingState, f64)>,
+    /// The impostor renders prepared since the last recorded frame: (ring, impostor, sprites).
+    pub pending: Vec<(usize, usize, u32)>,
+    /// Blocks drawn into the ring this frame.
+    pub blocks_far: u32,
+    /// Where the hand-over band has faded the ring halfway, metres (`None`: no band): a far
+    /// block that arrives whole beyond it (joining the field at its rim) is no reason to
+    /// rebuild at once.
+    pub half_faded_m: Option<f64>,
+    /// Time the ring has seen pass (the sum of the frames' steps), seconds.
+    pub clock_s: f64,
+    /// Builds started.
+    pub builds: u64,
+    /// The last pass over every block while the ring was steady.
+    last_split: Option<SplitCheck>,
+    /// The ids of the blocks this view draws as sprites (held, not in the ring), as of the last
+    /// pass over every block: what the view's draw list looks at, not the thousands held.
+    pub near: Vec<u64>,
+    /// What `near` was found with: the blocks' changes and the build of the ring whose blocks
+    /// it leaves out. While both stand it stands, through builds and crossfades.
+    near_of: Option<(u64, Option<u64>)>,
+}
+
+/// What a pass over every block found while the ring was steady (shown, no build, no fade),
+/// and what with: while no block came, went or was written, the same ring is shown and the
+/// camera's height and the drift moved less than a tenth of the ring's own rebuild distances
+/// (which blocks are far from the ring centre does not depend on where the camera is across
+/// the ground), the blocks' near marks and the crossings stand, and the thousands of blocks
+/// are not walked again (a block that drifted across the ring radius starts a rebuild that
+/// little later).
+#[derive(Debug, Clone, Copy)]
+struct SplitCheck {
+    changes: u64,
+    builds: u64,
+    view_radius_m: f64,
+    camera_z_m: f64,
+    drift_m: DVec3,
+    far_now: usize,
+    same: bool,
+    /// Whether a far block not in the shown ring is drawn whole
+    /// ([`Fade::Steady`](crate::render::Fade::Steady)).
+    whole_new: bool,
+}
+
 impl ImpostorRing {
-    /// Decides this frame's near blocks ([`Self::near`]: drawn as sprites) and
-    /// starts or advances a rebuild. Call [`Self::prepare_builds`] after, with the frame's
-    /// uniform. One pass over the blocks.
-    pub(in crate::render) fn split(
+    /// This frame's plan ([`RingPlan::split`] over the resident blocks, with the ring's
+    /// settings cut to its reach): its near blocks ([`Self::near`]: drawn as sprites), a
+    /// rebuild started or advanced. Call [`Self::prepare_builds`] after, with the frame's
+    /// uniform.
+    pub(in crate::render) fn plan(
         &mut self,
-        resident: &mut ResidentSet,
+        resident: &ResidentSet,
         camera_m: DVec3,
         sun: Vec3,
         dt_s: f64,
     ) {
         let s = self.reach_settings();
+        let recorded = self.recorded.replace(false);
+        let blocks = (&resident.blocks, resident.changes, resident.drift_m);
+        if (self.plan).split(&s, blocks, (camera_m, sun, dt_s), recorded) {
+            // The orders kept for blocks gone go with the build that starts.
+            self.sorts.retain(&resident.blocks);
+        }
+    }
+}
+
+impl RingPlan {
+    /// Decides this frame's near blocks and starts or advances a rebuild, for a camera at
+    /// `camera_m` under the sun `sun`, `dt_s` after the last frame, over `blocks` (with the
+    /// resident set's count of changes and its drift). `recorded`: the renders planned before
+    /// went into a recorded frame. One pass over the blocks. Returns whether a rebuild started.
+    pub fn split(
+        &mut self,
+        s: &ImpostorSettings,
+        (blocks, changes, drift_m): (&Blocks, u64, DVec3),
+        (camera_m, sun, dt_s): (DVec3, Vec3, f64),
+        recorded: bool,
+    ) -> bool {
+        let s = *s;
         self.clock_s += dt_s.max(0.0);
-        if self.recorded.replace(false) {
+        if recorded {
             self.pending.clear();
         }
-        let (changes, drift_m) = (resident.changes, resident.drift_m);
-        let blocks = &mut resident.blocks;
         self.blocks_far = 0;
         if !s.enabled {
             self.near_of = None;
             self.near.clear();
             self.near.extend(blocks.keys());
-            return;
+            return false;
         }
         // Advance the crossfade; a finished fade makes the new ring the shown one.
         if let Some((ring, state, w)) = self.fade.take() {
@@ -118,7 +192,7 @@ impl ImpostorRing {
         }
         self.blocks_far = far_count;
         if self.build.is_some() {
-            return;
+            return false;
         }
         let start = match (&self.shown, &self.fade) {
             (None, None) => true,
@@ -134,7 +208,7 @@ impl ImpostorRing {
             _ => false,
         };
         if !start {
-            return;
+            return false;
         }
         let ring = self.shown.as_ref().map_or(0, |(r, _)| 1 - r);
         // Renders into that ring not recorded yet (frames prepared and never recorded) are of a
@@ -169,7 +243,6 @@ impl ImpostorRing {
             self.near.retain(|id| !far_ids.contains(id));
             self.blocks_far = far_ids.len() as u32;
         }
-        self.sorts.retain(blocks);
         self.builds += 1;
         self.build = Some(Build {
             ring,
@@ -184,5 +257,68 @@ impl ImpostorRing {
                 begun_s: self.clock_s,
             },
         });
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::scene::{SkyBlock, SkyCloud};
+    use crate::render::sprites::draw_list::tests::small_cloud;
+    use crate::render::sprites::resident::Resident;
+
+    /// Blocks of one small cloud each at `centres`, ids 0, 1, ...
+    fn blocks_at(centres: &[DVec3]) -> Blocks {
+        (centres.iter().enumerate())
+            .map(|(id, &centre_m)| {
+                let block = SkyBlock {
+                    id: id as u64,
+                    centre_m,
+                    clouds: vec![SkyCloud {
+                        centre_m,
+                        ..small_cloud()
+                    }],
+                };
+                (id as u64, Resident::new(block, Default::default()))
+            })
+            .collect()
+    }
+
+    /// The first plan builds a ring of the blocks beyond its radius at once and leaves the near
+    /// one to the sprites; the frames of its build start no other; switched off, every block
+    /// is near and nothing is built. No device: the plan is plain data.
+    #[test]
+    fn the_first_plan_puts_the_far_blocks_in_the_ring_and_leaves_the_near_to_the_sprites() {
+        let s = ImpostorSettings::default();
+        let camera = DVec3::new(0.0, 0.0, 1000.0);
+        let blocks = blocks_at(&[
+            DVec3::new(0.0, 5_000.0, 1500.0),
+            DVec3::new(0.0, 30_000.0, 1500.0),
+            DVec3::new(-40_000.0, 0.0, 1500.0),
+            // Beyond the view radius: neither in the ring nor near.
+            DVec3::new(0.0, -150_000.0, 1500.0),
+        ]);
+        let frame = (&blocks, 4, DVec3::ZERO);
+        let mut plan = RingPlan::default();
+        assert!(plan.split(&s, frame, (camera, Vec3::Z, 0.016), false));
+        let build = plan.build.as_ref().map(|b| &b.state);
+        let far: IdSet = [1, 2].into_iter().collect();
+        assert_eq!(build.map(|st| &st.far_ids), Some(&far));
+        assert_eq!(plan.blocks_far, 2);
+        let mut near = plan.near.clone();
+        near.sort_unstable();
+        assert_eq!(near, vec![0, 3]);
+        // The build goes on over the next frames: no new one starts.
+        assert!(!plan.split(&s, frame, (camera, Vec3::Z, 0.016), false));
+        assert_eq!(plan.builds, 1);
+        let off = ImpostorSettings {
+            enabled: false,
+            ..s
+        };
+        let mut plan = RingPlan::default();
+        assert!(!plan.split(&off, frame, (camera, Vec3::Z, 0.016), false));
+        assert!(plan.build.is_none());
+        assert_eq!(plan.near.len(), 4);
     }
 }

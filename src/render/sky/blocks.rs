@@ -21,6 +21,7 @@ impl Sky {
         let start = Stopwatch::start();
         let ids: HashSet<u64> = blocks.iter().map(|b| b.id).collect();
         let gone: Vec<u64> = self
+            .sprites
             .resident
             .blocks
             .keys()
@@ -31,16 +32,17 @@ impl Sky {
             self.retire(id);
         }
         for block in blocks {
-            match self.resident.blocks.get_mut(&block.id) {
+            match self.sprites.resident.blocks.get_mut(&block.id) {
                 Some(r) if r.block == block => {
                     if r.motion != BlockMotion::default() {
                         let steady = BlockMotion::default();
-                        self.resident.fades += r.motion.fade.kind_changes(steady.fade) as u64;
+                        self.sprites.resident.fades +=
+                            r.motion.fade.kind_changes(steady.fade) as u64;
                         r.motion = steady;
-                        self.resident.changes += 1;
+                        self.sprites.resident.changes += 1;
                     }
                 }
-                _ => self.resident.insert(block, BlockMotion::default()),
+                _ => self.sprites.resident.insert(block, BlockMotion::default()),
             }
         }
         self.pending += start.spent();
@@ -84,7 +86,7 @@ impl Sky {
         }
         for (block, motion) in came {
             self.retire(block.id);
-            self.resident.insert(block, motion);
+            self.sprites.resident.insert(block, motion);
         }
         for (id, fade) in fades {
             self.set_block_fade(id, fade);
@@ -123,7 +125,7 @@ impl Sky {
         let start = Stopwatch::start();
         for (block, motion) in blocks {
             self.retire(block.id);
-            self.resident.insert(block, motion);
+            self.sprites.resident.insert(block, motion);
         }
         self.pending += start.spent();
     }
@@ -133,7 +135,7 @@ impl Sky {
     /// grow, they grow for those as well, once. Each call replaces the last; 0, 0 when none
     /// wait.
     pub fn expect_blocks(&mut self, sprites: u64, clouds: u64) {
-        self.resident.expected = (sprites, clouds);
+        self.sprites.resident.expected = (sprites, clouds);
     }
 
     /// Adds a block drawn as sprites however far it is, never into the impostor ring nor cut at
@@ -152,8 +154,8 @@ impl Sky {
     fn insert_distant(&mut self, block: SkyBlock, motion: BlockMotion) {
         let id = block.id;
         self.retire(id);
-        self.resident.insert(block, motion);
-        if let Some(r) = self.resident.blocks.get_mut(&id) {
+        self.sprites.resident.insert(block, motion);
+        if let Some(r) = self.sprites.resident.blocks.get_mut(&id) {
             r.distant = true;
         }
     }
@@ -173,7 +175,7 @@ impl Sky {
     }
 
     fn retire(&mut self, id: u64) -> bool {
-        match self.resident.remove(id) {
+        match self.sprites.resident.remove(id) {
             Some(slots) => {
                 for view in &mut self.views {
                     view.locks.release(slots.clone());
@@ -187,11 +189,11 @@ impl Sky {
     /// Moves a block (its drift) and sets where it is in its life; nothing is uploaded but the
     /// frame's draw list. False if the sky does not hold it.
     pub fn set_block_motion(&mut self, id: u64, motion: BlockMotion) -> bool {
-        match self.resident.blocks.get_mut(&id) {
+        match self.sprites.resident.blocks.get_mut(&id) {
             Some(r) => {
                 // What the shadow map watches for (a block moved by other means than the drift).
-                self.resident.changes += (r.motion.offset_m != motion.offset_m) as u64;
-                self.resident.fades += r.motion.fade.kind_changes(motion.fade) as u64;
+                self.sprites.resident.changes += (r.motion.offset_m != motion.offset_m) as u64;
+                self.sprites.resident.fades += r.motion.fade.kind_changes(motion.fade) as u64;
                 r.motion = motion;
                 true
             }
@@ -202,18 +204,18 @@ impl Sky {
     /// Moves every block the sky holds to the same drift offset (a field drifting with the air as
     /// one): one write a block, no lookups, nothing uploaded.
     pub fn set_drift(&mut self, offset_m: glam::DVec3) {
-        for r in self.resident.blocks.values_mut() {
+        for r in self.sprites.resident.blocks.values_mut() {
             r.motion.offset_m = offset_m;
         }
-        self.resident.drift_m = offset_m;
+        self.sprites.resident.drift_m = offset_m;
         self.shadows.set_drift(offset_m);
     }
 
     /// Sets where a block is in its life, keeping its drift; false if the sky does not hold it.
     pub fn set_block_fade(&mut self, id: u64, fade: crate::render::Fade) -> bool {
-        match self.resident.blocks.get_mut(&id) {
+        match self.sprites.resident.blocks.get_mut(&id) {
             Some(r) => {
-                self.resident.fades += r.motion.fade.kind_changes(fade) as u64;
+                self.sprites.resident.fades += r.motion.fade.kind_changes(fade) as u64;
                 r.motion.fade = fade;
                 true
             }
@@ -223,11 +225,11 @@ impl Sky {
 
     /// The ids of the blocks the sky holds.
     pub fn block_ids(&self) -> impl Iterator<Item = u64> + '_ {
-        self.resident.blocks.keys().copied()
+        self.sprites.resident.blocks.keys().copied()
     }
 
     /// A block the sky holds.
     pub fn block(&self, id: u64) -> Option<&SkyBlock> {
-        self.resident.blocks.get(&id).map(|r| &r.block)
+        self.sprites.resident.blocks.get(&id).map(|r| &r.block)
     }
 }

@@ -4,18 +4,12 @@
 
 use crate::clouds::CloudsConfig;
 use crate::render::RenderError;
-use crate::render::gpu_types::GpuSpriteVertex;
 use crate::render::overhead_ease::OverheadEase;
 use crate::render::pipeline::PassDesc;
 use crate::render::pipeline::SceneDepth;
 use crate::render::pipeline::background_test;
-use crate::render::pipeline::pipeline;
 use crate::render::pipeline::pipeline_with_depth;
-use crate::render::pipeline::premultiplied_over;
-use crate::render::sprites::build::SpriteBuild;
-use crate::render::sprites::resident::ResidentSet;
-use crate::render::sprites::resident::quad_index_buffer;
-use crate::render::sprites::scatter::Scatter;
+use crate::render::sprites::pass::{SpritePass, SpriteShared};
 use crate::render::sprites::sprite_view;
 use crate::render::stats::Spent;
 use crate::render::targets;
@@ -24,9 +18,7 @@ use crate::render::view::ViewShared;
 use crate::weather::BlockWeather;
 use wgpu::util::DeviceExt;
 
-use super::IN_CLOUD_WGSL;
 use super::SKY_WGSL;
-use super::SPRITES_WGSL;
 use super::Sky;
 use super::SkyConfig;
 
@@ -119,14 +111,21 @@ impl Sky {
                 },
             ],
         });
-        let format = config.targets.colour_format;
-        let resident = ResidentSet::new(device, 0);
         let view_layout = sprite_view::layout(device);
         let crops = crate::render::sprites::sheet_crop::cell_crops(sheet);
-        let build = SpriteBuild::new(device, &view_layout, resident.layout(), &crops);
+        let sprites = SpritePass::new(
+            device,
+            &SpriteShared {
+                format: config.targets.colour_format,
+                samples,
+                frame_layout: &frame_layout,
+                sheet_layout: &sheet_layout,
+                view_layout: &view_layout,
+                crops: &crops,
+            },
+        );
+        let format = config.targets.colour_format;
         let frame_only = [Some(&frame_layout)];
-        let sprite_groups = [Some(&frame_layout), Some(&sheet_layout)];
-        let over = Some(premultiplied_over());
         let sky_pipeline_for = |fs, depth| {
             pipeline_with_depth(
                 device,
@@ -152,34 +151,6 @@ impl Sky {
                 Some(background_test(depth_format, wgpu::CompareFunction::Equal)),
             )
         });
-        let sprite_pipeline = pipeline(
-            device,
-            &PassDesc {
-                label: "sky.sprites",
-                wgsl: SPRITES_WGSL,
-                vs: "vs_sprite",
-                fs: "fs_sprite",
-                bind_groups: &sprite_groups,
-                buffers: &[Some(GpuSpriteVertex::layout())],
-                targets: &[(format, over)],
-                samples,
-                scene: SceneDepth::host(samples),
-            },
-        );
-        let in_cloud_pipeline = pipeline(
-            device,
-            &PassDesc {
-                label: "sky.in_cloud",
-                wgsl: IN_CLOUD_WGSL,
-                vs: "vs_in_cloud",
-                fs: "fs_in_cloud",
-                bind_groups: &frame_only,
-                buffers: &[],
-                targets: &[(format, over)],
-                samples,
-                scene: SceneDepth::host(samples),
-            },
-        );
         let light = config.time_of_day.at(45.0);
         let offscreen_targets = crate::render::cloud_target::cloud_targets();
         let far_field = crate::render::far_field::FarField::new(
@@ -226,12 +197,7 @@ impl Sky {
             sheet_bytes: sheet.mips.iter().map(|m| m.len() as u64).sum(),
             sky_pipeline,
             sky_tested_pipeline,
-            sprite_pipeline,
-            in_cloud_pipeline,
-            resident,
-            quads: (quad_index_buffer(device, 4096), 4096),
-            scatter: Scatter::new(device),
-            build,
+            sprites,
             view_layout,
             views: vec![main],
             far_field,

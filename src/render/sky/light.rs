@@ -6,12 +6,43 @@ use glam::Vec3;
 
 use super::Sky;
 use super::SkyFlash;
+use crate::render::stats::Lighting;
 use crate::shading::SunPosition;
 use crate::shading::TimeOfDay;
 use crate::shading::hidden_above;
 use crate::weather::BlockWeather;
 
 impl Sky {
+    /// The frame's light, planned before any pass (CPU only): the clear light of the sun's
+    /// elevation that the clouds are lit with, the host's light under the cover over a camera
+    /// at `altitude_m` (eased through a change of the weather) and the share of the sun that
+    /// cover lets through.
+    pub(super) fn light_frame(&mut self, sun: &SunPosition, altitude_m: f64) -> Lighting {
+        self.clear_light = self.time_of_day.at(sun.elevation_deg as f32);
+        let (hidden, _) = self.overhead_ease.show(
+            self.sky_hidden_at(altitude_m),
+            self.fog.0.visibility_m(&self.fog.1),
+            self.elapsed_s,
+        );
+        self.seen_light = self
+            .clear_light
+            .under_cover(hidden, &self.time_of_day.overcast);
+        // The host's sun is the clear sun, on or off: the shadow map dims it where the clouds
+        // stop it, and with the shadows off nothing does (off casts no shadows; it does not
+        // dim the ground evenly). The cover's mean dimming is kept apart for a host without
+        // the map.
+        self.cover_transmittance = 1.0 - hidden.clamp(0.0, 1.0);
+        self.seen_light.directional_rgb = self.clear_light.directional_rgb;
+        Lighting {
+            sun_dir: sun.direction_enu().as_vec3(),
+            time_of_day: self.clear_light,
+            mapping: self.time_of_day.directional_mapping,
+            forward: self.time_of_day.forward_scattering,
+            model: self.time_of_day.shading.model,
+            harris_lastra: self.time_of_day.harris_lastra,
+        }
+    }
+
     /// Replaces the fog and haze settings (the shipped `config/fog.toml` until called).
     pub fn set_fog_settings(&mut self, fog: crate::shading::FogSettings) {
         self.fog.0 = fog;

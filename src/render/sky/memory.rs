@@ -9,10 +9,10 @@ impl Sky {
     /// draw list, the ring); [`Self::memory`] counts the textures too.
     pub fn gpu_buffer_bytes(&self) -> u64 {
         self.views.iter().map(View::gpu_buffer_bytes).sum::<u64>()
-            + self.resident.gpu_bytes()
-            + self.quads.0.size()
-            + self.build.gpu_bytes()
-            + self.scatter.gpu_bytes()
+            + self.sprites.resident.gpu_bytes()
+            + self.sprites.quads.0.size()
+            + self.sprites.build.gpu_bytes()
+            + self.sprites.scatter.gpu_bytes()
             + self.shadows.gpu_bytes()
     }
 
@@ -20,17 +20,17 @@ impl Sky {
     /// included), and the blocks and slots behind the resident buffers: what a long flight
     /// watches for growth.
     pub fn memory(&self) -> SkyMemory {
-        let (blocks, sprites, sprite_slots, cloud_slots) = self.resident.occupancy();
+        let (blocks, sprites, sprite_slots, cloud_slots) = self.sprites.resident.occupancy();
         SkyMemory {
-            resident_bytes: self.resident.gpu_bytes(),
+            resident_bytes: self.sprites.resident.gpu_bytes(),
             draw_bytes: self
                 .views
                 .iter()
                 .map(|v| v.frame_buffer.size() + v.view.gpu_bytes())
                 .sum::<u64>()
-                + self.quads.0.size()
-                + self.build.gpu_bytes()
-                + self.scatter.gpu_bytes(),
+                + self.sprites.quads.0.size()
+                + self.sprites.build.gpu_bytes()
+                + self.sprites.scatter.gpu_bytes(),
             ring_bytes: self.views.iter().map(|v| v.ring.gpu_bytes()).sum(),
             cloud_target_bytes: self.views.iter().map(|v| v.clouds.gpu_bytes()).sum(),
             shadow_bytes: self.shadows.gpu_bytes(),

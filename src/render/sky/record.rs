@@ -86,16 +86,16 @@ impl Sky {
             }
         };
         stamp(encoder, Stamp::Start);
-        self.scatter.record(encoder);
+        self.sprites.scatter.record(encoder);
         // The impostors this view's frame (and any frames prepared since its last recorded
         // one) rebuilt: in the host's submission, never in one of the sky's own, which could
         // hold the host's frame thread while the device is busy.
         v.ring.record_builds(
             encoder,
             &self.sheet_group,
-            &self.build,
-            &self.resident.group,
-            &self.quads.0,
+            &self.sprites.build,
+            &self.sprites.resident.group,
+            &self.sprites.quads.0,
         );
         let view_group = v.view.group().filter(|_| v.sprites_to_draw > 0);
         let parts: Vec<(u32, u32, u32)> = view_group
@@ -105,8 +105,7 @@ impl Sky {
             && let Some(group) = view_group
         {
             let (c, _, n) = parts[0];
-            self.build
-                .record(encoder, group, &self.resident.group, (c, n));
+            self.sprites.record_build(encoder, group, (c, n));
         }
         // Below full resolution the clouds go to the cloud target, composited at the end with
         // the sky background; at full resolution they are drawn over the sky in the host's colour.
@@ -145,7 +144,7 @@ impl Sky {
         };
         let (sprite_pipeline, in_cloud_pipeline) = match &offscreen {
             Some(target) => (target.sprite_pipeline(), target.in_cloud_pipeline()),
-            None => (&self.sprite_pipeline, &self.in_cloud_pipeline),
+            None => self.sprites.pipelines(),
         };
         // The far field behind the distant cells, they behind the ring, it behind the sprites
         // (blended over, back to front). The distant cells' sprites come first in the draw
@@ -163,7 +162,8 @@ impl Sky {
             0
         };
         if distant > 0 {
-            self.draw_sprites(&mut pass, sprite_pipeline, 0..distant);
+            self.sprites
+                .draw(&mut pass, (sprite_pipeline, &self.sheet_group), 0..distant);
         }
         v.ring.draw(&mut pass, offscreen.is_some());
         if timer.is_some() {
@@ -175,13 +175,16 @@ impl Sky {
             if parts.len() > 1 {
                 drop(pass);
                 if let Some(group) = view_group {
-                    self.build
-                        .record(encoder, group, &self.resident.group, (c, n));
+                    self.sprites.record_build(encoder, group, (c, n));
                 }
                 pass =
                     self.clouds_pass_again(encoder, offscreen.as_ref(), colour_view, &frame_group);
             }
-            self.draw_sprites(&mut pass, sprite_pipeline, distant.min(n)..n);
+            self.sprites.draw(
+                &mut pass,
+                (sprite_pipeline, &self.sheet_group),
+                distant.min(n)..n,
+            );
         }
         if v.in_cloud > 0.0 {
             pass.set_pipeline(in_cloud_pipeline);
@@ -199,21 +202,6 @@ impl Sky {
         v.recorded.set(true);
         v.record.set(start.spent());
         Ok(())
-    }
-
-    /// Draws `sprites` of the quads the build pass made this frame with `pipeline` (the host's
-    /// colour or the cloud target's).
-    fn draw_sprites(
-        &self,
-        pass: &mut wgpu::RenderPass<'_>,
-        pipeline: &wgpu::RenderPipeline,
-        sprites: std::ops::Range<u32>,
-    ) {
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(1, &self.sheet_group, &[]);
-        pass.set_vertex_buffer(0, self.build.vertices().slice(..));
-        pass.set_index_buffer(self.quads.0.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(sprites.start * 6..sprites.end * 6, 0, 0..1);
     }
 
     /// The clouds' pass taken up again after a break between passes (a timestamp while timing,

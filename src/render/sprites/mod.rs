@@ -23,6 +23,8 @@ pub(super) mod build;
 pub(super) mod cloud_light;
 mod draw_entries;
 pub mod draw_list;
+// The near sprites as one pass of the sky: new, place, plan, upload, record.
+pub(super) mod pass;
 pub(super) mod records;
 pub(super) mod resident;
 mod resident_light;

@@ -420,7 +420,7 @@ impl ResidentSet {
         )
     }
 
-    /// Adds or replaces a block (uploaded by the next [`Self::place_and_upload`]).
+    /// Adds or replaces a block (uploaded by the next [`Self::place`]).
     pub fn insert(&mut self, block: SkyBlock, motion: BlockMotion) {
         self.remove(block.id);
         self.waiting.insert(block.id);
@@ -443,16 +443,11 @@ impl ResidentSet {
         }
     }
 
-    /// Places every block not on the GPU yet (growing or packing the buffers where the limits
-    /// allow; past them the farthest from `camera_m` are left out) and writes the new ones,
-    /// nearest first, up to `budget_sprites` sprites. Returns the bytes written and the blocks
-    /// left out. Blocks a packing moved keep what was written ([`Self::moved_slot`]).
-    pub fn place_and_upload(
-        &mut self,
-        queue: &wgpu::Queue,
-        camera_m: DVec3,
-        budget_sprites: u32,
-    ) -> (u64, u32) {
+    /// Places every block not on the GPU yet in slots (growing or packing the buffers where
+    /// the limits allow, which is the only device work of it; past them the farthest from
+    /// `camera_m` are left out). Returns the blocks left out. Blocks a packing moved keep what
+    /// was written ([`Self::moved_slot`]); [`Self::write_placed`] writes the new ones.
+    pub fn place(&mut self, queue: &wgpu::Queue, camera_m: DVec3) -> u32 {
         self.packs.clear();
         self.grow_wait = Spent::default();
         let blocks = &self.blocks;
@@ -468,34 +463,42 @@ impl ResidentSet {
             let waiting: Vec<(f64, u64)> =
                 waiting.iter().map(|(d2, r)| (*d2, r.block.id)).collect();
             for &(d2, id) in &waiting {
-                self.place(queue, id, d2, camera_m);
+                self.place_one(queue, id, d2, camera_m);
             }
         }
         // Blocks that did not fit, and any a nearer one took the place of.
         let blocks = &self.blocks;
-        let left_out = self
-            .waiting
+        self.waiting
             .iter()
             .filter_map(|id| blocks.get(id))
             .filter(|r| r.place.is_none())
-            .count() as u32;
+            .count() as u32
+    }
+
+    /// Writes the blocks [`Self::place`] placed, nearest first, up to `budget_sprites` sprites
+    /// (and the order and list buffers whole when they are new). Returns the bytes written.
+    pub fn write_placed(
+        &mut self,
+        queue: &wgpu::Queue,
+        camera_m: DVec3,
+        budget_sprites: u32,
+    ) -> u64 {
         // Once, however many times the buffers grew or packed (the first frame of the FL350
         // cruise grows them 71 times: 52 MB written whole into buffers dropped at once).
         let mut written = 0;
         if std::mem::take(&mut self.whole_due) {
             written += self.write_whole(queue);
         }
-        written += self.upload(queue, camera_m, budget_sprites);
-        (written, left_out)
+        written + self.upload(queue, camera_m, budget_sprites)
     }
 
-    /// Whether the last [`Self::place_and_upload`] packed the buffers (moved blocks to other
+    /// Whether the last [`Self::place`] packed the buffers (moved blocks to other
     /// slots).
     pub fn packed(&self) -> bool {
         !self.packs.is_empty()
     }
 
-    /// Where sprite slot `slot` of a block held before the last [`Self::place_and_upload`] is
+    /// Where sprite slot `slot` of a block held before the last [`Self::place`] is
     /// now, after the packings it made (none: where it was); `None` if no block placed then
     /// holds that slot now. For what keeps sprite slots across frames (the facing locks).
     pub fn moved_slot(&self, slot: u32) -> Option<u32> {

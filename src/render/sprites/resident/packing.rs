@@ -20,7 +20,7 @@ use crate::render::stats::Stopwatch;
 
 impl ResidentSet {
     /// Places one block: in free slots, else after growing, else in place of farther ones.
-    pub(super) fn place(&mut self, queue: &wgpu::Queue, id: u64, d2: f64, camera_m: DVec3) {
+    pub(super) fn place_one(&mut self, queue: &wgpu::Queue, id: u64, d2: f64, camera_m: DVec3) {
         loop {
             if self.try_place(id) {
                 return;
