@@ -1541,6 +1541,9 @@ fn ring_rebuilds_do_not_pop() {
 /// were kept again when the drawing and the probes came to share one geometry (decks standing on
 /// a floor, base sprites never culled, a scattered cumulus layer's sprites per box fitted to the
 /// paper's overdraw again): the Cb line 0.044 a channel from before, the others under 0.017.
+/// The cumulus field from below was kept again when a run of FEW or SCT layers came to step down
+/// within its class (KLAX's `FEW025 FEW060 SCT160 SCT250`: the lower layers less cover):
+/// 0.0101 a channel from before.
 #[test]
 fn gpu_sprites_draw_the_frames_of_the_cpu_path() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("reference");
