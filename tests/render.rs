@@ -477,6 +477,10 @@ fn soft_edge_at_scale(slope: &HeightField, sprite_cloud: &SkyCloud, scale: f32) 
         if let Some(f) = fade_m {
             settings.clouds.soft_depth_fade_m = f;
         }
+        // Without the clouds' shadows: the sprite's own shadow on the slope (its dense core's,
+        // an outline as sharp as the map's texels) would add its edge to the edge measured here,
+        // the sprite's against the ground.
+        settings.cloud_shadows.enabled = false;
         let mut rig = Rig::with_settings(slope.clone(), settings);
         let cam = rig.camera(DVec3::new(0.0, 0.0, 130.0), 0.0, 0.0);
         rig.set_clouds(Vec::new());
