@@ -32,7 +32,8 @@ struct Cloud {
     level_rgba: array<vec4<f32>, 5>,
     level_height: vec4<f32>,
     level4_radius_flat: vec4<f32>,
-    // x: its flat base, metres from its centre (`FLOOR_NONE_M` for none); yzw: padding.
+    // x: its flat base, metres from its centre (`FLOOR_NONE_M` for none); y: the factor on the
+    // extinction through its cores (its type's optical density); zw: padding.
     floor_pad: vec4<f32>,
 };
 
@@ -536,7 +537,8 @@ fn core_unit(p: vec3<f32>, along: vec2<f32>, semi: vec3<f32>) -> vec3<f32> {
 // the quad, so each fragment gets its own point), `uv` and `stands_for.y` the ray's direction
 // in the unit sphere, `colour.w` the base in the unit sphere's z, `stands_for.x` the optical
 // depth's weight (the formation or dissipation fade, the probes' `lifecycle::alpha_at`, times
-// how many sprites it stands for), negative for a base sprite. Rain and snow are not cloud.
+// the cloud's optical density, times how many sprites it stands for), negative for a base
+// sprite. Rain and snow are not cloud.
 fn build_core(k: u32, at: u32) {
     let b = draws.blocks[block_of(k)];
     let in_block = k - b.first + lists[b.list_base].first;
@@ -578,7 +580,7 @@ fn build_core(k: u32, at: u32) {
     // a fragment's ray is the line through its point on the quad along the sun.
     let face = facing_towards(normalize_or(view.sun_dir_camera_z.xyz, vec3<f32>(0.0, 0.0, 1.0)));
     let ray = core_unit(face.normal, along, semi);
-    let weight = fade * f32(stride) * select(1.0, -1.0, base);
+    let weight = fade * cloud.floor_pad.y * f32(stride) * select(1.0, -1.0, base);
     for (var c = 0u; c < 4u; c++) {
         let corner = vec2<f32>(f32(c & 1u), f32(c >> 1u)) * 2.0 - 1.0;
         let p = (face.right * corner.x + face.up * corner.y) * reach;

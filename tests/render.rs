@@ -91,6 +91,7 @@ fn cumulus(centre: DVec3) -> SkyCloud {
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
         floor_slab_m: [0.0; 2],
+        optical_density: 1.0,
     }
 }
 
@@ -115,6 +116,7 @@ fn overcast(centre: DVec2, base: f64) -> SkyCloud {
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
         floor_slab_m: [0.0; 2],
+        optical_density: 1.0,
     }
 }
 
@@ -462,6 +464,7 @@ fn cloud_terrain_edge_is_a_ramp() {
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
         floor_slab_m: [0.0; 2],
+        optical_density: 1.0,
     };
     for scale in CLOUD_SCALES {
         soft_edge_at_scale(&slope, &sprite_cloud, scale);

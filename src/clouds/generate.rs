@@ -874,6 +874,7 @@ pub(super) fn finish_cloud(
         shaded_base_m: 0.0,
         floor_m: (-thickness / 2.0) as f32,
         floor_slab_m: [0.0; 2],
+        optical_density: config.optical_density.unwrap_or(1.0),
         colour_levels,
         shading_groups,
         sprites,

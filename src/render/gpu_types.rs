@@ -134,7 +134,8 @@ pub struct GpuCloud {
     /// w: a deck's sunlit depth, metres (0: lit from every side).
     pub level4_radius_flat: [f32; 4],
     /// x: its flat base, metres from its centre ([`FLOOR_NONE_M`] for none): the cores the
-    /// shadow map draws are cut there, as every probe's are (`clouds::core`); yzw: padding.
+    /// shadow map draws are cut there, as every probe's are (`clouds::core`); y: the factor on
+    /// the extinction through its cores (`SkyCloud::optical_density`); zw: padding.
     pub floor_pad: [f32; 4],
 }
 const _: () = assert!(std::mem::size_of::<GpuCloud>() == 144);

@@ -69,7 +69,12 @@ pub fn gpu_cloud(cloud: &SkyCloud, block_m: DVec3) -> GpuCloud {
             if cloud.flat { 1.0 } else { 0.0 },
             cloud.sunlit_depth_m.max(0.0),
         ],
-        floor_pad: [cloud.floor_m.max(FLOOR_NONE_M), 0.0, 0.0, 0.0],
+        floor_pad: [
+            cloud.floor_m.max(FLOOR_NONE_M),
+            cloud.optical_density.max(0.0),
+            0.0,
+            0.0,
+        ],
     }
 }
 
