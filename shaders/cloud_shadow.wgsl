@@ -26,7 +26,7 @@ struct VertexIn {
     @location(1) ray_xy: vec2<f32>,
     // xyz: the corner in the core's unit sphere; w: the cloud's base in its z.
     @location(2) corner_floor: vec4<f32>,
-    // x: the optical depth's weight (its fade times how many sprites it stands for), negative
+    // x: the optical depth's weight (fade x type's optical density x sprites stood for), negative
     // for a base sprite (its column down to the base); y: the ray's direction's z.
     @location(3) weight_ray_z: vec2<f32>,
 };
