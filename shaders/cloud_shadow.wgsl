@@ -1,36 +1,46 @@
 // Pass `sky.cloud_shadow`: the clouds drawn from the sun into the shadow map (R16Float), from
-// the corners the build pass (`sprite_build.wgsl`) made facing an eye far up the sun's rays.
-// Orthographic: clip space is the map across the rays. Each fragment adds the optical depth its
-// opacity shows the eye, -ln(1 - alpha) (Beer's law), so the blending adds and needs no sort.
-// A host multiplies its direct sunlight by exp(-tau) (src/render/shadow/mod.rs).
+// the corners the build pass made of their sprites' dense cores (`build_core` in
+// `sprite_build.wgsl`), facing an eye far up the sun's rays. Orthographic: clip space is the map
+// across the rays. Each fragment adds the optical depth of its ray inside one core: the
+// extinction inside a cloud (3 / the in-cloud visibility, Koschmieder, as the probes' lines of
+// sight) times the length inside the core above the cloud's base, times the core's fade (Beer's
+// law; additive, so no sort is needed). The cloud is what every probe asks (src/clouds/core.rs),
+// so `World::sun_occlusion` at a ground point reads what the map shows there. A host multiplies
+// its direct sunlight by exp(-tau) (src/render/shadow/mod.rs).
 
 // Keep in sync with `GpuCloudShadow` in src/render/shadow/mod.rs.
 struct ShadowFrame {
     clip_from_eye: mat4x4<f32>,
-    // x: optical depth per the optical depth of a fragment's opacity; y: the fraction of the
-    // map across which its edge fades out.
+    // x: optical depth per metre of cloud core along the ray (the extinction times the
+    // settings' `opacity_scale`, less as the sun nears the horizon); y: the fraction of the map
+    // across which its edge fades out; zw unused.
     params: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> shadow: ShadowFrame;
-@group(1) @binding(0) var sheet: texture_2d<f32>;
-@group(1) @binding(1) var sheet_sampler: sampler;
 
-// Keep in sync with `GpuSpriteVertex` in src/render/gpu_types.rs.
+// Keep in sync with `GpuSpriteVertex` in src/render/gpu_types.rs, as `build_core` fills it.
 struct VertexIn {
     @location(0) position_visible: vec4<f32>,
-    @location(1) uv: vec2<f32>,
-    @location(2) colour: vec4<f32>,
-    // x: how many sprites of its cloud this one stands for (far clouds are built sparser).
-    @location(3) stands_for: vec2<f32>,
+    // The ray's direction in the core's unit sphere, x and y.
+    @location(1) ray_xy: vec2<f32>,
+    // xyz: the corner in the core's unit sphere; w: the cloud's base in its z.
+    @location(2) corner_floor: vec4<f32>,
+    // x: the optical depth's weight (fade x type's optical density x sprites stood for), negative
+    // for a base sprite (its column down to the base); y: the ray's direction's z.
+    @location(3) weight_ray_z: vec2<f32>,
 };
 
 struct VertexOut {
     @builtin(position) position: vec4<f32>,
-    // xy: sheet texture coordinates; z: the corner's opacity (its fades included).
-    @location(0) uv_alpha: vec3<f32>,
-    // xy: the corner in clip space (the edge fade); z: how many sprites it stands for.
-    @location(1) clip_stands_for: vec3<f32>,
+    // The fragment's ray through the core's unit sphere: a point of it (metres along the ray
+    // are units of t), and its direction.
+    @location(0) point: vec3<f32>,
+    @location(1) @interpolate(flat) ray: vec3<f32>,
+    // x: the weight, as `VertexIn`; y: the cloud's base in the unit sphere's z.
+    @location(2) @interpolate(flat) weight_floor: vec2<f32>,
+    // The corner in clip space (the edge fade).
+    @location(3) clip: vec2<f32>,
 };
 
 @vertex
@@ -42,20 +52,50 @@ fn vs_shadow(v: VertexIn) -> VertexOut {
         return o;
     }
     o.position = shadow.clip_from_eye * vec4<f32>(v.position_visible.xyz, 1.0);
-    o.uv_alpha = vec3<f32>(v.uv, v.colour.a);
-    o.clip_stands_for = vec3<f32>(o.position.xy, max(v.stands_for.x, 1.0));
+    o.point = v.corner_floor.xyz;
+    o.ray = vec3<f32>(v.ray_xy, v.weight_ray_z.y);
+    o.weight_floor = vec2<f32>(v.weight_ray_z.x, v.corner_floor.w);
+    o.clip = o.position.xy;
     return o;
+}
+
+// Where the line `o + t d` is inside the unit circle (`xy`) or sphere: (t in, t out), empty
+// (in > out) where it misses.
+fn unit_chord(o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
+    let dd = max(dot(d, d), 1e-12);
+    let half_b = dot(o, d);
+    let disc = half_b * half_b - dd * (dot(o, o) - 1.0);
+    if (disc <= 0.0) {
+        return vec2<f32>(1.0, -1.0);
+    }
+    let root = sqrt(disc);
+    return vec2<f32>(-half_b - root, -half_b + root) / dd;
 }
 
 @fragment
 fn fs_shadow(i: VertexOut) -> @location(0) vec4<f32> {
-    let texel = textureSample(sheet, sheet_sampler, i.uv_alpha.xy);
-    // Below 1: a fragment never stops all the light (its log would be infinite).
-    let alpha = clamp(texel.a * i.uv_alpha.z, 0.0, 0.98);
+    let o = i.point;
+    let d = i.ray;
+    let floor = i.weight_floor.y;
+    // Above the base: t past where the ray (going up, towards the sun) crosses it.
+    let above = (floor - o.z) / max(d.z, 1e-9);
+    var core = unit_chord(o, d);
+    core.x = max(core.x, above);
+    var length_m = max(core.y - core.x, 0.0);
+    if (i.weight_floor.x < 0.0) {
+        // A base sprite's column: inside its outline across, between the base and its middle;
+        // the part of it not in the ellipsoid too (each stretch counted once, as the probes'
+        // union of a cloud's cores).
+        var column = unit_chord(vec3<f32>(o.xy, 0.0), vec3<f32>(d.xy, 0.0));
+        column.x = max(column.x, above);
+        column.y = min(column.y, -o.z / max(d.z, 1e-9));
+        let both = max(min(core.y, column.y) - max(core.x, column.x), 0.0);
+        length_m += max(column.y - column.x, 0.0) - select(0.0, both, length_m > 0.0);
+    }
     // The map's last texels fade out: a shadow ends softly at its edge, and the edge texels a
     // host's clamped lookup repeats beyond it hold nothing.
-    let edge = max(abs(i.clip_stands_for.x), abs(i.clip_stands_for.y));
+    let edge = max(abs(i.clip.x), abs(i.clip.y));
     let keep = 1.0 - smoothstep(1.0 - shadow.params.y, 1.0 - 0.25 * shadow.params.y, edge);
-    let tau = -log(1.0 - alpha) * i.clip_stands_for.z;
-    return vec4<f32>(tau * shadow.params.x * keep, 0.0, 0.0, 0.0);
+    let tau = length_m * abs(i.weight_floor.x) * shadow.params.x;
+    return vec4<f32>(tau * keep, 0.0, 0.0, 0.0);
 }

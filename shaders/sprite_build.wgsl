@@ -32,6 +32,9 @@ struct Cloud {
     level_rgba: array<vec4<f32>, 5>,
     level_height: vec4<f32>,
     level4_radius_flat: vec4<f32>,
+    // x: its flat base, metres from its centre (`FLOOR_NONE_M` for none); y: the factor on the
+    // extinction through its cores (its type's optical density); zw: padding.
+    floor_pad: vec4<f32>,
 };
 
 // Keep in sync with `GpuDrawBlock`.
@@ -509,4 +512,94 @@ fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     build_sprite(k, local * 4u);
+}
+
+// Keep in sync with `SPRITE_BASE` in src/render/gpu_types.rs.
+const SPRITE_BASE: u32 = 1024u;
+// A sprite's dense core and a base sprite's (src/clouds/core.rs `CORE_HALF_EXTENT`,
+// `BASE_HALF_EXTENT`): fractions of its full width and height from its centre.
+const CORE_HALF_EXTENT: f32 = 0.35;
+const BASE_HALF_EXTENT: f32 = 0.5;
+
+// `p` (metres, from a core's centre) in the core's unit sphere: turned by `along` (its first
+// horizontal axis), divided by its semi-axes. Same as `SpriteCore::unit` in src/clouds/core.rs.
+fn core_unit(p: vec3<f32>, along: vec2<f32>, semi: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(p.xy, along), along.x * p.y - along.y * p.x, p.z) / semi;
+}
+
+// The shadow map's corners (`cs_build_cores`): sprite `k` of the shadow view (in its slots'
+// order) as its dense core, what every probe of the air data asks (src/clouds/core.rs: an
+// ellipsoid of `CORE_HALF_EXTENT` of its size, a flat cloud's turned with it; a base sprite's
+// as wide as it is, with the column under it down to the cloud's base; nothing below the
+// base). The quad faces the map's sun (`sun_dir_camera_z`) and holds the core's outline, and
+// each corner carries what the shadow pass (`cloud_shadow.wgsl`) needs to find the length of
+// its ray inside the core: `colour.xyz` the corner in the core's unit sphere (linear across
+// the quad, so each fragment gets its own point), `uv` and `stands_for.y` the ray's direction
+// in the unit sphere, `colour.w` the base in the unit sphere's z, `stands_for.x` the optical
+// depth's weight (the formation or dissipation fade, the probes' `lifecycle::alpha_at`, times
+// the cloud's optical density, times how many sprites it stands for), negative for a base
+// sprite. Rain and snow are not cloud.
+fn build_core(k: u32, at: u32) {
+    let b = draws.blocks[block_of(k)];
+    let in_block = k - b.first + lists[b.list_base].first;
+    let entry = lists[cloud_of(b, in_block)];
+    let stride = max(entry.stride, 1u);
+    let slot = entry.order_base + (in_block - entry.first) * stride;
+    let s = sprites[slot];
+    let cloud = clouds[entry.cloud];
+    let centre_rel = b.origin_rel + cloud.centre_block.xyz + s.offset;
+    let size = unpack2x16float(s.size);
+    let rotation = f32(s.group_z_rotation >> 16u) * (6.283185307 / 65536.0);
+    let radius_fraction = unpack2x16unorm(s.morph_radius).y;
+    let fade = lifecycle_alpha(b.fade_kind & 3u, b.fade_progress, radius_fraction);
+    let rain = (s.bits & 512u) != 0u;
+    if (rain || !(fade > 0.0)) {
+        for (var c = 0u; c < 4u; c++) {
+            built[at + c].position_visible = vec4<f32>(0.0);
+        }
+        return;
+    }
+    // Keep in sync with `SpriteCore::new` and `SpriteCore::of` in src/clouds/core.rs.
+    let flat = cloud.level4_radius_flat.z > 0.5;
+    var semi = vec3<f32>(size.x, size.x, size.y) * CORE_HALF_EXTENT;
+    var along = vec2<f32>(1.0, 0.0);
+    if (flat) {
+        semi = vec3<f32>(size.x, size.y, min(size.x, size.y)) * CORE_HALF_EXTENT;
+        along = vec2<f32>(cos(rotation), sin(rotation));
+    }
+    let base = (s.bits & SPRITE_BASE) != 0u;
+    if (base) {
+        semi = vec3<f32>(semi.xy * (BASE_HALF_EXTENT / CORE_HALF_EXTENT), semi.z);
+    }
+    semi = max(semi, vec3<f32>(1e-3));
+    // The cloud's base from the core's centre: a base sprite's column reaches down to it.
+    let floor_rel = cloud.floor_pad.x - s.offset.z;
+    let column = select(0.0, max(-floor_rel, 0.0), base);
+    let reach = length(vec2<f32>(max(semi.x, max(semi.y, semi.z)), column));
+    // Facing the map's sun (the shadow view's): the map is drawn orthographically along it, so
+    // a fragment's ray is the line through its point on the quad along the sun.
+    let face = facing_towards(normalize_or(view.sun_dir_camera_z.xyz, vec3<f32>(0.0, 0.0, 1.0)));
+    let ray = core_unit(face.normal, along, semi);
+    let weight = fade * cloud.floor_pad.y * f32(stride) * select(1.0, -1.0, base);
+    for (var c = 0u; c < 4u; c++) {
+        let corner = vec2<f32>(f32(c & 1u), f32(c >> 1u)) * 2.0 - 1.0;
+        let p = (face.right * corner.x + face.up * corner.y) * reach;
+        built[at + c] = BuiltCorner(
+            vec4<f32>(centre_rel + p, 1.0),
+            ray.xy,
+            vec2<f32>(weight, ray.z),
+            vec4<f32>(core_unit(p, along, semi), floor_rel / semi.z),
+        );
+    }
+}
+
+// Sprite `id` of the shadow view's chunk as its core (`build_core`).
+@compute @workgroup_size(64)
+fn cs_build_cores(@builtin(global_invocation_id) id: vec3<u32>) {
+    let local = id.x + id.y * (65535u * 64u);
+    let k = chunk.x + local;
+    if (local >= CHUNK || k >= draws.counts.z) {
+        return;
+    }
+    build_core(k, local * 4u);
 }

@@ -70,6 +70,7 @@ fn blocks() -> Vec<SkyBlock> {
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
         floor_slab_m: [0.0; 2],
+        optical_density: 1.0,
     };
     vec![SkyBlock {
         id: 1,
@@ -91,6 +92,7 @@ fn plain_cloud(centre_m: DVec3, sprites: Vec<SkySprite>, colour_levels: ColourLe
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
         floor_slab_m: [0.0; 2],
+        optical_density: 1.0,
     }
 }
 

@@ -90,12 +90,22 @@ pub struct Cloud {
     /// ([`super::core`]).
     #[serde(default)]
     pub floor_slab_m: [f32; 2],
+    /// Factor on the in-cloud extinction through its cores (the type's `optical_density`): 1
+    /// for water cloud, less for thin ice cloud (cirrus), for the probes' optical depth and the
+    /// shadow map alike.
+    #[serde(default = "full_density")]
+    pub optical_density: f32,
     /// Five ambient colour levels, lowest first.
     pub colour_levels: [ColourLevel; 5],
     /// The cloud's shading groups.
     pub shading_groups: Vec<ShadingGroup>,
     /// The sprites.
     pub sprites: Vec<Sprite>,
+}
+
+/// A cloud read without its optical density: as dense as a water cloud.
+fn full_density() -> f32 {
+    1.0
 }
 
 /// A cloud read without a base: its cores reach as low as they do.
@@ -194,6 +204,9 @@ impl CloudBlock {
             }
             if c.shaded_base_m != 0.0 {
                 h = fnv1a(&c.shaded_base_m.to_le_bytes(), h);
+            }
+            if c.optical_density != 1.0 {
+                h = fnv1a(&c.optical_density.to_le_bytes(), h);
             }
             for lvl in &c.colour_levels {
                 h = fnv1a(&lvl.height_m.to_le_bytes(), h);

@@ -192,6 +192,7 @@ pub(crate) mod tests {
             shaded_base_m: 0.0,
             floor_m: f32::MIN,
             floor_slab_m: [0.0; 2],
+            optical_density: 1.0,
             colour_levels: [ColourLevel {
                 height_m: 0.0,
                 rgba: [1.0; 4],

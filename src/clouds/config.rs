@@ -260,6 +260,12 @@ pub struct CloudTypeConfig {
     /// with every sprite lengthwise along it (cirrus fibres); `cloud_size_m` is its length.
     #[serde(default)]
     pub streak_length_over_width: Option<f32>,
+    /// Factor on the extinction inside the type's clouds (`[in_cloud] visibility_m` of
+    /// config/air.toml): the optical depth the probes and the shadow map find through its dense
+    /// cores. Absent: 1, a water cloud's (cumulus, stratus); below 1 for thin ice cloud
+    /// (cirrus: an optical depth of about 0.03-3 through the whole layer).
+    #[serde(default)]
+    pub optical_density: Option<f32>,
     /// Most boxes per block, by cover.
     pub boxes_per_block: BoxesByCover,
     /// Sprites per box before the cull, 1..=100.
@@ -627,6 +633,13 @@ fn validate(c: &CloudTypeConfig, name: &str, text: &str, path: &Path) -> Result<
             (1.0..=10_000.0).contains(&height) && !c.continuous && !c.flat,
             "shaded_base_m",
             "must be 1..=10000 metres, on a heaped type (not continuous, not flat)",
+        )?;
+    }
+    if let Some(density) = c.optical_density {
+        v.check(
+            (0.001..=1.0).contains(&density),
+            "optical_density",
+            "must be 0.001..=1 (a factor on the in-cloud extinction)",
         )?;
     }
     if let Some(aspect) = c.streak_length_over_width {

@@ -102,11 +102,15 @@ impl SpriteCore {
         }
     }
 
-    /// How far from its centre any of the core (its column included) reaches, metres.
+    /// How far from its centre any of the core (its column included) reaches, metres: a
+    /// column's bottom rim lies its depth down and its horizontal radius out.
     fn reach_m(&self) -> f64 {
         let r = self.semi_axes_m.max_element();
         match self.floor_m {
-            Some(floor) => r.max(self.centre_m.z - floor),
+            Some(floor) => {
+                let across = self.semi_axes_m.x.max(self.semi_axes_m.y);
+                r.max(across.hypot(self.centre_m.z - floor))
+            }
             None => r,
         }
     }
@@ -396,6 +400,29 @@ mod tests {
         assert!((distance_m(&c, DVec3::new(0.0, 0.0, -300.0)) - 200.0).abs() < 1e-6);
         // Beside the core (its corner box would hold this point): clear.
         assert_eq!(inside(&c, DVec3::new(300.0, 300.0, 0.0), 0.35), 0.0);
+    }
+
+    /// A line past a base sprite's column near its bottom rim, farther from the core's centre
+    /// than its depth or its radius alone, is inside it (the walk's reach once left it out).
+    #[test]
+    fn a_line_by_a_columns_bottom_rim_is_in_it() {
+        let mut c = cube_cloud(DVec3::ZERO, 100.0, CloudType::CumulusCongestus);
+        c.sprites[0].base = true;
+        c.floor_m = -300.0;
+        let across = 100.0 * BASE_HALF_EXTENT / CORE_HALF_EXTENT;
+        let (a, b) = (
+            DVec3::new(-500.0, 130.0, -290.0),
+            DVec3::new(500.0, 130.0, -290.0),
+        );
+        let mut spans = Vec::new();
+        segment(&c, a, b, &mut spans);
+        let half = (across * across - 130.0 * 130.0).sqrt();
+        assert_eq!(spans.len(), 1, "{spans:?}");
+        let (enter, exit) = (spans[0].0 * 1000.0 - 500.0, spans[0].1 * 1000.0 - 500.0);
+        assert!(
+            (enter + half).abs() < 1e-3 && (exit - half).abs() < 1e-3,
+            "{spans:?}"
+        );
     }
 
     #[test]

@@ -874,6 +874,7 @@ pub(super) fn finish_cloud(
         shaded_base_m: 0.0,
         floor_m: (-thickness / 2.0) as f32,
         floor_slab_m: [0.0; 2],
+        optical_density: config.optical_density.unwrap_or(1.0),
         colour_levels,
         shading_groups,
         sprites,
@@ -890,7 +891,8 @@ mod golden {
     use crate::weather::TypeSource;
 
     /// The content hash of a few pinned blocks: equal on every machine and run. A deliberate
-    /// change to the generator or to config/cloud_types.toml changes it; update it then.
+    /// change to the generator or to config/cloud_types.toml changes it; update it then (the
+    /// cirrus block's changed with its `optical_density`, part of its content).
     #[test]
     fn pinned_blocks_hash_the_same_everywhere() {
         let types = CloudTypes::builtin();
@@ -921,7 +923,7 @@ mod golden {
                 "8162f54a59074a59",
                 "7ccbffc21b226faa",
                 "5393761c2f982975",
-                "f6cfc024a1869c4d"
+                "b74bec24fe678181"
             ]
         );
     }

@@ -9,7 +9,9 @@
 //! rises from 0 at its boundary to 1 at `ramp_fraction` of its radius in, times the cloud's fade
 //! where the point is ([`super::lifecycle::alpha_at`] at the point's radius fraction). A line of
 //! sight meets a cloud where it enters a core; its optical depth is the extinction inside a
-//! cloud (`3 / visibility_m`, Koschmieder) times the length inside the cores, times the fade.
+//! cloud (`3 / visibility_m`, Koschmieder) times its type's `optical_density` (1 for water
+//! cloud, far less for thin ice cloud: cirrus), times the length inside the cores, times the
+//! fade. The in-cloud measure stays geometric: inside a cirrus is still inside cloud.
 //!
 //! The walks go through the box around each cloud's cores ([`super::boxes`]) first, and ask the
 //! cores only of a cloud whose box they enter. The boxes of a generation are worked out once, on
@@ -420,7 +422,7 @@ impl<'a> CloudProbe<'a> {
                 if fade <= 0.0 {
                     continue;
                 }
-                let depth = sigma * (t1 - t0) * length * fade;
+                let depth = sigma * f64::from(cloud.optical_density) * (t1 - t0) * length * fade;
                 depth_here += depth;
                 entry.get_or_insert(t0);
                 if let Some(spans) = spans.as_deref_mut() {

@@ -220,6 +220,7 @@ pub fn part_in_block(whole: &Cloud, block: BlockIndex, layer: u8) -> Option<Clou
         shaded_base_m: whole.shaded_base_m,
         floor_m: whole.floor_m,
         floor_slab_m: whole.floor_slab_m,
+        optical_density: whole.optical_density,
         colour_levels: whole.colour_levels,
         shading_groups: whole
             .shading_groups

@@ -114,6 +114,7 @@ impl From<&Cloud> for SkyCloud {
             shaded_base_m: c.shaded_base_m,
             floor_m: c.floor_m,
             floor_slab_m: c.floor_slab_m,
+            optical_density: c.optical_density,
         }
     }
 }

@@ -115,9 +115,12 @@ impl GpuSpriteVertex {
 pub const SPRITE_UPRIGHT: u32 = 1 << 8;
 /// `GpuSprite::bits`: falling rain or snow, drawn darker and greyer.
 pub const SPRITE_PRECIPITATION: u32 = 1 << 9;
+/// `GpuSprite::bits`: stands on its cloud's base (`SkySprite::base`): its dense core spans its
+/// width and the column under it down to the base (`clouds::core`), as the shadow map draws it.
+pub const SPRITE_BASE: u32 = 1 << 10;
 
-/// One cloud's shading constants on the GPU (written with its block). Keep in sync with
-/// `Cloud` in `shaders/sprites.wgsl`.
+/// One cloud's shading constants and base on the GPU (written with its block). Keep in sync
+/// with `Cloud` in `shaders/sprite_build.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuCloud {
@@ -130,8 +133,16 @@ pub struct GpuCloud {
     /// x: height of level 4, metres; y: cloud radius, metres; z: 1 for a flat cloud (cirrus);
     /// w: a deck's sunlit depth, metres (0: lit from every side).
     pub level4_radius_flat: [f32; 4],
+    /// x: its flat base, metres from its centre ([`FLOOR_NONE_M`] for none): the cores the
+    /// shadow map draws are cut there, as every probe's are (`clouds::core`); y: the factor on
+    /// the extinction through its cores (`SkyCloud::optical_density`); zw: padding.
+    pub floor_pad: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<GpuCloud>() == 128);
+const _: () = assert!(std::mem::size_of::<GpuCloud>() == 144);
+
+/// `GpuCloud::floor_pad` of a cloud without a base (`SkyCloud::floor_m` is `f32::MIN`): far
+/// enough below anything drawn, near enough that arithmetic on it stays finite.
+pub const FLOOR_NONE_M: f32 = -1.0e6;
 
 /// One block of a frame's draw list, back to front: where it is relative to the camera (f64 on
 /// the CPU, so nothing jitters far out), where its clouds' list is, and its fade. Keep in sync

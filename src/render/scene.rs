@@ -76,6 +76,9 @@ pub struct SkyCloud {
     /// An overcast deck's closed underside (`clouds::Cloud::floor_slab_m`): a slab on its
     /// floor, half as wide as the first value and as deep as the second; zeros for none.
     pub floor_slab_m: [f32; 2],
+    /// Factor on the in-cloud extinction through its cores (`clouds::Cloud::optical_density`):
+    /// how dark its shadow is, as the probes' optical depth.
+    pub optical_density: f32,
 }
 
 /// A 4 km x 4 km block of clouds.

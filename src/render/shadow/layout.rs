@@ -51,8 +51,8 @@ pub struct ShadowSettings {
     pub recentre_fraction: f64,
     /// Draw it again after the sun turned more than this, degrees.
     pub rebuild_sun_deg: f64,
-    /// Optical depth of a sprite fragment along the sun's ray per the optical depth its opacity
-    /// shows the eye (`-ln(1 - alpha)`): 1 casts the shadow the clouds look like they would.
+    /// The map's optical depth per the probes' (3 per `[in_cloud] visibility_m` of the sprites'
+    /// dense cores along the sun's ray): 1 casts the shadows `World::sun_occlusion` reports.
     pub opacity_scale: f32,
     /// Blocks within this distance of the camera across the sun's rays cast the shadows of all
     /// their sprites, metres.

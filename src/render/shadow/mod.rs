@@ -5,10 +5,12 @@
 //! R16Float texture of the optical depth `tau` of the clouds along the sun's ray through each
 //! texel, and the matrix from a camera-relative position to its texture coordinates
 //! ([`CloudShadowMap`]). The draw (`shaders/cloud_shadow.wgsl`, pass `sky.cloud_shadow`) is
-//! orthographic along the sun's rays: the build pass (`shaders/sprite_build.wgsl`) makes the
-//! sprites' corners facing an eye far up the rays, with their formation and dissipation fades
-//! (so the shadows fade with the clouds), and each fragment adds `-ln(1 - alpha)` of its
-//! opacity, the optical depth it shows the eye (Beer's law; additive, so no sort is needed).
+//! orthographic along the sun's rays: the build pass (`cs_build_cores` in
+//! `shaders/sprite_build.wgsl`) makes a quad facing the sun around each sprite's dense core
+//! (`clouds::core`, what every probe asks), with its formation and dissipation fade (so the
+//! shadows fade with the clouds), and each fragment adds the optical depth of its ray inside
+//! the core, the probes' extinction times the length (Beer's law; additive, so no sort is
+//! needed): `World::sun_occlusion` reads what the map holds.
 //! Its own draw list and cloud lists (every cloud of the blocks it covers, a few tens of KB)
 //! take each cloud's sprites in their slots' order (not the camera's sort, which would change
 //! the half-float sums as the camera moves), so it holds nothing per sprite.
@@ -59,9 +61,9 @@ const NO_FAR_FADE_M: f32 = 1.0e9;
 struct GpuCloudShadow {
     /// Positions relative to the draw's eye to clip space (orthographic along the rays).
     clip_from_eye: [[f32; 4]; 4],
-    /// x: optical depth per the optical depth a fragment's opacity shows the eye (the
-    /// settings' `opacity_scale`, less as the sun nears the horizon); y: the fraction of the map
-    /// across which its edge fades out; zw unused.
+    /// x: optical depth per metre of cloud core along the ray (the probes' extinction times
+    /// the settings' `opacity_scale`, less as the sun nears the horizon); y: the fraction of
+    /// the map across which its edge fades out; zw unused.
     params: [f32; 4],
 }
 const _: () = assert!(std::mem::size_of::<GpuCloudShadow>() == 80);
@@ -118,6 +120,9 @@ impl ShadowImage {
 /// The map: its texture, pipeline, view of the resident sprites and when it was drawn.
 pub struct CloudShadows {
     settings: ShadowSettings,
+    /// Optical depth per metre inside a cloud's cores: the probes' (3 / the in-cloud
+    /// visibility), so the map and `World::sun_occlusion` answer from the same clouds.
+    extinction_per_m: f32,
     device: wgpu::Device,
     pipeline: wgpu::RenderPipeline,
     uniform: wgpu::Buffer,
@@ -232,11 +237,12 @@ fn shadow_texture(device: &wgpu::Device, side: u32) -> (wgpu::Texture, wgpu::Tex
 
 impl CloudShadows {
     /// The pipeline (groups: its uniform, the sprite sheet of `sheet_layout`) and the texture
-    /// (a cleared texel while switched off). `view_layout`: the build pass's view group.
+    /// (a cleared texel while switched off). `view_layout`: the build pass's view group;
+    /// `in_cloud_visibility_m`: the visibility inside a cloud (`[in_cloud]`).
     pub(super) fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        settings: ShadowSettings,
+        (settings, in_cloud_visibility_m): (ShadowSettings, f32),
         sheet_layout: &wgpu::BindGroupLayout,
         view_layout: &wgpu::BindGroupLayout,
     ) -> Self {
@@ -315,6 +321,7 @@ impl CloudShadows {
         let (texture, view) = shadow_texture(device, 1);
         let mut shadows = Self {
             settings,
+            extinction_per_m: 3.0 / in_cloud_visibility_m.max(1e-3),
             device: device.clone(),
             pipeline,
             uniform,
@@ -533,7 +540,12 @@ impl CloudShadows {
             let sun_up = smoothstep(1.0f64.to_radians().sin(), 5.0f64.to_radians().sin(), sun.z);
             let uniform = GpuCloudShadow {
                 clip_from_eye: frame.clip_from_eye_relative().to_cols_array_2d(),
-                params: [s.opacity_scale * sun_up as f32, 0.05, 0.0, 0.0],
+                params: [
+                    self.extinction_per_m * s.opacity_scale * sun_up as f32,
+                    0.05,
+                    0.0,
+                    0.0,
+                ],
             };
             queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
             bytes += std::mem::size_of::<GpuCloudShadow>() as u64;
@@ -586,7 +598,7 @@ impl CloudShadows {
         for k in 0..parts.len().max(1) {
             let part = parts.get(k).copied();
             if let (Some(view), Some((c, _, n))) = (view, part) {
-                build.record(encoder, view, resident, (c, n));
+                build.record_cores(encoder, view, resident, (c, n));
             }
             let load = if k == 0 && !self.adding {
                 wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)

@@ -29,6 +29,8 @@ impl CloudShadows {
             farthest_m: NO_FAR_FADE_M,
             ..*light
         });
+        // The cores' rays run along the map's own sun (`build_core`).
+        header.sun_dir_camera_z[..3].copy_from_slice(&frame.sun.as_vec3().to_array());
         // Seen from the sun: no facing locks (the eye is never near), upright base sprites
         // never fade (from a high sun they are edge on anyway), no far fade.
         header.forward_lock[1] = 0.0;

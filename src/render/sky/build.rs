@@ -181,7 +181,10 @@ impl Sky {
         let shadows = crate::render::shadow::CloudShadows::new(
             device,
             queue,
-            config.settings.cloud_shadows,
+            (
+                config.settings.cloud_shadows,
+                config.settings.in_cloud.visibility_m,
+            ),
             &sheet_layout,
             &view_layout,
         );

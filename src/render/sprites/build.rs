@@ -3,7 +3,9 @@
 //! draw list, cloud lists and orders, into a vertex buffer the sprite draw reads. The buffer
 //! holds at most [`CHUNK`] sprites: a larger view is built and drawn a chunk at a time, in
 //! drawing order, so its memory stays bounded whatever is in view. One buffer serves every view
-//! of a frame: each build is followed by its draw before the next.
+//! of a frame: each build is followed by its draw before the next. The shadow map's view is
+//! built by its own entry point (`cs_build_cores`): each sprite as its dense core, what the
+//! probes ask, not as its textured quad.
 
 use crate::render::gpu_types::GpuSpriteVertex;
 
@@ -22,6 +24,8 @@ const ROW: u32 = 65_535;
 /// The pipeline, and the vertex buffer with its bind group.
 pub(in crate::render) struct SpriteBuild {
     pipeline: wgpu::ComputePipeline,
+    /// The shadow map's build: the sprites' cores (`cs_build_cores`).
+    cores_pipeline: wgpu::ComputePipeline,
     out_layout: wgpu::BindGroupLayout,
     vertices: wgpu::Buffer,
     /// Per chunk its first sprite, at [`CHUNK_STRIDE`] bytes apart (written once).
@@ -82,14 +86,17 @@ impl SpriteBuild {
                 format!("{}\n{WGSL}", super::sheet_crop::crops_wgsl(cell_crops)).into(),
             ),
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("sky.sprite_build"),
-            layout: Some(&layout),
-            module: &module,
-            entry_point: Some("cs_build"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline_of = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("sky.sprite_build"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let (pipeline, cores_pipeline) = (pipeline_of("cs_build"), pipeline_of("cs_build_cores"));
         let mut starts = vec![0u8; (MAX_CHUNKS as u64 * CHUNK_STRIDE) as usize];
         for c in 0..MAX_CHUNKS {
             let at = (c as u64 * CHUNK_STRIDE) as usize;
@@ -107,6 +114,7 @@ impl SpriteBuild {
         let (vertices, out_group) = vertex_buffer(device, &out_layout, &chunk_starts, capacity);
         Self {
             pipeline,
+            cores_pipeline,
             out_layout,
             vertices,
             chunk_starts,
@@ -143,6 +151,28 @@ impl SpriteBuild {
         encoder: &mut wgpu::CommandEncoder,
         view: &wgpu::BindGroup,
         resident: &wgpu::BindGroup,
+        chunk: (u32, u32),
+    ) {
+        self.record_with(&self.pipeline, encoder, (view, resident), chunk);
+    }
+
+    /// [`Self::record`] for the shadow map: each sprite built as its dense core
+    /// (`build_core` in `shaders/sprite_build.wgsl`).
+    pub fn record_cores(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::BindGroup,
+        resident: &wgpu::BindGroup,
+        chunk: (u32, u32),
+    ) {
+        self.record_with(&self.cores_pipeline, encoder, (view, resident), chunk);
+    }
+
+    fn record_with(
+        &self,
+        pipeline: &wgpu::ComputePipeline,
+        encoder: &mut wgpu::CommandEncoder,
+        (view, resident): (&wgpu::BindGroup, &wgpu::BindGroup),
         (chunk, sprites): (u32, u32),
     ) {
         if sprites == 0 {
@@ -153,7 +183,7 @@ impl SpriteBuild {
             label: Some("sky.sprite_build"),
             timestamp_writes: None,
         });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, view, &[]);
         pass.set_bind_group(1, resident, &[]);
         let offset = chunk as u64 * CHUNK_STRIDE;

@@ -108,6 +108,7 @@ pub(in crate::render) fn small_cloud() -> SkyCloud {
         shaded_base_m: 0.0,
         floor_m: f32::MIN,
         floor_slab_m: [0.0; 2],
+        optical_density: 1.0,
     }
 }
 

@@ -4,7 +4,9 @@
 
 use glam::{DVec3, Vec3};
 
-use crate::render::gpu_types::{GpuCloud, GpuSprite, SPRITE_PRECIPITATION, SPRITE_UPRIGHT};
+use crate::render::gpu_types::{
+    FLOOR_NONE_M, GpuCloud, GpuSprite, SPRITE_BASE, SPRITE_PRECIPITATION, SPRITE_UPRIGHT,
+};
 use crate::render::scene::SkyCloud;
 
 /// Two values as the low and high halves of a `u32` (WGSL's `pack2x16float`).
@@ -46,7 +48,8 @@ pub fn gpu_sprite(cloud: &SkyCloud, s: &crate::render::scene::SkySprite) -> GpuS
                 SPRITE_PRECIPITATION
             } else {
                 0
-            },
+            }
+            | if s.base { SPRITE_BASE } else { 0 },
     }
 }
 
@@ -65,6 +68,12 @@ pub fn gpu_cloud(cloud: &SkyCloud, block_m: DVec3) -> GpuCloud {
             cloud.radius_m().max(1.0),
             if cloud.flat { 1.0 } else { 0.0 },
             cloud.sunlit_depth_m.max(0.0),
+        ],
+        floor_pad: [
+            cloud.floor_m.max(FLOOR_NONE_M),
+            cloud.optical_density.max(0.0),
+            0.0,
+            0.0,
         ],
     }
 }
