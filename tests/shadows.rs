@@ -537,7 +537,7 @@ fn shadows_are_as_dark_as_the_sky_makes_them_and_the_probe_agrees() {
         stats.shadow_redrawn && stats.shadow_sprites > 0,
         "{stats:?}"
     );
-    let map = host.sky.read_back_cloud_shadows(&host.gpu.queue).unwrap();
+    let map = host.sky.sky().read_back_cloud_shadows(&host.gpu.queue).unwrap();
     let lookup = host.sky.cloud_shadows().uv_from_camera_relative;
     let sun = host.sky.lighting().sun_direction.as_dvec3();
     let elevation = sun.z.asin().to_degrees();
@@ -646,10 +646,10 @@ fn shadows_are_as_dark_as_the_sky_makes_them_and_the_probe_agrees() {
         pitch,
     );
     let (on, _) = host.step_frame(&camera, unix_s, 0.0).unwrap();
-    let map = host.sky.read_back_cloud_shadows(&host.gpu.queue).unwrap();
+    let map = host.sky.sky().read_back_cloud_shadows(&host.gpu.queue).unwrap();
     let lookup = host.sky.cloud_shadows().uv_from_camera_relative;
     on.write_png(&out_dir().join("congestus_on.png")).unwrap();
-    host.sky.set_cloud_shadows(false);
+    host.sky.sky_mut().set_cloud_shadows(false);
     let (off, _) = host.step_frame(&camera, unix_s, 0.0).unwrap();
     off.write_png(&out_dir().join("congestus_off.png")).unwrap();
     let taus = ground_taus(&on, &camera, &map, lookup);
@@ -676,7 +676,7 @@ fn shadows_are_as_dark_as_the_sky_makes_them_and_the_probe_agrees() {
     // colour), taken off; it veils shadowed and sunlit ground alike and pulls any ratio towards
     // 1 (fog far brighter than dark fields).
     let haze = host.sky.ground_haze(f32::INFINITY);
-    let fog = luminance(host.sky.fog().rgb.extend(1.0).to_array());
+    let fog = luminance(host.sky.sky().fog().rgb.extend(1.0).to_array());
     let camera_z = camera.position_m.z as f32;
     let light = |frame: &Frame, i: usize| {
         let p = points[i].expect("a ground pixel");
