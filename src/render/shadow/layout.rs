@@ -43,9 +43,9 @@ pub struct ShadowSettings {
     /// Half the side of the square the map covers across the sun's rays, metres (at least the
     /// sprites' draw distance, so every cloud drawn casts its shadow).
     pub half_extent_m: f64,
-    /// While a cloud it covers forms or dissipates, draw its footprint again after this much
-    /// sky time, seconds (between draws the map moves with the clouds' drift; steady clouds need
-    /// no new drawing).
+    /// While a cloud it covers forms or dissipates, draw the map again whole after this much sky
+    /// time, seconds (between draws the map moves with the clouds' drift; steady clouds need no
+    /// new drawing).
     pub update_interval_s: f64,
     /// Scroll it (centre it anew by whole texels, drawing only the strips that came into range),
     /// after the camera moved this fraction of the half extent across the sun's rays.
@@ -64,11 +64,15 @@ pub struct ShadowSettings {
     /// haze. 1: every sprite everywhere.
     #[serde(default = "default_far_sprite_stride")]
     pub far_sprite_stride: u32,
-    /// Texels a frame draws again for blocks gone, forming or dissipating (their footprints,
-    /// queued; one at least a frame), beyond the strips a scroll draws: spreads the cost of a
-    /// changing sky over frames.
+    /// Texels a frame draws again for blocks gone or written again (their footprints, queued;
+    /// one at least a frame), beyond the strips a scroll draws: spreads the cost of a changing
+    /// sky over frames.
     #[serde(default = "default_redraw_texels_per_frame")]
     pub redraw_texels_per_frame: u32,
+    /// Sprites a frame adds to the map of the blocks that arrived (nearest first; one block at
+    /// least a frame): the map drawn in when a sky first fills spreads over frames.
+    #[serde(default = "default_add_sprites_per_frame")]
+    pub add_sprites_per_frame: u32,
 }
 
 fn default_full_detail_m() -> f64 {
@@ -81,6 +85,10 @@ fn default_far_sprite_stride() -> u32 {
 
 fn default_redraw_texels_per_frame() -> u32 {
     65_536
+}
+
+fn default_add_sprites_per_frame() -> u32 {
+    2_048
 }
 
 impl Default for ShadowSettings {
@@ -96,6 +104,7 @@ impl Default for ShadowSettings {
             full_detail_m: default_full_detail_m(),
             far_sprite_stride: default_far_sprite_stride(),
             redraw_texels_per_frame: default_redraw_texels_per_frame(),
+            add_sprites_per_frame: default_add_sprites_per_frame(),
         }
     }
 }
@@ -190,6 +199,21 @@ impl ShadowFrame {
             DVec3::X
         };
         let up = sun.cross(right).normalize();
+        Self {
+            sun,
+            right,
+            up,
+            centre_m: DVec3::ZERO,
+            half_extent_m: settings.half_extent_m,
+            eye_m: DVec3::ZERO,
+        }
+        .moved_to(camera_m, settings)
+    }
+
+    /// The map with the same axes (to the bit: a frame made anew from its sun could differ in
+    /// the last one, and a scroll needs the same axes) centred around `camera_m`.
+    pub fn moved_to(&self, camera_m: DVec3, settings: &ShadowSettings) -> Self {
+        let (sun, right, up) = (self.sun, self.right, self.up);
         let texel = settings.texel_m();
         let snap = |x: f64| (x / texel).round() * texel;
         // Along the rays too, on a coarse grid: the eye then stays where it was as the camera
@@ -203,12 +227,10 @@ impl ShadowFrame {
             + up * cell(up.dot(centre_m))
             + sun * cell(sun.dot(centre_m));
         Self {
-            sun,
-            right,
-            up,
             centre_m,
             half_extent_m: settings.half_extent_m,
             eye_m: foot + sun * EYE_DISTANCE_M,
+            ..*self
         }
     }
 
@@ -267,8 +289,7 @@ pub struct RedrawDue {
     pub recentre: bool,
     /// The sun turned more than `rebuild_sun_deg`: drawn again whole.
     pub turned: bool,
-    /// `update_interval_s` went by while clouds it covers form or dissipate: their footprints
-    /// are drawn again.
+    /// `update_interval_s` went by while clouds it covers form or dissipate: drawn again whole.
     pub aged: bool,
 }
 
@@ -593,7 +614,7 @@ mod tests {
         for (dx, dy) in [(3, 0), (0, -5), (7, 4), (-2, 9), (-11, -1), (1, 1)] {
             let to_centre = from.centre_m + from.right * (dx as f64 * s.texel_m())
                 - from.up * (dy as f64 * s.texel_m());
-            let to = ShadowFrame::new(to_centre, sun, &s);
+            let to = from.moved_to(to_centre, &s);
             let shift = scroll_shift(&from, &to, s.size_px);
             assert_eq!(shift, Some((dx, dy)));
             // A world point keeps its place: texel (i, j) of the old map is (i - x, j - y).
@@ -652,8 +673,17 @@ mod tests {
         // Another sun, or a jump of more than a quarter of the map: drawn whole.
         let turned = ShadowFrame::new(from.centre_m, self::sun(36.0, 200.0), &s);
         assert_eq!(scroll_shift(&from, &turned, s.size_px), None);
-        let far = ShadowFrame::new(from.centre_m + from.right * 40.0 * s.texel_m(), sun, &s);
+        let far = from.moved_to(from.centre_m + from.right * 40.0 * s.texel_m(), &s);
         assert_eq!(scroll_shift(&from, &far, s.size_px), None);
+        // Into another cell of the eye's grid (a half extent): drawn whole.
+        let cells = ShadowSettings::default();
+        let a = ShadowFrame::new(DVec3::new(0.0, 0.0, 1_000.0), sun, &cells);
+        let near = a.moved_to(a.centre_m + a.right * 20_000.0, &cells);
+        assert_eq!(near.eye_m, a.eye_m);
+        assert!(scroll_shift(&a, &near, cells.size_px).is_some());
+        let over = a.moved_to(a.centre_m + a.right * 31_000.0, &cells);
+        assert_ne!(over.eye_m, a.eye_m);
+        assert_eq!(scroll_shift(&a, &over, cells.size_px), None);
     }
 
     #[test]

@@ -21,8 +21,12 @@
 //! same way), and the map costs only when something in it changes:
 //!
 //! - **Whole** (the only drawing that clears all of it): the first, after the sun has turned
-//!   `rebuild_sun_deg`, when asked ([`CloudShadows::redraw`]) or switched on, and when the
-//!   camera jumped more than a quarter of the map at once.
+//!   `rebuild_sun_deg`, every `update_interval_s` of sky time while a cloud it covers forms or
+//!   dissipates (its footprint alone drawn again would reach its neighbours' clouds, and a sky
+//!   of building cumulus has many such: the Cb circle drew more that way than whole), when
+//!   asked ([`CloudShadows::redraw`]) or switched on, when the camera jumped more than a quarter
+//!   of the map at once or into another cell of the eye's grid (`layout`), and when more than
+//!   `MAX_QUEUED` rectangles wait.
 //! - **Scrolled**: when the camera has gone `recentre_fraction` of the half extent from the
 //!   map's centre, the map is centred on it again by whole texels: the texels the old and new
 //!   map share are copied to their new place (in the map itself, a band of 64 rows at a time
@@ -30,18 +34,21 @@
 //!   and only the strips that came into range are drawn, with the fade bands that were the old
 //!   edge and are the new one (the fade depends on a texel's place in the map, so those are
 //!   drawn again, not copied). Blocks the move takes across `full_detail_m` (drawn at another
-//!   stride by a fresh drawing) are queued as patches, below. The
-//!   sums are additive (each fragment adds `-ln(1 - alpha)`), so a strip cleared and drawn
-//!   under a scissor with every sprite that reaches it holds what a whole drawing holds there:
-//!   a scrolled map equals a fresh one up to half-float rounding (a test holds them together).
-//! - **Patched**: a block the map holds that is gone (taken away, or no longer placed), and
-//!   every `update_interval_s` of sky time each block that forms or dissipates, leave a
-//!   rectangle to draw again: the texels their shadow may fall on. They are queued and drawn a
-//!   few a frame (`redraw_texels_per_frame` texels beyond a scroll's strips, one rectangle at
-//!   least; the map keeps the old shadow there until its turn), each cleared and drawn under
-//!   its scissor with the blocks of the map that reach it.
+//!   stride by a fresh drawing) are queued as patches, below. The sums are additive (each
+//!   fragment adds `-ln(1 - alpha)`), so a strip cleared and drawn with every sprite that
+//!   reaches it holds what a whole drawing holds there: a scrolled map equals a fresh one up to
+//!   half-float rounding (a test holds them together). The draw's eye stays in its cell as the
+//!   map scrolls, so both turn every sprite alike.
+//! - **Patched**: a block the map holds that is gone (taken away, or no longer placed) or was
+//!   written again (placed again) leaves a rectangle to draw again: the texels its shadow may
+//!   fall on. They are queued and drawn a few a frame (`redraw_texels_per_frame` texels beyond a
+//!   scroll's strips, one rectangle at least; the map keeps the old shadow there until its
+//!   turn), each cleared and filled with the clouds of the map's blocks that reach it, in one
+//!   draw whose fragments the shader keeps to the rectangles.
 //! - **Added**: a block that arrives (or comes into range with a scroll) is added to the map,
-//!   its own sprites drawn over the whole map, the sums being additive.
+//!   its own sprites drawn over the whole map, the sums being additive: nearest the centre
+//!   first, `add_sprites_per_frame` sprites a frame (one block at least), so a sky that fills
+//!   draws its map in over frames.
 //!
 //! What is drawn when is decided on the CPU from plain data (`layout`: the shift, the strips,
 //! the footprints, merged so that no texel is drawn twice); the map's view of the resident
@@ -98,6 +105,9 @@ struct GpuCloudShadow {
     rects: [[u32; 4]; MASK_RECTS],
 }
 const _: () = assert!(std::mem::size_of::<GpuCloudShadow>() == 96 + 16 * MASK_RECTS);
+
+/// Most rectangles queued before the map is drawn whole instead.
+const MAX_QUEUED: usize = 256;
 
 /// Most rectangles a frame draws again (a scroll's strips take four at most). Keep in sync with
 /// `MASK_RECTS` in `shaders/cloud_shadow.wgsl`.
@@ -177,9 +187,8 @@ pub struct CloudShadows {
     /// (the view's group is made anew then).
     list_buffer: wgpu::Buffer,
     list_buffers_made: u64,
-    /// Where the map stands (moved by its scrolls), the sky time of its last whole drawing or
-    /// of the last patches of the blocks that form or dissipate, and the clouds' drift at its
-    /// whole drawing (every later drawing into it draws the blocks moved back by the drift
+    /// Where the map stands (moved by its scrolls), the sky time of its last whole drawing, and
+    /// the clouds' drift at that drawing (every later drawing into it draws the blocks moved back by the drift
     /// since: the map holds the clouds where they were then).
     drawn: Option<(ShadowFrame, f64, DVec3)>,
     /// The blocks whose shadows the map holds (by id): their centre and radius in the map
@@ -187,8 +196,11 @@ pub struct CloudShadows {
     /// written again is placed again: its footprint is drawn again).
     in_map: IdMap<(DVec3, f64, u64)>,
     /// Blocks' centres and radii (in the map) whose footprints are yet to be drawn again
-    /// (blocks gone, blocks forming or dissipating), oldest first.
+    /// (blocks gone or written again, blocks a scroll took across `full_detail_m`), oldest
+    /// first.
     dirty: Vec<(DVec3, f64)>,
+    /// Blocks that arrived (covered, not yet in the map), drawn in a budget a frame.
+    arriving: IdSet,
     /// This frame's drawing: whether it is whole, the copies of a scroll, the rectangles drawn
     /// again (cleared, and the mask of the draw that fills them) and the segments of its draw
     /// list.
@@ -299,6 +311,7 @@ impl CloudShadows {
             drawn: None,
             in_map: IdMap::default(),
             dirty: Vec::new(),
+            arriving: IdSet::default(),
             whole: false,
             copies: Vec::new(),
             clears: Vec::new(),
@@ -420,10 +433,15 @@ impl CloudShadows {
                 // The camera in the map (which holds the clouds where they were when it was
                 // drawn whole).
                 let here = camera_m - (self.drift_m - drift_then);
-                let due = redraw_due(&frame, (at_s, now_s), here, sun, false, &s);
-                whole |= due.turned;
+                // While clouds it covers form or dissipate, drawn whole every
+                // `update_interval_s` (their footprints drawn again instead cost more: a sky of
+                // building cumulus has many, each reaching its neighbours' clouds); and whole
+                // when the queue of rectangles has grown past what patches are for.
+                let changing = self.cover.as_ref().is_some_and(|c| !c.changing.is_empty());
+                let due = redraw_due(&frame, (at_s, now_s), here, sun, changing, &s);
+                whole |= due.turned || due.aged || self.dirty.len() > MAX_QUEUED;
                 if due.recentre && !whole {
-                    let to = ShadowFrame::new(here, frame.sun, &s);
+                    let to = frame.moved_to(here, &s);
                     match layout::scroll_shift(&frame, &to, s.size_px) {
                         Some(shift) => scroll = Some((to, shift)),
                         // A jump of more than a quarter of the map: drawn whole.
@@ -435,7 +453,7 @@ impl CloudShadows {
         let bytes = if whole {
             self.prepare_whole(queue, resident, light, camera_m, sun, now_s, dark)
         } else {
-            self.prepare_patches(queue, resident, light, scroll, now_s, dark)
+            self.prepare_patches(queue, resident, light, scroll, dark)
         };
         if let Some((frame, _, drift_then)) = &self.drawn {
             self.lookup = frame.uv_from_camera_relative(camera_m, self.drift_m - *drift_then);
@@ -471,11 +489,12 @@ impl CloudShadows {
         // under its cloud moves 17 m at 0.5 degrees): the sun a host gives follows the
         // camera's place and time, and a map turned by a millionth of a radian puts its
         // sprites' edges across other texels' centres.
-        let sun = match &self.drawn {
-            Some((f, _, _)) if f.sun.angle_between(sun).to_degrees() <= s.rebuild_sun_deg => f.sun,
-            _ => sun,
+        let frame = match &self.drawn {
+            Some((f, _, _)) if f.sun.angle_between(sun).to_degrees() <= s.rebuild_sun_deg => {
+                f.moved_to(camera_m, &s)
+            }
+            _ => ShadowFrame::new(camera_m, sun, &s),
         };
-        let frame = ShadowFrame::new(camera_m, sun, &s);
         self.draws.clear();
         self.lists.clear();
         let order = if dark {
@@ -487,6 +506,7 @@ impl CloudShadows {
         let covered: IdSet = order.iter().map(|r| r.block.id).collect();
         self.kept_lists.retain(|id, _| covered.contains(id));
         let sprites = self.push_draws(&order, &frame, DVec3::ZERO, 0);
+        self.arriving.clear();
         self.in_map = order
             .iter()
             .map(|r| (r.block.id, (r.centre_m(), r.radius_m, r.place_serial)))
@@ -508,18 +528,17 @@ impl CloudShadows {
     }
 
     /// Draws what changed into the map drawn before: its scroll to `scroll` (the new frame and
-    /// the shift), the rectangles of blocks gone or changing (a budget of them), the blocks that
-    /// arrived. Nothing but a scroll while `dark`.
+    /// the shift), the rectangles of blocks gone or written again (a budget of them), the blocks
+    /// that arrived (a budget of them). Nothing but a scroll while `dark`.
     fn prepare_patches(
         &mut self,
         queue: &wgpu::Queue,
         resident: &ResidentSet,
         light: &ViewLight,
         scroll: Option<(ShadowFrame, (i32, i32))>,
-        now_s: f64,
         dark: bool,
     ) -> u64 {
-        let Some((mut frame, mut at_s, drift_then)) = self.drawn else {
+        let Some((mut frame, at_s, drift_then)) = self.drawn else {
             return 0;
         };
         let s = self.settings;
@@ -574,11 +593,12 @@ impl CloudShadows {
                         self.dirty.push((c, r));
                     }
                 }
-                arrived = drawing_order(
-                    now.keys()
-                        .filter(|id| !self.in_map.contains_key(id))
-                        .filter_map(|id| blocks.get(id)),
-                );
+                let new: Vec<u64> = now
+                    .keys()
+                    .filter(|id| !self.in_map.contains_key(id) && !self.arriving.contains(id))
+                    .copied()
+                    .collect();
+                self.arriving.extend(new);
                 self.cover = Some(CoverCheck {
                     changes: resident.changes,
                     fades: resident.fades,
@@ -586,25 +606,6 @@ impl CloudShadows {
                     drift_m: self.drift_m,
                     changing,
                 });
-            }
-            let changing = self.cover.as_ref().map_or(&[][..], |c| &c.changing[..]);
-            let due = redraw_due(
-                &frame,
-                (at_s, now_s),
-                frame.centre_m,
-                frame.sun,
-                !changing.is_empty(),
-                &s,
-            );
-            if due.aged {
-                at_s = now_s;
-                for id in changing {
-                    if let Some(&(c, r, _)) = self.in_map.get(id)
-                        && !self.dirty.contains(&(c, r))
-                    {
-                        self.dirty.push((c, r));
-                    }
-                }
             }
             // The queue's oldest rectangles, within the budget (one at least) and the mask's room.
             let mut budget = u64::from(s.redraw_texels_per_frame);
@@ -620,6 +621,30 @@ impl CloudShadows {
                 }
             }
             self.dirty.drain(..taken);
+            // The blocks that arrived, nearest the map's centre first, within their budget (one
+            // at least); the rest wait (and those gone or out of range meanwhile are dropped).
+            if !self.arriving.is_empty() {
+                let mut queue: Vec<(f64, &Resident)> = self
+                    .arriving
+                    .iter()
+                    .filter_map(|id| blocks.get(id))
+                    .filter(|r| is_covered(r, &frame))
+                    .map(|r| ((r.centre_m() - back - frame.centre_m).length_squared(), r))
+                    .collect();
+                queue.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let mut budget = s.add_sprites_per_frame;
+                let mut taken = Vec::new();
+                for (_, r) in queue.iter() {
+                    if !taken.is_empty() && budget == 0 {
+                        break;
+                    }
+                    budget = budget.saturating_sub(block_sprites(r, &frame, back, &s));
+                    taken.push(*r);
+                }
+                let waiting: IdSet = queue[taken.len()..].iter().map(|q| q.1.block.id).collect();
+                self.arriving = waiting;
+                arrived = drawing_order(taken.into_iter());
+            }
         }
         self.drawn = Some((frame, at_s, drift_then));
         if rects.is_empty() && arrived.is_empty() && scroll.is_none() {
@@ -638,7 +663,7 @@ impl CloudShadows {
         );
         self.draws.clear();
         self.lists.clear();
-        let sprites = self.push_draws(&held, &frame, back, 0);
+        let sprites = self.push_masked_draws(&held, &frame, back, &rects);
         self.segments.push(Segment {
             masked: true,
             first: 0,
@@ -733,6 +758,17 @@ fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (IdMap<u64>, Vec<u64>) {
         })
         .collect();
     (ids, changing)
+}
+
+/// The sprites a drawing at `frame` draws of a block moved back by `back_m` (every
+/// `far_sprite_stride`th beyond `full_detail_m`).
+fn block_sprites(r: &Resident, frame: &ShadowFrame, back_m: DVec3, s: &ShadowSettings) -> u32 {
+    let stride = if is_near(frame, r.centre_m() - back_m, r.radius_m, s) {
+        1
+    } else {
+        s.far_sprite_stride
+    };
+    r.clouds.iter().map(|c| c.sprites.div_ceil(stride)).sum()
 }
 
 /// How much of their shadows the clouds cast for the sun along `sun`: 1 above 5 degrees, 0

@@ -6,6 +6,7 @@
 
 use glam::DVec3;
 
+use super::layout::{TexelRect, footprint};
 use super::{CloudShadows, NO_FAR_FADE_M, ShadowFrame, is_near};
 use crate::render::gpu_types::{GpuDrawBlock, GpuListCloud};
 use crate::render::sprites::draw_list::fade_code;
@@ -120,6 +121,65 @@ impl CloudShadows {
                 fade_progress,
             });
             total += kept.sprites;
+        }
+        total
+    }
+}
+
+impl CloudShadows {
+    /// Appends the draws of the blocks of `order` (in [`drawing_order`]) to an empty draw list
+    /// as [`Self::push_draws`] does, but with only the clouds whose shadow may fall in one of
+    /// `rects` (a block's sprites are listed cloud by cloud, so the rest are left out: a
+    /// rectangle drawn again costs the clouds that reach it, not whole blocks); returns the
+    /// sprites.
+    pub(super) fn push_masked_draws(
+        &mut self,
+        order: &[&Resident],
+        frame: &ShadowFrame,
+        back_m: DVec3,
+        rects: &[TexelRect],
+    ) -> u32 {
+        let n = self.settings.size_px;
+        let mut total = 0u32;
+        for r in order {
+            let offset = r.centre_m() - r.block.centre_m - back_m;
+            let Some(reach) = footprint(frame, r.centre_m() - back_m, r.radius_m, n) else {
+                continue;
+            };
+            let near: Vec<&TexelRect> = rects.iter().filter(|q| q.overlaps(&reach)).collect();
+            let stride = if is_near(frame, r.centre_m() - back_m, r.radius_m, &self.settings) {
+                1
+            } else {
+                self.settings.far_sprite_stride
+            };
+            let list_base = self.lists.len() as u32;
+            let mut first = 0u32;
+            for state in r.clouds.iter().filter(|c| c.sprites > 0) {
+                let at = footprint(frame, state.centre_m + offset, state.radius_m as f64, n);
+                if !at.is_some_and(|f| near.iter().any(|q| q.overlaps(&f))) {
+                    continue;
+                }
+                self.lists.push(GpuListCloud {
+                    cloud: state.cloud_slot,
+                    first,
+                    order_base: state.sprite_base,
+                    stride,
+                });
+                first += state.sprites.div_ceil(stride);
+            }
+            if first == 0 {
+                continue;
+            }
+            let (fade_kind, fade_progress) = fade_code(r.motion.fade);
+            self.draws.push(GpuDrawBlock {
+                origin_rel: (r.centre_m() - back_m - frame.eye_m).as_vec3().to_array(),
+                first: total,
+                list_base,
+                list_len: self.lists.len() as u32 - list_base,
+                fade_kind,
+                fade_progress,
+            });
+            total += first;
         }
         total
     }
