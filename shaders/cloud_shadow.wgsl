@@ -8,6 +8,9 @@
 // so `World::sun_occlusion` at a ground point reads what the map shows there. A host multiplies
 // its direct sunlight by exp(-tau) (src/render/shadow/mod.rs).
 
+// Keep in sync with `MASK_RECTS` in src/render/shadow/mod.rs.
+const MASK_RECTS: u32 = 32u;
+
 // Keep in sync with `GpuCloudShadow` in src/render/shadow/mod.rs.
 struct ShadowFrame {
     clip_from_eye: mat4x4<f32>,
@@ -15,6 +18,10 @@ struct ShadowFrame {
     // settings' `opacity_scale`, less as the sun nears the horizon); y: the fraction of the map
     // across which its edge fades out; zw unused.
     params: vec4<f32>,
+    // x: how many of `rects` a masked draw keeps to.
+    mask: vec4<u32>,
+    // The rectangles of texels drawn again: first column, first row, one past the last.
+    rects: array<vec4<u32>, MASK_RECTS>,
 };
 
 @group(0) @binding(0) var<uniform> shadow: ShadowFrame;
@@ -41,11 +48,14 @@ struct VertexOut {
     @location(2) @interpolate(flat) weight_floor: vec2<f32>,
     // The corner in clip space (the edge fade).
     @location(3) clip: vec2<f32>,
+    // 1: only the fragments in the rectangles drawn again are kept (instance 1 of the draw).
+    @location(4) @interpolate(flat) masked: u32,
 };
 
 @vertex
-fn vs_shadow(v: VertexIn) -> VertexOut {
+fn vs_shadow(v: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     var o: VertexOut;
+    o.masked = instance;
     if (v.position_visible.w < 0.5) {
         // Faded out: every corner outside the clip volume.
         o.position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
@@ -72,8 +82,23 @@ fn unit_chord(o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(-half_b - root, -half_b + root) / dd;
 }
 
+// Whether a texel is in one of the rectangles drawn again: a map patched adds a sprite to
+// those alone (the rest of the map holds it already), once however the rectangles overlap.
+fn in_rects(texel: vec2<u32>) -> bool {
+    for (var k = 0u; k < min(shadow.mask.x, MASK_RECTS); k++) {
+        let r = shadow.rects[k];
+        if (all(texel >= r.xy) && all(texel < r.zw)) {
+            return true;
+        }
+    }
+    return false;
+}
+
 @fragment
 fn fs_shadow(i: VertexOut) -> @location(0) vec4<f32> {
+    if (i.masked != 0u && !in_rects(vec2<u32>(i.position.xy))) {
+        discard;
+    }
     let o = i.point;
     let d = i.ray;
     let floor = i.weight_floor.y;
@@ -98,4 +123,17 @@ fn fs_shadow(i: VertexOut) -> @location(0) vec4<f32> {
     let keep = 1.0 - smoothstep(1.0 - shadow.params.y, 1.0 - 0.25 * shadow.params.y, edge);
     let tau = length_m * abs(i.weight_floor.x) * shadow.params.x;
     return vec4<f32>(tau * keep, 0.0, 0.0, 0.0);
+}
+
+// A rectangle of the map drawn again is cleared first: a triangle over the whole map writing 0
+// (no blending), cut to the rectangle by the scissor (src/render/shadow/draw.rs).
+@vertex
+fn vs_clear(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let corner = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
+}
+
+@fragment
+fn fs_clear() -> @location(0) vec4<f32> {
+    return vec4<f32>(0.0, 0.0, 0.0, 0.0);
 }

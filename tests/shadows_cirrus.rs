@@ -64,7 +64,11 @@ fn cirrus_shadows_are_light_and_the_probe_agrees() {
         stats.shadow_redrawn && stats.shadow_sprites > 0,
         "{stats:?}"
     );
-    let map = host.sky.sky().read_back_cloud_shadows(&host.gpu.queue).unwrap();
+    let map = host
+        .sky
+        .sky()
+        .read_back_cloud_shadows(&host.gpu.queue)
+        .unwrap();
     let lookup = host.sky.cloud_shadows().uv_from_camera_relative;
     let sun = host.sky.lighting().sun_direction.as_dvec3();
     let world = host.sky.world();

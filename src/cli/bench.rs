@@ -144,6 +144,10 @@ struct FrameRecord {
     impostors_rebuilt: u32,
     /// Bytes of the sky's off-screen cloud target (0 at scale 1).
     cloud_target_bytes: u64,
+    /// Sprites and texels drawn into the cloud shadow map (`FrameStats::shadow_sprites`,
+    /// `shadow_texels`).
+    shadow_sprites: u32,
+    shadow_texels: u64,
     /// The sky's passes one by one (`--passes`, where the device times them).
     passes: Option<skycast::render::PassTimes>,
 }
@@ -446,6 +450,8 @@ fn draw_to_steady(
             blocks_far: stats.blocks_far,
             impostors_rebuilt: stats.impostors_rebuilt,
             cloud_target_bytes: stats.cloud_target_bytes,
+            shadow_sprites: stats.shadow_sprites,
+            shadow_texels: stats.shadow_texels,
             passes: host.sky.sky().pass_times(),
         });
         if steady {
@@ -856,6 +862,8 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
         "blocks_far",
         "impostors_rebuilt",
         "cloud_target_bytes",
+        "shadow_sprites",
+        "shadow_texels",
     ];
     header.extend(passes::COLUMNS.map(|(name, _)| name));
     csv.write_record(&header)?;
@@ -882,6 +890,8 @@ fn write_frames_csv(path: &Path, runs: &[Run]) -> anyhow::Result<()> {
                 f.blocks_far.to_string(),
                 f.impostors_rebuilt.to_string(),
                 f.cloud_target_bytes.to_string(),
+                f.shadow_sprites.to_string(),
+                f.shadow_texels.to_string(),
             ];
             row.extend(passes::COLUMNS.map(|(_, read)| {
                 f.passes

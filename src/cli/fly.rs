@@ -261,6 +261,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "air_thread_us",
         "far_field_us",
         "far_field_gpu_bytes",
+        "shadow_sprites",
+        "shadow_texels",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
@@ -385,6 +387,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             stats.thread.air_us.to_string(),
             stats.far_field_us.to_string(),
             stats.far_field_gpu_bytes.to_string(),
+            stats.shadow_sprites.to_string(),
+            stats.shadow_texels.to_string(),
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);

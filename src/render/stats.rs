@@ -111,8 +111,13 @@ pub struct FrameStats {
     /// Whether the cloud shadow map was drawn this frame (else its last drawing, moved with the
     /// clouds' drift, is looked up).
     pub shadow_redrawn: bool,
-    /// Sprites drawn into the shadow map this frame (0 when it was not drawn).
+    /// Sprites drawn into the shadow map this frame (0 when it was not drawn): a whole drawing,
+    /// or a scroll's strips, the rectangles drawn again and the blocks added.
     pub shadow_sprites: u32,
+    /// Texels of the shadow map cleared and drawn again this frame: the whole map, or a
+    /// scroll's strips and the rectangles of blocks gone or changing (blocks added to the map
+    /// add over it and are not counted; a scroll's copy is not).
+    pub shadow_texels: u64,
     /// CPU time of the host's air-data queries this frame (`SkySystem::air_at`, lines of
     /// sight), microseconds: set by the host that asks (`skycast fly` does), 0 otherwise.
     pub air_us: u64,

@@ -17,34 +17,70 @@
 //!
 //! The map covers a square across the sun's rays around the camera (`half_extent_m`, at least
 //! the sprites' draw distance), centred on a texel of a grid fixed to the world, so a camera
-//! moving within a texel leaves every shadow as it was (no shimmer). It is drawn again after
-//! `update_interval_s` of sky time while a cloud it covers forms or dissipates, when the camera has gone
-//! `recentre_fraction` of the half extent, the sun has turned `rebuild_sun_deg`, or a block
-//! that may shadow the ground within `full_detail_m` of the camera went; a block that arrives
-//! is added to the map (its own sprites drawn over it, the sums being additive), and one that
-//! goes farther off keeps its shadow until the next drawing. With the sun below 1 degree the
-//! map is drawn empty. Between draws the lookup matrix moves the map with the clouds' drift
-//! (SilverLining reuses its map across frames the same way). Its last texels are faded out, so
-//! the shadows end softly at the map's edge. Geometry and rules: `layout`. Units: metres.
+//! moving within a texel leaves every shadow as it was (no shimmer). Its last texels are faded
+//! out in the draw, so the shadows end softly at the map's edge. Between drawings the lookup
+//! matrix moves the map with the clouds' drift (SilverLining reuses its map across frames the
+//! same way), and the map costs only when something in it changes:
+//!
+//! - **Whole** (the only drawing that clears all of it): the first, after the sun has turned
+//!   `rebuild_sun_deg`, every `update_interval_s` of sky time while a cloud it covers forms or
+//!   dissipates (its footprint alone drawn again would reach its neighbours' clouds, and a sky
+//!   of building cumulus has many such: the Cb circle drew more that way than whole), when
+//!   asked ([`CloudShadows::redraw`]) or switched on, when the camera jumped more than a quarter
+//!   of the map at once or into another cell of the eye's grid (`layout`), and when more than
+//!   `MAX_QUEUED` rectangles wait.
+//! - **Scrolled**: when the camera has gone `recentre_fraction` of the half extent from the
+//!   map's centre, the map is centred on it again by whole texels: the texels the old and new
+//!   map share are copied to their new place (in the map itself, a band of 64 rows at a time
+//!   through a small scratch texture, 128 KiB at 1024 texels, so a scroll takes no second map),
+//!   and only the strips that came into range are drawn, with the fade bands that were the old
+//!   edge and are the new one (the fade depends on a texel's place in the map, so those are
+//!   drawn again, not copied). Blocks the move takes across `full_detail_m` (drawn at another
+//!   stride by a fresh drawing) are queued as patches, below. The sums are additive (each
+//!   fragment adds `-ln(1 - alpha)`), so a strip cleared and drawn with every sprite that
+//!   reaches it holds what a whole drawing holds there: a scrolled map equals a fresh one up to
+//!   half-float rounding (a test holds them together). The draw's eye stays in its cell as the
+//!   map scrolls, so both turn every sprite alike.
+//! - **Patched**: a block the map holds that is gone (taken away, or no longer placed) or was
+//!   written again (placed again) leaves a rectangle to draw again: the texels its shadow may
+//!   fall on. They are queued and drawn a few a frame (`redraw_texels_per_frame` texels beyond a
+//!   scroll's strips, one rectangle at least; the map keeps the old shadow there until its
+//!   turn), each cleared and filled with the clouds of the map's blocks that reach it, in one
+//!   draw whose fragments the shader keeps to the rectangles.
+//! - **Added**: a block that arrives (or comes into range with a scroll) is added to the map,
+//!   its own sprites drawn over the whole map, the sums being additive: nearest the centre
+//!   first, `add_sprites_per_frame` sprites a frame (one block at least), so a sky that fills
+//!   draws its map in over frames.
+//!
+//! What is drawn when is decided on the CPU from plain data (`layout`: the shift, the strips,
+//! the footprints, merged so that no texel is drawn twice); the map's view of the resident
+//! sprites (`view`) reuses each block's cloud lists, and a frame writes the draw list of the
+//! blocks it draws only (a frame that draws nothing writes nothing). Recording: `draw`. With
+//! the sun below 1 degree the map is drawn empty (again only as it scrolls). Units: metres.
 
 // The map's settings live here, so the settings tree reads them without the map.
 pub(super) mod layout;
 // The map's own view of the resident sprites (its draw list and cloud lists), written when a
 // drawing is decided.
 mod view;
+// Its textures, pipelines and the recording of a drawing.
+mod draw;
 
 use std::cell::Cell;
 
 use glam::{DVec3, Mat4, Vec3};
+use view::drawing_order;
 
-pub use layout::{EYE_DISTANCE_M, MAX_SIZE_PX, ShadowFrame, ShadowSettings, needs_redraw};
+pub use layout::{
+    BandCopy, EYE_DISTANCE_M, MAX_SIZE_PX, RedrawDue, ShadowFrame, ShadowSettings, TexelRect,
+    redraw_due,
+};
 
 use super::RenderError;
-use super::gpu_types::{GpuDrawBlock, GpuListCloud, GpuSpriteVertex};
+use super::gpu_types::{GpuDrawBlock, GpuListCloud};
 use super::id_hash::{IdMap, IdSet};
-use super::sprites::build::{SpriteBuild, chunks};
 use super::sprites::draw_list::Blocks;
-use super::sprites::resident::{ResidentSet, storage_buffer};
+use super::sprites::resident::{Resident, ResidentSet, storage_buffer};
 use super::sprites::sprite_view::{ViewBuffers, ViewLight};
 use super::stats::FrameStats;
 
@@ -65,8 +101,19 @@ struct GpuCloudShadow {
     /// the settings' `opacity_scale`, less as the sun nears the horizon); y: the fraction of
     /// the map across which its edge fades out; zw unused.
     params: [f32; 4],
+    /// x: how many of `rects` a masked draw keeps to; yzw unused.
+    mask: [u32; 4],
+    /// The rectangles drawn again (first column, first row, one past the last of each).
+    rects: [[u32; 4]; MASK_RECTS],
 }
-const _: () = assert!(std::mem::size_of::<GpuCloudShadow>() == 80);
+const _: () = assert!(std::mem::size_of::<GpuCloudShadow>() == 96 + 16 * MASK_RECTS);
+
+/// Most rectangles queued before the map is drawn whole instead.
+const MAX_QUEUED: usize = 256;
+
+/// Most rectangles a frame draws again (a scroll's strips take four at most). Keep in sync with
+/// `MASK_RECTS` in `shaders/cloud_shadow.wgsl`.
+const MASK_RECTS: usize = 32;
 
 /// What a host needs to put the clouds' shadows on its ground (from [`super::Sky::cloud_shadows`]).
 ///
@@ -125,10 +172,14 @@ pub struct CloudShadows {
     extinction_per_m: f32,
     device: wgpu::Device,
     pipeline: wgpu::RenderPipeline,
+    /// Writes 0 (a rectangle's texels, under its scissor, before they are drawn again).
+    clear_pipeline: wgpu::RenderPipeline,
     uniform: wgpu::Buffer,
     group: wgpu::BindGroup,
     texture: wgpu::Texture,
     view: wgpu::TextureView,
+    /// The band a scroll moves the map's texels through ([`layout::SCROLL_BAND_ROWS`] rows).
+    scratch: wgpu::Texture,
     view_layout: wgpu::BindGroupLayout,
     sprites_view: ViewBuffers,
     draws: Vec<GpuDrawBlock>,
@@ -141,15 +192,28 @@ pub struct CloudShadows {
     /// (the view's group is made anew then).
     list_buffer: wgpu::Buffer,
     list_buffers_made: u64,
-    /// The last drawing: where it stood, the sky time and the clouds' drift then.
+    /// Where the map stands (moved by its scrolls), the sky time of its last whole drawing, and
+    /// the clouds' drift at that drawing (every later drawing into it draws the blocks moved back by the drift
+    /// since: the map holds the clouds where they were then).
     drawn: Option<(ShadowFrame, f64, DVec3)>,
-    /// The blocks whose shadows the map holds (by id): their centre and radius when drawn.
-    /// Blocks that arrive later are added to the map; one that leaves is kept there until the
-    /// next whole drawing unless its shadow lies within `full_detail_m`.
-    in_map: IdMap<(DVec3, f64)>,
-    /// Whether this frame's draw adds to the map (blocks that arrived) rather than clearing it.
-    adding: bool,
-    /// Counts whole drawings.
+    /// The blocks whose shadows the map holds (by id): their centre and radius in the map
+    /// (moved back by the drift since its whole drawing), and the placing drawn (a block
+    /// written again is placed again: its footprint is drawn again).
+    in_map: IdMap<(DVec3, f64, u64)>,
+    /// Blocks' centres and radii (in the map) whose footprints are yet to be drawn again
+    /// (blocks gone or written again, blocks a scroll took across `full_detail_m`), oldest
+    /// first.
+    dirty: Vec<(DVec3, f64)>,
+    /// Blocks that arrived (covered, not yet in the map), drawn in a budget a frame.
+    arriving: IdSet,
+    /// This frame's drawing: whether it is whole, the copies of a scroll, the rectangles drawn
+    /// again (cleared, and the mask of the draw that fills them) and the segments of its draw
+    /// list.
+    whole: bool,
+    copies: Vec<BandCopy>,
+    clears: Vec<TexelRect>,
+    segments: Vec<Segment>,
+    /// Counts whole drawings and scrolls (the cover is looked at again after either).
     drawings: u64,
     /// The last look over every block the sky holds, while it still holds.
     cover: Option<CoverCheck>,
@@ -166,11 +230,11 @@ pub struct CloudShadows {
     timed: Cell<bool>,
 }
 
-/// What a look over every block the sky holds found for the map's drawing: the blocks the map
-/// holds that are no longer covered, and whether a covered block forms or dissipates. Looked
-/// at again only when a block came, went, was written, moved or changed its fade, or the drift
-/// moved a texel, or the map was drawn anew: a frame of a steady sky walks none of its
-/// thousands of blocks for the map.
+/// What a look over every block the sky holds found for the map's drawing: the covered blocks
+/// that form or dissipate (the blocks gone and arrived are dealt with as it looks). Looked at
+/// again only when a block came, went, was written, moved or changed its fade, or the drift
+/// moved a texel, or the map was drawn whole or scrolled: a frame of a steady sky walks none of
+/// its thousands of blocks for the map.
 #[derive(Debug)]
 struct CoverCheck {
     /// `ResidentSet::changes` and `fades`, the whole drawing, and the drift it was made at.
@@ -178,65 +242,22 @@ struct CoverCheck {
     fades: u64,
     drawing: u64,
     drift_m: DVec3,
-    /// The blocks of `in_map` left out of the cover then: their centre and radius when drawn.
-    gone: Vec<(DVec3, f64)>,
-    changing: bool,
+    /// The covered blocks that form or dissipate.
+    changing: Vec<u64>,
 }
 
-/// The built corners as the shadow pass reads them: `GpuSpriteVertex`'s position, uv, how many
-/// sprites it stands for, and colour (its alpha).
-fn shadow_vertex_layout() -> wgpu::VertexBufferLayout<'static> {
-    const ATTRS: [wgpu::VertexAttribute; 4] = wgpu::vertex_attr_array![
-        0 => Float32x4, 1 => Float32x2, 2 => Float32x4, 3 => Float32x2
-    ];
-    // Offsets: position 0, uv 16, stands_for 24, colour 32 (`GpuSpriteVertex`).
-    const PLACED: [wgpu::VertexAttribute; 4] = [
-        ATTRS[0],
-        wgpu::VertexAttribute {
-            offset: 16,
-            ..ATTRS[1]
-        },
-        wgpu::VertexAttribute {
-            offset: 32,
-            ..ATTRS[2]
-        },
-        wgpu::VertexAttribute {
-            offset: 24,
-            ..ATTRS[3]
-        },
-    ];
-    wgpu::VertexBufferLayout {
-        array_stride: std::mem::size_of::<GpuSpriteVertex>() as u64,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &PLACED,
-    }
-}
-
-/// A texture of `side` x `side` texels of optical depth.
-fn shadow_texture(device: &wgpu::Device, side: u32) -> (wgpu::Texture, wgpu::TextureView) {
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("sky.cloud_shadow"),
-        size: wgpu::Extent3d {
-            width: side,
-            height: side,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: SHADOW_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC
-            | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    let view = texture.create_view(&Default::default());
-    (texture, view)
+/// A run of the draw list: the sprites `first..first + sprites` of the view, masked to the
+/// rectangles drawn again (the blocks of the map that reach them) or not (a whole drawing,
+/// blocks that arrived).
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    masked: bool,
+    first: u32,
+    sprites: u32,
 }
 
 impl CloudShadows {
-    /// The pipeline (groups: its uniform, the sprite sheet of `sheet_layout`) and the texture
+    /// The pipelines (groups: its uniform, the sprite sheet of `sheet_layout`) and the textures
     /// (a cleared texel while switched off). `view_layout`: the build pass's view group;
     /// `in_cloud_visibility_m`: the visibility inside a cloud (`[in_cloud]`).
     pub(super) fn new(
@@ -273,61 +294,20 @@ impl CloudShadows {
                 resource: uniform.as_entire_binding(),
             }],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sky.cloud_shadow"),
-            bind_group_layouts: &[Some(&layout), Some(sheet_layout)],
-            immediate_size: 0,
-        });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("sky.cloud_shadow"),
-            source: wgpu::ShaderSource::Wgsl(WGSL.into()),
-        });
-        let add = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("sky.cloud_shadow"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_shadow"),
-                compilation_options: Default::default(),
-                buffers: &[Some(shadow_vertex_layout())],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_shadow"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: SHADOW_FORMAT,
-                    blend: Some(wgpu::BlendState {
-                        color: add,
-                        alpha: add,
-                    }),
-                    write_mask: wgpu::ColorWrites::RED,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let (texture, view) = shadow_texture(device, 1);
+        let [pipeline, clear_pipeline] = draw::pipelines(device, &layout, sheet_layout);
+        let (texture, view) = draw::shadow_texture(device, [1, 1]);
+        let scratch = draw::shadow_texture(device, [1, 1]).0;
         let mut shadows = Self {
             settings,
             extinction_per_m: 3.0 / in_cloud_visibility_m.max(1e-3),
             device: device.clone(),
             pipeline,
+            clear_pipeline,
             uniform,
             group,
             texture,
             view,
+            scratch,
             view_layout: view_layout.clone(),
             sprites_view: ViewBuffers::new(device, false),
             draws: Vec::new(),
@@ -337,7 +317,12 @@ impl CloudShadows {
             list_buffers_made: 0,
             drawn: None,
             in_map: IdMap::default(),
-            adding: false,
+            dirty: Vec::new(),
+            arriving: IdSet::default(),
+            whole: false,
+            copies: Vec::new(),
+            clears: Vec::new(),
+            segments: Vec::new(),
             drawings: 0,
             cover: None,
             force: false,
@@ -356,7 +341,9 @@ impl CloudShadows {
     pub fn set_enabled(&mut self, queue: &wgpu::Queue, enabled: bool) {
         self.settings.enabled = enabled;
         let side = if enabled { self.settings.size_px } else { 1 };
-        (self.texture, self.view) = shadow_texture(&self.device, side);
+        (self.texture, self.view) = draw::shadow_texture(&self.device, [side, side]);
+        let band = if enabled { layout::SCROLL_BAND_ROWS } else { 1 };
+        self.scratch = draw::shadow_texture(&self.device, [side, band]).0;
         self.drawn = None;
         if !enabled {
             // Cleared: a texel of tau 0.
@@ -394,15 +381,16 @@ impl CloudShadows {
         self.drift_m = offset_m;
     }
 
-    /// Bytes of its texture and buffers.
+    /// Bytes of its textures and buffers.
     pub fn gpu_bytes(&self) -> u64 {
         let side = self.texture.width() as u64;
+        let scratch = self.scratch.width() as u64 * self.scratch.height() as u64 * 2;
         let view = if self.settings.enabled {
             self.sprites_view.gpu_bytes()
         } else {
             0
         };
-        side * side * 2 + self.uniform.size() + view + self.list_buffer.size()
+        side * side * 2 + scratch + self.uniform.size() + view + self.list_buffer.size()
     }
 
     /// The map and its lookup for the last prepared frame.
@@ -416,10 +404,11 @@ impl CloudShadows {
         }
     }
 
-    /// Decides whether the map is drawn this frame and, if so, writes its view of the resident
-    /// sprites (`resident`, lit as `light` says) and its uniform; sets the lookup for the camera
-    /// at `camera_m`. Returns the bytes written. Call [`Self::record`] after, in the frame's
-    /// own submission, after the patch of the resident orders.
+    /// Decides what of the map is drawn this frame ([module docs](self)) and, if anything,
+    /// writes its view of the resident sprites (`resident`, lit as `light` says) and its
+    /// uniform; sets the lookup for the camera at `camera_m`. Returns the bytes written. Call
+    /// [`Self::record`] after, in the frame's own submission, after the patch of the resident
+    /// orders.
     pub(super) fn prepare(
         &mut self,
         queue: &wgpu::Queue,
@@ -429,6 +418,9 @@ impl CloudShadows {
         stats: &mut FrameStats,
     ) -> u64 {
         self.pending = None;
+        self.copies.clear();
+        self.segments.clear();
+        self.clears.clear();
         self.timed.set(false);
         stats.shadow_gpu_bytes = self.gpu_bytes();
         if !self.settings.enabled {
@@ -437,131 +429,296 @@ impl CloudShadows {
         }
         let sun = sun.as_dvec3();
         let s = self.settings;
-        let blocks = &resident.blocks;
-        // A whole drawing when the map is due (moved, turned, aged, forced) or a block whose
-        // shadow lies near was taken away; else only the blocks that arrived since are drawn,
-        // added to the map (the sums are additive): a block arriving at the edge of the sprites'
-        // reach no longer costs a drawing of every cloud (most frames of the storm bench did).
-        let mut added: Option<IdSet> = None;
         // The shadows fade out as the sun nears the horizon (they would reach for ever); with
         // it below 1 degree nothing shows, and the map is drawn with no sprite.
-        let sun_up = smoothstep(1.0f64.to_radians().sin(), 5.0f64.to_radians().sin(), sun.z);
-        let dark = sun_up <= 0.0;
-        let stale = match &self.drawn {
-            None => true,
-            Some((frame, at_s, _)) => {
-                let same = self.cover.as_ref().is_some_and(|c| {
-                    c.changes == resident.changes
-                        && c.fades == resident.fades
-                        && c.drawing == self.drawings
-                        && (c.drift_m - self.drift_m).length() <= s.texel_m()
-                });
-                let mut arrived = IdSet::default();
-                if !same {
-                    let (now, changing) = covered(blocks, frame);
-                    let gone = self
-                        .in_map
-                        .iter()
-                        .filter(|(id, _)| !now.contains(id))
-                        .map(|(_, &place)| place)
-                        .collect();
-                    arrived = now
-                        .iter()
-                        .filter(|id| !self.in_map.contains_key(id))
-                        .copied()
-                        .collect();
-                    self.cover = Some(CoverCheck {
-                        changes: resident.changes,
-                        fades: resident.fades,
-                        drawing: self.drawings,
-                        drift_m: self.drift_m,
-                        gone,
-                        changing,
-                    });
+        let dark = sun_fade(sun) <= 0.0;
+        let mut whole = std::mem::take(&mut self.force);
+        let mut scroll = None;
+        match self.drawn {
+            None => whole = true,
+            Some((frame, at_s, drift_then)) => {
+                // The camera in the map (which holds the clouds where they were when it was
+                // drawn whole).
+                let here = camera_m - (self.drift_m - drift_then);
+                // While clouds it covers form or dissipate, drawn whole every
+                // `update_interval_s` (their footprints drawn again instead cost more: a sky of
+                // building cumulus has many, each reaching its neighbours' clouds); and whole
+                // when the queue of rectangles has grown past what patches are for.
+                let changing = self.cover.as_ref().is_some_and(|c| !c.changing.is_empty());
+                let due = redraw_due(&frame, (at_s, now_s), here, sun, changing, &s);
+                whole |= due.turned || due.aged || self.dirty.len() > MAX_QUEUED;
+                if due.recentre && !whole {
+                    let to = frame.moved_to(here, &s);
+                    match layout::scroll_shift(&frame, &to, s.size_px) {
+                        Some(shift) => scroll = Some((to, shift)),
+                        // A jump of more than a quarter of the map: drawn whole.
+                        None => whole = true,
+                    }
                 }
-                let (gone, changing) = self
-                    .cover
-                    .as_ref()
-                    .map_or((&[][..], false), |c| (&c.gone[..], c.changing));
-                let times = (*at_s, now_s);
-                let due = std::mem::take(&mut self.force)
-                    || needs_redraw(frame, times, camera_m, sun, changing, &s);
-                let near_gone = gone
-                    .iter()
-                    .any(|&(centre, radius)| shadow_is_near(frame, centre, radius, camera_m, &s));
-                // Nothing to add or take away while the sun is too low for shadows (the map
-                // is drawn empty then).
-                let near_gone = near_gone && !dark;
-                if !(due || near_gone || dark || arrived.is_empty()) {
-                    added = Some(arrived);
-                } else if !arrived.is_empty() {
-                    // Not added now: looked for again next frame.
-                    self.cover = None;
-                }
-                due || near_gone
             }
+        }
+        let bytes = if whole {
+            self.prepare_whole(queue, resident, light, camera_m, sun, now_s, dark)
+        } else {
+            self.prepare_patches(queue, resident, light, scroll, dark)
         };
-        let mut bytes = 0;
-        if let (false, Some(arrived), Some((frame, _, drift_then))) = (stale, &added, self.drawn) {
-            // The new blocks where they stood when the map was drawn (the lookup moves the map
-            // with the drift since).
-            let back = self.drift_m - drift_then;
-            let sprites = self.shadow_view(blocks, &frame, Some(arrived), back, false);
-            bytes += self.write_view(queue, resident, light, &frame, sprites);
-            for r in blocks.values().filter(|r| arrived.contains(&r.block.id)) {
-                self.in_map
-                    .insert(r.block.id, (r.centre_m() - back, r.radius_m));
-            }
-            self.adding = true;
-            self.pending = Some(sprites);
-            self.timed.set(self.timer.is_some());
-            stats.shadow_sprites = sprites;
-        }
-        if stale {
-            // The sun of the last drawing until it has turned `rebuild_sun_deg` (a shadow 2 km
-            // under its cloud moves 17 m at 0.5 degrees): the sun a host gives follows the
-            // camera's place and time, and a map turned by a millionth of a radian puts its
-            // sprites' edges across other texels' centres.
-            let sun = match &self.drawn {
-                Some((f, _, _)) if f.sun.angle_between(sun).to_degrees() <= s.rebuild_sun_deg => {
-                    f.sun
-                }
-                _ => sun,
-            };
-            let frame = ShadowFrame::new(camera_m, sun, &s);
-            let sprites = self.shadow_view(blocks, &frame, None, DVec3::ZERO, dark);
-            self.in_map = blocks
-                .values()
-                .filter(|r| is_covered(r, &frame) && !dark)
-                .map(|r| (r.block.id, (r.centre_m(), r.radius_m)))
-                .collect();
-            bytes += self.write_view(queue, resident, light, &frame, sprites);
-            // The fade of the drawing's own sun (the last one's, within `rebuild_sun_deg`).
-            let sun_up = smoothstep(1.0f64.to_radians().sin(), 5.0f64.to_radians().sin(), sun.z);
-            let uniform = GpuCloudShadow {
-                clip_from_eye: frame.clip_from_eye_relative().to_cols_array_2d(),
-                params: [
-                    self.extinction_per_m * s.opacity_scale * sun_up as f32,
-                    0.05,
-                    0.0,
-                    0.0,
-                ],
-            };
-            queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-            bytes += std::mem::size_of::<GpuCloudShadow>() as u64;
-            self.drawn = Some((frame, now_s, self.drift_m));
-            self.drawings += 1;
-            self.adding = false;
-            self.pending = Some(sprites);
-            self.timed.set(self.timer.is_some());
-            stats.shadow_sprites = sprites;
-        }
         if let Some((frame, _, drift_then)) = &self.drawn {
             self.lookup = frame.uv_from_camera_relative(camera_m, self.drift_m - *drift_then);
         }
-        stats.shadow_redrawn = stale || added.is_some();
+        let sprites = self.pending.unwrap_or(0);
+        stats.shadow_redrawn = self.pending.is_some();
+        stats.shadow_sprites = sprites;
+        stats.shadow_texels = self.clears.iter().map(TexelRect::area).sum::<u64>()
+            + if self.whole && self.pending.is_some() {
+                u64::from(s.size_px).pow(2)
+            } else {
+                0
+            };
         stats.shadow_gpu_bytes = self.gpu_bytes();
         bytes
+    }
+
+    /// A whole drawing around the camera at `camera_m` (empty if `dark`).
+    #[allow(clippy::too_many_arguments)]
+    fn prepare_whole(
+        &mut self,
+        queue: &wgpu::Queue,
+        resident: &ResidentSet,
+        light: &ViewLight,
+        camera_m: DVec3,
+        sun: DVec3,
+        now_s: f64,
+        dark: bool,
+    ) -> u64 {
+        let s = self.settings;
+        let blocks = &resident.blocks;
+        // The sun of the last drawing until it has turned `rebuild_sun_deg` (a shadow 2 km
+        // under its cloud moves 17 m at 0.5 degrees): the sun a host gives follows the
+        // camera's place and time, and a map turned by a millionth of a radian puts its
+        // sprites' edges across other texels' centres.
+        let frame = match &self.drawn {
+            Some((f, _, _)) if f.sun.angle_between(sun).to_degrees() <= s.rebuild_sun_deg => {
+                f.moved_to(camera_m, &s)
+            }
+            _ => ShadowFrame::new(camera_m, sun, &s),
+        };
+        self.draws.clear();
+        self.lists.clear();
+        let order = if dark {
+            Vec::new()
+        } else {
+            drawing_order(blocks.values().filter(|r| is_covered(r, &frame)))
+        };
+        // Lists of blocks no longer covered are not kept.
+        let covered: IdSet = order.iter().map(|r| r.block.id).collect();
+        self.kept_lists.retain(|id, _| covered.contains(id));
+        let sprites = self.push_draws(&order, &frame, DVec3::ZERO, 0);
+        self.arriving.clear();
+        self.in_map = order
+            .iter()
+            .map(|r| (r.block.id, (r.centre_m(), r.radius_m, r.place_serial)))
+            .collect();
+        self.dirty.clear();
+        self.segments.push(Segment {
+            masked: false,
+            first: 0,
+            sprites,
+        });
+        let mut bytes = self.write_view(queue, resident, light, &frame, sprites);
+        bytes += self.write_uniform(queue, &frame);
+        self.drawn = Some((frame, now_s, self.drift_m));
+        self.drawings += 1;
+        self.whole = true;
+        self.pending = Some(sprites);
+        self.timed.set(self.timer.is_some());
+        bytes
+    }
+
+    /// Draws what changed into the map drawn before: its scroll to `scroll` (the new frame and
+    /// the shift), the rectangles of blocks gone or written again (a budget of them), the blocks
+    /// that arrived (a budget of them). Nothing but a scroll while `dark`.
+    fn prepare_patches(
+        &mut self,
+        queue: &wgpu::Queue,
+        resident: &ResidentSet,
+        light: &ViewLight,
+        scroll: Option<(ShadowFrame, (i32, i32))>,
+        dark: bool,
+    ) -> u64 {
+        let Some((mut frame, at_s, drift_then)) = self.drawn else {
+            return 0;
+        };
+        let s = self.settings;
+        let n = s.size_px;
+        let blocks = &resident.blocks;
+        let back = self.drift_m - drift_then;
+        let mut rects = Vec::new();
+        if let Some((to, shift)) = scroll {
+            // Blocks the scroll takes across `full_detail_m` are drawn at another stride by a
+            // fresh drawing: drawn again, as the budget allows.
+            let s = &self.settings;
+            let crossed = self
+                .in_map
+                .values()
+                .filter(|&&(c, r, _)| is_near(&frame, c, r, s) != is_near(&to, c, r, s))
+                .map(|&(c, r, _)| (c, r));
+            self.dirty.extend(crossed);
+            frame = to;
+            self.copies = layout::scroll_copies(shift, n);
+            self.drawings += 1;
+            rects = layout::scroll_rects(shift, n);
+        }
+        let mut arrived = Vec::new();
+        if !dark {
+            let fresh = self.cover.as_ref().is_some_and(|c| {
+                c.changes == resident.changes
+                    && c.fades == resident.fades
+                    && c.drawing == self.drawings
+                    && (c.drift_m - self.drift_m).length() <= s.texel_m()
+            });
+            if !fresh {
+                let (now, changing) = covered(blocks, &frame);
+                // Blocks gone from the map: their footprints drawn again (nothing, for those
+                // the scroll left off the map).
+                // Blocks written again (placed again): where they were and where they are.
+                let mut gone = Vec::new();
+                for (id, held) in self.in_map.iter_mut() {
+                    match now.get(id) {
+                        None => gone.push(*id),
+                        Some(&serial) if serial != held.2 => {
+                            self.dirty.push((held.0, held.1));
+                            if let Some(r) = blocks.get(id) {
+                                *held = (r.centre_m() - back, r.radius_m, serial);
+                                self.dirty.push((held.0, held.1));
+                            }
+                        }
+                        Some(_) => {}
+                    }
+                }
+                for id in gone {
+                    if let Some((c, r, _)) = self.in_map.remove(&id) {
+                        self.dirty.push((c, r));
+                    }
+                }
+                let new: Vec<u64> = now
+                    .keys()
+                    .filter(|id| !self.in_map.contains_key(id) && !self.arriving.contains(id))
+                    .copied()
+                    .collect();
+                self.arriving.extend(new);
+                self.cover = Some(CoverCheck {
+                    changes: resident.changes,
+                    fades: resident.fades,
+                    drawing: self.drawings,
+                    drift_m: self.drift_m,
+                    changing,
+                });
+            }
+            // The queue's oldest rectangles, within the budget (one at least) and the mask's room.
+            let mut budget = u64::from(s.redraw_texels_per_frame);
+            let mut taken = 0;
+            for &(centre, radius) in &self.dirty {
+                if (taken > 0 && budget == 0) || rects.len() == MASK_RECTS {
+                    break;
+                }
+                taken += 1;
+                if let Some(rect) = layout::footprint(&frame, centre, radius, n) {
+                    budget = budget.saturating_sub(rect.area());
+                    rects.push(rect);
+                }
+            }
+            self.dirty.drain(..taken);
+            // The blocks that arrived, nearest the map's centre first, within their budget (one
+            // at least); the rest wait (and those gone or out of range meanwhile are dropped).
+            if !self.arriving.is_empty() {
+                let mut queue: Vec<(f64, &Resident)> = self
+                    .arriving
+                    .iter()
+                    .filter_map(|id| blocks.get(id))
+                    .filter(|r| is_covered(r, &frame))
+                    .map(|r| ((r.centre_m() - back - frame.centre_m).length_squared(), r))
+                    .collect();
+                queue.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let mut budget = s.add_sprites_per_frame;
+                let mut taken = Vec::new();
+                for (_, r) in queue.iter() {
+                    if !taken.is_empty() && budget == 0 {
+                        break;
+                    }
+                    budget = budget.saturating_sub(block_sprites(r, &frame, back, &s));
+                    taken.push(*r);
+                }
+                let waiting: IdSet = queue[taken.len()..].iter().map(|q| q.1.block.id).collect();
+                self.arriving = waiting;
+                arrived = drawing_order(taken.into_iter());
+            }
+        }
+        self.drawn = Some((frame, at_s, drift_then));
+        if rects.is_empty() && arrived.is_empty() && scroll.is_none() {
+            return 0;
+        }
+        // The map's blocks that reach a rectangle, drawn once, masked to the rectangles (each
+        // texel in one gets every sprite that reaches it once, however they overlap); then the
+        // blocks that arrived, over the whole map.
+        let reach = |r: &Resident| layout::footprint(&frame, r.centre_m() - back, r.radius_m, n);
+        let held = drawing_order(
+            self.in_map
+                .keys()
+                .filter_map(|id| blocks.get(id))
+                .filter(|r| is_covered(r, &frame))
+                .filter(|r| reach(r).is_some_and(|f| rects.iter().any(|rect| rect.overlaps(&f)))),
+        );
+        self.draws.clear();
+        self.lists.clear();
+        let sprites = self.push_masked_draws(&held, &frame, back, &rects);
+        self.segments.push(Segment {
+            masked: true,
+            first: 0,
+            sprites,
+        });
+        let added = self.push_draws(&arrived, &frame, back, sprites);
+        self.segments.push(Segment {
+            masked: false,
+            first: sprites,
+            sprites: added,
+        });
+        let sprites = sprites + added;
+        for r in &arrived {
+            self.in_map.insert(
+                r.block.id,
+                (r.centre_m() - back, r.radius_m, r.place_serial),
+            );
+        }
+        self.clears = rects;
+        let mut bytes = self.write_view(queue, resident, light, &frame, sprites);
+        bytes += self.write_uniform(queue, &frame);
+        self.whole = false;
+        self.pending = Some(sprites);
+        self.timed.set(self.timer.is_some());
+        bytes
+    }
+
+    /// Writes the uniform of a drawing at `frame` (with the mask of this frame's rectangles);
+    /// returns the bytes written.
+    fn write_uniform(&self, queue: &wgpu::Queue, frame: &ShadowFrame) -> u64 {
+        let mut rects = [[0; 4]; MASK_RECTS];
+        for (to, r) in rects.iter_mut().zip(&self.clears) {
+            *to = [r.x0, r.y0, r.x1, r.y1];
+        }
+        // The fade of the drawing's own sun (the last one's, within `rebuild_sun_deg`).
+        let uniform = GpuCloudShadow {
+            clip_from_eye: frame.clip_from_eye_relative().to_cols_array_2d(),
+            params: [
+                self.extinction_per_m * self.settings.opacity_scale * sun_fade(frame.sun) as f32,
+                layout::EDGE_FADE,
+                0.0,
+                0.0,
+            ],
+            mask: [self.clears.len().min(MASK_RECTS) as u32, 0, 0, 0],
+            rects,
+        };
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        std::mem::size_of::<GpuCloudShadow>() as u64
     }
 
     /// The sprites of this frame's draw (0 if the map is not drawn this frame).
@@ -573,134 +730,11 @@ impl CloudShadows {
     pub(super) fn has_pending(&self) -> bool {
         self.pending.is_some()
     }
-
-    /// Records this frame's draw, if any (its own passes, in the sky's submission before the
-    /// host's frame): the map cleared, then the sprites' corners built from the resident
-    /// sprites (`resident`) by `build` and drawn a chunk at a time (`indices`: the quad index
-    /// buffer; `sheet`: the sprite sheet's group).
-    pub(super) fn record(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        sheet: &wgpu::BindGroup,
-        build: &SpriteBuild,
-        resident: &wgpu::BindGroup,
-        indices: &wgpu::Buffer,
-    ) {
-        let Some(sprites) = self.pending else {
-            return;
-        };
-        let timer = self.timer.as_ref().filter(|_| self.timed.get());
-        if let Some(t) = timer {
-            t.write(encoder, 0);
-        }
-        let view = self.sprites_view.group().filter(|_| sprites > 0);
-        let parts: Vec<(u32, u32, u32)> = chunks(sprites).collect();
-        for k in 0..parts.len().max(1) {
-            let part = parts.get(k).copied();
-            if let (Some(view), Some((c, _, n))) = (view, part) {
-                build.record_cores(encoder, view, resident, (c, n));
-            }
-            let load = if k == 0 && !self.adding {
-                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
-            } else {
-                wgpu::LoadOp::Load
-            };
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("sky.cloud_shadow"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &self.view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load,
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if let (Some(_), Some((_, _, n))) = (view, part) {
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &self.group, &[]);
-                pass.set_bind_group(1, sheet, &[]);
-                pass.set_vertex_buffer(0, build.vertices().slice(..));
-                pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..n * 6, 0, 0..1);
-            }
-        }
-        if let Some(t) = timer {
-            t.write(encoder, 1);
-            t.resolve(encoder);
-        }
-    }
-
-    /// Times the draw on the GPU (two timestamps around it) from the next frame on, or stops.
-    pub(super) fn set_timing(&mut self, queue: &wgpu::Queue, on: bool) {
-        self.timer = if on {
-            super::Timestamps::new(&self.device, queue, "sky.cloud_shadow_time", 2)
-        } else {
-            None
-        };
-    }
-
-    /// GPU milliseconds of the last prepared frame's draw (0 if it drew none), once submitted;
-    /// `None` while not timing. Waits for the device.
-    pub(super) fn last_ms(&self) -> Option<f64> {
-        let timer = self.timer.as_ref()?;
-        if !self.timed.get() {
-            return Some(0.0);
-        }
-        timer.read_ms(&self.device)?.get(1).copied()
-    }
-
-    /// Reads the map back (tests and tools): waits for the device.
-    pub fn read_back(&self, queue: &wgpu::Queue) -> Result<ShadowImage, RenderError> {
-        let side = self.texture.width();
-        let row = (side * 2).div_ceil(256) * 256;
-        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sky.cloud_shadow_read"),
-            size: row as u64 * side as u64,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        encoder.copy_texture_to_buffer(
-            self.texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: None,
-                },
-            },
-            self.texture.size(),
-        );
-        queue.submit([encoder.finish()]);
-        buffer.map_async(wgpu::MapMode::Read, .., |_| {});
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Device(e.to_string()))?;
-        let data = buffer
-            .get_mapped_range(..)
-            .map_err(|e| RenderError::Device(e.to_string()))?;
-        let tau = data
-            .chunks_exact(row as usize)
-            .flat_map(|r| {
-                r[..side as usize * 2]
-                    .chunks_exact(2)
-                    .map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32())
-            })
-            .collect();
-        Ok(ShadowImage { size_px: side, tau })
-    }
 }
 
 /// Whether a block (placed on the GPU) may cast a shadow into the map: its sphere's shadow
 /// reaches the square across the rays.
-fn is_covered(r: &super::sprites::resident::Resident, frame: &ShadowFrame) -> bool {
+fn is_covered(r: &Resident, frame: &ShadowFrame) -> bool {
     if r.place.is_none() || !r.uploaded {
         return false;
     }
@@ -716,35 +750,38 @@ fn is_near(frame: &ShadowFrame, centre_m: DVec3, radius_m: f64, s: &ShadowSettin
     x.abs().max(y.abs()) - radius_m <= s.full_detail_m
 }
 
-/// Whether a block (its centre and radius, placed) may shadow the ground within
-/// `full_detail_m` of the camera: its centre that close to the camera's sun ray across the
-/// rays, and not down-sun of the camera (its shadow then falls farther from the sun).
-fn shadow_is_near(
-    frame: &ShadowFrame,
-    centre_m: DVec3,
-    radius_m: f64,
-    camera_m: DVec3,
-    s: &ShadowSettings,
-) -> bool {
-    let to = centre_m - camera_m;
-    let sunward = to.dot(frame.sun);
-    let across = (to - frame.sun * sunward).length();
-    sunward >= -radius_m && across - radius_m <= s.full_detail_m
-}
-
-/// The blocks a drawing at `frame` covers (their ids), and whether any of them forms or
-/// dissipates.
-fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (IdSet, bool) {
-    let mut changing = false;
+/// The blocks a drawing at `frame` covers (their ids, with their placing), and those of them
+/// that form or dissipate.
+fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (IdMap<u64>, Vec<u64>) {
+    let mut changing = Vec::new();
     let ids = blocks
         .values()
         .filter(|r| is_covered(r, frame))
         .map(|r| {
-            changing |= r.motion.fade != super::Fade::Steady;
-            r.block.id
+            if r.motion.fade != super::Fade::Steady {
+                changing.push(r.block.id);
+            }
+            (r.block.id, r.place_serial)
         })
         .collect();
     (ids, changing)
+}
+
+/// The sprites a drawing at `frame` draws of a block moved back by `back_m` (every
+/// `far_sprite_stride`th beyond `full_detail_m`).
+fn block_sprites(r: &Resident, frame: &ShadowFrame, back_m: DVec3, s: &ShadowSettings) -> u32 {
+    let stride = if is_near(frame, r.centre_m() - back_m, r.radius_m, s) {
+        1
+    } else {
+        s.far_sprite_stride
+    };
+    r.clouds.iter().map(|c| c.sprites.div_ceil(stride)).sum()
+}
+
+/// How much of their shadows the clouds cast for the sun along `sun`: 1 above 5 degrees, 0
+/// below 1 (the shadows would reach for ever).
+fn sun_fade(sun: DVec3) -> f64 {
+    smoothstep(1.0f64.to_radians().sin(), 5.0f64.to_radians().sin(), sun.z)
 }
 
 /// A block's cloud lists for the shadow map, kept between drawings.

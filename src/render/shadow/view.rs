@@ -1,20 +1,21 @@
-//! The shadow map's view of the resident sprites: the draw list of the blocks a drawing covers,
-//! each with every cloud of its in its list (kept between drawings, `KeptLists`), and their
-//! upload with the view's uniform ([`CloudShadows::write_view`]). What
-//! [`CloudShadows::prepare`] writes once it has decided to draw.
+//! The shadow map's view of the resident sprites: the draw list of the blocks a drawing draws
+//! (all it covers, or those reaching its rectangles, or those that arrived), each with every
+//! cloud of its in its list (kept between drawings, `KeptLists`), and their upload with the
+//! view's uniform ([`CloudShadows::write_view`]). What [`CloudShadows::prepare`] writes once it
+//! has decided what to draw.
 
 use glam::DVec3;
 
-use super::{CloudShadows, NO_FAR_FADE_M, ShadowFrame, is_covered, is_near};
+use super::layout::{TexelRect, footprint};
+use super::{CloudShadows, NO_FAR_FADE_M, ShadowFrame, is_near};
 use crate::render::gpu_types::{GpuDrawBlock, GpuListCloud};
-use crate::render::id_hash::IdSet;
-use crate::render::sprites::draw_list::{Blocks, fade_code};
-use crate::render::sprites::resident::{ResidentSet, storage_buffer};
+use crate::render::sprites::draw_list::fade_code;
+use crate::render::sprites::resident::{Resident, ResidentSet, storage_buffer};
 use crate::render::sprites::sprite_view::{self, ViewData, ViewLight};
 
 impl CloudShadows {
     /// Writes the cloud lists and the view of the resident sprites for a drawing at `frame` of
-    /// `sprites` (the draw list `shadow_view` made); returns the bytes written.
+    /// `sprites` (the draw list `push_draws` made); returns the bytes written.
     pub(super) fn write_view(
         &mut self,
         queue: &wgpu::Queue,
@@ -73,52 +74,20 @@ impl CloudShadows {
         bytes
     }
 
-    /// The draw list of the blocks the map covers (placed on the GPU, their drift included),
-    /// with every cloud of theirs in its list (its sprites in the resident order); returns the
-    /// sprites. `only`: just these blocks (added to a map drawn before), each moved back by
-    /// `back_m` (the clouds' drift since that drawing). `none`: no block (the sun is too low
-    /// for shadows).
-    pub(super) fn shadow_view(
+    /// Appends the draws of the blocks of `order` (in [`drawing_order`]) to the map's draw
+    /// list, each with every cloud of its in its list (its sprites in the resident order) and
+    /// moved back by `back_m` (the clouds' drift since the map was drawn whole), after the
+    /// `first` sprites the list holds; returns the sprites appended. A block's lists are kept
+    /// between drawings.
+    pub(super) fn push_draws(
         &mut self,
-        blocks: &Blocks,
+        order: &[&Resident],
         frame: &ShadowFrame,
-        only: Option<&IdSet>,
         back_m: DVec3,
-        none: bool,
+        first: u32,
     ) -> u32 {
-        self.draws.clear();
-        self.lists.clear();
-        if none {
-            return 0;
-        }
-        // A fixed order (by place, then id): the half-float sums come out the same every run.
-        // Blocks added to a map are a few of the thousands held: looked up, not searched for.
-        // Sorted on keys copied out of the blocks (a comparison that reads two blocks costs two
-        // cache misses).
-        let mut order: Vec<(f64, f64, u64, &crate::render::sprites::resident::Resident)> =
-            match only {
-                Some(ids) => ids
-                    .iter()
-                    .filter_map(|id| blocks.get(id))
-                    .collect::<Vec<_>>(),
-                None => blocks.values().collect(),
-            }
-            .into_iter()
-            .filter(|r| is_covered(r, frame))
-            .map(|r| (r.block.centre_m.x, r.block.centre_m.y, r.block.id, r))
-            .collect();
-        order.sort_by(|a, b| {
-            a.0.total_cmp(&b.0)
-                .then(a.1.total_cmp(&b.1))
-                .then(a.2.cmp(&b.2))
-        });
-        if only.is_none() {
-            // Lists of blocks no longer covered are not kept.
-            let covered: IdSet = order.iter().map(|o| o.2).collect();
-            self.kept_lists.retain(|id, _| covered.contains(id));
-        }
         let mut total = 0u32;
-        for (_, _, id, r) in order {
+        for r in order {
             let list_base = self.lists.len() as u32;
             // Beyond `full_detail_m` across the rays, every `far_sprite_stride`th sprite of a
             // cloud stands for that many (its optical depth times the stride): far shadows lie
@@ -128,7 +97,7 @@ impl CloudShadows {
             } else {
                 self.settings.far_sprite_stride
             };
-            let kept = self.kept_lists.entry(id).or_default();
+            let kept = self.kept_lists.entry(r.block.id).or_default();
             if kept.built_for != Some((r.place_serial, stride)) {
                 kept.lists.clear();
                 let mut first = 0u32;
@@ -147,7 +116,7 @@ impl CloudShadows {
             let (fade_kind, fade_progress) = fade_code(r.motion.fade);
             self.draws.push(GpuDrawBlock {
                 origin_rel: (r.centre_m() - back_m - frame.eye_m).as_vec3().to_array(),
-                first: total,
+                first: first + total,
                 list_base,
                 list_len: self.lists.len() as u32 - list_base,
                 fade_kind,
@@ -157,4 +126,79 @@ impl CloudShadows {
         }
         total
     }
+}
+
+impl CloudShadows {
+    /// Appends the draws of the blocks of `order` (in [`drawing_order`]) to an empty draw list
+    /// as [`Self::push_draws`] does, but with only the clouds whose shadow may fall in one of
+    /// `rects` (a block's sprites are listed cloud by cloud, so the rest are left out: a
+    /// rectangle drawn again costs the clouds that reach it, not whole blocks); returns the
+    /// sprites.
+    pub(super) fn push_masked_draws(
+        &mut self,
+        order: &[&Resident],
+        frame: &ShadowFrame,
+        back_m: DVec3,
+        rects: &[TexelRect],
+    ) -> u32 {
+        let n = self.settings.size_px;
+        let mut total = 0u32;
+        for r in order {
+            let offset = r.centre_m() - r.block.centre_m - back_m;
+            let Some(reach) = footprint(frame, r.centre_m() - back_m, r.radius_m, n) else {
+                continue;
+            };
+            let near: Vec<&TexelRect> = rects.iter().filter(|q| q.overlaps(&reach)).collect();
+            let stride = if is_near(frame, r.centre_m() - back_m, r.radius_m, &self.settings) {
+                1
+            } else {
+                self.settings.far_sprite_stride
+            };
+            let list_base = self.lists.len() as u32;
+            let mut first = 0u32;
+            for state in r.clouds.iter().filter(|c| c.sprites > 0) {
+                let at = footprint(frame, state.centre_m + offset, state.radius_m as f64, n);
+                if !at.is_some_and(|f| near.iter().any(|q| q.overlaps(&f))) {
+                    continue;
+                }
+                self.lists.push(GpuListCloud {
+                    cloud: state.cloud_slot,
+                    first,
+                    order_base: state.sprite_base,
+                    stride,
+                });
+                first += state.sprites.div_ceil(stride);
+            }
+            if first == 0 {
+                continue;
+            }
+            let (fade_kind, fade_progress) = fade_code(r.motion.fade);
+            self.draws.push(GpuDrawBlock {
+                origin_rel: (r.centre_m() - back_m - frame.eye_m).as_vec3().to_array(),
+                first: total,
+                list_base,
+                list_len: self.lists.len() as u32 - list_base,
+                fade_kind,
+                fade_progress,
+            });
+            total += first;
+        }
+        total
+    }
+}
+
+/// `blocks` in the order every drawing of the map draws them (by place, then id): the
+/// half-float sums then come out the same every run, and a rectangle drawn again adds its
+/// sprites in the order a whole drawing does. Sorted on keys copied out of the blocks (a
+/// comparison that reads two blocks costs two cache misses).
+pub(super) fn drawing_order<'a>(blocks: impl Iterator<Item = &'a Resident>) -> Vec<&'a Resident> {
+    let mut keyed: Vec<(f64, f64, u64, &Resident)> = blocks
+        .map(|r| (r.block.centre_m.x, r.block.centre_m.y, r.block.id, r))
+        .collect();
+    keyed.sort_by(|a, b| {
+        a.0.total_cmp(&b.0)
+            .then(a.1.total_cmp(&b.1))
+            .then(a.2.cmp(&b.2))
+    });
+    keyed.into_iter().map(|k| k.3).collect()
 }
