@@ -14,7 +14,7 @@
 //! SCT or BKN by the toss of 40 readings):
 //! 1. Every base of every reading, sorted, is cut into layers where one base lies more than
 //!    max(100 ft, 10%) above the one before; a layer so found is cut again where a few bases
-//!    chained two layers into one ([`split_chained`]: both sides more than a stray reading's
+//!    chained two layers into one (`split_chained`: both sides more than a stray reading's
 //!    share, their medians more than max(100 ft, 10%) apart).
 //! 2. A layer's base is the median of its bases, rounded as a METAR writes it (to 100 ft up to
 //!    5,000 ft, 500 ft to 10,000 ft, 1,000 ft above).

@@ -457,7 +457,7 @@ pub struct BandCopy {
     pub src: [u32; 2],
     /// First texel written.
     pub dst: [u32; 2],
-    /// Columns and rows, at most [`SCROLL_BAND_ROWS`] rows.
+    /// Columns and rows, at most `SCROLL_BAND_ROWS` rows.
     pub size: [u32; 2],
 }
 
