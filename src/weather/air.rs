@@ -8,8 +8,11 @@
 //! report's at and under the anemometer height (10 m); through the boundary layer the speed grows
 //! as the power law `v(z) = v10 (z / 10 m)^a` (a = 1/7 over land) and the direction turns with
 //! `ln(z / 10 m)` by `turn_deg` at its top (veering in the northern hemisphere, backing in the
-//! southern); the gust excess shrinks linearly to none at the top. Above it, the gradient wind at
-//! the top holds, or goes over linearly (as a vector) to a wind aloft from the settings.
+//! southern); the gust excess shrinks linearly to none at the top. The surface wind it grows
+//! from goes over, with the same `ln(z / 10 m)`, from the point's own to the regional surface
+//! wind ([`SurfaceAir::regional_wind_kt`]: a report's wind is local, the gradient wind
+//! large-scale). Above it, the gradient wind at the top holds, or goes over linearly (as a
+//! vector) to a wind aloft from the settings.
 //!
 //! Temperature: the ICAO standard lapse (6.5 C/km) from the surface report to the tropopause
 //! (ICAO Doc 7488). Pressure: the ISA pressure at the altitude for the reported QNH,
