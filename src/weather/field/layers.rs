@@ -17,7 +17,7 @@
 //!    a ceilometer meets through the gaps of the one below) and has at least `min_added_oktas`
 //!    of its own (2 oktas a pilot between them sees), times its presence, as far as the sky
 //!    seen from below stays in the class reported at its base (BKN: at most 7 oktas;
-//!    `SCT030 SCT050` leaves the upper layer `min_coverage_oktas`); above an overcast its
+//!    over a SCT at the class's top, `min_coverage_oktas`); above an overcast its
 //!    stations' own covers.
 //!    A CB/TCU layer keeps its stations' own amounts, weighted (`FEW025CB` over a broken deck is
 //!    2 oktas of Cb at the station), and needs `convective.weight_min` of presence.
