@@ -4,19 +4,18 @@
 //! data's `sun_occlusion`, under the towering cumulus of Cordoba. Frames and maps are written to
 //! `target/tmp/shadow-tests/` to look at.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use glam::{DVec2, DVec3, Vec2, Vec4Swizzles};
 use skycast::demo::terrain::{HeightField, Terrain};
 use skycast::demo::{DemoHost, Frame, GroundSettings, demo_ground, headless};
-use skycast::flight::{SkySystemConfig, Weather};
+use skycast::flight::SkySystemConfig;
 use skycast::render::{Camera, ShadowImage};
 
-const W: u32 = 320;
-const H: u32 = 180;
-const METARS: &str = "weather/awc-metars-2025-01-27T22Z.cache.csv";
-/// The shipped weather file's time, 2025-01-27T22:00:00Z.
-const UNIX_S: f64 = 1_738_015_200.0;
+#[path = "support/shadow_host.rs"]
+mod shadow_host;
+use shadow_host::{UNIX_S, host_over, quantile, sun_down_to};
+
 /// The cruise under the cumulus (`tests/reference/cruise_under_cumulus.png`'s place).
 const CRUISE: (f64, f64) = (33.90, -118.36);
 const FEET: f64 = 0.3048;
@@ -32,19 +31,17 @@ fn out_dir() -> PathBuf {
 fn cruise_host(configure: impl FnOnce(&mut SkySystemConfig)) -> DemoHost {
     let mut config = SkySystemConfig::new(headless::TARGETS, CRUISE);
     configure(&mut config);
-    let flat = HeightField::from_fn(DVec2::ZERO, 1_000.0, 2, |_| 0.0);
-    let mut host = DemoHost::new(W, H, &flat, config)
-        .unwrap_or_else(|e| panic!("shadow tests need an adapter: {e}"));
-    // Every cloud around in the first frame, as `skycast render` has it (a simulator's first
-    // frames wait for none and fade them in as they arrive).
-    host.sky.world_mut().set_synchronous_clouds(true);
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-    host.sky
-        .set_weather(Weather::File(&manifest.join(METARS)))
-        .unwrap();
+    let mut host = host_over(config);
+    on_demo_ground(&mut host);
+    host
+}
+
+/// Lays the demo ground of the host's weather field under it (as `skycast render` has it);
+/// returns the ground.
+fn on_demo_ground(host: &mut DemoHost) -> HeightField {
     let ground = demo_ground(host.sky.world().field(), &GroundSettings::default());
     host.terrain = Terrain::new(&host.gpu.device, headless::COLOUR_FORMAT, &ground);
-    host
+    ground
 }
 
 /// The map as a picture: the sunlight it lets through, exp(-tau), white in open sun.
@@ -421,34 +418,10 @@ fn sub_texel_camera_moves_leave_the_shadows_unchanged() {
 /// shade all the ground; an untyped BKN low layer is stratocumulus by the type rule.)
 const CONGESTUS: (f64, f64) = (-31.324, -64.208);
 
-/// The first instant after `from_s` (whole seconds, going forward) the sun stands at
-/// `elevation_deg` or lower over `at` (it sets through the afternoon there).
-fn sun_down_to(at: (f64, f64), from_s: f64, elevation_deg: f64) -> f64 {
-    let elevation = |t: f64| skycast::shading::sun_position(t, at.0, at.1).elevation_deg;
-    let (mut lo, mut hi) = (from_s, from_s + 6.0 * 3600.0);
-    assert!(elevation(lo) > elevation_deg && elevation(hi) < elevation_deg);
-    while hi - lo > 1.0 {
-        let mid = 0.5 * (lo + hi);
-        if elevation(mid) > elevation_deg {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
-}
-
 /// The median of `v` (sorted in place); 0 for none.
 fn median(v: &mut [f32]) -> f32 {
     v.sort_by(f32::total_cmp);
     v.get(v.len() / 2).copied().unwrap_or(0.0)
-}
-
-/// The quantile `q` of `v` (sorted in place); 0 for none.
-fn quantile(v: &mut [f32], q: f32) -> f32 {
-    v.sort_by(f32::total_cmp);
-    let k = ((v.len() as f32 * q) as usize).min(v.len().saturating_sub(1));
-    v.get(k).copied().unwrap_or(0.0)
 }
 
 /// The ground points compared with the probe: a grid of `2 GRID + 1` a side, `GRID_M` apart,
@@ -514,16 +487,8 @@ fn shadows_are_as_dark_as_the_sky_makes_them_and_the_probe_agrees() {
     // Clouds 12 km around (the ground compared lies within 6 km; the sun's rays from it climb
     // through the tops within 12 km).
     config.world.cloud_radius_m = 12_000.0;
-    let flat = HeightField::from_fn(DVec2::ZERO, 1_000.0, 2, |_| 0.0);
-    let mut host = DemoHost::new(W, H, &flat, config)
-        .unwrap_or_else(|e| panic!("shadow tests need an adapter: {e}"));
-    host.sky.world_mut().set_synchronous_clouds(true);
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-    host.sky
-        .set_weather(Weather::File(&manifest.join(METARS)))
-        .unwrap();
-    let ground = demo_ground(host.sky.world().field(), &GroundSettings::default());
-    host.terrain = Terrain::new(&host.gpu.device, headless::COLOUR_FORMAT, &ground);
+    let mut host = host_over(config);
+    let ground = on_demo_ground(&mut host);
     let sun_az = skycast::shading::sun_position(unix_s, CONGESTUS.0, CONGESTUS.1).azimuth_deg;
     let heading = (sun_az + 180.0).rem_euclid(360.0);
     let ground_m = ground.height_at_m(DVec2::ZERO);

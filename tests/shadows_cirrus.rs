@@ -4,36 +4,16 @@
 //! (lavapipe here; a missing adapter fails it). Apart from tests/shadows.rs, which is near the
 //! 800 lines a file may have.
 
-use std::path::Path;
+use glam::{DVec3, Vec4Swizzles};
+use skycast::demo::headless;
+use skycast::flight::SkySystemConfig;
 
-use glam::{DVec2, DVec3, Vec4Swizzles};
-use skycast::demo::terrain::HeightField;
-use skycast::demo::{DemoHost, headless};
-use skycast::flight::{SkySystemConfig, Weather};
-
-const METARS: &str = "weather/awc-metars-2025-01-27T22Z.cache.csv";
-/// The shipped weather file's time, 2025-01-27T22:00:00Z.
-const UNIX_S: f64 = 1_738_015_200.0;
+#[path = "support/shadow_host.rs"]
+mod shadow_host;
+use shadow_host::{UNIX_S, host_over, quantile, sun_down_to};
 /// Providence, Rhode Island (`KPVD 272151Z 20012KT 10SM SCT250 01/M08 A2976`): cirrus
 /// scattered at 25,000 ft, nothing under it.
 const KPVD: (f64, f64) = (41.7225, -71.4325);
-
-/// The first instant after `from_s` (whole seconds) the sun stands at `elevation_deg` or lower
-/// over `at`.
-fn sun_down_to(at: (f64, f64), from_s: f64, elevation_deg: f64) -> f64 {
-    let elevation = |t: f64| skycast::shading::sun_position(t, at.0, at.1).elevation_deg;
-    let (mut lo, mut hi) = (from_s, from_s + 6.0 * 3600.0);
-    assert!(elevation(lo) > elevation_deg && elevation(hi) < elevation_deg);
-    while hi - lo > 1.0 {
-        let mid = 0.5 * (lo + hi);
-        if elevation(mid) > elevation_deg {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
-}
 
 /// Under Providence's scattered cirrus, the winter sun at 25 degrees, at ground points every
 /// 100 m within 4 km of the station: some ground is shaded at all, and the map's occlusion
@@ -168,25 +148,4 @@ fn thin_and_thick_high_clouds_have_their_optical_depths() {
         assert!(met > 100, "{name}: {met} lines meet cloud");
         assert!((lo..=hi).contains(&median), "{name}: median {median}");
     }
-}
-
-/// The demo host (flat ground) over the shipped weather file around `config`'s place, every
-/// cloud around generated in the first frame.
-fn host_over(config: SkySystemConfig) -> DemoHost {
-    let flat = HeightField::from_fn(DVec2::ZERO, 1_000.0, 2, |_| 0.0);
-    let mut host = DemoHost::new(320, 180, &flat, config)
-        .unwrap_or_else(|e| panic!("shadow tests need an adapter: {e}"));
-    host.sky.world_mut().set_synchronous_clouds(true);
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-    host.sky
-        .set_weather(Weather::File(&manifest.join(METARS)))
-        .unwrap();
-    host
-}
-
-/// The quantile `q` of `v` (sorted in place); 0 for none.
-fn quantile(v: &mut [f32], q: f32) -> f32 {
-    v.sort_by(f32::total_cmp);
-    let k = ((v.len() as f32 * q) as usize).min(v.len().saturating_sub(1));
-    v.get(k).copied().unwrap_or(0.0)
 }
