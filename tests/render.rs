@@ -999,6 +999,7 @@ fn ring_holds_far_blocks_and_near_ones_are_sprites() {
     let forming = BlockMotion {
         offset_m: DVec3::ZERO,
         fade: Fade::Forming(0.0),
+        ..BlockMotion::default()
     };
     assert!(rig.host.sky.sky_mut().set_block_motion(4, forming));
     let waiting: Vec<_> = (0..3)

@@ -389,6 +389,21 @@ pub struct FieldConfig {
     pub seed: u64,
     /// Layer wind over surface wind (clouds drift faster than the surface wind), >= 0.
     pub wind_factor: f64,
+    /// How many drift bands the layers are split into, 1..=[`MAX_DRIFT_BANDS`]: a block's
+    /// lowest layer is band 0, the next band 1, and so on, the last band taking the rest. Each
+    /// band drifts with the wind at its own height (one field of blocks each, see
+    /// [`super::field::CloudField`]); 1: every layer drifts as one.
+    #[serde(default = "default_drift_bands")]
+    pub drift_bands: u8,
+}
+
+/// The most drift bands a field may have (a METAR reports at most six layers; past the fourth
+/// they are rare).
+pub const MAX_DRIFT_BANDS: u8 = 4;
+
+/// [`FieldConfig::drift_bands`] where a settings file does not set it.
+fn default_drift_bands() -> u8 {
+    MAX_DRIFT_BANDS
 }
 
 /// `config/clouds.toml`: lifecycle and field settings.
@@ -446,6 +461,11 @@ impl CloudsConfig {
         let f = &config.field;
         v.check(f.radius_m > 0.0, "radius_m", "must be > 0 metres")?;
         v.check(f.wind_factor >= 0.0, "wind_factor", "must be >= 0")?;
+        v.check(
+            (1..=MAX_DRIFT_BANDS).contains(&f.drift_bands),
+            "drift_bands",
+            "must be within 1..=4",
+        )?;
         Ok(config)
     }
 }

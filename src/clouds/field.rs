@@ -22,6 +22,7 @@ use glam::DVec2;
 use rayon::prelude::*;
 
 use super::CloudsError;
+use super::bands::DriftBand;
 use super::block::CloudBlock;
 use super::boxes::GenerationBoxes;
 use super::config::{CloudTypes, CloudsConfig, LifecycleConfig};
@@ -88,6 +89,11 @@ impl BlockGenerator {
         }
     }
 
+    /// The pool it runs on (for another generator beside it: [`Self::with_pool`]).
+    pub fn pool(&self) -> Arc<rayon::ThreadPool> {
+        Arc::clone(&self.pool)
+    }
+
     /// Queues one block; returns at once.
     pub fn submit(&mut self, index: BlockIndex, weather: BlockWeather, seed: u64) {
         let tx = self.tx.clone();
@@ -106,13 +112,13 @@ impl BlockGenerator {
         });
     }
 
-    /// Queues one block of the cloud field, whose cumulonimbus are the storm `cells` that reach
-    /// over it ([`super::generate::generate_block_in_field`]); returns at once.
+    /// Queues one block of the cloud field (the layers of drift `band`), whose cumulonimbus are
+    /// the storm `cells` that reach over it ([`super::generate::generate_block_in_field`]); returns at once.
     pub fn submit_in_field(
         &mut self,
         index: BlockIndex,
         weather: BlockWeather,
-        cells: Vec<StormCell>,
+        (cells, band): (Vec<StormCell>, DriftBand),
         seed: u64,
     ) {
         let tx = self.tx.clone();
@@ -120,7 +126,8 @@ impl BlockGenerator {
         let cache = Arc::clone(&self.cells);
         self.pending += 1;
         self.pool.spawn(move || {
-            let block = generate_block_in_field(index, &weather, &cells, &cache, seed, &types);
+            let block =
+                generate_block_in_field(index, &weather, (&cells, band), &cache, seed, &types);
             let boxes = Arc::new(GenerationBoxes::of(&block.clouds));
             let _ = tx.send(Generated {
                 index,
@@ -205,9 +212,26 @@ pub fn blocks_within(centre_m: DVec2, radius_m: f64) -> Vec<BlockIndex> {
 /// type changed, coverage by an okta or more (at the sample point or on the rim, see
 /// [`BlockCover::differs`]), base or thickness by 300 ft or more.
 pub fn weather_changed(a: &BlockWeather, b: &BlockWeather) -> bool {
+    weather_changed_in(DriftBand::WHOLE, a, b)
+}
+
+/// [`weather_changed`] for the layers of drift `band` alone (a cover change at the rim counts
+/// for every band).
+pub fn weather_changed_in(band: DriftBand, a: &BlockWeather, b: &BlockWeather) -> bool {
+    let of_band = |w: &BlockWeather| {
+        w.layers
+            .iter()
+            .filter(|l| band.holds(&w.layers, l.base_ft_agl))
+            .copied()
+            .collect::<Vec<_>>()
+    };
+    let (la, lb) = match band.count {
+        1 => (a.layers.clone(), b.layers.clone()),
+        _ => (of_band(a), of_band(b)),
+    };
     BlockCover::differs(a.cover.as_ref(), b.cover.as_ref(), 1.0)
-        || a.layers.len() != b.layers.len()
-        || a.layers.iter().zip(&b.layers).any(|(x, y)| {
+        || la.len() != lb.len()
+        || la.iter().zip(&lb).any(|(x, y)| {
             x.cloud_type != y.cloud_type
                 || (x.coverage_oktas - y.coverage_oktas).abs() >= 1.0
                 || (x.base_ft_agl - y.base_ft_agl).abs() >= 300.0
@@ -281,6 +305,10 @@ struct Slot {
     joins: Phase,
     /// Where it is in the field's queue of phase ends (`CloudField::phase_ends`).
     ends_s: Option<f64>,
+    /// An upper drift band's block over ground without a layer of its rank: held, without
+    /// clouds or a generation asked for, so that it is not asked again while its weather stays,
+    /// and a layer that the weather brings later forms instead of appearing at once.
+    held_empty: bool,
 }
 
 /// A ground block and the version of the weather a field block over it was asked for with.
@@ -291,6 +319,8 @@ type AskedFor = (BlockIndex, u64);
 pub struct CloudField {
     config: CloudsConfig,
     generator: BlockGenerator,
+    /// The layers it holds ([`super::bands`]): its own drift is theirs.
+    band: DriftBand,
     time_s: f64,
     drift_m: DVec2,
     /// The velocity the clouds drift with when the flight stage sets it (the air data's wind at
@@ -331,6 +361,7 @@ impl CloudField {
         Self {
             config,
             generator,
+            band: DriftBand::WHOLE,
             time_s: 0.0,
             drift_m: DVec2::ZERO,
             drift_velocity_m_s: None,
@@ -343,6 +374,19 @@ impl CloudField {
             storms: StormContext::default(),
             cells: Vec::new(),
         }
+    }
+
+    /// The field holding only the layers of drift `band` (one field per band, each drifting
+    /// with its own wind: [`super::bands`]); its generations' serials are unique among the
+    /// bands' fields (`serial % band.count == band.index`). Band 0 decides the storm cells.
+    pub fn in_band(mut self, band: DriftBand) -> Self {
+        self.band = band;
+        self
+    }
+
+    /// The layers it holds.
+    pub fn band(&self) -> DriftBand {
+        self.band
     }
 
     /// What the storm cells are decided with.
@@ -438,8 +482,10 @@ impl CloudField {
                 (!kept).then(|| (index, weather(ground), key))
             })
             .collect();
-        let cb_seen = self.slots.values().any(|s| has_cb(&s.weather))
-            || asked.iter().any(|(_, w, _)| has_cb(w));
+        // Only band 0 draws the cells.
+        let cb_seen = self.band.index == 0
+            && (self.slots.values().any(|s| has_cb(&s.weather))
+                || asked.iter().any(|(_, w, _)| has_cb(w)));
         let mut cells: Option<Vec<StormCell>> = None;
         let mut cells_for = |field: &Self, index: BlockIndex| {
             if cells.is_none() && cb_seen {
@@ -457,9 +503,23 @@ impl CloudField {
         };
         for (index, w, key) in asked {
             match self.slots.get(&index) {
+                // An upper band holds no block over ground without a layer of its rank.
+                None if !self.band.holds_any(&w) => {
+                    let slot = Slot {
+                        weather: w,
+                        asked: key,
+                        generations: Vec::new(),
+                        joins: Phase::Steady,
+                        ends_s: None,
+                        held_empty: true,
+                    };
+                    self.slots.insert(index, slot);
+                }
                 None => {
                     let mine = cells_for(self, index);
-                    self.generator.submit_in_field(index, w.clone(), mine, seed);
+                    let band = self.band;
+                    self.generator
+                        .submit_in_field(index, w.clone(), (mine, band), seed);
                     // From the blocks with clouds beside it: not from those joining with it,
                     // which have none yet, so the same in any order.
                     let joins = self.joining_phase(index);
@@ -471,14 +531,23 @@ impl CloudField {
                             generations: Vec::new(),
                             joins,
                             ends_s: None,
+                            held_empty: false,
                         },
                     );
                 }
-                Some(slot) if weather_changed(&slot.weather, &w) => {
+                Some(slot) if weather_changed_in(self.band, &slot.weather, &w) => {
                     let mine = cells_for(self, index);
-                    self.generator.submit_in_field(index, w.clone(), mine, seed);
+                    let band = self.band;
+                    self.generator
+                        .submit_in_field(index, w.clone(), (mine, band), seed);
+                    let now = self.time_s;
                     if let Some(slot) = self.slots.get_mut(&index) {
                         (slot.weather, slot.asked) = (w, key);
+                        // A layer came where the band had none: it forms, as a weather change's
+                        // new clouds do.
+                        if std::mem::take(&mut slot.held_empty) {
+                            slot.joins = Phase::Forming { since_s: now };
+                        }
                     }
                 }
                 Some(_) => {
@@ -564,11 +633,12 @@ impl CloudField {
             }
             self.next_serial += 1;
             self.membership += 1;
+            let band = self.band;
             slot.generations.push(FieldBlock {
                 block: done.block,
                 boxes: done.boxes,
                 phase,
-                serial: self.next_serial,
+                serial: self.next_serial * u64::from(band.count) + u64::from(band.index),
             });
             slot.schedule(done.index, &mut self.phase_ends, &lifecycle);
         }
@@ -1056,5 +1126,33 @@ mod tests {
                 .all(|s| s.alpha_morph == 1.0),
             "the field never rewrites the sprites"
         );
+    }
+
+    /// An upper drift band holds no clouds over ground without a layer of its rank, and asks
+    /// nothing again while the weather stays; when the weather brings a second layer, its
+    /// clouds form there (they do not appear at once).
+    #[test]
+    fn an_upper_band_forms_the_layer_the_weather_brings() {
+        let mut field = small_field().in_band(DriftBand::new(1, 2));
+        let one = weather(4.0);
+        let mut two = weather(4.0);
+        two.layers.push(BlockLayer {
+            base_ft_agl: 9000.0,
+            ..two.layers[0]
+        });
+        field.update_for(DVec2::ZERO, &|_| one.clone(), 1);
+        field.wait_for_pending();
+        let held = field.block_count();
+        assert!(held > 0);
+        assert_eq!(field.blocks().count(), 0, "no clouds of band 1");
+        field.advance(30.0);
+        field.update_for(DVec2::ZERO, &|_| two.clone(), 2);
+        field.wait_for_pending();
+        assert_eq!(field.blocks().count(), held);
+        for (_, g) in field.blocks() {
+            assert!(matches!(g.phase, Phase::Forming { .. }), "{:?}", g.phase);
+            assert_eq!(g.serial % 2, 1, "band 1's serials");
+            assert!(g.block.layers.iter().all(|l| l.base_m > 2_000.0));
+        }
     }
 }

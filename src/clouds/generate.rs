@@ -28,6 +28,7 @@
 
 use glam::{DVec2, DVec3};
 
+use super::bands::DriftBand;
 use super::block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};
 use super::config::{CloudTypeConfig, CloudTypes, TextureCategory};
 use super::core::CORE_HALF_EXTENT;
@@ -61,29 +62,43 @@ pub fn generate_block(
     seed: u64,
     types: &CloudTypes,
 ) -> CloudBlock {
-    generate_layers(index, weather, false, seed, types)
+    generate_layers(index, weather, (false, DriftBand::WHOLE), seed, types)
 }
 
 /// Generates the clouds of one block of the cloud field, whose cumulonimbus are the weather
 /// field's storm `cells` (`weather::storms`): the block draws its part of each (the cells that
 /// reach over it) instead of heaps of its own. Pure, as [`generate_block`]; `cache` only saves
-/// drawing a cell again for each block it spans.
+/// drawing a cell again for each block it spans. Only the layers of drift `band` are generated
+/// (each as it would be in the whole block: the union over the bands is the whole block); the
+/// cells belong to band 0 ([`super::bands`]).
 pub fn generate_block_in_field(
     index: BlockIndex,
     weather: &BlockWeather,
-    cells: &[StormCell],
+    (cells, band): (&[StormCell], DriftBand),
     cache: &CellCache,
     seed: u64,
     types: &CloudTypes,
 ) -> CloudBlock {
-    let mut block = generate_layers(index, weather, true, seed, types);
+    let mut block = generate_layers(index, weather, (true, band), seed, types);
+    if band.index != 0 {
+        return block;
+    }
     let config = types.get(CloudType::Cumulonimbus);
-    let layer = weather
-        .layers
-        .iter()
-        .position(|l| l.cloud_type == CloudType::Cumulonimbus)
-        .unwrap_or(weather.layers.len())
-        .min(u8::MAX as usize) as u8;
+    // The cells' layer: the cumulonimbus layer's place (among the band's summaries when the
+    // block is cut into bands).
+    let layer = match band.count {
+        1 => weather
+            .layers
+            .iter()
+            .position(|l| l.cloud_type == CloudType::Cumulonimbus)
+            .unwrap_or(weather.layers.len()),
+        _ => block
+            .layers
+            .iter()
+            .position(|l| l.cloud_type == CloudType::Cumulonimbus)
+            .unwrap_or(block.layers.len()),
+    }
+    .min(u8::MAX as usize) as u8;
     for cell in cells {
         let whole = cache.whole(cell, config, weather);
         if let Some(part) = part_in_block(&whole, index, layer) {
@@ -96,7 +111,7 @@ pub fn generate_block_in_field(
 fn generate_layers(
     index: BlockIndex,
     weather: &BlockWeather,
-    cells_decided: bool,
+    (cells_decided, band): (bool, DriftBand),
     seed: u64,
     types: &CloudTypes,
 ) -> CloudBlock {
@@ -108,6 +123,10 @@ fn generate_layers(
     };
     let layers = BlockCover::layers_over_block_grouped(weather.cover.as_ref(), &weather.layers);
     for (li, (layer, cover, group)) in layers.iter().enumerate() {
+        // Another band's layer: that band's field generates it, keyed as here (`li`).
+        if !band.holds(&weather.layers, layer.base_ft_agl) {
+            continue;
+        }
         let config = types.get(layer.cloud_type);
         let frame = LayerFrame::new(layer, config, weather.ground_elevation_m as f64);
         // The layers one layer of cloud was cut into by type, this one among them.
@@ -141,6 +160,12 @@ fn generate_layers(
         } else {
             scattered_layer(index, &ctx, seed, &mut block.clouds)
         };
+        // A cloud names its layer by its place in the block's summaries (one a layer this
+        // band holds: `li` when the block is generated whole).
+        let summary = block.layers.len().min(u8::MAX as usize) as u8;
+        for c in &mut block.clouds[first..] {
+            c.layer = summary;
+        }
         let clouds = &block.clouds[first..];
         let area: f64 = clouds.iter().map(Cloud::sprite_area_m2).sum();
         block.layers.push(LayerSummary {

@@ -854,3 +854,41 @@ fn scattered_clouds_lie_more_evenly_than_chance() {
     );
     assert!(even > chance + 0.1, "{even} {chance}");
 }
+
+/// The drift bands' fields together are the whole block: each band generates its layers of a
+/// block exactly as the whole block has them (the same clouds, keyed alike), every cloud naming
+/// its layer among its band's summaries.
+#[test]
+fn the_drift_bands_together_are_the_whole_block() {
+    let mut w = weather(CloudType::CumulusMediocris, 3.0, 2500.0, 2000.0);
+    let mut add = |cloud_type, oktas, base_ft_agl, thickness_ft| {
+        w.layers.push(BlockLayer {
+            cloud_type,
+            type_source: TypeSource::HeightRule,
+            coverage_oktas: oktas,
+            base_ft_agl,
+            thickness_ft,
+        });
+    };
+    add(CloudType::Altocumulus, 4.0, 9000.0, 1500.0);
+    add(CloudType::Cirrus, 3.0, 25000.0, 1000.0);
+    let index = BlockIndex::new(3, -2);
+    let cache = CellCache::default();
+    let whole = generate_block_in_field(index, &w, (&[], DriftBand::WHOLE), &cache, 7, types());
+    let mut banded: Vec<Cloud> = Vec::new();
+    for band in DriftBand::all(4) {
+        let b = generate_block_in_field(index, &w, (&[], band), &cache, 7, types());
+        // Three layers in four bands: the last band holds none.
+        assert_eq!(b.layers.len(), usize::from(band.index < 3), "{band:?}");
+        for c in &b.clouds {
+            let summary = b.layers[usize::from(c.layer)];
+            assert_eq!(summary.cloud_type, c.cloud_type);
+        }
+        banded.extend(b.clouds);
+    }
+    assert!(whole.clouds.len() > 10);
+    assert_eq!(banded.len(), whole.clouds.len());
+    for (a, b) in banded.iter().zip(&whole.clouds) {
+        assert_eq!((a.centre_m, a.sprites.len()), (b.centre_m, b.sprites.len()));
+    }
+}

@@ -19,6 +19,7 @@
 //! Units: world positions are f64 metres east, north and up (above mean sea level); everything
 //! inside a cloud is f32 metres relative to the cloud centre, ready for a GPU.
 
+pub mod bands;
 pub mod block;
 pub mod boxes;
 pub mod config;
@@ -31,6 +32,7 @@ pub mod lifecycle;
 pub mod noise;
 pub mod preview;
 pub mod probe;
+pub mod probe_bands;
 pub mod rain;
 pub mod rng;
 pub mod sheet;
@@ -38,6 +40,7 @@ mod sight;
 pub mod storm;
 mod uneven;
 
+pub use bands::DriftBand;
 pub use block::{Cloud, CloudBlock, ColourLevel, LayerSummary, ShadingGroup, Sprite};
 pub use config::{CloudTypeConfig, CloudTypes, CloudsConfig, LifecycleConfig, TextureCategory};
 pub use field::{BlockGenerator, CloudField};

@@ -363,7 +363,7 @@ impl<'a> CloudProbe<'a> {
     /// The walk of [`Self::line_of_sight`] (`whole`) or [`Self::first_cloud`], stopped once the
     /// optical depth counted reaches `enough`; each stretch inside a cloud's cores goes into
     /// `spans` (t in, t out, optical depth, type) where given.
-    fn sight(
+    pub(super) fn sight(
         &self,
         a: DVec3,
         b: DVec3,
@@ -454,11 +454,11 @@ impl<'a> CloudProbe<'a> {
 }
 
 /// A stretch of one cloud's cores along a line of sight: t in, t out, optical depth, type.
-type Span = (f64, f64, f64, CloudType);
+pub(super) type Span = (f64, f64, f64, CloudType);
 
 /// The stretches of cloud along a segment `length_m` long: the clouds' spans, those that
 /// overlap joined (each typed by the cloud that gives it most depth).
-fn crossings(mut spans: Vec<Span>, length_m: f64) -> Vec<CloudCrossing> {
+pub(super) fn crossings(mut spans: Vec<Span>, length_m: f64) -> Vec<CloudCrossing> {
     spans.sort_by(|x, y| x.0.total_cmp(&y.0));
     let mut out: Vec<(CloudCrossing, f64)> = Vec::new();
     for (t0, t1, depth, cloud_type) in spans {

@@ -25,7 +25,10 @@ use std::sync::Mutex;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 
-use crate::clouds::probe::{BoxCache, CloudProbe, CloudsAtPoint, SightHit};
+use crate::clouds::DriftBand;
+use crate::clouds::config::MAX_DRIFT_BANDS;
+use crate::clouds::probe::{BoxCache, CloudsAtPoint, SightHit};
+use crate::clouds::probe_bands::BandedProbe;
 use crate::shading::FogSettings;
 use crate::weather::StationTable;
 use crate::weather::air::{AirSettings, SurfaceAir, air_at_aloft, feet};
@@ -163,8 +166,9 @@ impl World {
 
     /// How the clouds at `point_m` (local metres, up above mean sea level) drift: the air
     /// data's wind there ([`Self::air_at`]'s, the winds aloft included), as the velocity it
-    /// blows towards, metres a second east and north. The living clouds drift with it at the
-    /// lowest layer's middle over the camera ([`Self::drift_height_m`]).
+    /// blows towards, metres a second east and north. The living clouds of each drift band
+    /// drift with it at the middle of their layer over the camera
+    /// ([`Self::band_drift_height_m`]): every reported layer with its own height's wind.
     pub fn cloud_drift_at(&self, point_m: DVec3) -> DVec2 {
         let s = &self.air.settings;
         let (weather, gust, qnh) =
@@ -206,13 +210,22 @@ impl World {
         (aloft, lat)
     }
 
-    /// The height the living clouds drift at over ground point `point_m`, metres above mean
-    /// sea level: the middle of the lowest cloud layer there (one drift moves the whole field,
-    /// every layer with it); `None` under a clear sky.
+    /// The height the lowest drift band's living clouds drift at over ground point `point_m`
+    /// ([`Self::band_drift_height_m`] of band 0: the middle of the lowest cloud layer there);
+    /// `None` under a clear sky.
     pub fn drift_height_m(&self, point_m: DVec2) -> Option<f64> {
+        let bands = self.clouds_config().field.drift_bands;
+        self.band_drift_height_m(point_m, DriftBand::new(0, bands))
+    }
+
+    /// The height drift `band`'s living clouds drift at over ground point `point_m`, metres
+    /// above mean sea level: the middle of the band's layer there
+    /// ([`DriftBand::steering_layer`]: the layer of its rank, or the highest there is);
+    /// `None` under a clear sky.
+    pub fn band_drift_height_m(&self, point_m: DVec2, band: DriftBand) -> Option<f64> {
         let weather = self.field().weather_at(point_m);
         let ground = f64::from(weather.ground_elevation_m);
-        weather.layers.first().map(|l| {
+        band.steering_layer(&weather.layers).map(|l| {
             ground
                 + f64::from(l.base_ft_agl + 0.5 * l.thickness_ft) * crate::weather::METRES_PER_FOOT
         })
@@ -224,9 +237,11 @@ impl World {
         self.air.fog = fog;
     }
 
-    fn probe(&self) -> Option<CloudProbe<'_>> {
-        self.living_field()
-            .map(|f| CloudProbe::new(f, &self.air.cache, &self.air.settings.in_cloud))
+    /// The probe over every drift band's living field (`None` before they exist).
+    fn probe(&self) -> Option<BandedProbe<'_>> {
+        self.living_field()?;
+        let bands = self.living_fields().zip(&self.air.caches);
+        Some(BandedProbe::new(bands, &self.air.settings.in_cloud))
     }
 
     /// The clouds at a ground point (nothing before the living clouds exist).
@@ -348,7 +363,8 @@ type HereWeather = (BlockWeather, f64, f64);
 pub struct AirState {
     settings: AirSettings,
     fog: FogSettings,
-    cache: BoxCache,
+    /// Each drift band's field's boxes, the lowest band's first.
+    caches: [BoxCache; MAX_DRIFT_BANDS as usize],
     /// The last answer of [`World::weather_here`].
     here: Mutex<Option<(HereKey, HereWeather)>>,
     /// The FB product's winds and temperatures aloft, placed in the world's frame.

@@ -202,6 +202,7 @@ impl FarCells {
                     } else {
                         Fade::Forming(0.0)
                     },
+                    drift_band: 0,
                 },
             ));
             self.shown.insert(

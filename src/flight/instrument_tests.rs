@@ -5,6 +5,7 @@ use std::path::Path;
 
 use glam::{DVec2, DVec3};
 
+use crate::clouds::DriftBand;
 use crate::clouds::block::LayerSummary;
 use crate::clouds::core::SpriteCore;
 use crate::flight::{World, WorldSettings};
@@ -27,10 +28,12 @@ fn cell_centres() -> impl Iterator<Item = DVec2> {
 /// generation there (its clouds and those of the neighbours' same layer, which overhang): the
 /// cover the drawn sprites show a person looking up.
 fn drawn_cover(world: &World, layer: &LayerSummary) -> f64 {
-    let field = world.living_field().expect("living clouds");
-    let drift = field.drift_m();
     let mut cores: Vec<(DVec3, SpriteCore)> = Vec::new();
-    for (_, g) in field.blocks() {
+    for (field, (_, g)) in world
+        .living_fields()
+        .flat_map(|f| f.blocks().map(move |b| (f, b)))
+    {
+        let drift = field.drift_m();
         // The same layer in a neighbour (its base a little off where the weather varies).
         let same = |l: &LayerSummary| {
             l.cloud_type == layer.cloud_type && l.base_m < layer.top_m && l.top_m > layer.base_m
@@ -52,6 +55,19 @@ fn drawn_cover(world: &World, layer: &LayerSummary) -> f64 {
         })
         .count();
     covered as f64 / (CELLS * CELLS) as f64
+}
+
+/// The layers of the station's block (0, 0), lowest first: the first generation's of every
+/// drift band's field there (asked before the clouds drifted, each band's block (0, 0) is over
+/// the station).
+fn station_layers(world: &World) -> Vec<LayerSummary> {
+    let mut layers: Vec<LayerSummary> = world
+        .living_fields()
+        .filter_map(|f| f.generations(BlockIndex::new(0, 0)).first())
+        .flat_map(|g| g.block.layers.iter().copied())
+        .collect();
+    layers.sort_by(|a, b| a.base_m.total_cmp(&b.base_m));
+    layers
 }
 
 /// The share of block (0, 0) where a vertical line of sight from under the layer to over it
@@ -136,15 +152,12 @@ fn the_cover_probes_see_from_below_is_the_cover_drawn() {
         world
             .settle_clouds_around(DVec3::new(2_000.0, 2_000.0, 0.0))
             .expect("clouds");
-        let g = world
-            .living_field()
-            .and_then(|f| f.generations(BlockIndex::new(0, 0)).first())
-            .expect("the station's block");
-        let Some(layer) = g.block.layers.first().copied() else {
+        let layers = station_layers(&world);
+        let Some(layer) = layers.first().copied() else {
             continue;
         };
         // Another layer reaching into this one's heights would be seen by the same lines.
-        let apart = g.block.layers[1..]
+        let apart = layers[1..]
             .iter()
             .all(|l| l.base_m > layer.top_m + 60.0 || l.top_m < layer.base_m - 60.0);
         if !apart {
@@ -201,6 +214,7 @@ fn quantile(values: &[f64], q: f64) -> f64 {
 /// mean sea level: under a storm's anvil the first cloud is the anvil, kilometres up, and the
 /// base the report gives is the tower's.
 fn first_hits_under_towers(world: &World, ground_m: f64) -> Vec<f64> {
+    // The cells are the lowest band's.
     let field = world.living_field().expect("living clouds");
     let drift = field.drift_m().extend(0.0);
     let station = DVec2::splat(BLOCK_SIZE_M / 2.0);
@@ -475,11 +489,8 @@ fn between_two_broken_layers_the_upper_one_covers_two_oktas() {
         world
             .settle_clouds_around(DVec3::new(2_000.0, 2_000.0, ground_m))
             .expect("clouds");
-        let g = world
-            .living_field()
-            .and_then(|f| f.generations(BlockIndex::new(0, 0)).first())
-            .expect("the station's block");
-        let (low, high) = (g.block.layers[0], g.block.layers[1]);
+        let layers = station_layers(&world);
+        let (low, high) = (layers[0], layers[1]);
         let between = 0.5 * (f64::from(low.top_m) + f64::from(high.base_m));
         let top = f64::from(high.top_m) + 30.0;
         let upper_seen = covered_between(&world, between, top);
@@ -691,8 +702,9 @@ fn ceilometer_round_trip_at_200() {
 }
 
 /// The clouds drift with the wind the air data reports at their height: over real reports (and
-/// with NOAA's winds aloft over the US), the field moves in a minute what `air_at`'s wind at the
-/// lowest layer's middle carries it, within 1 kt and 5 degrees.
+/// with NOAA's winds aloft over the US), each reported layer's drift band moves in a minute what
+/// `air_at`'s wind at that layer's middle carries it, within 1 kt and 5 degrees, upper layers
+/// included (one drift for every layer moved them with the lowest one's wind).
 #[test]
 fn the_clouds_drift_with_the_air_datas_wind_at_their_height() {
     use crate::weather::winds_aloft::WindsAloft;
@@ -700,7 +712,7 @@ fn the_clouds_drift_with_the_air_datas_wind_at_their_height() {
     let input = WeatherInput::load(&root.join(REAL), None).expect("the bulk file");
     let aloft = WindsAloft::load(&root.join("weather/fd1us1-2026-01-31T06Z.txt")).expect("FB");
     let table = crate::weather::StationTable::builtin();
-    let mut checked = 0;
+    let (mut checked, mut upper) = (0, 0);
     for (station, lat, lon) in [
         ("KDEN", 39.85, -104.66),
         ("EGLL", 51.4775, -0.4614),
@@ -718,36 +730,52 @@ fn the_clouds_drift_with_the_air_datas_wind_at_their_height() {
             if with_aloft {
                 world.set_winds_aloft(Some(&aloft), &table);
             }
-            let Some(height) = world.drift_height_m(DVec2::ZERO) else {
+            let layers = world.field().weather_at(DVec2::ZERO).layers.len();
+            if layers == 0 {
                 continue;
-            };
-            let camera = DVec3::new(0.0, 0.0, height);
-            world.settle_clouds_around(camera).expect("clouds");
-            let before = world.living_field().expect("clouds").drift_m();
-            world.advance_clouds_around(camera, 60.0).expect("clouds");
-            let moved = (world.living_field().expect("clouds").drift_m() - before) / 60.0;
-            let air = world.air_at(camera, DVec3::Z);
-            let to = (air.wind_from_deg + 180.0).to_radians();
-            let wind =
-                DVec2::new(to.sin(), to.cos()) * air.wind_kt * crate::weather::METRES_PER_KNOT;
-            let knots = |v: DVec2| v.length() / crate::weather::METRES_PER_KNOT;
-            let off_deg = if wind.length() > 0.5 && moved.length() > 0.5 {
-                moved.angle_to(wind).to_degrees().abs()
-            } else {
-                0.0
-            };
-            eprintln!(
-                "{station} (aloft {with_aloft}) at {height:.0} m: drift {:.1} kt, air data {:.1} kt from {:.0}, {off_deg:.1} degrees apart",
-                knots(moved),
-                air.wind_kt,
-                air.wind_from_deg
-            );
-            assert!((knots(moved) - air.wind_kt).abs() <= 1.0, "{station}");
-            assert!(off_deg <= 5.0, "{station}: {off_deg} degrees");
-            checked += 1;
+            }
+            world.settle_clouds_around(DVec3::ZERO).expect("clouds");
+            let before: Vec<DVec2> = world.living_fields().map(|f| f.drift_m()).collect();
+            world
+                .advance_clouds_around(DVec3::ZERO, 60.0)
+                .expect("clouds");
+            let bands: Vec<(DriftBand, DVec2)> = (world.living_fields())
+                .zip(&before)
+                .map(|(f, b)| (f.band(), (f.drift_m() - *b) / 60.0))
+                .collect();
+            // Each band whose own layer is over the station: the lowest, the second, ...
+            for (band, moved) in bands.into_iter().take(layers) {
+                let Some(height) = world.band_drift_height_m(DVec2::ZERO, band) else {
+                    continue;
+                };
+                let air = world.air_at(DVec3::new(0.0, 0.0, height), DVec3::Z);
+                let to = (air.wind_from_deg + 180.0).to_radians();
+                let wind =
+                    DVec2::new(to.sin(), to.cos()) * air.wind_kt * crate::weather::METRES_PER_KNOT;
+                let knots = |v: DVec2| v.length() / crate::weather::METRES_PER_KNOT;
+                let off_deg = if wind.length() > 0.5 && moved.length() > 0.5 {
+                    moved.angle_to(wind).to_degrees().abs()
+                } else {
+                    0.0
+                };
+                eprintln!(
+                    "{station} (aloft {with_aloft}) band {} at {height:.0} m: drift {:.1} kt, air data {:.1} kt from {:.0}, {off_deg:.1} degrees apart",
+                    band.index,
+                    knots(moved),
+                    air.wind_kt,
+                    air.wind_from_deg
+                );
+                assert!((knots(moved) - air.wind_kt).abs() <= 1.0, "{station}");
+                assert!(off_deg <= 5.0, "{station}: {off_deg} degrees");
+                checked += 1;
+                upper += usize::from(band.index > 0);
+            }
         }
     }
-    assert!(checked >= 8, "{checked}");
+    assert!(
+        checked >= 8 && upper >= 4,
+        "{checked} layers, {upper} above the lowest"
+    );
 }
 
 /// The cover drawn is the cover asked, type by type, at real station blocks: over 700 stations
@@ -792,13 +820,10 @@ fn drawn_cover_is_the_cover_asked_at_real_station_blocks() {
         world
             .settle_clouds_around(DVec3::new(2_000.0, 2_000.0, 0.0))
             .expect("clouds");
-        let Some(layers) = world
-            .living_field()
-            .and_then(|f| f.generations(BlockIndex::new(0, 0)).first())
-            .map(|g| g.block.layers.clone())
-        else {
+        let layers = station_layers(&world);
+        if world.living_field().is_none() {
             continue;
-        };
+        }
         stations += 1;
         for (k, layer) in layers.iter().enumerate() {
             // A storm's cover is its cells', not the block's; a layer another reaches into is

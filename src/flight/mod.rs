@@ -14,6 +14,7 @@ pub mod air;
 mod block_weathers;
 pub mod ceilometer;
 mod far_cells;
+mod living;
 mod path;
 pub mod radar;
 mod spline;

@@ -9,20 +9,19 @@
 //! the sky (where the impostor ring and the far field take over) it is given as values
 //! ([`World::set_sky_reach`]).
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::clouds::config::LifecycleConfig;
-use crate::clouds::lifecycle::{Phase, phase_at, progress};
+use crate::clouds::config::MAX_DRIFT_BANDS;
 use crate::clouds::{
-    Cloud, CloudField, CloudTypes, CloudsConfig, field::FieldBlock, field::weather_changed,
+    BlockGenerator, Cloud, CloudField, CloudTypes, CloudsConfig, DriftBand, field::weather_changed,
     generate_block,
 };
 #[cfg(doc)]
 use crate::render::Sky;
-use crate::render::scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite};
+use crate::render::scene::{BandOffsets, SkyBlock, SkyCloud, SkySprite};
 use crate::render::update::{SkyReach, SkyUpdate};
 use crate::render::{RenderError, SpriteSheet, Stopwatch};
 use crate::shading::{ColourLevel, ColourLevels};
@@ -31,6 +30,7 @@ use crate::weather::storms::{Flash, FlashKind, flashes_between};
 use crate::weather::{BLOCK_SIZE_M, BlockIndex, BlockWeather};
 
 use super::block_weathers::BlockWeathers;
+use super::living::{BandClouds, HandOver, LivingClouds};
 use std::sync::Arc;
 
 /// Settings of the world (`render` and `fly` use the defaults; `bench` widens the cloud radius
@@ -119,33 +119,6 @@ impl From<&Cloud> for SkyCloud {
     }
 }
 
-/// The clouds stage's living field (background generation, drift, formation and dissipation)
-/// as a [`World`] flies through it, and which of its generations the sky holds.
-pub struct LivingClouds {
-    field: CloudField,
-    weather: BlockWeathers,
-    /// The camera's air block, the drift's block and the field version when the blocks around
-    /// were last asked for: asked again only when one changes.
-    asked: Option<(BlockIndex, BlockIndex, u64)>,
-    in_sky: HashSet<u64>,
-    seen: HashSet<u64>,
-    /// The newest generation met, and the field's membership count then.
-    newest_serial: u64,
-    /// Generations met that the frames' budget of sprites has not handed to the sky yet
-    /// ([`WorldSettings::joined_sprites_per_frame`]).
-    waiting: HashSet<u64>,
-    membership: Option<u64>,
-    /// Generations fading in as they arrive (see [`WorldSettings::arrival_fade_s`]), with the
-    /// field time they arrived at.
-    arriving: HashMap<u64, f64>,
-    /// Generations forming or dissipating this frame and the last (serial, phase and the step
-    /// of the fade the sky was last given, see [`fade_step`]), by serial.
-    fading: Vec<(u64, Phase, FadeStep)>,
-    was_fading: Vec<(u64, Phase, FadeStep)>,
-    /// Storm cells beyond the field, drawn whole.
-    far_cells: super::far_cells::FarCells,
-}
-
 /// Weather field and cloud blocks around a reference point.
 pub struct World {
     /// Shared with the worker that works out the weather of the blocks ahead.
@@ -208,7 +181,7 @@ impl World {
     /// The in-cloud flash lighting its cell now, as the sky draws it: its light fades from the
     /// settings' `brightness` to none over `duration_s` (`config/storms.toml`).
     pub fn flash_now(&self) -> Option<crate::render::SkyFlash> {
-        let field = &self.living.as_ref()?.field;
+        let field = self.living.as_ref()?.lowest();
         let f = self.lit?;
         let l = field.storms().settings.lightning;
         let age = field.time_s() - f.time_s;
@@ -233,7 +206,7 @@ impl World {
         let Some(living) = self.living.as_ref() else {
             return;
         };
-        let field = &living.field;
+        let field = living.lowest();
         let now = field.time_s();
         let drift = field.drift_m();
         let lightning = field.storms().settings.lightning;
@@ -260,6 +233,11 @@ impl World {
     /// field radius and seed stay the world's.
     pub fn set_clouds_config(&mut self, config: CloudsConfig) {
         self.clouds_config = config;
+    }
+
+    /// The clouds settings in use (the world's radius and seed in its field's).
+    pub fn clouds_config(&self) -> &CloudsConfig {
+        &self.clouds_config
     }
 
     /// When `on`, every frame of [`Self::advance_sky`] waits for the blocks it queued, so what
@@ -298,9 +276,18 @@ impl World {
         });
     }
 
-    /// The clouds stage's living field, once [`Self::advance_sky`] has run.
+    /// The clouds stage's living field of the lowest drift band (the lowest layer of every
+    /// block, and the storm cells), once [`Self::advance_sky`] has run.
     pub fn living_field(&self) -> Option<&CloudField> {
-        self.living.as_ref().map(|l| &l.field)
+        self.living.as_ref().map(LivingClouds::lowest)
+    }
+
+    /// The clouds stage's living fields, one per drift band ([`crate::clouds::bands`]), the
+    /// lowest first; empty before [`Self::advance_sky`] has run.
+    pub fn living_fields(&self) -> impl Iterator<Item = &CloudField> {
+        self.living
+            .iter()
+            .flat_map(|l| l.bands.iter().map(|b| &b.field))
     }
 
     /// The texture sheet of the clouds stage.
@@ -391,22 +378,24 @@ impl World {
             true => 0,
             false => std::thread::available_parallelism().map_or(1, |n| n.get().max(2) - 1),
         };
-        let mut field = CloudField::new(config, Arc::new(self.types.clone()), threads)
-            .map_err(|e| RenderError::Clouds(e.to_string()))?;
-        field.set_storms(self.storm_context(Default::default()));
+        // One pool for every band's field: the bands share the cores, as one field did.
+        let types = Arc::new(self.types.clone());
+        let pool = BlockGenerator::new(Arc::clone(&types), threads)
+            .map_err(|e| RenderError::Clouds(e.to_string()))?
+            .pool();
+        let storms = self.storm_context(Default::default());
+        let bands = DriftBand::all(config.field.drift_bands)
+            .map(|band| {
+                let generator = BlockGenerator::with_pool(Arc::clone(&types), Arc::clone(&pool));
+                let mut field = CloudField::with_generator(config, generator).in_band(band);
+                field.set_storms(storms);
+                BandClouds::new(field)
+            })
+            .collect();
         self.clouds_config = config;
         self.living = Some(LivingClouds {
-            field,
+            bands,
             weather: BlockWeathers::default(),
-            asked: None,
-            in_sky: HashSet::new(),
-            seen: HashSet::new(),
-            newest_serial: 0,
-            waiting: HashSet::new(),
-            membership: None,
-            arriving: HashMap::new(),
-            fading: Vec::new(),
-            was_fading: Vec::new(),
             far_cells: super::far_cells::FarCells::new(
                 crate::weather::storms::StormSettings::default().far,
             ),
@@ -490,20 +479,13 @@ impl World {
         self.advance_clouds_around(point_m, 0.0)
     }
 
-    /// The velocity the living clouds over ground point `point_m` drift with: the air data's
-    /// wind at the lowest layer's middle there ([`Self::cloud_drift_at`]); `None` under a clear
-    /// sky (the clouds stage's own guess then).
-    fn drift_velocity(&self, point_m: DVec2) -> Option<DVec2> {
-        let height = self.drift_height_m(point_m)?;
+    /// The velocity drift `band`'s living clouds over ground point `point_m` drift with: the
+    /// air data's wind at the middle of its layer there ([`Self::cloud_drift_at`],
+    /// [`Self::band_drift_height_m`]); `None` under a clear sky (the clouds stage's own guess
+    /// then).
+    fn drift_velocity(&self, point_m: DVec2, band: DriftBand) -> Option<DVec2> {
+        let height = self.band_drift_height_m(point_m, band)?;
         Some(self.cloud_drift_at(point_m.extend(height)))
-    }
-
-    /// Sets the living clouds' drift for ground point `point_m` ([`Self::drift_velocity`]).
-    fn set_field_drift(&mut self, point_m: DVec2) {
-        let velocity = self.drift_velocity(point_m);
-        if let Some(living) = self.living.as_mut() {
-            living.field.set_drift_velocity(velocity);
-        }
     }
 
     /// Advances the living clouds by `dt_s` seconds around `point_m` without a sky, waiting for
@@ -511,14 +493,20 @@ impl World {
     /// instruments on the ground (`flight::ceilometer`) and tests.
     pub fn advance_clouds_around(&mut self, point_m: DVec3, dt_s: f64) -> Result<(), RenderError> {
         self.start_living()?;
-        self.set_field_drift(point_m.truncate());
+        let ground_m = point_m.truncate();
+        let mut velocities = [None; MAX_DRIFT_BANDS as usize];
+        for (velocity, field) in velocities.iter_mut().zip(self.living_fields()) {
+            *velocity = self.drift_velocity(ground_m, field.band());
+        }
         let weather_field = &self.field;
         if let Some(living) = self.living.as_mut() {
-            living
-                .field
-                .update(point_m.truncate(), &|i| weather_field.block_weather(i));
-            living.field.wait_for_pending();
-            living.field.advance(dt_s);
+            for (band, velocity) in living.bands.iter_mut().zip(velocities) {
+                band.field.set_drift_velocity(velocity);
+                band.field
+                    .update(ground_m, &|i| weather_field.block_weather(i));
+                band.field.wait_for_pending();
+                band.field.advance(dt_s);
+            }
         }
         Ok(())
     }
@@ -539,50 +527,50 @@ impl World {
         if self.start_living()? {
             update.lifecycle = Some(self.clouds_config.lifecycle);
         }
-        // The blocks around are asked for again only when the camera entered another block of
-        // the moving air, the air drifted past a block, or the weather changed: then the
-        // drift's wind is looked up again too.
+        // A band's blocks around are asked for again only when the camera entered another
+        // block of its moving air, its air drifted past a block, or the weather changed: then
+        // its drift's wind is looked up again too.
+        let version = self.field_version;
         let key_of = |drift: DVec2| {
             (
                 BlockIndex::containing(camera_m.truncate() - drift),
                 BlockIndex::containing(drift),
-                self.field_version,
+                version,
             )
         };
-        let asking = self
-            .living
-            .as_ref()
-            .is_some_and(|l| l.asked != Some(key_of(l.field.drift_m())));
-        let drift_velocity = if asking {
-            self.drift_velocity(camera_m.truncate())
-        } else {
-            None
-        };
+        let mut velocities = [None; MAX_DRIFT_BANDS as usize];
+        if let Some(living) = self.living.as_ref() {
+            for (velocity, band) in velocities.iter_mut().zip(&living.bands) {
+                if band.asked != Some(key_of(band.field.drift_m())) {
+                    *velocity = Some(self.drift_velocity(camera_m.truncate(), band.field.band()));
+                }
+            }
+        }
         let weather_field = &self.field;
+        let synchronous = self.synchronous_clouds;
         let Some(living) = self.living.as_mut() else {
             return Ok(update);
         };
-        let drift = living.field.drift_m();
-        let key = key_of(drift);
-        let version = self.field_version;
-        // Where the block weathers are worked out ahead of the field (`BlockWeathers`).
-        let around = (camera_m.truncate() - drift, drift, living.field.radius_m());
+        let lowest = &living.bands[0];
+        let drift = lowest.field.drift_m();
+        // Where the block weathers are worked out ahead of the field (`BlockWeathers`): around
+        // the lowest band's blocks (the upper bands ask for few blocks, where layers are).
+        let around = (camera_m.truncate() - drift, drift, lowest.field.radius_m());
         // A new weather field's block weathers are worked out on the field's pool first; its
         // blocks stay those of the last weather until then (offline frames take it at once).
-        let filling =
-            living.asked.is_some_and(|asked| asked.2 != version) && !self.synchronous_clouds && {
-                let field = &living.field;
-                living
-                    .weather
-                    .fill(weather_field, version, around, |job| field.spawn(job))
-            };
-        if living.asked != Some(key) && !filling {
-            living.field.set_drift_velocity(drift_velocity);
+        let filling = lowest.asked.is_some_and(|asked| asked.2 != version) && !synchronous && {
+            let field = &lowest.field;
+            living
+                .weather
+                .fill(weather_field, version, around, |job| field.spawn(job))
+        };
+        let asking = velocities.iter().any(Option::is_some);
+        if asking && !filling {
             let cache = std::cell::RefCell::new(std::mem::take(&mut living.weather));
             // The field's own blocks take their cover at the rim; the storm cells it decides
             // reach well beyond them (a square and an anvil's reach around the radius), and a
             // storm reads a block's layers alone, at a tenth of the cost.
-            let own_m = living.field.radius_m() + 2.0 * BLOCK_SIZE_M;
+            let own_m = living.lowest().radius_m() + 2.0 * BLOCK_SIZE_M;
             let ground_m = camera_m.truncate();
             let weather = |index: BlockIndex| {
                 if (index.centre_m() - ground_m).length() <= own_m {
@@ -591,251 +579,81 @@ impl World {
                     weather_field.block_layers_weather(index)
                 }
             };
-            living
-                .field
-                .update_for(camera_m.truncate(), &weather, version);
+            for (band, velocity) in living.bands.iter_mut().zip(velocities) {
+                let Some(velocity) = velocity else {
+                    band.field.poll();
+                    continue;
+                };
+                band.field.set_drift_velocity(velocity);
+                band.field.update_for(ground_m, &weather, version);
+                band.asked = Some(key_of(band.field.drift_m()));
+            }
             living.weather = cache.into_inner();
-            living.asked = Some(key);
             // The next row's weathers, off the frame thread before the camera brings it in.
-            let field = &living.field;
+            let field = &living.bands[0].field;
             living
                 .weather
                 .ask_ahead(weather_field, version, around, |job| field.spawn(job));
         } else {
             living.weather.take_ready(version);
-            living.field.poll();
+            living.bands.iter_mut().for_each(|b| b.field.poll());
         }
-        if self.synchronous_clouds {
-            living.field.wait_for_pending();
+        for band in &mut living.bands {
+            if synchronous {
+                band.field.wait_for_pending();
+            }
+            band.field.advance(dt_s);
         }
-        living.field.advance(dt_s);
         self.queue_flashes(dt_s);
         let Some(living) = self.living.as_mut() else {
             return Ok(update);
         };
-        let drift = living.field.drift_m();
+        let lowest = &living.bands[0].field;
+        let drift = lowest.drift_m();
         living.far_cells.update(
             &mut update.distant,
             &super::far_cells::FarCellFrame {
                 weather: &self.field,
                 version: self.field_version,
-                storms: (living.field.storms(), living.field.seed()),
+                storms: (lowest.storms(), lowest.seed()),
                 types: &self.types,
                 camera_air_m: camera_m.truncate() - drift,
                 drift_m: drift,
                 field_radius_m: self.clouds_config.field.radius_m,
                 band_start_m: (self.sky_reach.hand_over_m).map(|(start, _)| f64::from(start)),
-                now_s: living.field.time_s(),
+                now_s: lowest.time_s(),
                 whole: self.synchronous_clouds,
             },
         );
-        let offset_m = DVec3::new(drift.x, drift.y, 0.0);
-        let now = living.field.time_s();
-        let lifecycle = *living.field.lifecycle();
-        update.drift_m = Some(offset_m);
-        // (Generations still waiting to be handed over are looked for every frame.)
-        let same_members =
-            living.membership == Some(living.field.membership()) && living.waiting.is_empty();
-        // Nothing came, went, forms, dissipates or arrives: only the drift changed.
-        if same_members && living.was_fading.is_empty() && living.arriving.is_empty() {
-            update.field_cpu = start.spent();
-            return Ok(update);
-        }
-        // Nothing came or went: only the generations that were fading can be fading now (a
-        // steady one starts to dissipate only beside a new one), so only they are looked at,
-        // from their phases kept here, not the field's thousands of generations (the Cb
-        // circle's building cumulus fade for minutes).
-        if same_members && living.arriving.is_empty() {
-            living.fading.clear();
-            for &(serial, phase, shown) in &living.was_fading {
-                // The phase moves on with time alone (as `CloudField::advance` moves it); one
-                // that ended (gone) would have changed the membership.
-                let phase = phase_at(phase, now, &lifecycle);
-                let fade = fade_of(phase, None, now, &lifecycle);
-                // Told only when it has moved on a step: a weather change's thousand forming
-                // generations were a thousand look-ups of the sky's blocks every frame.
-                let step = fade_step(serial, fade);
-                if step != shown {
-                    update.fades.push((serial, fade));
-                }
-                if fade != Fade::Steady {
-                    living.fading.push((serial, phase, step));
-                }
-            }
-            std::mem::swap(&mut living.was_fading, &mut living.fading);
-            update.field_cpu = start.spent();
-            return Ok(update);
-        }
-        living.membership = Some(living.field.membership());
-        // Generations are handed over when they appear (serials only grow; those a frame's
-        // budget left waiting are in `waiting`) and when they go; per frame only the drift (one
-        // value) and the fades of the blocks forming or dissipating change.
-        let mut count = 0;
-        let newest = living.newest_serial;
-        living.fading.clear();
-        // Which new generations fade in as they arrive: steady ones (a weather change's form
-        // instead) within the impostor ring (beyond it the ring's crossfade brings them in).
-        // Flying on, blocks join at the field's rim, beyond the ring: only a sky that had no
-        // clouds around (the first frames, a jump) has arrivals to fade.
-        let fade_in_s = self.settings.arrival_fade_s;
-        let fade_in = fade_in_s > 0.0 && !self.synchronous_clouds;
-        let ring_m = self.sky_reach.ring_radius_m;
-        let ground_m = camera_m.truncate();
-        // The new generations, nearest first after the walk: (distance squared, serial,
-        // index, generation).
-        let mut new: Vec<(f64, u64, BlockIndex, &FieldBlock)> = Vec::new();
-        for (index, fb) in living.field.blocks() {
-            count += 1;
-            let is_new = fb.serial > newest
-                || (!living.waiting.is_empty() && living.waiting.contains(&fb.serial));
-            if is_new {
-                let d2 = (index.centre_m() + drift).distance_squared(ground_m);
-                new.push((d2, fb.serial, index, fb));
-                living.newest_serial = living.newest_serial.max(fb.serial);
-            }
-            // Arrivals are few and brief (the first frames, a jump): with none, the field's
-            // thousands of blocks cost no lookup each a frame.
-            let arrival = (!living.arriving.is_empty())
-                .then(|| living.arriving.get(&fb.serial))
-                .flatten()
-                .map(|&since| ((now - since) / fade_in_s) as f32)
-                .filter(|&p| p < 1.0);
-            if arrival.is_none() && !living.arriving.is_empty() {
-                living.arriving.remove(&fb.serial);
-            }
-            let fade = fade_of(fb.phase, arrival, now, &lifecycle);
-            if fade != Fade::Steady {
-                let step = fade_step(fb.serial, fade);
-                // Told only when it has moved on a step since the last frame, as when nothing
-                // came or went (`was_fading` is sorted by serial): a block crossing hands over a
-                // few generations, not the thousand that form after a weather change.
-                let shown = (living.was_fading)
-                    .binary_search_by_key(&fb.serial, |f| f.0)
-                    .ok()
-                    .map(|k| living.was_fading[k].2);
-                if !is_new && shown != Some(step) {
-                    update.fades.push((fb.serial, fade));
-                }
-                living.fading.push((fb.serial, fb.phase, step));
-            }
-        }
-        // The nearest first, as many as the frame's budget of sprites (offline frames: all).
-        new.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let budget = match self.synchronous_clouds {
-            true => u64::MAX,
-            false => u64::from(self.settings.joined_sprites_per_frame),
+        // Each band's drift; bands the field is not split into move as its last.
+        let offsets: BandOffsets = std::array::from_fn(|k| {
+            let band = &living.bands[k.min(living.bands.len() - 1)];
+            band.field.drift_m().extend(0.0)
+        });
+        update.drift_m = Some(offsets);
+        let mut hand_over = HandOver {
+            fade_in_s: self.settings.arrival_fade_s,
+            fade_in: self.settings.arrival_fade_s > 0.0 && !self.synchronous_clouds,
+            ring_m: self.sky_reach.ring_radius_m,
+            ground_m: camera_m.truncate(),
+            budget: match self.synchronous_clouds {
+                true => u64::MAX,
+                false => u64::from(self.settings.joined_sprites_per_frame),
+            },
+            spent: 0,
+            waiting: (0, 0),
+            walked: false,
         };
-        let (mut spent, mut waiting_sprites) = (0u64, 0u64);
-        let joined = &mut update.came;
-        let mut waiting_clouds = 0u64;
-        for &(d2, serial, index, fb) in &new {
-            let sprites: u64 = fb.block.clouds.iter().map(|c| c.sprites.len() as u64).sum();
-            if !joined.is_empty() && spent + sprites > budget {
-                living.waiting.insert(serial);
-                waiting_sprites += sprites;
-                waiting_clouds += fb.block.clouds.len() as u64;
-                continue;
-            }
-            spent += sprites;
-            living.waiting.remove(&serial);
-            let arrives =
-                fade_in && fb.phase == Phase::Steady && ring_m.is_none_or(|r| d2 <= r * r);
-            let arrival = arrives.then(|| {
-                living.arriving.insert(serial, now);
-                0.0
-            });
-            let fade = fade_of(fb.phase, arrival, now, &lifecycle);
-            if arrives {
-                // Its fade, kept with the others' (it was steady in the walk).
-                let step = fade_step(serial, fade);
-                living.fading.push((serial, fb.phase, step));
-            }
-            living.in_sky.insert(serial);
-            joined.push((living_block(index, fb), BlockMotion { offset_m, fade }));
-        }
-        // What still waits, so that the sky grows its buffers once for all of it.
-        update.expected = Some((waiting_sprites, waiting_clouds));
-        // The ones that finished forming since the last frame (told after the new ones come,
-        // which they may be).
-        living.fading.sort_unstable_by_key(|f| f.0);
-        for &(id, _, _) in &living.was_fading {
-            if living.fading.binary_search_by_key(&id, |f| f.0).is_err() {
-                update.fades.push((id, Fade::Steady));
-            }
-        }
-        std::mem::swap(&mut living.was_fading, &mut living.fading);
-        // Every block of the field is in the sky or waits; more there means some went.
-        if living.in_sky.len() + living.waiting.len() != count {
-            living.seen.clear();
-            living
-                .seen
-                .extend(living.field.blocks().map(|(_, fb)| fb.serial));
-            let gone: Vec<u64> = living.in_sky.difference(&living.seen).copied().collect();
-            for id in &gone {
-                living.in_sky.remove(id);
-                living.arriving.remove(id);
-            }
-            let seen = &living.seen;
-            living.waiting.retain(|id| seen.contains(id));
-            update.went = gone;
-        }
+        super::living::hand_over(&mut living.bands, &offsets, &mut hand_over, &mut update);
         // The field's own time: the sky counts its applying in its own update.
         update.field_cpu = start.spent();
         Ok(update)
     }
 }
 
-/// A living generation as the sky's block: its id is the generation's serial, its clouds where
-/// they were generated (the drift is the block's motion).
-fn living_block(index: BlockIndex, fb: &FieldBlock) -> SkyBlock {
-    let clouds: Vec<SkyCloud> = fb.block.clouds.iter().map(SkyCloud::from).collect();
-    let c = index.centre_m();
-    let mean_z = clouds.iter().map(|c| c.centre_m.z).sum::<f64>() / clouds.len().max(1) as f64;
-    SkyBlock {
-        id: fb.serial,
-        centre_m: DVec3::new(c.x, c.y, mean_z),
-        clouds,
-    }
-}
-
 /// A block's id for the vertex cache: its index packed into 64 bits.
 pub fn block_id(index: BlockIndex) -> u64 {
     ((index.i as u32 as u64) << 32) | index.j as u32 as u64
-}
-
-/// Steps of a fade's progress (0 to 1) that the sky is told of. A step is 1/1024 of a
-/// formation (0.6 s of the shipped 10 minutes): its change of opacity is a quarter of what an
-/// 8-bit colour can show.
-const FADE_STEPS: f64 = 1024.0;
-
-/// A fade's kind (0 steady, 1 forming, 2 dissipating) and which of its [`FADE_STEPS`] its
-/// progress is at.
-type FadeStep = (u8, i64);
-
-/// The step of `fade` for generation `serial`. The steps of each generation are shifted by a
-/// fraction of a step of its own (from its serial), so that generations that began to fade
-/// together (every block around after a weather change) do not all step in the same frame.
-fn fade_step(serial: u64, fade: Fade) -> FadeStep {
-    let shift = (serial.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 11) as f64 / (1u64 << 53) as f64;
-    let at = |p: f32| (f64::from(p) * FADE_STEPS + shift).floor() as i64;
-    match fade {
-        Fade::Steady => (0, 0),
-        Fade::Forming(p) => (1, at(p)),
-        Fade::Dissipating(p) => (2, at(p)),
-    }
-}
-
-/// How a generation in `phase` is drawn at field time `now_s`: forming, dissipating or steady,
-/// or fading in by `arrival` (0..1) as it arrives.
-fn fade_of(phase: Phase, arrival: Option<f32>, now_s: f64, lifecycle: &LifecycleConfig) -> Fade {
-    match phase {
-        Phase::Steady => arrival.map_or(Fade::Steady, Fade::Forming),
-        Phase::Forming { .. } | Phase::Unforming { .. } => {
-            Fade::Forming(progress(phase, now_s, lifecycle))
-        }
-        Phase::Dissipating { .. } => Fade::Dissipating(progress(phase, now_s, lifecycle)),
-        Phase::Gone => Fade::Dissipating(1.0),
-    }
 }
 
 #[cfg(test)]
@@ -868,7 +686,7 @@ mod tests {
         });
         let camera_m = DVec3::new(0.0, 0.0, 1_500.0);
         let first = world.advance_sky(camera_m, 0.0).expect("first update");
-        let blocks = world.living_field().expect("living").blocks().count();
+        let blocks: usize = world.living_fields().map(|f| f.blocks().count()).sum();
         assert!(first.lifecycle.is_some());
         assert!(blocks > 0);
         assert_eq!(first.came.len(), blocks);
@@ -880,71 +698,5 @@ mod tests {
         assert_eq!(next.lifecycle, None);
         assert!(next.came.is_empty() && next.went.is_empty() && next.fades.is_empty());
         assert!(next.drift_m.is_some());
-    }
-
-    /// How opaque a block with `fade` is drawn as a whole (the renderer's own measure).
-    fn opacity(fade: Fade) -> f32 {
-        match fade {
-            Fade::Steady => 1.0,
-            Fade::Forming(p) => p,
-            Fade::Dissipating(q) => 1.0 - q,
-        }
-    }
-
-    /// A formation of 10 minutes seen at 60 frames a second: the fade the sky holds is never
-    /// more than a step behind the field's, and it is told about once a step, not every frame.
-    #[test]
-    fn a_fade_is_handed_over_a_step_at_a_time_and_never_lags_a_step() {
-        let lifecycle = crate::clouds::config::CloudsConfig::builtin().lifecycle;
-        let phase = Phase::Forming { since_s: 0.0 };
-        let frames = (f64::from(lifecycle.formation_s) * 60.0) as usize;
-        let (mut told, mut shown, mut shown_step) = (0, Fade::Forming(0.0), (9, 0));
-        for k in 0..=frames {
-            let now = k as f64 / 60.0;
-            let fade = fade_of(phase_at(phase, now, &lifecycle), None, now, &lifecycle);
-            let step = fade_step(7, fade);
-            if step != shown_step {
-                (told, shown, shown_step) = (told + 1, fade, step);
-            }
-            let behind = opacity(fade) - opacity(shown);
-            assert!(
-                (0.0..=1.0 / FADE_STEPS as f32 + 1e-6).contains(&behind),
-                "frame {k}: {behind}"
-            );
-        }
-        assert_eq!(shown, Fade::Steady);
-        assert!((1024..=1026).contains(&told), "{told} of {frames} frames");
-    }
-
-    /// A thousand generations that begin to form in the same frame (a weather change) step in
-    /// different frames: no frame tells the sky of much more than its share.
-    #[test]
-    fn generations_that_fade_together_step_in_different_frames() {
-        let lifecycle = crate::clouds::config::CloudsConfig::builtin().lifecycle;
-        let phase = Phase::Forming { since_s: 0.0 };
-        let serials: Vec<u64> = (1000..2000).collect();
-        let mut last: Vec<FadeStep> = serials
-            .iter()
-            .map(|&s| fade_step(s, Fade::Forming(0.0)))
-            .collect();
-        // 10 frames a second: about 10 steps of 1,024 per 6 s, 0.17 a frame for each generation.
-        let (mut most, mut all) = (0, 0);
-        for k in 1..=600 {
-            let now = k as f64 / 10.0;
-            let fade = fade_of(phase_at(phase, now, &lifecycle), None, now, &lifecycle);
-            let mut told = 0;
-            for (s, l) in serials.iter().zip(&mut last) {
-                let step = fade_step(*s, fade);
-                told += (step != *l) as usize;
-                *l = step;
-            }
-            (most, all) = (most.max(told), all + told);
-        }
-        let share = all as f64 / 600.0;
-        assert!((100.0..250.0).contains(&share), "{share} a frame");
-        assert!(
-            (most as f64) < 2.0 * share,
-            "{most} in one frame, {share} a frame on average"
-        );
     }
 }

@@ -174,7 +174,15 @@ pub struct BlockMotion {
     pub offset_m: DVec3,
     /// Formation or dissipation.
     pub fade: Fade,
+    /// Which of the drifts a [`crate::render::SkyUpdate`] gives moves it
+    /// ([`BandOffsets`]: the clouds stage's drift bands, [`crate::clouds::bands`]); 0 for a
+    /// block of the host's own.
+    pub drift_band: u8,
 }
+
+/// The drift offset of each drift band, metres ([`crate::clouds::bands`]: each of a block's
+/// layers drifts with the wind at its own height), lowest band first.
+pub type BandOffsets = [DVec3; crate::clouds::config::MAX_DRIFT_BANDS as usize];
 
 /// A sprite convenience for tests and hosts: a square sprite, fully opaque.
 pub fn square_sprite(offset_m: Vec3, size_m: f32, cell: u8, group: u16) -> SkySprite {

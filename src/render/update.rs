@@ -11,8 +11,8 @@
 
 use glam::DVec3;
 
-use crate::clouds::config::LifecycleConfig;
-use crate::render::scene::{BlockMotion, Fade, SkyBlock};
+use crate::clouds::config::{LifecycleConfig, MAX_DRIFT_BANDS};
+use crate::render::scene::{BandOffsets, BlockMotion, Fade, SkyBlock};
 use crate::render::stats::Spent;
 
 /// One frame's changes of the blocks a living field hands the sky, applied in this order by
@@ -38,9 +38,9 @@ pub struct SkyUpdate {
     /// Blocks the sky holds whose fade moved on (by id), or that finished fading
     /// ([`Fade::Steady`]).
     pub fades: Vec<(u64, Fade)>,
-    /// Every block's drift offset with the wind, metres (one value for the field: it drifts
-    /// as one). `None`: left as it is.
-    pub drift_m: Option<DVec3>,
+    /// Each drift band's offset with the wind, metres: a block moves with its
+    /// [`BlockMotion::drift_band`]'s. `None`: left as it is.
+    pub drift_m: Option<BandOffsets>,
     /// Ids of the generations that went.
     pub went: Vec<u64>,
     /// The CPU time the field spent making this update on the frame thread (the clouds
@@ -50,10 +50,10 @@ pub struct SkyUpdate {
 }
 
 impl SkyUpdate {
-    /// An update that only moves every block to the drift `offset_m`.
+    /// An update that only moves every block to the drift `offset_m` (every band alike).
     pub fn drift(offset_m: DVec3) -> Self {
         Self {
-            drift_m: Some(offset_m),
+            drift_m: Some([offset_m; MAX_DRIFT_BANDS as usize]),
             ..Self::default()
         }
     }
@@ -102,7 +102,10 @@ mod tests {
     #[test]
     fn a_drift_alone_moves_no_blocks() {
         let u = SkyUpdate::drift(DVec3::new(1.0, 2.0, 0.0));
-        assert_eq!(u.drift_m, Some(DVec3::new(1.0, 2.0, 0.0)));
+        assert_eq!(
+            u.drift_m,
+            Some([DVec3::new(1.0, 2.0, 0.0); MAX_DRIFT_BANDS as usize])
+        );
         assert!(!u.moves_blocks());
         let faded = SkyUpdate {
             distant: vec![DistantChange::Fade(7, Fade::Forming(0.5))],

@@ -10,7 +10,7 @@ use glam::{DVec3, Vec3};
 use super::layout::{IMPOSTORS, ImpostorSettings, is_far, needs_rebuild, sectors_of};
 use super::{Build, ImpostorRing, RingState};
 use crate::render::id_hash::IdSet;
-use crate::render::scene::Fade;
+use crate::render::scene::{BandOffsets, Fade};
 use crate::render::sprites::draw_list::Blocks;
 use crate::render::sprites::resident::ResidentSet;
 
@@ -57,7 +57,7 @@ struct SplitCheck {
     builds: u64,
     view_radius_m: f64,
     camera_z_m: f64,
-    drift_m: DVec3,
+    drift_m: BandOffsets,
     far_now: usize,
     same: bool,
     /// Whether a far block not in the shown ring is drawn whole
@@ -95,7 +95,7 @@ impl RingPlan {
     pub fn split(
         &mut self,
         s: &ImpostorSettings,
-        (blocks, changes, drift_m): (&Blocks, u64, DVec3),
+        (blocks, changes, drift_m): (&Blocks, u64, BandOffsets),
         (camera_m, sun, dt_s): (DVec3, Vec3, f64),
         recorded: bool,
     ) -> bool {
@@ -140,7 +140,8 @@ impl RingPlan {
                 && c.changes == changes
                 && c.builds == self.builds
                 && c.view_radius_m == s.view_radius_m
-                && (c.camera_z_m - camera_m.z).abs() + (c.drift_m - drift_m).length() <= slack_m
+                && (c.camera_z_m - camera_m.z).abs() + drift_moved_m(&c.drift_m, &drift_m)
+                    <= slack_m
         });
         let far = (self.fade.as_ref().map(|(_, st, _)| st))
             .or(shown)
@@ -261,6 +262,14 @@ impl RingPlan {
     }
 }
 
+/// How far the farthest-moved drift band has moved from `then` to `now`, metres.
+fn drift_moved_m(then: &BandOffsets, now: &BandOffsets) -> f64 {
+    then.iter()
+        .zip(now)
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0, f64::max)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -299,7 +308,7 @@ mod tests {
             // Beyond the view radius: neither in the ring nor near.
             DVec3::new(0.0, -150_000.0, 1500.0),
         ]);
-        let frame = (&blocks, 4, DVec3::ZERO);
+        let frame = (&blocks, 4, BandOffsets::default());
         let mut plan = RingPlan::default();
         assert!(plan.split(&s, frame, (camera, Vec3::Z, 0.016), false));
         let build = plan.build.as_ref().map(|b| &b.state);

@@ -79,6 +79,7 @@ pub use layout::{
 use super::RenderError;
 use super::gpu_types::{GpuDrawBlock, GpuListCloud};
 use super::id_hash::{IdMap, IdSet};
+use super::scene::BandOffsets;
 use super::sprites::draw_list::Blocks;
 use super::sprites::resident::{Resident, ResidentSet, storage_buffer};
 use super::sprites::sprite_view::{ViewBuffers, ViewLight};
@@ -108,8 +109,15 @@ struct GpuCloudShadow {
 }
 const _: () = assert!(std::mem::size_of::<GpuCloudShadow>() == 96 + 16 * MASK_RECTS);
 
-/// Most rectangles queued before the map is drawn whole instead.
-const MAX_QUEUED: usize = 256;
+/// Most rectangles queued before the map is drawn whole instead: a 9 km move takes a few
+/// hundred blocks off the map in each drift band that has clouds there (each band a block of
+/// its own over the same ground), and the queue is worked through a texel budget a frame.
+const MAX_QUEUED: usize = 1024;
+
+/// Texels an upper drift band's shadows may lag where its clouds are before the map is drawn
+/// whole again: two 117 m texels are a shadow's soft edge, and with 20 kt of shear between the
+/// layers a band slips that far in about 25 s.
+const BAND_SLIP_TEXELS: f64 = 2.0;
 
 /// Most rectangles a frame draws again (a scroll's strips take four at most). Keep in sync with
 /// `MASK_RECTS` in `shaders/cloud_shadow.wgsl`.
@@ -219,8 +227,12 @@ pub struct CloudShadows {
     cover: Option<CoverCheck>,
     /// Draw the map at the next prepare whatever changed ([`Self::redraw`]).
     force: bool,
-    /// The clouds' drift now ([`super::Sky::set_drift`]).
+    /// The clouds' drift now ([`super::Sky::set_band_drifts`]): the lowest band's, which the
+    /// map moves with between draws.
     drift_m: DVec3,
+    /// How far each upper drift band has moved against the lowest now, and when the map was
+    /// last drawn whole: their shadows stay where they were drawn until the map is drawn again.
+    band_slip_m: (BandOffsets, BandOffsets),
     /// This frame's draw: its sprites, if the map is drawn this frame.
     pending: Option<u32>,
     lookup: Mat4,
@@ -327,6 +339,7 @@ impl CloudShadows {
             cover: None,
             force: false,
             drift_m: DVec3::ZERO,
+            band_slip_m: Default::default(),
             pending: None,
             lookup: Mat4::ZERO,
             timer: None,
@@ -375,10 +388,21 @@ impl CloudShadows {
         &self.settings
     }
 
-    /// The clouds' drift now (one offset for every block, as [`super::Sky::set_drift`] sets
-    /// it): between draws the map moves with it.
-    pub fn set_drift(&mut self, offset_m: DVec3) {
-        self.drift_m = offset_m;
+    /// The clouds' drift now, each drift band's ([`super::Sky::set_band_drifts`]): between
+    /// draws the map moves with the lowest band's.
+    pub fn set_drift(&mut self, offsets_m: &BandOffsets) {
+        self.drift_m = offsets_m[0];
+        self.band_slip_m.0 = offsets_m.map(|o| o - offsets_m[0]);
+    }
+
+    /// Whether an upper drift band has slipped more than [`BAND_SLIP_TEXELS`] against the
+    /// lowest since the map was drawn whole.
+    fn bands_slipped(&self) -> bool {
+        let (now, then) = &self.band_slip_m;
+        let limit = BAND_SLIP_TEXELS * self.settings.texel_m();
+        now.iter()
+            .zip(then)
+            .any(|(a, b)| (*a - *b).length() > limit)
     }
 
     /// Bytes of its textures and buffers.
@@ -446,7 +470,8 @@ impl CloudShadows {
                 // when the queue of rectangles has grown past what patches are for.
                 let changing = self.cover.as_ref().is_some_and(|c| !c.changing.is_empty());
                 let due = redraw_due(&frame, (at_s, now_s), here, sun, changing, &s);
-                whole |= due.turned || due.aged || self.dirty.len() > MAX_QUEUED;
+                whole |=
+                    due.turned || due.aged || self.dirty.len() > MAX_QUEUED || self.bands_slipped();
                 if due.recentre && !whole {
                     let to = frame.moved_to(here, &s);
                     match layout::scroll_shift(&frame, &to, s.size_px) {
@@ -527,6 +552,7 @@ impl CloudShadows {
         let mut bytes = self.write_view(queue, resident, light, &frame, sprites);
         bytes += self.write_uniform(queue, &frame);
         self.drawn = Some((frame, now_s, self.drift_m));
+        self.band_slip_m.1 = self.band_slip_m.0;
         self.drawings += 1;
         self.whole = true;
         self.pending = Some(sprites);

@@ -91,8 +91,8 @@ impl Sky {
         for (id, fade) in fades {
             self.set_block_fade(id, fade);
         }
-        if let Some(offset_m) = drift_m {
-            self.set_drift(offset_m);
+        if let Some(offsets_m) = drift_m {
+            self.set_band_drifts(&offsets_m);
         }
         for id in went {
             self.retire(id);
@@ -202,13 +202,21 @@ impl Sky {
     }
 
     /// Moves every block the sky holds to the same drift offset (a field drifting with the air as
-    /// one): one write a block, no lookups, nothing uploaded.
+    /// one, every drift band alike): one write a block, no lookups, nothing uploaded.
     pub fn set_drift(&mut self, offset_m: glam::DVec3) {
+        self.set_band_drifts(&[offset_m; crate::clouds::config::MAX_DRIFT_BANDS as usize]);
+    }
+
+    /// Moves every block the sky holds to its drift band's offset (each band of layers drifts
+    /// with the wind at its own height, [`crate::clouds::bands`]): one write a block, no
+    /// lookups, nothing uploaded.
+    pub fn set_band_drifts(&mut self, offsets_m: &crate::render::scene::BandOffsets) {
+        let last = offsets_m.len() - 1;
         for r in self.sprites.resident.blocks.values_mut() {
-            r.motion.offset_m = offset_m;
+            r.motion.offset_m = offsets_m[usize::from(r.motion.drift_band).min(last)];
         }
-        self.sprites.resident.drift_m = offset_m;
-        self.shadows.set_drift(offset_m);
+        self.sprites.resident.drift_m = *offsets_m;
+        self.shadows.set_drift(offsets_m);
     }
 
     /// Sets where a block is in its life, keeping its drift; false if the sky does not hold it.

@@ -292,7 +292,7 @@ pub(in crate::render) struct ResidentSet {
     /// every frame.
     pub fades: u64,
     /// The drift [`crate::render::Sky::set_drift`] last moved every block to.
-    pub drift_m: DVec3,
+    pub drift_m: crate::render::scene::BandOffsets,
     /// Placings of blocks so far ([`Resident::place_serial`]).
     placings: u64,
     /// Sprites and clouds of blocks the caller will insert in the next frames
@@ -389,7 +389,7 @@ impl ResidentSet {
             waiting: IdSet::default(),
             changes: 0,
             fades: 0,
-            drift_m: DVec3::ZERO,
+            drift_m: Default::default(),
             placings: 0,
             expected: (0, 0),
         }
