@@ -62,6 +62,7 @@
 pub(super) mod layout;
 // The map's own view of the resident sprites (its draw list and cloud lists), written when a
 // drawing is decided.
+mod slip;
 mod view;
 // Its textures, pipelines and the recording of a drawing.
 mod draw;
@@ -113,11 +114,6 @@ const _: () = assert!(std::mem::size_of::<GpuCloudShadow>() == 96 + 16 * MASK_RE
 /// hundred blocks off the map in each drift band that has clouds there (each band a block of
 /// its own over the same ground), and the queue is worked through a texel budget a frame.
 const MAX_QUEUED: usize = 1024;
-
-/// Texels an upper drift band's shadows may lag where its clouds are before the map is drawn
-/// whole again: two 117 m texels are a shadow's soft edge, and with 20 kt of shear between the
-/// layers a band slips that far in about 25 s.
-const BAND_SLIP_TEXELS: f64 = 2.0;
 
 /// Most rectangles a frame draws again (a scroll's strips take four at most). Keep in sync with
 /// `MASK_RECTS` in `shaders/cloud_shadow.wgsl`.
@@ -230,9 +226,8 @@ pub struct CloudShadows {
     /// The clouds' drift now ([`super::Sky::set_band_drifts`]): the lowest band's, which the
     /// map moves with between draws.
     drift_m: DVec3,
-    /// How far each upper drift band has moved against the lowest now, and when the map was
-    /// last drawn whole: their shadows stay where they were drawn until the map is drawn again.
-    band_slip_m: (BandOffsets, BandOffsets),
+    /// How far the upper drift bands slipped against the lowest since the last whole drawing.
+    band_slip: slip::BandSlip,
     /// This frame's draw: its sprites, if the map is drawn this frame.
     pending: Option<u32>,
     lookup: Mat4,
@@ -339,7 +334,7 @@ impl CloudShadows {
             cover: None,
             force: false,
             drift_m: DVec3::ZERO,
-            band_slip_m: Default::default(),
+            band_slip: Default::default(),
             pending: None,
             lookup: Mat4::ZERO,
             timer: None,
@@ -392,17 +387,7 @@ impl CloudShadows {
     /// draws the map moves with the lowest band's.
     pub fn set_drift(&mut self, offsets_m: &BandOffsets) {
         self.drift_m = offsets_m[0];
-        self.band_slip_m.0 = offsets_m.map(|o| o - offsets_m[0]);
-    }
-
-    /// Whether an upper drift band has slipped more than [`BAND_SLIP_TEXELS`] against the
-    /// lowest since the map was drawn whole.
-    fn bands_slipped(&self) -> bool {
-        let (now, then) = &self.band_slip_m;
-        let limit = BAND_SLIP_TEXELS * self.settings.texel_m();
-        now.iter()
-            .zip(then)
-            .any(|(a, b)| (*a - *b).length() > limit)
+        self.band_slip.set(offsets_m);
     }
 
     /// Bytes of its textures and buffers.
@@ -470,8 +455,10 @@ impl CloudShadows {
                 // when the queue of rectangles has grown past what patches are for.
                 let changing = self.cover.as_ref().is_some_and(|c| !c.changing.is_empty());
                 let due = redraw_due(&frame, (at_s, now_s), here, sun, changing, &s);
-                whole |=
-                    due.turned || due.aged || self.dirty.len() > MAX_QUEUED || self.bands_slipped();
+                whole |= due.turned
+                    || due.aged
+                    || self.dirty.len() > MAX_QUEUED
+                    || self.band_slip.slipped(s.texel_m());
                 if due.recentre && !whole {
                     let to = frame.moved_to(here, &s);
                     match layout::scroll_shift(&frame, &to, s.size_px) {
@@ -552,7 +539,7 @@ impl CloudShadows {
         let mut bytes = self.write_view(queue, resident, light, &frame, sprites);
         bytes += self.write_uniform(queue, &frame);
         self.drawn = Some((frame, now_s, self.drift_m));
-        self.band_slip_m.1 = self.band_slip_m.0;
+        self.band_slip.drawn();
         self.drawings += 1;
         self.whole = true;
         self.pending = Some(sprites);
