@@ -400,7 +400,6 @@ impl Sky {
         let sprites = &self.sprites;
         (self.shadows).record(
             &mut encoder,
-            &self.sheet_group,
             &sprites.build,
             &sprites.resident.group,
             &sprites.quads.0,

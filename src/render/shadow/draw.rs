@@ -62,17 +62,16 @@ pub(super) fn shadow_texture(
     (texture, view)
 }
 
-/// The pipelines over `layout` (the uniform) and `sheet_layout` (the sprite sheet): the sprites
-/// adding their optical depth, and the clear of a rectangle (a triangle over the map writing 0,
-/// cut by the scissor), which reads no group.
+/// The pipelines over `layout` (the uniform; the cores are analytic, so no sprite sheet is
+/// read): the sprites adding their optical depth, and the clear of a rectangle (a triangle over
+/// the map writing 0, cut by the scissor), which reads no group.
 pub(super) fn pipelines(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
-    sheet_layout: &wgpu::BindGroupLayout,
 ) -> [wgpu::RenderPipeline; 2] {
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("sky.cloud_shadow"),
-        bind_group_layouts: &[Some(layout), Some(sheet_layout)],
+        bind_group_layouts: &[Some(layout)],
         immediate_size: 0,
     });
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -154,12 +153,11 @@ impl CloudShadows {
     /// host's frame): a scroll moves the map's texels first; the rectangles drawn again are
     /// cleared (a triangle under each one's scissor); then, chunk by chunk, the sprites' corners
     /// are built from the resident sprites (`resident`) by `build` and drawn (`indices`: the
-    /// quad index buffer; `sheet`: the sprite sheet's group), the map's blocks kept to the
-    /// rectangles, the blocks that arrived over all of it.
+    /// quad index buffer), the map's blocks kept to the rectangles, the blocks that arrived over
+    /// all of it.
     pub(in crate::render) fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        sheet: &wgpu::BindGroup,
         build: &SpriteBuild,
         resident: &wgpu::BindGroup,
         indices: &wgpu::Buffer,
@@ -232,7 +230,6 @@ impl CloudShadows {
             if let (Some(_), Some((_, first, n))) = (view, part) {
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &self.group, &[]);
-                pass.set_bind_group(1, sheet, &[]);
                 pass.set_vertex_buffer(0, build.vertices().slice(..));
                 pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
                 for segment in &self.segments {

@@ -264,14 +264,13 @@ struct Segment {
 }
 
 impl CloudShadows {
-    /// The pipelines (groups: its uniform, the sprite sheet of `sheet_layout`) and the textures
-    /// (a cleared texel while switched off). `view_layout`: the build pass's view group;
-    /// `in_cloud_visibility_m`: the visibility inside a cloud (`[in_cloud]`).
+    /// The pipelines (their group: the uniform) and the textures (a cleared texel while switched
+    /// off). `view_layout`: the build pass's view group; `in_cloud_visibility_m`: the visibility
+    /// inside a cloud (`[in_cloud]`).
     pub(super) fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         (settings, in_cloud_visibility_m): (ShadowSettings, f32),
-        sheet_layout: &wgpu::BindGroupLayout,
         view_layout: &wgpu::BindGroupLayout,
     ) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -301,7 +300,7 @@ impl CloudShadows {
                 resource: uniform.as_entire_binding(),
             }],
         });
-        let [pipeline, clear_pipeline] = draw::pipelines(device, &layout, sheet_layout);
+        let [pipeline, clear_pipeline] = draw::pipelines(device, &layout);
         let (texture, view) = draw::shadow_texture(device, [1, 1]);
         let scratch = draw::shadow_texture(device, [1, 1]).0;
         let mut shadows = Self {

@@ -185,7 +185,6 @@ impl Sky {
                 config.settings.cloud_shadows,
                 config.settings.in_cloud.visibility_m,
             ),
-            &sheet_layout,
             &view_layout,
         );
         Ok(Self {
