@@ -239,6 +239,11 @@ pub fn weather_changed_in(band: DriftBand, a: &BlockWeather, b: &BlockWeather) -
         })
 }
 
+/// Whether a generation holds clouds.
+fn has_clouds(g: &FieldBlock) -> bool {
+    !g.block.clouds.is_empty()
+}
+
 /// A field time as a key of the queue of phase ends (times are finite).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct FieldTime(f64);
@@ -331,6 +336,11 @@ pub struct CloudField {
     next_serial: u64,
     /// Counts changes to which generations exist (added, gone).
     membership: u64,
+    /// Generations that hold clouds (an upper band's field may hold none: the probes pass it).
+    clouded: usize,
+    /// The lowest and highest heights any generation taken in reached (its boxes and rain),
+    /// metres: a line of sight that passes under or over them meets none of this field's clouds.
+    heights_m: (f64, f64),
     /// The blocks with generations forming or dissipating, by when the first of them ends:
     /// advancing time touches only the blocks whose phases end then, not the thousands that
     /// fade at once across a weather change (building cumulus fade for ten minutes).
@@ -369,6 +379,8 @@ impl CloudField {
             slots: BTreeMap::new(),
             next_serial: 0,
             membership: 0,
+            clouded: 0,
+            heights_m: (f64::INFINITY, f64::NEG_INFINITY),
             phase_ends: PhaseEnds::new(),
             ending: Vec::new(),
             storms: StormContext::default(),
@@ -565,7 +577,7 @@ impl CloudField {
         // Blocks a block beyond the rim leave the field.
         let keep = radius + BLOCK_SIZE_M;
         let before = self.slots.len();
-        let phase_ends = &mut self.phase_ends;
+        let (phase_ends, clouded) = (&mut self.phase_ends, &mut self.clouded);
         let mut gone = Vec::new();
         self.slots.retain(|index, slot| {
             let kept = index.centre_m().distance_squared(air_centre) <= keep * keep;
@@ -573,6 +585,7 @@ impl CloudField {
                 if let Some(t) = slot.ends_s {
                     phase_ends.remove(&(FieldTime(t), *index));
                 }
+                *clouded -= slot.generations.iter().filter(|g| has_clouds(g)).count();
                 gone.append(&mut slot.generations);
             }
             kept
@@ -634,6 +647,11 @@ impl CloudField {
             self.next_serial += 1;
             self.membership += 1;
             let band = self.band;
+            self.clouded += usize::from(!done.block.clouds.is_empty());
+            if !done.boxes.boxes.is_empty() {
+                let (lo, hi) = &mut self.heights_m;
+                (*lo, *hi) = (lo.min(done.boxes.lo_m.z), hi.max(done.boxes.hi_m.z));
+            }
             slot.generations.push(FieldBlock {
                 block: done.block,
                 boxes: done.boxes,
@@ -672,6 +690,7 @@ impl CloudField {
             }
             let before = freed.len();
             freed.extend(slot.generations.extract_if(.., |g| g.phase == Phase::Gone));
+            self.clouded -= freed[before..].iter().filter(|g| has_clouds(g)).count();
             if freed.len() != before {
                 self.membership += 1;
             }
@@ -757,6 +776,18 @@ impl CloudField {
     /// Blocks in the field (with or without clouds generated yet).
     pub fn block_count(&self) -> usize {
         self.slots.len()
+    }
+
+    /// Whether any generation holds clouds (an upper drift band's field over a sky of one layer
+    /// holds none).
+    pub fn has_clouds(&self) -> bool {
+        self.clouded > 0
+    }
+
+    /// The lowest and highest heights its clouds have reached since it began (never less: a
+    /// bound, not the clouds now), metres above mean sea level.
+    pub fn heights_m(&self) -> (f64, f64) {
+        self.heights_m
     }
 
     /// Blocks queued for generation and not yet taken in.
@@ -1145,10 +1176,16 @@ mod tests {
         let held = field.block_count();
         assert!(held > 0);
         assert_eq!(field.blocks().count(), 0, "no clouds of band 1");
+        assert!(!field.has_clouds());
         field.advance(30.0);
         field.update_for(DVec2::ZERO, &|_| two.clone(), 2);
         field.wait_for_pending();
         assert_eq!(field.blocks().count(), held);
+        assert!(field.has_clouds());
+        // Its clouds (their boxes and the rain spheres under them) reach over the upper
+        // layer's base, 9,000 ft (2,743 m) over the 0 m ground.
+        let (lo, hi) = field.heights_m();
+        assert!(hi > 2_743.0 && lo < hi, "{lo} {hi}");
         for (_, g) in field.blocks() {
             assert!(matches!(g.phase, Phase::Forming { .. }), "{:?}", g.phase);
             assert_eq!(g.serial % 2, 1, "band 1's serials");

@@ -14,32 +14,51 @@ use crate::weather::air::InCloudAirSettings;
 /// Queries over the fields of every drift band. See the module docs.
 #[derive(Debug, Clone, Copy)]
 pub struct BandedProbe<'a> {
-    probes: [Option<CloudProbe<'a>>; MAX_DRIFT_BANDS as usize],
+    /// Each band's probe with the heights its clouds reach ([`CloudField::heights_m`]).
+    probes: [Option<(CloudProbe<'a>, (f64, f64))>; MAX_DRIFT_BANDS as usize],
+    /// How far the nearest cloud is looked for, metres.
+    reach_m: f64,
 }
 
 impl<'a> BandedProbe<'a> {
     /// Queries on each band's field with its own cache (at most [`MAX_DRIFT_BANDS`], lowest
-    /// band first; more are left out).
+    /// band first; more are left out), passing the fields without clouds.
     pub fn new(
         bands: impl IntoIterator<Item = (&'a CloudField, &'a BoxCache)>,
         settings: &'a InCloudAirSettings,
     ) -> Self {
         let mut probes = [None; MAX_DRIFT_BANDS as usize];
         for (slot, (field, cache)) in probes.iter_mut().zip(bands) {
-            *slot = Some(CloudProbe::new(field, cache, settings));
+            // A band without clouds (a sky of fewer layers) costs no query.
+            *slot = field
+                .has_clouds()
+                .then(|| (CloudProbe::new(field, cache, settings), field.heights_m()));
         }
-        Self { probes }
+        Self {
+            probes,
+            reach_m: settings.search_radius_m,
+        }
     }
 
-    fn each(&self) -> impl Iterator<Item = &CloudProbe<'a>> {
-        self.probes.iter().flatten()
+    /// The probes of the bands whose clouds reach the heights `lo_m..=hi_m` (a line of sight
+    /// under or over a band's clouds meets none of them).
+    fn each(&self, lo_m: f64, hi_m: f64) -> impl Iterator<Item = &CloudProbe<'a>> {
+        (self.probes.iter().flatten())
+            .filter(move |(_, (lo, hi))| hi_m >= *lo && lo_m <= *hi)
+            .map(|(probe, _)| probe)
+    }
+
+    /// [`Self::each`] for the segment `a`..`b`.
+    fn along(&self, a: DVec3, b: DVec3) -> impl Iterator<Item = &CloudProbe<'a>> {
+        self.each(a.z.min(b.z), a.z.max(b.z))
     }
 
     /// The clouds at ground point `p`: the deepest in-cloud measure (with its type), the
     /// deepest cumulonimbus and rain, the nearest cloud and cumulonimbus of any band.
     pub fn at(&self, p: DVec3) -> CloudsAtPoint {
         let mut out = CloudsAtPoint::default();
-        for probe in self.each() {
+        // The nearest cloud is looked for within the reach: a band beyond it has nothing to say.
+        for probe in self.each(p.z - self.reach_m, p.z + self.reach_m) {
             let here = probe.at(p);
             if here.in_cloud > out.in_cloud {
                 out.in_cloud = here.in_cloud;
@@ -59,7 +78,7 @@ impl<'a> BandedProbe<'a> {
         let mut spans: Vec<Span> = Vec::new();
         let mut first: Option<SightHit> = None;
         let mut total = 0.0;
-        for probe in self.each() {
+        for probe in self.along(a, b) {
             if let Some(hit) = probe.sight(a, b, true, f64::INFINITY, Some(&mut spans)) {
                 total += hit.total_optical_depth;
                 first = Some(nearest_hit(first, hit));
@@ -75,7 +94,7 @@ impl<'a> BandedProbe<'a> {
     /// reaches `enough`.
     pub fn optical_depth_until(&self, a: DVec3, b: DVec3, enough: f64) -> f64 {
         let mut depth = 0.0;
-        for probe in self.each() {
+        for probe in self.along(a, b) {
             if depth >= enough {
                 break;
             }
@@ -86,7 +105,7 @@ impl<'a> BandedProbe<'a> {
 
     /// [`CloudProbe::first_cloud`] of the band whose first cloud is nearest.
     pub fn first_cloud(&self, a: DVec3, b: DVec3) -> Option<SightHit> {
-        self.each()
+        self.along(a, b)
             .filter_map(|probe| probe.first_cloud(a, b))
             .reduce(|x, y| nearest_hit(Some(x), y))
     }

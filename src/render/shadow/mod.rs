@@ -70,7 +70,7 @@ mod draw;
 use std::cell::Cell;
 
 use glam::{DVec3, Mat4, Vec3};
-use view::drawing_order;
+use view::{block_sprites, covered, drawing_order, is_covered, is_near};
 
 pub use layout::{
     BandCopy, EYE_DISTANCE_M, MAX_SIZE_PX, RedrawDue, ShadowFrame, ShadowSettings, TexelRect,
@@ -81,7 +81,6 @@ use super::RenderError;
 use super::gpu_types::{GpuDrawBlock, GpuListCloud};
 use super::id_hash::{IdMap, IdSet};
 use super::scene::BandOffsets;
-use super::sprites::draw_list::Blocks;
 use super::sprites::resident::{Resident, ResidentSet, storage_buffer};
 use super::sprites::sprite_view::{ViewBuffers, ViewLight};
 use super::stats::FrameStats;
@@ -742,52 +741,6 @@ impl CloudShadows {
     pub(super) fn has_pending(&self) -> bool {
         self.pending.is_some()
     }
-}
-
-/// Whether a block (placed on the GPU) may cast a shadow into the map: its sphere's shadow
-/// reaches the square across the rays.
-fn is_covered(r: &Resident, frame: &ShadowFrame) -> bool {
-    if r.place.is_none() || !r.uploaded {
-        return false;
-    }
-    let (x, y) = frame.across(r.centre_m());
-    let reach = frame.half_extent_m + r.radius_m;
-    x.abs() <= reach && y.abs() <= reach
-}
-
-/// Whether a block's shadow (centre and radius, placed) lies within `full_detail_m` of the
-/// map's centre across the rays.
-fn is_near(frame: &ShadowFrame, centre_m: DVec3, radius_m: f64, s: &ShadowSettings) -> bool {
-    let (x, y) = frame.across(centre_m);
-    x.abs().max(y.abs()) - radius_m <= s.full_detail_m
-}
-
-/// The blocks a drawing at `frame` covers (their ids, with their placing), and those of them
-/// that form or dissipate.
-fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (IdMap<u64>, Vec<u64>) {
-    let mut changing = Vec::new();
-    let ids = blocks
-        .values()
-        .filter(|r| is_covered(r, frame))
-        .map(|r| {
-            if r.motion.fade != super::Fade::Steady {
-                changing.push(r.block.id);
-            }
-            (r.block.id, r.place_serial)
-        })
-        .collect();
-    (ids, changing)
-}
-
-/// The sprites a drawing at `frame` draws of a block moved back by `back_m` (every
-/// `far_sprite_stride`th beyond `full_detail_m`).
-fn block_sprites(r: &Resident, frame: &ShadowFrame, back_m: DVec3, s: &ShadowSettings) -> u32 {
-    let stride = if is_near(frame, r.centre_m() - back_m, r.radius_m, s) {
-        1
-    } else {
-        s.far_sprite_stride
-    };
-    r.clouds.iter().map(|c| c.sprites.div_ceil(stride)).sum()
 }
 
 /// How much of their shadows the clouds cast for the sun along `sun`: 1 above 5 degrees, 0

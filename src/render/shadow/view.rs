@@ -6,9 +6,12 @@
 
 use glam::DVec3;
 
+use super::layout::ShadowSettings;
 use super::layout::{TexelRect, footprint};
-use super::{CloudShadows, NO_FAR_FADE_M, ShadowFrame, is_near};
+use super::{CloudShadows, NO_FAR_FADE_M, ShadowFrame};
 use crate::render::gpu_types::{GpuDrawBlock, GpuListCloud};
+use crate::render::id_hash::IdMap;
+use crate::render::sprites::draw_list::Blocks;
 use crate::render::sprites::draw_list::fade_code;
 use crate::render::sprites::resident::{Resident, ResidentSet, storage_buffer};
 use crate::render::sprites::sprite_view::{self, ViewData, ViewLight};
@@ -201,4 +204,60 @@ pub(super) fn drawing_order<'a>(blocks: impl Iterator<Item = &'a Resident>) -> V
             .then(a.2.cmp(&b.2))
     });
     keyed.into_iter().map(|k| k.3).collect()
+}
+
+/// Whether a block (placed on the GPU) may cast a shadow into the map: its sphere's shadow
+/// reaches the square across the rays.
+pub(super) fn is_covered(r: &Resident, frame: &ShadowFrame) -> bool {
+    if r.place.is_none() || !r.uploaded {
+        return false;
+    }
+    let (x, y) = frame.across(r.centre_m());
+    let reach = frame.half_extent_m + r.radius_m;
+    x.abs() <= reach && y.abs() <= reach
+}
+
+/// Whether a block's shadow (centre and radius, placed) lies within `full_detail_m` of the
+/// map's centre across the rays.
+pub(super) fn is_near(
+    frame: &ShadowFrame,
+    centre_m: DVec3,
+    radius_m: f64,
+    s: &ShadowSettings,
+) -> bool {
+    let (x, y) = frame.across(centre_m);
+    x.abs().max(y.abs()) - radius_m <= s.full_detail_m
+}
+
+/// The blocks a drawing at `frame` covers (their ids, with their placing), and those of them
+/// that form or dissipate.
+pub(super) fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (IdMap<u64>, Vec<u64>) {
+    let mut changing = Vec::new();
+    let ids = blocks
+        .values()
+        .filter(|r| is_covered(r, frame))
+        .map(|r| {
+            if r.motion.fade != crate::render::Fade::Steady {
+                changing.push(r.block.id);
+            }
+            (r.block.id, r.place_serial)
+        })
+        .collect();
+    (ids, changing)
+}
+
+/// The sprites a drawing at `frame` draws of a block moved back by `back_m` (every
+/// `far_sprite_stride`th beyond `full_detail_m`).
+pub(super) fn block_sprites(
+    r: &Resident,
+    frame: &ShadowFrame,
+    back_m: DVec3,
+    s: &ShadowSettings,
+) -> u32 {
+    let stride = if is_near(frame, r.centre_m() - back_m, r.radius_m, s) {
+        1
+    } else {
+        s.far_sprite_stride
+    };
+    r.clouds.iter().map(|c| c.sprites.div_ceil(stride)).sum()
 }
