@@ -138,13 +138,37 @@ fn fs_impostor_offscreen(i: RingOut) -> CloudOut {
     return cloud_out(hit.colour, hit.distance_m);
 }
 
-fn ring_hit(i: RingOut) -> RingHit {
+// The steady frames' ring pass, nothing fading in (`ring_pass.rs` picks it on the CPU): the
+// shown ring's lookup alone. Lavapipe runs both sides of `ring_hit`'s branch on the crossfade
+// weight, so there every steady pixel paid for a second lookup it did not show.
+@fragment
+fn fs_impostor_shown(i: RingOut) -> @location(0) vec4<f32> {
+    return shown_hit(i).colour;
+}
+
+@fragment
+fn fs_impostor_shown_offscreen(i: RingOut) -> CloudOut {
+    let hit = shown_hit(i);
+    return cloud_out(hit.colour, hit.distance_m);
+}
+
+// The unit view ray of a ring pass pixel.
+fn ray_dir(i: RingOut) -> vec3<f32> {
     let far = far_point(i.ndc);
-    let dir = normalize(far.xyz / far.w);
-    let w = ring.old_centre_weight.w;
-    let before = ring_sample(
-        old_colour, old_depth, ring.old_centre_weight.xyz, ring.size.z, dir, i.position.xy
+    return normalize(far.xyz / far.w);
+}
+
+// What the shown ring shows along the pixel's ray.
+fn shown_hit(i: RingOut) -> RingHit {
+    return ring_sample(
+        old_colour, old_depth, ring.old_centre_weight.xyz, ring.size.z, ray_dir(i), i.position.xy
     );
+}
+
+fn ring_hit(i: RingOut) -> RingHit {
+    let dir = ray_dir(i);
+    let w = ring.old_centre_weight.w;
+    let before = shown_hit(i);
     if (w <= 0.0) {
         return before;
     }

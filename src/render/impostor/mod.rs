@@ -30,6 +30,7 @@
 pub(super) mod layout;
 mod order_buffer;
 mod orders;
+mod ring_pass;
 // Which blocks the ring draws and when it rebuilds: the CPU's decision, apart from the GPU work.
 mod split;
 
@@ -55,6 +56,7 @@ use super::sprites::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
 use order_buffer::OrderBuffer;
 use orders::{RingOrders, RingSort};
+use ring_pass::RingPassPipelines;
 
 const IMPOSTOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// Alpha-weighted cloud depth, kilometres times alpha (half floats: about 30 m at 60 km).
@@ -90,10 +92,8 @@ pub struct ImpostorRing {
     settings: ImpostorSettings,
     device: wgpu::Device,
     sprite_pipeline: wgpu::RenderPipeline,
-    quad_pipeline: wgpu::RenderPipeline,
-    /// The ring pass into the sky's off-screen cloud target (when the clouds are drawn below
-    /// full resolution).
-    quad_offscreen_pipeline: Option<wgpu::RenderPipeline>,
+    /// The ring pass, into the host's colour or the sky's off-screen cloud target.
+    quad_pipelines: RingPassPipelines,
     /// `[ring][impostor]` colour and depth views the impostor passes render into.
     views: Vec<Vec<wgpu::TextureView>>,
     depth_views: Vec<Vec<wgpu::TextureView>>,
@@ -113,8 +113,9 @@ pub struct ImpostorRing {
     /// Which blocks the ring holds, the rings shown, built and fading, the renders pending:
     /// the CPU's decisions, plain data ([`RingPlan::split`]).
     plan: RingPlan,
-    /// This frame's ring pass: (old ring, new ring), if any ring is shown.
-    quads: Option<(usize, usize)>,
+    /// This frame's ring pass: (old ring, new ring, whether the new one fades in), if any ring
+    /// is shown.
+    quads: Option<(usize, usize, bool)>,
     /// Whether the plan's pending renders went into a recorded frame (then the next plan
     /// starts afresh).
     recorded: Cell<bool>,
@@ -131,7 +132,6 @@ pub struct ImpostorRing {
 
 const SPRITES_WGSL: &str = include_str!("../../../shaders/sprites.wgsl");
 const IMPOSTOR_SPRITES_WGSL: &str = include_str!("../../../shaders/impostor_sprites.wgsl");
-const QUAD_WGSL: &str = include_str!("../../../shaders/impostor_quad.wgsl");
 
 /// What a frame's impostor builds need from the sky.
 #[derive(Clone, Copy)]
@@ -224,36 +224,7 @@ impl ImpostorRing {
                 scene: SceneDepth::Host,
             },
         );
-        let quad_pipeline = pipeline(
-            device,
-            &PassDesc {
-                label: "ring.quads",
-                wgsl: QUAD_WGSL,
-                vs: "vs_impostor",
-                fs: "fs_impostor",
-                bind_groups: &[Some(shared.host_frame_layout), Some(&tex_layout)],
-                buffers: &[],
-                targets: &[(shared.targets.colour_format, over)],
-                samples: shared.targets.sample_count,
-                scene: SceneDepth::host(shared.targets.sample_count),
-            },
-        );
-        let quad_offscreen_pipeline = shared.cloud_targets.map(|targets| {
-            pipeline(
-                device,
-                &PassDesc {
-                    label: "ring.quads_offscreen",
-                    wgsl: QUAD_WGSL,
-                    vs: "vs_impostor",
-                    fs: "fs_impostor_offscreen",
-                    bind_groups: &[Some(shared.frame_layout), Some(&tex_layout)],
-                    buffers: &[],
-                    targets,
-                    samples: 1,
-                    scene: SceneDepth::FarthestMetres,
-                },
-            )
-        });
+        let quad_pipelines = RingPassPipelines::new(device, shared, &tex_layout);
         let rings = if settings.enabled { 2 } else { 0 };
         let side = settings.size_px;
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -396,8 +367,7 @@ impl ImpostorRing {
             settings,
             device: device.clone(),
             sprite_pipeline,
-            quad_pipeline,
-            quad_offscreen_pipeline,
+            quad_pipelines,
             views,
             depth_views,
             quad_groups,
@@ -630,7 +600,7 @@ impl ImpostorRing {
             };
             queue.write_buffer(&self.ring_uniform, 0, bytemuck::bytes_of(&uniform));
             bytes += std::mem::size_of::<GpuRing>() as u64;
-            self.quads = Some((*old, new));
+            self.quads = Some((*old, new, w > 0.0));
         }
         stats.blocks_far = self.plan.blocks_far;
         stats.blocks_near = blocks.len() as u32 - self.plan.blocks_far;
@@ -721,14 +691,10 @@ impl ImpostorRing {
     /// full-screen pass that mixes the shown ring with the one fading in. `offscreen`: the pass
     /// is the sky's cloud target (colour and distance), not the host's colour.
     pub fn draw(&self, pass: &mut wgpu::RenderPass, offscreen: bool) {
-        let Some((old, new)) = self.quads else {
+        let Some((old, new, fading)) = self.quads else {
             return;
         };
-        let quads = match (offscreen, &self.quad_offscreen_pipeline) {
-            (true, Some(p)) => p,
-            _ => &self.quad_pipeline,
-        };
-        pass.set_pipeline(quads);
+        pass.set_pipeline(self.quad_pipelines.get(offscreen, fading));
         pass.set_bind_group(1, &self.quad_groups[old][new], &[]);
         pass.draw(0..3, 0..1);
     }
