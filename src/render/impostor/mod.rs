@@ -26,7 +26,7 @@
 //! them where its scene is nearer (a mountain beyond the ring radius among far clouds). Rules
 //! and geometry: `layout`. Units: metres, degrees.
 
-pub mod band;
+mod band;
 // The ring's settings live here, so the settings tree reads them without the ring.
 pub(super) mod layout;
 mod order_buffer;
