@@ -30,7 +30,7 @@ use super::generate::{generate_block, generate_block_in_field};
 use super::lifecycle::{Phase, ends_at, phase_at};
 use super::storm::CellCache;
 use crate::weather::storms::{StormCell, StormContext, cells_over};
-use crate::weather::{BLOCK_SIZE_M, BlockCover, BlockIndex, BlockWeather, CloudType};
+use crate::weather::{BLOCK_SIZE_M, BlockCover, BlockIndex, BlockLayer, BlockWeather, CloudType};
 
 /// A finished generation job.
 #[derive(Debug, Clone, PartialEq)]
@@ -218,20 +218,17 @@ pub fn weather_changed(a: &BlockWeather, b: &BlockWeather) -> bool {
 /// [`weather_changed`] for the layers of drift `band` alone (a cover change at the rim counts
 /// for every band).
 pub fn weather_changed_in(band: DriftBand, a: &BlockWeather, b: &BlockWeather) -> bool {
-    let of_band = |w: &BlockWeather| {
-        w.layers
+    // Without a copy: a weather change compares the thousands of blocks of every band.
+    fn of_band(band: DriftBand, w: &BlockWeather) -> impl Iterator<Item = &BlockLayer> {
+        let layers = &w.layers;
+        layers
             .iter()
-            .filter(|l| band.holds(&w.layers, l.base_ft_agl))
-            .copied()
-            .collect::<Vec<_>>()
-    };
-    let (la, lb) = match band.count {
-        1 => (a.layers.clone(), b.layers.clone()),
-        _ => (of_band(a), of_band(b)),
-    };
+            .filter(move |l| band.holds(layers, l.base_ft_agl))
+    }
+    let of_band = |w| of_band(band, w);
     BlockCover::differs(a.cover.as_ref(), b.cover.as_ref(), 1.0)
-        || la.len() != lb.len()
-        || la.iter().zip(&lb).any(|(x, y)| {
+        || of_band(a).count() != of_band(b).count()
+        || of_band(a).zip(of_band(b)).any(|(x, y)| {
             x.cloud_type != y.cloud_type
                 || (x.coverage_oktas - y.coverage_oktas).abs() >= 1.0
                 || (x.base_ft_agl - y.base_ft_agl).abs() >= 300.0

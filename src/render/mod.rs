@@ -53,7 +53,7 @@ pub use camera::{Camera, Frustum};
 // The draw list's module stays public under its old path (benches sort with it).
 pub use pass_timing::{PassTimes, Timestamps};
 pub use readback::SpriteCorner;
-pub use scene::{BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};
+pub use scene::{BandOffsets, BlockMotion, Fade, SkyBlock, SkyCloud, SkySprite, square_sprite};
 pub use settings::RenderSettings;
 pub use shadow::{CloudShadowMap, ShadowImage, ShadowSettings};
 pub use sky::{Sky, SkyConfig, SkyFlash};
