@@ -636,10 +636,16 @@ fn a_weather_change_reaches_the_sky_a_budget_of_sprites_a_frame() {
         let m = host.sky.sky().memory();
         (m.blocks, m.sprites)
     };
-    // Until the field is generated and handed over whole (the first frames are budgeted too).
+    // Every drift band's field: blocks queued and generations held.
+    let fields = |host: &DemoHost| {
+        (host.sky.world().living_fields()).fold((0, 0u32), |(pending, held), f| {
+            (pending + f.pending(), held + f.blocks().count() as u32)
+        })
+    };
+    // Until the fields are generated and handed over whole (the first frames are budgeted too).
     let settled = |host: &DemoHost| {
-        let field = host.sky.world().living_field().unwrap();
-        (field.pending() == 0).then(|| field.blocks().count() as u32)
+        let (pending, held) = fields(host);
+        (pending == 0).then_some(held)
     };
     let mut held = step(&mut host);
     for _ in 0..2_000 {
@@ -657,9 +663,9 @@ fn a_weather_change_reaches_the_sky_a_budget_of_sprites_a_frame() {
 
     host.sky.set_weather_field(field_of(&new));
     let after_swap = step(&mut host);
-    let field = host.sky.world().living_field().unwrap();
+    let (pending, generations) = fields(&host);
     assert_eq!(
-        (field.pending(), field.blocks().count() as u32, after_swap),
+        (pending, generations, after_swap),
         (0, before, held),
         "the frame that takes the new field keeps the last weather's generations and asks for \
          none while its block weathers are worked out"
@@ -679,13 +685,12 @@ fn a_weather_change_reaches_the_sky_a_budget_of_sprites_a_frame() {
             most = most.max(sprites);
         }
         last = now;
-        let field = host.sky.world().living_field().unwrap();
-        if field.pending() == 0 && field.blocks().count() as u32 == now.0 && now.0 > before {
+        let (pending, generations) = fields(&host);
+        if pending == 0 && generations == now.0 && now.0 > before {
             break;
         }
     }
-    let field = host.sky.world().living_field().unwrap();
-    let (held, generations) = (last.0, field.blocks().count() as u32);
+    let (held, generations) = (last.0, fields(&host).1);
     eprintln!(
         "{before} generations, then {generations}: the new ones over {frames} frames, at most \
          {most} sprites a frame"
