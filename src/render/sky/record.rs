@@ -165,16 +165,7 @@ impl Sky {
             self.sprites
                 .draw(&mut pass, (sprite_pipeline, &self.sheet_group), 0..distant);
         }
-        let size = offscreen.as_ref().map_or_else(
-            || {
-                (
-                    colour_view.texture().width(),
-                    colour_view.texture().height(),
-                )
-            },
-            |target| target.size(),
-        );
-        v.ring.draw(&mut pass, offscreen.is_some(), size);
+        v.ring.draw(&mut pass, offscreen.is_some());
         if timer.is_some() {
             drop(pass);
             stamp(encoder, Stamp::Ring);
