@@ -1,9 +1,9 @@
 //! The living clouds of a [`super::World`]: one field of blocks per drift band
 //! ([`crate::clouds::bands`]: each band of layers drifts with the wind at its own height), and
 //! for each which of its generations the sky holds, what it was last told of their fades, and
-//! what a frame's budget left waiting. Each frame every band hands the sky what changed of its
-//! field ([`BandClouds::hand_over`]); the block weathers and the far storm cells are the
-//! world's once.
+//! what a frame's budget left waiting. Each frame the bands hand the sky what changed of their
+//! fields ([`hand_over`]: nearest first across the bands); the block weathers and the far storm
+//! cells are the world's once.
 
 use std::collections::{HashMap, HashSet};
 
