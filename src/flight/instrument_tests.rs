@@ -678,9 +678,9 @@ fn a_ceilometer_under_the_drifting_clouds_reads_the_reports_back() {
 }
 
 /// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations, with the
-/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.926-0.952 of the layers
-/// and 0.915-0.935 of the ceilings (0.938 and 0.925 on average); at the stations with a calm or
-/// variable wind 56-60 of 69 layers, at the others 233-237 of 243 (`cargo test --lib
+/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.949-0.965 of the layers
+/// and 0.920-0.940 of the ceilings (0.958 and 0.926 on average); at the stations with a calm or
+/// variable wind 61-66 of 69 layers, at the others 234-237 of 243 (`cargo test --lib
 /// ceilometer_round_trip_at_200 -- --ignored --nocapture`).
 #[test]
 #[ignore]
@@ -698,7 +698,7 @@ fn ceilometer_round_trip_at_200() {
     let mean = |f: fn(&RoundTrip) -> f64| trips.iter().map(f).sum::<f64>() / trips.len() as f64;
     let (layers, ceilings) = (mean(|t| t.layers), mean(|t| t.ceilings));
     eprintln!("mean over the seeds: layers {layers:.3}, ceilings {ceilings:.3}");
-    assert!(layers >= 0.93 && ceilings >= 0.92);
+    assert!(layers >= 0.95 && ceilings >= 0.92);
 }
 
 /// The clouds drift with the wind the air data reports at their height: over real reports (and

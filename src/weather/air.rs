@@ -81,6 +81,17 @@ pub struct WindSettings {
     /// 0: each point's own surface wind all the way up.
     #[serde(default = "default_regional_radius_m")]
     pub regional_radius_m: f64,
+    /// The least gradient wind at the top of the boundary layer, knots, where the regional
+    /// wind is weaker (a region of calm surface winds under a moving sky): its direction the
+    /// regional wind's, or the latitude's prevailing one where that is calm too
+    /// ([`prevailing_from_deg`]). Only with the regional wind; 0: none.
+    #[serde(default = "default_calm_gradient_kt")]
+    pub calm_gradient_kt: f64,
+}
+
+/// [`WindSettings::calm_gradient_kt`] where a settings file does not set it.
+fn default_calm_gradient_kt() -> f64 {
+    10.0
 }
 
 /// [`WindSettings::regional_radius_m`] where a settings file does not set it.
@@ -221,6 +232,12 @@ impl TomlSettings for AirSettings {
             return Err(bad(
                 "wind.regional_radius_m",
                 "must be within 0..=2000000 (metres; 0 switches the regional wind off)",
+            ));
+        }
+        if !(0.0..=100.0).contains(&w.calm_gradient_kt) {
+            return Err(bad(
+                "wind.calm_gradient_kt",
+                "must be within 0..=100 (knots; 0 leaves a calm region's gradient wind calm)",
             ));
         }
         if let Some(a) = w.aloft {
@@ -524,7 +541,13 @@ pub fn wind_at(
         f64::from(surface.wind.speed_kt),
     );
     let base = match surface.regional_wind_kt {
-        Some(regional) => own.lerp(regional, share),
+        Some(regional) => {
+            let top_growth = (top / zr).powf(w.power_law_exponent);
+            own.lerp(
+                at_least(regional, w.calm_gradient_kt / top_growth, lat_deg),
+                share,
+            )
+        }
         None => own,
     };
     let (base_from, base_speed) = if surface.regional_wind_kt.is_some() {
@@ -554,6 +577,30 @@ pub fn wind_at(
     let v = velocity_kt(from, speed).lerp(velocity_kt(aloft.from_deg, aloft.speed_kt), t);
     let (from, speed) = from_velocity_kt(v);
     sample(from, speed, 0.0)
+}
+
+/// The regional surface wind `regional_kt` (knots east, north) made at least `least_kt`: along
+/// itself, or from the prevailing direction at `lat_deg` where it is under half a knot.
+fn at_least(regional_kt: DVec2, least_kt: f64, lat_deg: f64) -> DVec2 {
+    let speed = regional_kt.length();
+    if speed >= least_kt {
+        regional_kt
+    } else if speed >= 0.5 {
+        regional_kt * (least_kt / speed)
+    } else {
+        velocity_kt(prevailing_from_deg(lat_deg), least_kt)
+    }
+}
+
+/// The direction the prevailing wind blows from at `lat_deg`, degrees: the trade winds'
+/// easterlies within 30 degrees of the equator, the westerlies to 60 degrees, the polar
+/// easterlies beyond (the three cells of the general circulation).
+pub fn prevailing_from_deg(lat_deg: f64) -> f64 {
+    if (30.0..60.0).contains(&lat_deg.abs()) {
+        270.0
+    } else {
+        90.0
+    }
 }
 
 fn sample(from_deg: f64, speed_kt: f64, gust_excess_kt: f64) -> WindSample {
@@ -654,6 +701,45 @@ mod tests {
                 (a.speed_kt - b.speed_kt).abs() < 1e-9 && (a.from_deg - b.from_deg).abs() < 1e-6
             );
         }
+    }
+
+    #[test]
+    fn a_calm_region_still_has_a_gradient_wind_above_its_calm_stations() {
+        let s = AirSettings::default().wind;
+        let top_of = |regional: DVec2, lat_deg: f64, s: &WindSettings| {
+            let calm = surface(0.0, 0.0, 0.0).with_regional_wind_kt(Some(regional));
+            let top = s.boundary_layer_top_m;
+            // Above the boundary layer it holds.
+            assert_eq!(
+                wind_at(&calm, top, 200.0 + top, lat_deg, s),
+                wind_at(&calm, 3000.0, 3200.0, lat_deg, s)
+            );
+            // The anemometer still reads the station's calm.
+            assert_eq!(wind_at(&calm, 10.0, 210.0, lat_deg, s).speed_kt, 0.0);
+            wind_at(&calm, top, 200.0 + top, lat_deg, s)
+        };
+        assert_eq!(s.calm_gradient_kt, 10.0);
+        // A light regional wind is grown to the least gradient wind along itself (from 180,
+        // veered 30 degrees)...
+        let light = top_of(velocity_kt(180.0, 2.0), 45.0, &s);
+        assert!((light.speed_kt - 10.0).abs() < 1e-9, "{light:?}");
+        assert!((light.from_deg - 210.0).abs() < 1e-6, "{light:?}");
+        // ...a calm one blows from the latitude's prevailing direction, turned as the
+        // hemisphere turns it: westerlies at 45 N, trade easterlies at 15 N, westerlies at 45 S.
+        for (lat, from) in [(45.0, 300.0), (15.0, 120.0), (-45.0, 240.0), (70.0, 120.0)] {
+            let w = top_of(DVec2::ZERO, lat, &s);
+            assert!((w.speed_kt - 10.0).abs() < 1e-9, "{lat}: {w:?}");
+            assert!((w.from_deg - from).abs() < 1e-6, "{lat}: {w:?}");
+        }
+        // A regional wind strong enough is left as it is; none asked, a calm region stays calm.
+        let growth = (s.boundary_layer_top_m / s.reference_height_m).powf(s.power_law_exponent);
+        let strong = top_of(velocity_kt(180.0, 8.0), 45.0, &s);
+        assert!((strong.speed_kt - 8.0 * growth).abs() < 1e-9, "{strong:?}");
+        let off = WindSettings {
+            calm_gradient_kt: 0.0,
+            ..s
+        };
+        assert_eq!(top_of(DVec2::ZERO, 45.0, &off).speed_kt, 0.0);
     }
 
     #[test]
