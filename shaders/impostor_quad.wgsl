@@ -70,6 +70,10 @@ fn impostor_at(from_centre: vec3<f32>) -> vec4<f32> {
     return vec4<f32>((x + 1.0) * 0.5, (1.0 - y) * 0.5, layer, facing);
 }
 
+// How little the reprojected cloud distance may move in a step for the ring pass to stop
+// stepping, metres (the stored depth itself holds about 30 m at 60 km).
+const CONVERGED_M: f32 = 1.0;
+
 // What one ring shows along a ray: premultiplied colour, scene-depth faded, and the distance
 // of its clouds from the camera plane, metres.
 struct RingHit {
@@ -117,7 +121,16 @@ fn ring_sample(
             break;
         }
         // Stored: distance along the impostor's axis; the sphere wants it from the centre.
-        dist = max(d * 1000.0 / a, ring.size.x) / max(at.w, 1e-3);
+        let next = max(d * 1000.0 / a, ring.size.x) / max(at.w, 1e-3);
+        let moved_m = abs(next - dist);
+        dist = next;
+        // Settled: another lookup would land within a ten-thousandth of a texel of this one
+        // (the camera is at most a few kilometres from the centre; the clouds 20 km and more).
+        // Near the centre that is the second step; the loop ends once a block of pixels has
+        // settled, where lavapipe paid for all four.
+        if (moved_m < CONVERGED_M) {
+            break;
+        }
     }
     let cloud = on_sphere(centre, dir, dist);
     let cloud_m = (frame.view_proj * vec4<f32>(cloud, 1.0)).w;
@@ -138,13 +151,37 @@ fn fs_impostor_offscreen(i: RingOut) -> CloudOut {
     return cloud_out(hit.colour, hit.distance_m);
 }
 
-fn ring_hit(i: RingOut) -> RingHit {
+// The steady frames' ring pass, nothing fading in (`ring_pass.rs` picks it on the CPU): the
+// shown ring's lookup alone. Lavapipe runs both sides of `ring_hit`'s branch on the crossfade
+// weight, so there every steady pixel paid for a second lookup it did not show.
+@fragment
+fn fs_impostor_shown(i: RingOut) -> @location(0) vec4<f32> {
+    return shown_hit(i).colour;
+}
+
+@fragment
+fn fs_impostor_shown_offscreen(i: RingOut) -> CloudOut {
+    let hit = shown_hit(i);
+    return cloud_out(hit.colour, hit.distance_m);
+}
+
+// The unit view ray of a ring pass pixel.
+fn ray_dir(i: RingOut) -> vec3<f32> {
     let far = far_point(i.ndc);
-    let dir = normalize(far.xyz / far.w);
-    let w = ring.old_centre_weight.w;
-    let before = ring_sample(
-        old_colour, old_depth, ring.old_centre_weight.xyz, ring.size.z, dir, i.position.xy
+    return normalize(far.xyz / far.w);
+}
+
+// What the shown ring shows along the pixel's ray.
+fn shown_hit(i: RingOut) -> RingHit {
+    return ring_sample(
+        old_colour, old_depth, ring.old_centre_weight.xyz, ring.size.z, ray_dir(i), i.position.xy
     );
+}
+
+fn ring_hit(i: RingOut) -> RingHit {
+    let dir = ray_dir(i);
+    let w = ring.old_centre_weight.w;
+    let before = shown_hit(i);
     if (w <= 0.0) {
         return before;
     }
