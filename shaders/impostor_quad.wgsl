@@ -28,6 +28,13 @@ struct Ring {
 struct RingOut {
     @builtin(position) position: vec4<f32>,
     @location(0) ndc: vec2<f32>,
+    // The rings' centres (`Ring`'s xyz), handed on by the vertex stage rather than read from the
+    // uniform here: while the steady pass's fragment shader read the shown ring's centre from
+    // the uniform, lavapipe (Mesa 22) compiled it afresh at every draw, specialised on the
+    // uniform, and kept every copy (about 0.55 MB a frame, tests/memory.rs). A flat input is no
+    // uniform to specialise on.
+    @location(1) @interpolate(flat) old_centre: vec3<f32>,
+    @location(2) @interpolate(flat) new_centre: vec3<f32>,
 };
 
 @vertex
@@ -35,6 +42,8 @@ fn vs_impostor(@builtin(vertex_index) vi: u32) -> RingOut {
     var o: RingOut;
     o.position = fullscreen_position(vi);
     o.ndc = o.position.xy;
+    o.old_centre = ring.old_centre_weight.xyz;
+    o.new_centre = ring.new_centre.xyz;
     return o;
 }
 
@@ -174,7 +183,7 @@ fn ray_dir(i: RingOut) -> vec3<f32> {
 // What the shown ring shows along the pixel's ray.
 fn shown_hit(i: RingOut) -> RingHit {
     return ring_sample(
-        old_colour, old_depth, ring.old_centre_weight.xyz, ring.size.z, ray_dir(i), i.position.xy
+        old_colour, old_depth, i.old_centre, ring.size.z, ray_dir(i), i.position.xy
     );
 }
 
@@ -186,7 +195,7 @@ fn ring_hit(i: RingOut) -> RingHit {
         return before;
     }
     let after = ring_sample(
-        new_colour, new_depth, ring.new_centre.xyz, ring.size.w, dir, i.position.xy
+        new_colour, new_depth, i.new_centre, ring.size.w, dir, i.position.xy
     );
     // The distance of the mix: each ring's weighted by what it shows.
     let a = mix(before.colour.a * before.distance_m, after.colour.a * after.distance_m, w);
