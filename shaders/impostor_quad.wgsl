@@ -28,6 +28,13 @@ struct Ring {
 struct RingOut {
     @builtin(position) position: vec4<f32>,
     @location(0) ndc: vec2<f32>,
+    // The rings' centres (`Ring`'s xyz), handed on by the vertex stage rather than read from the
+    // uniform here: while the steady pass's fragment shader read the shown ring's centre from
+    // the uniform, lavapipe (Mesa 22) compiled it afresh at every draw, specialised on the
+    // uniform, and kept every copy (about 0.55 MB a frame, tests/memory.rs). A flat input is no
+    // uniform to specialise on.
+    @location(1) @interpolate(flat) old_centre: vec3<f32>,
+    @location(2) @interpolate(flat) new_centre: vec3<f32>,
 };
 
 @vertex
@@ -35,6 +42,8 @@ fn vs_impostor(@builtin(vertex_index) vi: u32) -> RingOut {
     var o: RingOut;
     o.position = fullscreen_position(vi);
     o.ndc = o.position.xy;
+    o.old_centre = ring.old_centre_weight.xyz;
+    o.new_centre = ring.new_centre.xyz;
     return o;
 }
 
@@ -69,6 +78,10 @@ fn impostor_at(from_centre: vec3<f32>) -> vec4<f32> {
     }
     return vec4<f32>((x + 1.0) * 0.5, (1.0 - y) * 0.5, layer, facing);
 }
+
+// How little the reprojected cloud distance may move in a step for the ring pass to stop
+// stepping, metres (the stored depth itself holds about 30 m at 60 km).
+const CONVERGED_M: f32 = 1.0;
 
 // What one ring shows along a ray: premultiplied colour, scene-depth faded, and the distance
 // of its clouds from the camera plane, metres.
@@ -117,7 +130,16 @@ fn ring_sample(
             break;
         }
         // Stored: distance along the impostor's axis; the sphere wants it from the centre.
-        dist = max(d * 1000.0 / a, ring.size.x) / max(at.w, 1e-3);
+        let next = max(d * 1000.0 / a, ring.size.x) / max(at.w, 1e-3);
+        let moved_m = abs(next - dist);
+        dist = next;
+        // Settled: another lookup would land within a ten-thousandth of a texel of this one
+        // (the camera is at most a few kilometres from the centre; the clouds 20 km and more).
+        // Near the centre that is the second step; the loop ends once a block of pixels has
+        // settled, where lavapipe paid for all four.
+        if (moved_m < CONVERGED_M) {
+            break;
+        }
     }
     let cloud = on_sphere(centre, dir, dist);
     let cloud_m = (frame.view_proj * vec4<f32>(cloud, 1.0)).w;
@@ -138,18 +160,42 @@ fn fs_impostor_offscreen(i: RingOut) -> CloudOut {
     return cloud_out(hit.colour, hit.distance_m);
 }
 
-fn ring_hit(i: RingOut) -> RingHit {
+// The steady frames' ring pass, nothing fading in (`ring_pass.rs` picks it on the CPU): the
+// shown ring's lookup alone. Lavapipe runs both sides of `ring_hit`'s branch on the crossfade
+// weight, so there every steady pixel paid for a second lookup it did not show.
+@fragment
+fn fs_impostor_shown(i: RingOut) -> @location(0) vec4<f32> {
+    return shown_hit(i).colour;
+}
+
+@fragment
+fn fs_impostor_shown_offscreen(i: RingOut) -> CloudOut {
+    let hit = shown_hit(i);
+    return cloud_out(hit.colour, hit.distance_m);
+}
+
+// The unit view ray of a ring pass pixel.
+fn ray_dir(i: RingOut) -> vec3<f32> {
     let far = far_point(i.ndc);
-    let dir = normalize(far.xyz / far.w);
-    let w = ring.old_centre_weight.w;
-    let before = ring_sample(
-        old_colour, old_depth, ring.old_centre_weight.xyz, ring.size.z, dir, i.position.xy
+    return normalize(far.xyz / far.w);
+}
+
+// What the shown ring shows along the pixel's ray.
+fn shown_hit(i: RingOut) -> RingHit {
+    return ring_sample(
+        old_colour, old_depth, i.old_centre, ring.size.z, ray_dir(i), i.position.xy
     );
+}
+
+fn ring_hit(i: RingOut) -> RingHit {
+    let dir = ray_dir(i);
+    let w = ring.old_centre_weight.w;
+    let before = shown_hit(i);
     if (w <= 0.0) {
         return before;
     }
     let after = ring_sample(
-        new_colour, new_depth, ring.new_centre.xyz, ring.size.w, dir, i.position.xy
+        new_colour, new_depth, i.new_centre, ring.size.w, dir, i.position.xy
     );
     // The distance of the mix: each ring's weighted by what it shows.
     let a = mix(before.colour.a * before.distance_m, after.colour.a * after.distance_m, w);

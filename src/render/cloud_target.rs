@@ -489,6 +489,12 @@ impl CloudFrame<'_> {
         pass
     }
 
+    /// The target's size, pixels.
+    pub fn size(&self) -> (u32, u32) {
+        let t = self.textures.colour.texture();
+        (t.width(), t.height())
+    }
+
     /// The sprite pipeline that draws into the target.
     pub fn sprite_pipeline(&self) -> &wgpu::RenderPipeline {
         &self.offscreen.sprites

@@ -26,10 +26,12 @@
 //! them where its scene is nearer (a mountain beyond the ring radius among far clouds). Rules
 //! and geometry: `layout`. Units: metres, degrees.
 
+mod band;
 // The ring's settings live here, so the settings tree reads them without the ring.
 pub(super) mod layout;
 mod order_buffer;
 mod orders;
+mod ring_pass;
 // Which blocks the ring draws and when it rebuilds: the CPU's decision, apart from the GPU work.
 mod split;
 
@@ -55,6 +57,7 @@ use super::sprites::sprite_view::{self, ViewBuffers, ViewData, ViewLight};
 use super::stats::FrameStats;
 use order_buffer::OrderBuffer;
 use orders::{RingOrders, RingSort};
+use ring_pass::RingPassPipelines;
 
 const IMPOSTOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// Alpha-weighted cloud depth, kilometres times alpha (half floats: about 30 m at 60 km).
@@ -69,6 +72,9 @@ struct RingState {
     /// Mean distance of those blocks from the centre (the ring radius if none), metres: the
     /// first guess of the ring pass's depth reprojection.
     far_mean_m: f64,
+    /// The elevations of those blocks' clouds seen from the centre, radians, lowest first
+    /// ([`band::cloud_elevations_rad`]): where the ring pass is drawn.
+    content_rad: (f64, f64),
     /// Which build made it (the ring's count of builds then).
     build: u64,
     /// The ring's clock when that build started (orders sorted since are good for it; a change
@@ -90,10 +96,8 @@ pub struct ImpostorRing {
     settings: ImpostorSettings,
     device: wgpu::Device,
     sprite_pipeline: wgpu::RenderPipeline,
-    quad_pipeline: wgpu::RenderPipeline,
-    /// The ring pass into the sky's off-screen cloud target (when the clouds are drawn below
-    /// full resolution).
-    quad_offscreen_pipeline: Option<wgpu::RenderPipeline>,
+    /// The ring pass, into the host's colour or the sky's off-screen cloud target.
+    quad_pipelines: RingPassPipelines,
     /// `[ring][impostor]` colour and depth views the impostor passes render into.
     views: Vec<Vec<wgpu::TextureView>>,
     depth_views: Vec<Vec<wgpu::TextureView>>,
@@ -113,8 +117,10 @@ pub struct ImpostorRing {
     /// Which blocks the ring holds, the rings shown, built and fading, the renders pending:
     /// the CPU's decisions, plain data ([`RingPlan::split`]).
     plan: RingPlan,
-    /// This frame's ring pass: (old ring, new ring), if any ring is shown.
-    quads: Option<(usize, usize)>,
+    /// This frame's ring pass: (old ring, new ring, whether the new one fades in, the rows of
+    /// the screen where it can show a cloud as normalised device y, lowest first), if any ring
+    /// is shown and crosses the screen.
+    quads: Option<(usize, usize, bool, (f32, f32))>,
     /// Whether the plan's pending renders went into a recorded frame (then the next plan
     /// starts afresh).
     recorded: Cell<bool>,
@@ -131,7 +137,6 @@ pub struct ImpostorRing {
 
 const SPRITES_WGSL: &str = include_str!("../../../shaders/sprites.wgsl");
 const IMPOSTOR_SPRITES_WGSL: &str = include_str!("../../../shaders/impostor_sprites.wgsl");
-const QUAD_WGSL: &str = include_str!("../../../shaders/impostor_quad.wgsl");
 
 /// What a frame's impostor builds need from the sky.
 #[derive(Clone, Copy)]
@@ -197,9 +202,11 @@ impl ImpostorRing {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
+                // The ring uniform: the vertex stage hands the rings' centres on to the
+                // fragment stage (`impostor_quad.wgsl`, `RingOut`).
                 wgpu::BindGroupLayoutEntry {
                     binding: 5,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
                     ty: wgpu::BindingType::Buffer {
                         ty: wgpu::BufferBindingType::Uniform,
                         has_dynamic_offset: false,
@@ -224,36 +231,7 @@ impl ImpostorRing {
                 scene: SceneDepth::Host,
             },
         );
-        let quad_pipeline = pipeline(
-            device,
-            &PassDesc {
-                label: "ring.quads",
-                wgsl: QUAD_WGSL,
-                vs: "vs_impostor",
-                fs: "fs_impostor",
-                bind_groups: &[Some(shared.host_frame_layout), Some(&tex_layout)],
-                buffers: &[],
-                targets: &[(shared.targets.colour_format, over)],
-                samples: shared.targets.sample_count,
-                scene: SceneDepth::host(shared.targets.sample_count),
-            },
-        );
-        let quad_offscreen_pipeline = shared.cloud_targets.map(|targets| {
-            pipeline(
-                device,
-                &PassDesc {
-                    label: "ring.quads_offscreen",
-                    wgsl: QUAD_WGSL,
-                    vs: "vs_impostor",
-                    fs: "fs_impostor_offscreen",
-                    bind_groups: &[Some(shared.frame_layout), Some(&tex_layout)],
-                    buffers: &[],
-                    targets,
-                    samples: 1,
-                    scene: SceneDepth::FarthestMetres,
-                },
-            )
-        });
+        let quad_pipelines = RingPassPipelines::new(device, shared, &tex_layout);
         let rings = if settings.enabled { 2 } else { 0 };
         let side = settings.size_px;
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -396,8 +374,7 @@ impl ImpostorRing {
             settings,
             device: device.clone(),
             sprite_pipeline,
-            quad_pipeline,
-            quad_offscreen_pipeline,
+            quad_pipelines,
             views,
             depth_views,
             quad_groups,
@@ -612,6 +589,22 @@ impl ImpostorRing {
             let (new, new_state) =
                 (self.plan.fade.as_ref()).map_or((*old, old_state), |(r, st, _)| (*r, st));
             let half = self.settings.ring_radius_m * (IMPOSTOR_FOV_DEG * 0.5).to_radians().tan();
+            let band_of = |state: &RingState| {
+                let (radius_m, size_px) = (self.settings.ring_radius_m, self.settings.size_px);
+                band::ring_band_rad(
+                    state.content_rad,
+                    camera_m - state.centre_m,
+                    radius_m,
+                    size_px,
+                )
+            };
+            let band = if w > 0.0 {
+                band::union(band_of(old_state), band_of(new_state))
+            } else {
+                band_of(old_state)
+            };
+            let inv_view_proj = glam::Mat4::from_cols_array_2d(&template.inv_view_proj);
+            let rows = band::screen_rows_ndc(band, inv_view_proj);
             let uniform = GpuRing {
                 old_centre_weight: (old_state.centre_m - camera_m)
                     .as_vec3()
@@ -630,7 +623,7 @@ impl ImpostorRing {
             };
             queue.write_buffer(&self.ring_uniform, 0, bytemuck::bytes_of(&uniform));
             bytes += std::mem::size_of::<GpuRing>() as u64;
-            self.quads = Some((*old, new));
+            self.quads = rows.map(|rows| (*old, new, w > 0.0, rows));
         }
         stats.blocks_far = self.plan.blocks_far;
         stats.blocks_near = blocks.len() as u32 - self.plan.blocks_far;
@@ -718,18 +711,25 @@ impl ImpostorRing {
     }
 
     /// Draws the ring into the sky pass (group 0, the sky's frame, must be bound): one
-    /// full-screen pass that mixes the shown ring with the one fading in. `offscreen`: the pass
-    /// is the sky's cloud target (colour and distance), not the host's colour.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass, offscreen: bool) {
-        let Some((old, new)) = self.quads else {
+    /// full-screen pass that mixes the shown ring with the one fading in, scissored to the rows
+    /// where it can show a cloud. `offscreen`: the pass is the sky's cloud target (colour and
+    /// distance), not the host's colour; `size`: that target's, pixels (the scissor is put back
+    /// to all of it).
+    pub fn draw(&self, pass: &mut wgpu::RenderPass, offscreen: bool, (width, height): (u32, u32)) {
+        let Some((old, new, fading, (low, high))) = self.quads else {
             return;
         };
-        let quads = match (offscreen, &self.quad_offscreen_pipeline) {
-            (true, Some(p)) => p,
-            _ => &self.quad_pipeline,
-        };
-        pass.set_pipeline(quads);
+        // Normalised device y up, rows down; whole rows, rounded outwards.
+        let row = |y: f32| (1.0 - y) * 0.5 * height as f32;
+        let top = (row(high).floor().max(0.0) as u32).min(height);
+        let bottom = (row(low).ceil().max(0.0) as u32).min(height);
+        if bottom <= top {
+            return;
+        }
+        pass.set_scissor_rect(0, top, width, bottom - top);
+        pass.set_pipeline(self.quad_pipelines.get(offscreen, fading));
         pass.set_bind_group(1, &self.quad_groups[old][new], &[]);
         pass.draw(0..3, 0..1);
+        pass.set_scissor_rect(0, 0, width, height);
     }
 }

@@ -228,6 +228,17 @@ impl RingPlan {
             far.iter().map(|f| f.1).sum::<f64>() / far.len() as f64
         };
         let far_ids: IdSet = far.iter().map(|f| f.0).collect();
+        let content_rad = blocks
+            .values()
+            .filter(|r| far_ids.contains(&r.block.id))
+            .flat_map(|r| {
+                r.clouds.iter().map(move |c| {
+                    let rel_m = c.centre_m + r.motion.offset_m - camera_m;
+                    super::band::cloud_elevations_rad(rel_m, f64::from(c.radius_m))
+                })
+            })
+            .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+            .unwrap_or((0.0, 0.0));
         let mut sectors: [Vec<u64>; IMPOSTORS] = Default::default();
         for r in blocks.values().filter(|r| far_ids.contains(&r.block.id)) {
             let bits = sectors_of(camera_m, r.centre_m());
@@ -254,6 +265,7 @@ impl RingPlan {
                 sun,
                 far_ids,
                 far_mean_m,
+                content_rad,
                 build: self.builds,
                 begun_s: self.clock_s,
             },

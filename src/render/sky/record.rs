@@ -165,7 +165,16 @@ impl Sky {
             self.sprites
                 .draw(&mut pass, (sprite_pipeline, &self.sheet_group), 0..distant);
         }
-        v.ring.draw(&mut pass, offscreen.is_some());
+        let size = offscreen.as_ref().map_or_else(
+            || {
+                (
+                    colour_view.texture().width(),
+                    colour_view.texture().height(),
+                )
+            },
+            |target| target.size(),
+        );
+        v.ring.draw(&mut pass, offscreen.is_some(), size);
         if timer.is_some() {
             drop(pass);
             stamp(encoder, Stamp::Ring);

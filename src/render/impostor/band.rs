@@ -1,0 +1,216 @@
+//! The rows of the screen where the ring pass can show anything, no GPU. The ring's far clouds
+//! lie in a narrow band of elevations seen from its centre (clouds 20 km and more away, within
+//! a few kilometres of the camera's height): outside it every lookup of the impostors finds
+//! nothing, and the full-screen pass blended zero there. The pass keeps its full-screen
+//! triangle (the same rays to the bit, so the same pixels) under a scissor of the rows that band
+//! crosses. Units: metres, radians above the level plane.
+
+use glam::{DVec3, Mat4, Vec4};
+
+use super::layout::IMPOSTOR_FOV_Y_DEG;
+
+/// Radians the band is widened by on each side, besides two impostor texels (the bilinear
+/// lookup's reach).
+const MARGIN_RAD: f64 = 0.005;
+
+/// The screen is searched for the band on a grid of this many cells down and across.
+const GRID: (u32, u32) = (48, 16);
+
+/// Metres added to a cloud's radius: the drift of its block while its impostor waits to be
+/// rendered, and a sprite's corner past its sphere.
+const CLOUD_MARGIN_M: f64 = 200.0;
+
+/// An Earth radius below the smallest the sky flies over: the curvature's drop of a far cloud
+/// in the impostor renders taken as larger than it is.
+const DROP_RADIUS_M: f64 = 6.0e6;
+
+/// The elevations from the ring centre (lowest first) of a cloud whose sprites lie within
+/// `radius_m` of `rel_m` (its centre relative to the ring centre), drawn on the round Earth.
+pub fn cloud_elevations_rad(rel_m: DVec3, radius_m: f64) -> (f64, f64) {
+    // A turned sprite's corner reaches past the sphere of its half side.
+    let r = radius_m * std::f64::consts::SQRT_2 + CLOUD_MARGIN_M;
+    let d = rel_m.truncate().length();
+    let (near, far) = ((d - r).max(0.0), d + r);
+    let top = rel_m.z + r;
+    let bottom = rel_m.z - r - far * far / (2.0 * DROP_RADIUS_M);
+    (
+        bottom.atan2(if bottom >= 0.0 { far } else { near }),
+        top.atan2(if top >= 0.0 { near } else { far }),
+    )
+}
+
+/// The band of elevations above the camera's level plane (lowest first) where the ring pass
+/// can show a cloud this frame. `content_rad`: the elevations of the ring's clouds from its
+/// centre ([`cloud_elevations_rad`] over them); `offset_m`: the camera relative to the centre;
+/// the pass looks the impostors up at `radius_m` or more from the centre along each ray;
+/// `size_px`: an impostor's side.
+pub fn ring_band_rad(
+    content_rad: (f64, f64),
+    offset_m: DVec3,
+    radius_m: f64,
+    size_px: u32,
+) -> (f64, f64) {
+    let texel_rad = IMPOSTOR_FOV_Y_DEG.to_radians() / f64::from(size_px.max(1));
+    let margin = MARGIN_RAD + 2.0 * texel_rad;
+    let (lo, hi) = (content_rad.0 - margin, content_rad.1 + margin);
+    let across = offset_m.truncate().length();
+    // A point `s` from the centre at elevation `e` from it, seen from the camera: the
+    // elevation grows with `e` (the camera is inside the sphere) and moves one way with `s`,
+    // so its extremes are at the ends of both, with the camera at either end of its
+    // horizontal offset.
+    let seen = |e: f64, s: f64, side: f64| {
+        let (sin, cos) = e.sin_cos();
+        (s * sin - offset_m.z).atan2((s * cos + side * across).max(0.0))
+    };
+    let ends = |e: f64| [e, seen(e, radius_m, -1.0), seen(e, radius_m, 1.0)];
+    let low = ends(lo).into_iter().fold(f64::MAX, f64::min);
+    let high = ends(hi).into_iter().fold(f64::MIN, f64::max);
+    (low, high.max(low))
+}
+
+/// The rows of the screen the band of elevations `band_rad` crosses, as normalised device y
+/// (lowest first), under the camera whose camera-relative clip-to-world matrix is
+/// `inv_view_proj`; `None` when it crosses none. Searched on a grid: a cell is kept when the
+/// elevations of its corners, widened by half its diagonal (no ray in it is farther from a
+/// corner), meet the band.
+pub fn screen_rows_ndc(band_rad: (f64, f64), inv_view_proj: Mat4) -> Option<(f32, f32)> {
+    let (rows, cols) = GRID;
+    let ray = |x: f32, y: f32| {
+        let far = inv_view_proj * Vec4::new(x, y, 0.5, 1.0);
+        (far.truncate() / far.w).as_dvec3().normalize_or_zero()
+    };
+    let ndc = |k: u32, n: u32| -1.0 + 2.0 * k as f32 / n as f32;
+    let grid: Vec<Vec<DVec3>> = (0..=rows)
+        .map(|j| {
+            (0..=cols)
+                .map(|i| ray(ndc(i, cols), ndc(j, rows)))
+                .collect()
+        })
+        .collect();
+    let mut found: Option<(f32, f32)> = None;
+    for j in 0..rows as usize {
+        for i in 0..cols as usize {
+            let corners = [
+                grid[j][i],
+                grid[j][i + 1],
+                grid[j + 1][i],
+                grid[j + 1][i + 1],
+            ];
+            let diagonal = corners[0]
+                .angle_between(corners[3])
+                .max(corners[1].angle_between(corners[2]));
+            let elevations = corners.map(|c| c.z.clamp(-1.0, 1.0).asin());
+            let low = elevations.iter().copied().fold(f64::MAX, f64::min) - 0.5 * diagonal;
+            let high = elevations.iter().copied().fold(f64::MIN, f64::max) + 0.5 * diagonal;
+            if low <= band_rad.1 && high >= band_rad.0 {
+                let (y0, y1) = (ndc(j as u32, rows), ndc(j as u32 + 1, rows));
+                found = Some(found.map_or((y0, y1), |(a, b)| (a.min(y0), b.max(y1))));
+            }
+        }
+    }
+    found
+}
+
+/// The band that holds both `a` and `b`.
+pub fn union(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+    (a.0.min(b.0), a.1.max(b.1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Elevation of `p` seen from `from`.
+    fn elevation(p: DVec3, from: DVec3) -> f64 {
+        let v = p - from;
+        v.z.atan2(v.truncate().length())
+    }
+
+    #[test]
+    fn every_lookup_that_can_find_a_cloud_is_inside_the_band() {
+        let radius_m = 20_000.0;
+        // A deck 1.3 km below the centre and a heap 2 km above it, 21 to 60 km off.
+        let clouds = [
+            (DVec3::new(21_000.0, 3_000.0, -1_300.0), 800.0),
+            (DVec3::new(-40_000.0, 45_000.0, 2_000.0), 1_500.0),
+        ];
+        let content = clouds
+            .iter()
+            .map(|&(c, r)| cloud_elevations_rad(c, r))
+            .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+            .unwrap();
+        for offset in [
+            DVec3::ZERO,
+            DVec3::new(2_900.0, 0.0, 390.0),
+            DVec3::new(-2_000.0, 2_000.0, -390.0),
+        ] {
+            let (lo, hi) = ring_band_rad(content, offset, radius_m, 256);
+            // Points at the cloud's elevations from the centre, at the ring radius and beyond,
+            // seen from the camera.
+            for &(c, r) in &clouds {
+                let (a, b) = cloud_elevations_rad(c, r);
+                for e in [a, b] {
+                    for s in [radius_m, 30_000.0, 100_000.0, 1.0e7] {
+                        for az in 0..32 {
+                            let az = f64::from(az) * std::f64::consts::TAU / 32.0;
+                            let p = DVec3::new(az.cos() * e.cos(), az.sin() * e.cos(), e.sin());
+                            let seen = elevation(p * s, offset);
+                            assert!(lo <= seen && seen <= hi, "{seen} not in {lo}..{hi}");
+                        }
+                    }
+                }
+            }
+            assert!(hi - lo < 0.5, "a narrow band: {lo}..{hi}");
+        }
+    }
+
+    #[test]
+    fn a_cloud_is_within_its_elevations() {
+        let c = DVec3::new(25_000.0, 0.0, -1_000.0);
+        let (lo, hi) = cloud_elevations_rad(c, 500.0);
+        for p in [
+            c,
+            c + DVec3::Z * 500.0,
+            c - DVec3::Z * 500.0,
+            c + DVec3::X * 500.0,
+        ] {
+            let e = elevation(p, DVec3::ZERO);
+            assert!(lo < e && e < hi);
+        }
+    }
+
+    #[test]
+    fn the_rows_hold_every_pixel_of_the_band() {
+        // 60 degrees high, 16:9, pitched down 3 degrees, heading east.
+        let camera = crate::render::camera::Camera {
+            position_m: DVec3::ZERO,
+            heading_deg: 90.0,
+            pitch_deg: -3.0,
+            fov_y_deg: 60.0,
+            aspect: 16.0 / 9.0,
+            near_m: 2.0,
+            far_m: 160_000.0,
+        };
+        let inv = camera.view_proj_relative().inverse();
+        let band = (-0.06, 0.04);
+        let (y0, y1) = screen_rows_ndc(band, inv).unwrap();
+        assert!(y1 - y0 < 0.6, "a strip: {y0}..{y1}");
+        for j in 0..=360 {
+            for i in 0..=64 {
+                let (x, y) = (-1.0 + i as f32 / 32.0, -1.0 + j as f32 / 180.0);
+                let far = inv * Vec4::new(x, y, 0.5, 1.0);
+                let dir = (far.truncate() / far.w).as_dvec3().normalize();
+                let e = dir.z.asin();
+                if band.0 <= e && e <= band.1 {
+                    assert!(
+                        y0 <= y && y <= y1,
+                        "{y} of elevation {e} outside {y0}..{y1}"
+                    );
+                }
+            }
+        }
+        // Straight up: no row.
+        assert_eq!(screen_rows_ndc((1.2, 1.3), inv), None);
+        assert_eq!(union((0.0, 0.1), (-0.2, 0.05)), (-0.2, 0.1));
+    }
+}
