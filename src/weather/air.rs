@@ -740,6 +740,11 @@ mod tests {
             ..s
         };
         assert_eq!(top_of(DVec2::ZERO, 45.0, &off).speed_kt, 0.0);
+        // A negative floor is an error naming its field and line.
+        let bad = BUILTIN.replace("calm_gradient_kt = 10.0", "calm_gradient_kt = -1.0");
+        let err = AirSettings::parse(&bad, Path::new("air.toml")).unwrap_err();
+        assert_eq!(err.field.as_deref(), Some("wind.calm_gradient_kt"));
+        assert!(err.line.is_some(), "{err}");
     }
 
     #[test]
