@@ -28,6 +28,7 @@ use glam::DVec3;
 use skycast::demo::{DemoHost, GroundSettings, demo_ground};
 use skycast::flight::{SkySystemConfig, Weather};
 use skycast::render::{SkyMemory, resident_slots_bound};
+use skycast::shading::FogSettings;
 use skycast::weather::{CloudTypeRule, FieldSettings, LocalFrame, WeatherInput};
 
 const W: u32 = 192;
@@ -188,6 +189,13 @@ fn soak(hours: u64) -> Soak {
         .unwrap();
     // Blocks arrive in the frame they are queued, so every cycle draws the same frames.
     host.sky.world_mut().set_synchronous_clouds(true);
+    // The weathers are calm so that every cycle asks for the same blocks: without the least
+    // gradient wind a calm region has (`[wind] calm_gradient_kt`) their clouds stay put too.
+    let mut air = *host.sky.world_mut().air_settings();
+    air.wind.calm_gradient_kt = 0.0;
+    host.sky
+        .world_mut()
+        .set_air_settings(air, FogSettings::default());
     let radius_m = SPEED_M_S * WEATHER_S as f64 / std::f64::consts::TAU;
     let cycle_s = WEATHER_S * weathers.len() as u64;
     let mut soak = Soak {
