@@ -191,7 +191,7 @@ fn soak(hours: u64) -> Soak {
     host.sky.world_mut().set_synchronous_clouds(true);
     // The weathers are calm so that every cycle asks for the same blocks: without the least
     // gradient wind a calm region has (`[wind] calm_gradient_kt`) their clouds stay put too.
-    let mut air = *host.sky.world_mut().air_settings();
+    let mut air = *host.sky.world().air_settings();
     air.wind.calm_gradient_kt = 0.0;
     host.sky
         .world_mut()
