@@ -8,10 +8,10 @@
 //! readings the clouds advance as a flight's do.
 //!
 //! The summary ([`summarize`]), an algorithm of skycast's own after NOAA's ASOS (ASOS User's
-//! Guide, 1998, section 3.9.2), with its cover bins centred on the covers skycast draws a report
-//! with (FEW 2, SCT 4, BKN 6, OVC 8 oktas, `[oktas]` of `config/weather_field.toml`, as
-//! FlightGear maps them), where ASOS's end at them (a scattered layer drawn at its 4 oktas read
-//! SCT or BKN by the toss of 40 readings):
+//! Guide, 1998, section 3.9.2), with its cover bins ([`CoverBins`]) centred between the covers
+//! skycast draws a report with (`[oktas]` of `config/weather_field.toml`: FEW 2, SCT 3.5,
+//! BKN 6, OVC 8), where ASOS's end at fixed eighths (a layer drawn on a bin's edge reads one
+//! class or the next by the toss of 40 readings):
 //! 1. Every base of every reading, sorted, is cut into layers where one base lies more than
 //!    max(100 ft, 10%) above the one before; a layer so found is cut again where a few bases
 //!    chained two layers into one (`split_chained`: both sides more than a stray reading's
@@ -20,7 +20,8 @@
 //!    5,000 ft, 500 ft to 10,000 ft, 1,000 ft above).
 //! 3. Its cover is what is seen from below up to it (the summation principle): the share of the
 //!    readings with a base at or under the layer's highest. Up to 5% is no layer (a stray
-//!    reading), to 3/8 FEW, to 5/8 SCT, to 7/8 BKN (ASOS's 87.5%), more OVC.
+//!    reading); then FEW, SCT and BKN each up to halfway to the next class's drawn cover (2.75,
+//!    4.75 and 7 oktas with the shipped ones: the last ASOS's 87.5%), more OVC.
 //! 4. A layer that adds no cover over the one below it (the same share) is still reported when
 //!    its own readings are over 5%: a pilot between the two sees it.
 
@@ -29,6 +30,7 @@ use serde::Serialize;
 
 use super::World;
 use crate::render::RenderError;
+use crate::weather::field::{FieldSettings, PerCover};
 use crate::weather::metar::Cover;
 use crate::weather::{BLOCK_SIZE_M, LocalFrame, METRES_PER_FOOT};
 
@@ -137,8 +139,54 @@ fn bases_over(world: &World, foot: DVec3, top: DVec3, ground_m: f64) -> Vec<f64>
 /// another layer above.
 pub const BEAM_DEPTH: f64 = 3.0;
 
-/// The METAR cloud groups `readings` sum up to, lowest first (the module's algorithm).
-pub fn summarize(readings: &[Reading]) -> Vec<Layer> {
+/// Where the summary's METAR covers part, as shares of the readings (the module's step 3): a
+/// layer seen over `few_max` of them is SCT, over `sct_max` BKN, over `bkn_max` OVC.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoverBins {
+    /// The most a FEW layer is seen, share of the readings.
+    pub few_max: f64,
+    /// The most a SCT layer is seen.
+    pub sct_max: f64,
+    /// The most a BKN layer is seen.
+    pub bkn_max: f64,
+}
+
+impl CoverBins {
+    /// Bins centred between the covers a report is drawn with (`oktas`, the field's
+    /// `[oktas]`): each class up to halfway to the next, so that a layer drawn at its class's
+    /// cover reads that class whichever way the readings toss it.
+    pub fn centred_on(oktas: &PerCover) -> Self {
+        let halfway = |a: f64, b: f64| (a + b) / 16.0;
+        Self {
+            few_max: halfway(oktas.few, oktas.sct),
+            sct_max: halfway(oktas.sct, oktas.bkn),
+            bkn_max: halfway(oktas.bkn, oktas.ovc),
+        }
+    }
+
+    /// The METAR cover of a layer seen over `share` of the readings; `None` for a stray
+    /// reading's share.
+    fn cover_of(&self, share: f64) -> Option<Cover> {
+        match share {
+            s if s <= STRAY_SHARE => None,
+            s if s <= self.few_max => Some(Cover::Few),
+            s if s <= self.sct_max => Some(Cover::Sct),
+            s if s <= self.bkn_max => Some(Cover::Bkn),
+            _ => Some(Cover::Ovc),
+        }
+    }
+}
+
+impl Default for CoverBins {
+    /// Centred on the shipped `config/weather_field.toml`'s covers.
+    fn default() -> Self {
+        Self::centred_on(&FieldSettings::default().oktas)
+    }
+}
+
+/// The METAR cloud groups `readings` sum up to, lowest first (the module's algorithm), their
+/// covers by `bins`.
+pub fn summarize(readings: &[Reading], bins: &CoverBins) -> Vec<Layer> {
     let n = readings.len().max(1) as f64;
     let mut bases: Vec<f64> = readings.iter().flat_map(|r| r.bases_ft.clone()).collect();
     bases.sort_by(f64::total_cmp);
@@ -174,7 +222,7 @@ pub fn summarize(readings: &[Reading]) -> Vec<Layer> {
         if own <= STRAY_SHARE {
             continue;
         }
-        let Some(cover) = cover_of(seen.max(own)) else {
+        let Some(cover) = bins.cover_of(seen.max(own)) else {
             continue;
         };
         layers.push(Layer {
@@ -221,17 +269,6 @@ const STRAY_SHARE: f64 = 0.05;
 /// How far above the last base of a layer the next may lie and still be the same layer, feet.
 fn gap_ft(base_ft: f64) -> f64 {
     (0.1 * base_ft).max(100.0)
-}
-
-/// The share of the sky seen covered as a METAR cover (the module's bins).
-fn cover_of(share: f64) -> Option<Cover> {
-    match share {
-        s if s <= STRAY_SHARE => None,
-        s if s <= 3.0 / 8.0 => Some(Cover::Few),
-        s if s <= 5.0 / 8.0 => Some(Cover::Sct),
-        s if s <= 7.0 / 8.0 => Some(Cover::Bkn),
-        _ => Some(Cover::Ovc),
-    }
 }
 
 /// A base as a METAR writes it: to 100 ft up to 5,000 ft, 500 ft to 10,000 ft, 1,000 ft above.
@@ -288,33 +325,36 @@ mod tests {
             all.push(b);
         }
         let refs: Vec<&[f64]> = all.iter().map(Vec::as_slice).collect();
-        let layers = summarize(&readings(&refs));
+        let layers = summarize(&readings(&refs), &CoverBins::default());
         let groups: Vec<String> = layers.iter().map(Layer::group).collect();
         assert_eq!(groups, ["BKN033", "BKN041"], "{layers:?}");
         assert_eq!(ceiling_ft(&layers), Some(3_300.0));
         // A clear sky is no layer and no ceiling.
-        let clear = summarize(&readings(&[&[], &[], &[]]));
+        let clear = summarize(&readings(&[&[], &[], &[]]), &CoverBins::default());
         assert!(clear.is_empty() && ceiling_ft(&clear).is_none());
         // Every reading under one base: overcast.
-        let ovc = summarize(&readings(&[&[600.0], &[590.0], &[610.0], &[600.0]]));
+        let ovc = summarize(
+            &readings(&[&[600.0], &[590.0], &[610.0], &[600.0]]),
+            &CoverBins::default(),
+        );
         assert_eq!(ovc.iter().map(Layer::group).collect::<Vec<_>>(), ["OVC006"]);
     }
 
     #[test]
     fn a_base_between_two_layers_does_not_chain_them_into_one() {
-        // KVTI's SCT080 OVC090 as read under skycast's clouds: the scattered layer over 24 of
+        // KVTI's SCT080 OVC090 as read under skycast's clouds: the scattered layer over 18 of
         // 40 readings, the deck over the rest, and one reading meeting a cumulus's upper puff
         // at 8,564 ft, which bridges the 1,000 ft between the two.
         let mut all: Vec<Vec<f64>> = Vec::new();
         for k in 0..40 {
             all.push(match k {
                 3 => vec![8_000.0, 8_564.0],
-                _ if k % 5 < 3 => vec![8_000.0],
+                _ if k % 20 < 9 => vec![8_000.0],
                 _ => vec![9_000.0],
             });
         }
         let refs: Vec<&[f64]> = all.iter().map(Vec::as_slice).collect();
-        let groups: Vec<String> = summarize(&readings(&refs))
+        let groups: Vec<String> = summarize(&readings(&refs), &CoverBins::default())
             .iter()
             .map(Layer::group)
             .collect();
@@ -322,7 +362,7 @@ mod tests {
         // One layer whose bases spread evenly over 10% is not cut.
         let spread: Vec<Vec<f64>> = (0..40).map(|k| vec![3_000.0 + 10.0 * k as f64]).collect();
         let refs: Vec<&[f64]> = spread.iter().map(Vec::as_slice).collect();
-        assert_eq!(summarize(&readings(&refs)).len(), 1);
+        assert_eq!(summarize(&readings(&refs), &CoverBins::default()).len(), 1);
     }
 
     #[test]

@@ -575,10 +575,11 @@ fn ceilometer_round_trip(stations: usize, seed: u64) -> RoundTrip {
             .map(|g| g.1 * 1.1 + 100.0)
             .fold(12_000.0, f64::max);
         let below = |ft: f64| !r.auto || ft < reach_ft;
-        let found: Vec<ceilometer::Layer> = ceilometer::summarize(&readings)
-            .into_iter()
-            .filter(|l| below(l.base_ft))
-            .collect();
+        let found: Vec<ceilometer::Layer> =
+            ceilometer::summarize(&readings, &ceilometer::CoverBins::default())
+                .into_iter()
+                .filter(|l| below(l.base_ft))
+                .collect();
         // Nothing above an overcast reaches a ceilometer: the layers reported over one are
         // the observer's, not an instrument's.
         let first_ovc = groups
@@ -678,10 +679,10 @@ fn a_ceilometer_under_the_drifting_clouds_reads_the_reports_back() {
 }
 
 /// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations, with the
-/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.949-0.965 of the layers
-/// and 0.920-0.940 of the ceilings (0.958 and 0.926 on average); at the stations with a calm or
-/// variable wind 61-66 of 69 layers, at the others 234-237 of 243 (`cargo test --lib
-/// ceilometer_round_trip_at_200 -- --ignored --nocapture`).
+/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.946-0.962 of the layers
+/// and 0.930-0.960 of the ceilings (0.954 and 0.948 on average; the shipped seed's 0.952 and
+/// 0.960); at the stations with a calm or variable wind 60-65 of 69 layers, at the others
+/// 233-237 of 243 (`cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`).
 #[test]
 #[ignore]
 fn ceilometer_round_trip_at_200() {
@@ -698,7 +699,7 @@ fn ceilometer_round_trip_at_200() {
     let mean = |f: fn(&RoundTrip) -> f64| trips.iter().map(f).sum::<f64>() / trips.len() as f64;
     let (layers, ceilings) = (mean(|t| t.layers), mean(|t| t.ceilings));
     eprintln!("mean over the seeds: layers {layers:.3}, ceilings {ceilings:.3}");
-    assert!(layers >= 0.95 && ceilings >= 0.92);
+    assert!(layers >= 0.95 && ceilings >= 0.94);
 }
 
 /// The clouds drift with the wind the air data reports at their height: over real reports (and

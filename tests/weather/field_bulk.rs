@@ -2,18 +2,17 @@
 //! compared with the service's own decode of the same row (its `sky_cover`/`cloud_base_ft_agl`
 //! pairs, `OVX` with base 0 for a vertical visibility).
 //!
-//! A reported layer is reproduced when the field has a layer whose base is within
-//! max(200 ft, 10%) of it and whose cover seen from below
-//! ([`skycast::weather::block::cover_seen_from_below_oktas`], over the field's layers that are not
-//! reported CB/TCU) is within 1 okta of the reported cover (FEW 2, SCT 4, BKN 6, OVC and OVX 8
-//! oktas; by the summation principle the largest such cover reported at or below the base). A CB
-//! or TCU group (read from the raw text, before any trend or remark) stands outside that
-//! principle (ICAO Annex 3): it is reproduced by a reported CB/TCU layer whose own coverage is
-//! within 1 okta of the group's amount. The ceiling is the lowest base where the cover seen from
-//! below, or a CB/TCU group's own amount, reaches 5 oktas (BKN); it is right when both are absent
-//! or the bases agree as above. The
-//! field is asked at each station and, the way the clouds stage asks it, for the 4 km block
-//! that holds the station.
+//! A reported layer is reproduced when the field has a layer whose base is within max(200 ft, 10%)
+//! of it and whose cover seen from below ([`skycast::weather::block::cover_seen_from_below_oktas`],
+//! over the field's layers that are not reported CB/TCU) is within 1 okta of the reported cover (as
+//! the shipped `[oktas]` draw it: FEW 2, SCT 3.5, BKN 6, OVC and OVX 8 oktas; by the summation
+//! principle the largest such cover reported at or below the base). A CB or TCU group (read from
+//! the raw text, before any trend or remark) stands outside that principle (ICAO Annex 3): it is
+//! reproduced by a reported CB/TCU layer whose own coverage is within 1 okta of the group's amount.
+//! The ceiling is the lowest base where the cover seen from below, or a CB/TCU group's own amount,
+//! reaches 5 oktas (BKN); it is right when both are absent or the bases agree as above. The field
+//! is asked at each station and, the way the clouds stage asks it, for the 4 km block that holds
+//! the station.
 //!
 //! Run alone with `cargo test --test tests field_bulk -- --nocapture` to print the figures.
 
@@ -54,14 +53,19 @@ fn convective_in(raw: &str, cover: &str, base_ft: f32) -> bool {
         })
 }
 
+/// A reported cover as the shipped `[oktas]` draw it.
 fn oktas(cover: &str) -> Option<f32> {
-    match cover {
-        "FEW" => Some(2.0),
-        "SCT" => Some(4.0),
-        "BKN" => Some(6.0),
-        "OVC" | "OVX" => Some(8.0),
-        _ => None,
-    }
+    static OKTAS: std::sync::LazyLock<skycast::weather::field::PerCover> =
+        std::sync::LazyLock::new(|| FieldSettings::default().oktas);
+    let o = *OKTAS;
+    let oktas = match cover {
+        "FEW" => o.few,
+        "SCT" => o.sct,
+        "BKN" => o.bkn,
+        "OVC" | "OVX" => o.ovc,
+        _ => return None,
+    };
+    Some(oktas as f32)
 }
 
 fn read_rows() -> Vec<Row> {
@@ -340,7 +344,7 @@ fn dublin_has_its_three_layers_and_a_4500_ft_ceiling() {
     let w = at_station("EIDW");
     let bases: Vec<f32> = w.layers.iter().map(|l| l.base_ft_agl).collect();
     assert_eq!(bases, [800.0, 2600.0, 4500.0], "{:?}", w.layers);
-    for (l, cover) in w.layers.iter().zip([2.0, 4.0, 6.0]) {
+    for (l, cover) in w.layers.iter().zip([2.0, 3.5, 6.0]) {
         let seen = cover_seen_from_below_oktas(&w.layers, l.base_ft_agl);
         assert!((seen - cover).abs() < 1e-4, "{seen} {:?}", w.layers);
     }

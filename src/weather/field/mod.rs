@@ -31,7 +31,7 @@ mod tests;
 
 pub use rule::{Band, CloudTypeRule, LayerFacts, Reported, Rule};
 pub use sample::{LayerKind, StationLayer, StationSample};
-pub use settings::{FieldSettings, StationHold};
+pub use settings::{FieldSettings, PerCover, StationHold};
 
 use std::collections::HashMap;
 use std::sync::Arc;

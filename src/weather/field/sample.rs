@@ -3,7 +3,7 @@
 //! surface values. Built from a [`PlacedReport`] with the settings.
 //!
 //! Every group with a cover and a base is a layer of its own: nothing is merged. Its cover is the
-//! report's (FEW 2, SCT 4, BKN 6, OVC 8 oktas), which by the summation principle counts all cloud
+//! report's (`[oktas]`: FEW 2, SCT 3.5, BKN 6, OVC 8 oktas), which by the summation principle counts all cloud
 //! at and below its base; the field turns those covers into each layer's own coverage. A CB or
 //! TCU group is a convective layer; `//////CB` (no cover, no base) one of FEW at the configured
 //! base. VV is a fog layer on the ground, overcast, as deep as the vertical visibility. FG, BR,
@@ -331,20 +331,23 @@ mod tests {
             named: None,
         };
         let plain = LayerKind::Plain;
-        // KA39's SCT033 SCT040 SCT047: 3, 3.25 and 4 oktas seen from below.
+        // KA39's SCT033 SCT040 SCT047 (SCT drawn 3.5 oktas): 2.75, 2.75 and 3.5 oktas seen
+        // from below, no lower than halfway to FEW's 2 (the layers' own rule then lifts the
+        // middle one 0.75 okta over the lowest, and the top to SCT's 4).
+        let sct = settings.oktas.sct;
         let mut three = [
-            layer(plain, 3300.0, 4.0),
-            layer(plain, 4000.0, 4.0),
-            layer(plain, 4700.0, 4.0),
+            layer(plain, 3300.0, sct),
+            layer(plain, 4000.0, sct),
+            layer(plain, 4700.0, sct),
         ];
         spread_within_class(&mut three, &settings);
         let seen: Vec<f64> = three.iter().map(|l| l.cover_below_oktas).collect();
-        assert_eq!(seen, [3.0, 3.25, 4.0]);
+        assert_eq!(seen, [2.75, 2.75, 3.5]);
         // BKN has room above; a CB stands apart; other classes stay.
         let mut mixed = [
             layer(plain, 1000.0, 2.0),
-            layer(plain, 2000.0, 4.0),
-            layer(LayerKind::Cb, 2500.0, 4.0),
+            layer(plain, 2000.0, sct),
+            layer(LayerKind::Cb, 2500.0, sct),
             layer(plain, 3000.0, 6.0),
             layer(plain, 4000.0, 6.0),
         ];
@@ -400,7 +403,7 @@ mod tests {
         assert_eq!(
             got,
             [
-                (LayerKind::Plain, 2800.0, 4.0),
+                (LayerKind::Plain, 2800.0, 3.5),
                 (LayerKind::Tcu, 3300.0, 6.0),
                 (LayerKind::Plain, 5000.0, 8.0),
                 (LayerKind::Plain, 25000.0, 2.0),
@@ -412,9 +415,9 @@ mod tests {
         };
         // The FEW250 under an overcast: the sky seen from below stays overcast.
         assert_eq!(sample.cover_below_oktas(30000.0), 8.0);
-        assert_eq!(sample.cover_below_oktas(3000.0), 4.0);
+        assert_eq!(sample.cover_below_oktas(3000.0), 3.5);
         // The BKN033TCU is the towers' own amount, not the sky's: still the SCT028 above it.
-        assert_eq!(sample.cover_below_oktas(4000.0), 4.0);
+        assert_eq!(sample.cover_below_oktas(4000.0), 3.5);
         assert_eq!(sample.cover_below_oktas(2000.0), 0.0);
     }
 

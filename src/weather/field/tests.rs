@@ -115,7 +115,7 @@ fn exact_at_the_stations() {
     let w = f.weather_at_lat_lon(50.0, 8.0);
     assert_eq!(w.layers[0].cloud_type, CloudType::Cumulonimbus);
     assert_eq!(w.layers[0].type_source, TypeSource::Reported);
-    assert_eq!(w.layers[0].coverage_oktas, 4.0);
+    assert_eq!(w.layers[0].coverage_oktas, 3.5);
     let w = f.weather_at_lat_lon(50.5, 7.3);
     assert_eq!(w.layers[0].cloud_type, CloudType::Cirrus);
 }
@@ -383,7 +383,7 @@ fn layers_at_similar_heights_blend_and_a_layer_one_station_has_fades() {
         assert_eq!(low.len(), 1, "{lon}: {layers:?}");
         assert!(low[0].base_ft_agl >= last_base, "{lon}: {layers:?}");
         assert!(
-            (low[0].coverage_oktas - 4.0).abs() < 0.5,
+            (low[0].coverage_oktas - 3.5).abs() < 0.5,
             "{lon}: {layers:?}"
         );
         last_base = low[0].base_ft_agl;
@@ -436,7 +436,7 @@ fn covers_follow_the_summation_principle_and_tops_the_type() {
         .map(|l| cover_seen_from_below_oktas(&layers, l.base_ft_agl))
         .collect();
     assert_eq!(layers.len(), 3);
-    for (got, want) in seen.iter().zip([2.0, 4.0, 6.0]) {
+    for (got, want) in seen.iter().zip([2.0, 3.5, 6.0]) {
         assert!((got - want).abs() < 1e-4, "{seen:?}");
     }
     assert_eq!(ceiling_ft(&layers, 5.0), Some(4500.0));
@@ -467,7 +467,7 @@ fn cb_and_tcu_keep_their_own_amount_above_a_deck() {
         layer(Bkn, 10000, None),
     ];
     // BKN010 SCT030TCU and a Cb of unknown amount and base (`//////CB`): the towers their own
-    // 4 oktas, the Cb drawn as FEW.
+    // 3.5 oktas (SCT's), the Cb drawn as FEW.
     let unknown = vec![
         layer(Bkn, 1000, None),
         layer(Sct, 3000, Some(ConvectiveKind::Tcu)),
@@ -488,7 +488,7 @@ fn cb_and_tcu_keep_their_own_amount_above_a_deck() {
         (own[2].0, own[2].1, own[2].2),
         (CloudType::Cumulonimbus, 2500.0, 2.0)
     );
-    // The plain layers sum among themselves: 4 oktas, then 6 seen from below at 1,700 ft.
+    // The plain layers sum among themselves: 3.5 oktas, then 6 seen from below at 1,700 ft.
     let plain: Vec<_> = layers
         .iter()
         .filter(|l| l.cloud_type != CloudType::Cumulonimbus)
@@ -501,7 +501,7 @@ fn cb_and_tcu_keep_their_own_amount_above_a_deck() {
         .iter()
         .find(|l| l.cloud_type == CloudType::CumulusCongestus)
         .expect("the TCU layer");
-    assert_eq!((towers.base_ft_agl, towers.coverage_oktas), (3000.0, 4.0));
+    assert_eq!((towers.base_ft_agl, towers.coverage_oktas), (3000.0, 3.5));
     let cells = layers
         .iter()
         .find(|l| l.cloud_type == CloudType::Cumulonimbus)
