@@ -31,32 +31,31 @@ pub struct DemoHost {
     timer: Option<GpuTimer>,
 }
 
-/// Five timestamps: around the sky's `prepare` (which submits work of its own only to flush a
-/// frame it prepared and never recorded), then before the frame's passes, between the ground
-/// and the sky, after; where the device has timestamp queries.
+/// Three timestamps in the frame's encoder: before the ground, between the ground and the sky,
+/// after the sky; where the device has timestamp queries. The sky times the submission its
+/// `prepare` makes of its own ([`crate::render::Sky::set_prepare_timing`]): stamps around the
+/// whole prepare, in submissions of their own, would also count the CPU's prepare (the device
+/// idles through it) and the latency of those submissions, and the sky's GPU time is only
+/// what the device spends on its commands.
 struct GpuTimer {
     stamps: Timestamps,
 }
 
 impl GpuTimer {
-    fn new(gpu: &HeadlessGpu) -> Option<Self> {
-        let stamps = Timestamps::new(&gpu.device, &gpu.queue, "host.frame_time", 5)?;
+    /// The timer, and the sky's prepare timed with it; `None` without timestamp queries.
+    fn new(gpu: &HeadlessGpu, sky: &mut SkySystem) -> Option<Self> {
+        let stamps = Timestamps::new(&gpu.device, &gpu.queue, "host.frame_time", 3)?;
+        sky.sky_mut().set_prepare_timing(true);
         Some(Self { stamps })
     }
 
-    /// Writes timestamp `index` in a submission of its own (around the sky's `prepare`).
-    fn stamp(&self, gpu: &HeadlessGpu, index: u32) {
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        self.stamps.write(&mut encoder, index);
-        gpu.queue.submit([encoder.finish()]);
-    }
-
-    /// Milliseconds of the ground and of the sky (anything `prepare` submitted, and its passes
+    /// Milliseconds of the ground and of the sky (what its `prepare` submitted, and its passes
     /// in the frame, impostor renders included) of the last submitted frame (waits for it).
-    fn read_ms(&self, gpu: &HeadlessGpu) -> Option<[f64; 2]> {
+    fn read_ms(&self, gpu: &HeadlessGpu, sky: &SkySystem) -> Option<[f64; 2]> {
         let t = self.stamps.read_ms(&gpu.device)?;
         let ms = |a: usize, b: usize| (t[b] - t[a]).max(0.0);
-        Some([ms(2, 3), ms(0, 1) + ms(3, 4)])
+        let prepare = sky.sky().prepare_gpu_ms().unwrap_or(0.0);
+        Some([ms(0, 1), prepare + ms(1, 2)])
     }
 }
 
@@ -83,8 +82,8 @@ impl DemoHost {
         let terrain = Terrain::new(&gpu.device, headless::COLOUR_FORMAT, ground);
         let mut config: SkySystemConfig = sky.into();
         config.sky.targets = headless::TARGETS;
-        let sky = SkySystem::with_config(&gpu.device, &gpu.queue, config)?;
-        let timer = GpuTimer::new(&gpu);
+        let mut sky = SkySystem::with_config(&gpu.device, &gpu.queue, config)?;
+        let timer = GpuTimer::new(&gpu, &mut sky);
         Ok(Self {
             gpu,
             target,
@@ -125,17 +124,11 @@ impl DemoHost {
         dt_s: f64,
         draw: bool,
     ) -> Result<(FrameStats, Vec<Result<std::path::PathBuf, String>>), SkyError> {
-        if draw && let Some(t) = &self.timer {
-            t.stamp(&self.gpu, 0);
-        }
         let (stats, changes) =
             self.sky
                 .update(&self.gpu.queue, &HostCamera::from(camera), utc_unix_s, dt_s)?;
         if !draw {
             return Ok((stats, changes));
-        }
-        if let Some(t) = &self.timer {
-            t.stamp(&self.gpu, 1);
         }
         let sun_dir = self.sky.lighting().sun_direction;
         // The ground's visibility is the sky's fog alone: the weather over the camera, eased
@@ -167,13 +160,7 @@ impl DemoHost {
         dt_s: f64,
         visibility_m: f32,
     ) -> Result<FrameStats, RenderError> {
-        if let Some(t) = &self.timer {
-            t.stamp(&self.gpu, 0);
-        }
         let stats = (self.sky.sky_mut()).prepare(&self.gpu.queue, camera, sun, dt_s);
-        if let Some(t) = &self.timer {
-            t.stamp(&self.gpu, 1);
-        }
         self.draw_prepared(camera, sun.direction_enu().as_vec3(), visibility_m, stats)
     }
 
@@ -207,7 +194,7 @@ impl DemoHost {
                 label: Some("host.frame"),
             });
         if let Some(t) = &self.timer {
-            t.stamps.write(&mut encoder, 2);
+            t.stamps.write(&mut encoder, 0);
         }
         self.terrain.record(
             &mut encoder,
@@ -215,7 +202,7 @@ impl DemoHost {
             &self.target.depth_view,
         );
         if let Some(t) = &self.timer {
-            t.stamps.write(&mut encoder, 3);
+            t.stamps.write(&mut encoder, 1);
         }
         // The renderer's own record: `draw` prepares it by hand, without the frame step.
         self.sky.sky().record(
@@ -225,7 +212,7 @@ impl DemoHost {
         )?;
         stats.set_record(self.sky.last_record());
         if let Some(t) = &self.timer {
-            t.stamps.write(&mut encoder, 4);
+            t.stamps.write(&mut encoder, 2);
             t.stamps.resolve(&mut encoder);
         }
         self.gpu.queue.submit([encoder.finish()]);
@@ -241,7 +228,7 @@ impl DemoHost {
     /// GPU time of the last drawn frame's ground passes and of its sky passes (impostor
     /// renders included), milliseconds, where the device has timestamp queries. Waits for it.
     pub fn last_gpu_split_ms(&self) -> Option<[f64; 2]> {
-        self.timer.as_ref()?.read_ms(&self.gpu)
+        self.timer.as_ref()?.read_ms(&self.gpu, &self.sky)
     }
 
     /// Waits until the device has finished everything submitted (the benchmark's wall-time

@@ -87,6 +87,8 @@ impl Timestamps {
             return None;
         }
         let bytes = count as u64 * 8;
+        // One query more than asked for: the one `write` writes after each (see there).
+        let queries = count + 1;
         let buffer = |usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -99,7 +101,7 @@ impl Timestamps {
             queries: device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some(label),
                 ty: wgpu::QueryType::Timestamp,
-                count,
+                count: queries,
             }),
             resolve: buffer(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
             read: buffer(wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ),
@@ -109,9 +111,16 @@ impl Timestamps {
         })
     }
 
-    /// Writes timestamp `index` (between passes).
+    /// Writes timestamp `index` (between passes), then the spare query after the timer's own,
+    /// which is never read: it only makes a software rasteriser take `index` before the work
+    /// that follows. Lavapipe writes a timestamp when its rasteriser threads reach it, and
+    /// hands them the commands before it only at the next timestamp or pass, while it runs a
+    /// compute dispatch at once on its command thread: compute work recorded after a lone
+    /// timestamp (the sprites' corner build after the sky's first one) was counted before it (in
+    /// the host's ground-to-sky gap, not in the sky's build). A real GPU orders them anyway.
     pub fn write(&self, encoder: &mut wgpu::CommandEncoder, index: u32) {
         encoder.write_timestamp(&self.queries, index);
+        encoder.write_timestamp(&self.queries, self.count);
     }
 
     /// Resolves them all and copies them where [`Self::read_ms`] finds them (at the end of the

@@ -108,6 +108,11 @@ pub struct Sky {
     far_field_us: u64,
     /// Timestamps between the passes, while pass timing is on.
     pass_timer: Option<super::Timestamps>,
+    /// Two timestamps around the submission `prepare` makes of its own (the shadow map's),
+    /// while its timing is on ([`Self::set_prepare_timing`]), and whether the last prepare
+    /// made one.
+    prepare_timer: Option<super::Timestamps>,
+    prepare_submitted: bool,
     /// Kept to make the pass timer.
     queue: wgpu::Queue,
     /// The time-of-day light of the last frame, clear sky: what the clouds are lit with.
@@ -379,6 +384,7 @@ impl Sky {
             .max(self.shadows.pending_sprites());
         self.sprites.reserve(&self.device, most);
         stats.upload_bytes = upload_bytes;
+        self.prepare_submitted = self.shadows.has_pending();
         gpu_wait += self.record_shadows(queue);
         self.count_costs(i, start.spent().saturating_sub(gpu_wait), gpu_wait, stats)
     }
@@ -396,6 +402,11 @@ impl Sky {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("sky.cloud_shadows"),
             });
+        // Timed from its first command to its last, on the device: the frame's GPU time
+        // without the CPU's prepare before the submission (the device idles through it).
+        if let Some(timer) = &self.prepare_timer {
+            timer.write(&mut encoder, 0);
+        }
         self.sprites.scatter.record_kept(&mut encoder);
         let sprites = &self.sprites;
         (self.shadows).record(
@@ -404,6 +415,10 @@ impl Sky {
             &sprites.resident.group,
             &sprites.quads.0,
         );
+        if let Some(timer) = &self.prepare_timer {
+            timer.write(&mut encoder, 1);
+            timer.resolve(&mut encoder);
+        }
         let wait = Stopwatch::start();
         queue.submit([encoder.finish()]);
         wait.spent()

@@ -209,6 +209,8 @@ impl Sky {
             field: Spent::default(),
             far_field_us: 0,
             pass_timer: None,
+            prepare_timer: None,
+            prepare_submitted: false,
             queue: queue.clone(),
             clear_light: light,
             seen_light: light,

@@ -115,6 +115,33 @@ impl Sky {
         self.pass_timer.is_some()
     }
 
+    /// Times on the GPU, from the next [`Self::prepare`] on, the submission a prepare makes of
+    /// its own (the cloud shadow map's draw, with the patch of changed orders it reads), from
+    /// its first command to its last, or stops. Returns whether timing is on (the device needs
+    /// [`crate::render::Timestamps::FEATURES`]). A host that times its frames adds
+    /// [`Self::prepare_gpu_ms`] to the span of [`Self::record`]'s passes in its encoder: the
+    /// sky's GPU time. Timestamps around the whole prepare would also count the CPU's prepare
+    /// before the submission, through which the device idles.
+    pub fn set_prepare_timing(&mut self, on: bool) -> bool {
+        self.prepare_timer = if on {
+            crate::render::Timestamps::new(&self.device, &self.queue, "sky.prepare_time", 2)
+        } else {
+            None
+        };
+        self.prepare_timer.is_some()
+    }
+
+    /// GPU milliseconds of the submission the last [`Self::prepare`] made of its own (0 when
+    /// it made none), once submitted; `None` while [`Self::set_prepare_timing`] is off or if
+    /// the time cannot be read. Waits for the device.
+    pub fn prepare_gpu_ms(&self) -> Option<f64> {
+        let timer = self.prepare_timer.as_ref()?;
+        if !self.prepare_submitted {
+            return Some(0.0);
+        }
+        timer.read_ms(&self.device)?.get(1).copied()
+    }
+
     /// GPU time of each group of passes of the last recorded frame, once it was submitted:
     /// waits for the device. `None` while pass timing is off or if the times cannot be read.
     pub fn pass_times(&self) -> Option<crate::render::PassTimes> {
