@@ -85,21 +85,32 @@ impl SpriteCore {
         rotation_deg: f32,
         flat: bool,
     ) -> Self {
-        let (w, h) = (f64::from(width_m), f64::from(height_m));
-        let (across, up) = if flat { (h, w.min(h)) } else { (w, h) };
+        let mut core = Self::unturned(offset_m, width_m, height_m, flat);
         // A camera-facing sprite's core is round across: its turn is nothing to it (and a sine
         // and cosine a sprite were most of a line of sight's time).
-        let along = if flat {
-            DVec2::from_angle(f64::from(rotation_deg).to_radians())
-        } else {
-            DVec2::X
-        };
+        if flat {
+            core.turn(rotation_deg);
+        }
+        core
+    }
+
+    /// [`Self::new`] with its first axis along east whatever the sprite's turn: a camera-facing
+    /// sprite's core, or a flat one's before [`Self::turn`] (its centre and reach are the
+    /// same either way).
+    fn unturned(offset_m: [f32; 3], width_m: f32, height_m: f32, flat: bool) -> Self {
+        let (w, h) = (f64::from(width_m), f64::from(height_m));
+        let (across, up) = if flat { (h, w.min(h)) } else { (w, h) };
         Self {
             centre_m: DVec3::from_array(offset_m.map(f64::from)),
-            along,
+            along: DVec2::X,
             semi_axes_m: DVec3::new(w, across, up) * CORE_HALF_EXTENT,
             floor_m: None,
         }
+    }
+
+    /// Turns a flat sprite's core `rotation_deg` (its first axis along that bearing from east).
+    fn turn(&mut self, rotation_deg: f32) {
+        self.along = DVec2::from_angle(f64::from(rotation_deg).to_radians());
     }
 
     /// How far from its centre any of the core (its column included) reaches, metres: a
@@ -110,6 +121,21 @@ impl SpriteCore {
             Some(floor) => {
                 let across = self.semi_axes_m.x.max(self.semi_axes_m.y);
                 r.max(across.hypot(self.centre_m.z - floor))
+            }
+            None => r,
+        }
+    }
+
+    /// At least [`Self::reach_m`], without its square root: a column's depth and radius added
+    /// (never less than their hypotenuse; widened by a millionth of a millionth against the
+    /// hypotenuse's rounding). A line farther from the centre than this is farther than the
+    /// reach too.
+    fn reach_bound_m(&self) -> f64 {
+        let r = self.semi_axes_m.max_element();
+        match self.floor_m {
+            Some(floor) => {
+                let across = self.semi_axes_m.x.max(self.semi_axes_m.y);
+                r.max((across + (self.centre_m.z - floor).abs()) * (1.0 + 1e-12))
             }
             None => r,
         }
@@ -215,6 +241,21 @@ pub fn cores(cloud: &Cloud) -> impl Iterator<Item = SpriteCore> + '_ {
             core.stand_on(f64::from(cloud.floor_m));
         }
         Some(core)
+    })
+}
+
+/// [`cores`] with a flat cloud's cores not turned yet, each with its sprite's turn: a line of
+/// sight passes most of a cloud's cores by on their centre and reach, which the turn does not
+/// change, and turns (a sine and a cosine) only those it comes near. Turned, each is the core
+/// [`cores`] gives.
+fn unturned_cores(cloud: &Cloud) -> impl Iterator<Item = (SpriteCore, f32)> + '_ {
+    cloud.sprites.iter().filter(|s| !s.precipitation).map(|s| {
+        let mut core = SpriteCore::unturned(s.offset_m, s.width_m, s.height_m, cloud.flat);
+        if s.base {
+            core.widen_to_base();
+            core.stand_on(f64::from(cloud.floor_m));
+        }
+        (core, s.rotation_deg)
     })
 }
 
@@ -329,12 +370,22 @@ pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
     }
     let d = b - a;
     let dd = d.length_squared().max(1e-12);
-    for core in cores(cloud) {
+    for (mut core, rotation_deg) in unturned_cores(cloud) {
         // Most of a cloud's cores lie off a line that crosses it: passed over on their
         // distance from the line, before the ellipsoid is asked.
-        let reach = core.reach_m();
-        if (core.centre_m - a).cross(d).length_squared() > reach * reach * dd {
+        // (On a bound of its reach first: the reach's hypotenuse is asked only of the cores
+        // the bound leaves near; a core the bound passes over the reach passes over too.)
+        let off = (core.centre_m - a).cross(d).length_squared();
+        let bound = core.reach_bound_m();
+        if off > bound * bound * dd {
             continue;
+        }
+        let reach = core.reach_m();
+        if off > reach * reach * dd {
+            continue;
+        }
+        if cloud.flat {
+            core.turn(rotation_deg);
         }
         core.segment_into(a, b, &mut spans);
         out.extend(
@@ -455,5 +506,39 @@ mod tests {
             &mut spans,
         );
         assert_eq!(spans.len(), 1);
+    }
+
+    /// A line of sight turns a flat cloud's cores only once it is near them: turned, they
+    /// are the cores every other probe asks, base sprites and rain among the sprites too.
+    #[test]
+    fn the_cores_turned_late_are_the_cores() {
+        for flat in [false, true] {
+            let mut c = cube_cloud(DVec3::ZERO, 100.0, CloudType::Stratus);
+            c.flat = flat;
+            c.floor_m = -400.0;
+            let first = c.sprites[0];
+            c.sprites = (0..9)
+                .map(|k| {
+                    let mut s = first;
+                    s.offset_m = [40.0 * k as f32, -25.0 * k as f32, 10.0 * (k % 3) as f32];
+                    s.width_m = 200.0 + 30.0 * k as f32;
+                    s.height_m = 150.0 + 10.0 * k as f32;
+                    s.rotation_deg = 37.0 * k as f32;
+                    s.base = k % 2 == 0;
+                    s.precipitation = k == 4;
+                    s
+                })
+                .collect();
+            let late: Vec<SpriteCore> = unturned_cores(&c)
+                .map(|(mut core, rotation_deg)| {
+                    if flat {
+                        core.turn(rotation_deg);
+                    }
+                    core
+                })
+                .collect();
+            assert_eq!(late, cores(&c).collect::<Vec<_>>());
+            assert_eq!(late.len(), 8);
+        }
     }
 }
