@@ -115,7 +115,7 @@ impl SpriteCore {
 
     /// How far from its centre any of the core (its column included) reaches, metres: a
     /// column's bottom rim lies its depth down and its horizontal radius out.
-    fn reach_m(&self) -> f64 {
+    pub(super) fn reach_m(&self) -> f64 {
         let r = self.semi_axes_m.max_element();
         match self.floor_m {
             Some(floor) => {
@@ -249,7 +249,12 @@ pub fn cores(cloud: &Cloud) -> impl Iterator<Item = SpriteCore> + '_ {
 /// change, and turns (a sine and a cosine) only those it comes near. Turned, each is the core
 /// [`cores`] gives.
 fn unturned_cores(cloud: &Cloud) -> impl Iterator<Item = (SpriteCore, f32)> + '_ {
-    cloud.sprites.iter().filter(|s| !s.precipitation).map(|s| {
+    cloud.sprites.iter().filter_map(|s| unturned_core(cloud, s))
+}
+
+/// One sprite's core of [`unturned_cores`] (`None` for rain or snow).
+fn unturned_core(cloud: &Cloud, s: &Sprite) -> Option<(SpriteCore, f32)> {
+    (!s.precipitation).then(|| {
         let mut core = SpriteCore::unturned(s.offset_m, s.width_m, s.height_m, cloud.flat);
         if s.base {
             core.widen_to_base();
@@ -257,6 +262,59 @@ fn unturned_cores(cloud: &Cloud) -> impl Iterator<Item = (SpriteCore, f32)> + '_
         }
         (core, s.rotation_deg)
     })
+}
+
+/// Cores a run of [`CoreRuns`] holds at most.
+const RUN_CORES: usize = 8;
+
+/// A cloud with more cores than this has them in runs ([`CoreRuns`]); fewer are looked at one
+/// by one.
+const RUNS_FROM: usize = 24;
+
+/// A cloud's cores in runs of neighbours, each with the bounds of its cores' reach: a line of
+/// sight that passes a run's bounds by enters none of its cores and looks at none of them (a
+/// deck's cloud has hundreds of sprites, a line crosses a few). Made once for a generation, with
+/// its boxes, off the frame thread; none for a cloud of few cores.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CoreRuns {
+    /// The cores' sprites (indices into the cloud's), run after run.
+    sprites: Vec<u32>,
+    /// Per run: the lowest and highest corner of the spheres its cores reach (and a metre),
+    /// from the cloud's centre, and where its sprites end in `sprites`.
+    runs: Vec<(DVec3, DVec3, u32)>,
+}
+
+impl CoreRuns {
+    /// The runs of `cloud`'s cores: in strips west to east, each south to north, cut every
+    /// [`RUN_CORES`]; empty for [`RUNS_FROM`] cores or fewer.
+    pub fn of(cloud: &Cloud) -> Self {
+        let mut cores: Vec<(u32, DVec3, f64)> = (cloud.sprites.iter().enumerate())
+            .filter_map(|(k, s)| {
+                unturned_core(cloud, s).map(|(c, _)| (k as u32, c.centre_m, c.reach_m()))
+            })
+            .collect();
+        if cores.len() <= RUNS_FROM {
+            return Self::default();
+        }
+        cores.sort_by(|x, y| x.1.x.total_cmp(&y.1.x));
+        // Strips of about as many runs as there are strips.
+        let runs = cores.len().div_ceil(RUN_CORES);
+        let strip = (runs as f64).sqrt().ceil() as usize * RUN_CORES;
+        let mut out = Self::default();
+        for strip in cores.chunks_mut(strip) {
+            strip.sort_by(|x, y| x.1.y.total_cmp(&y.1.y));
+            for run in strip.chunks(RUN_CORES) {
+                let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
+                for &(k, centre, reach) in run {
+                    let r = DVec3::splat(reach + 1.0);
+                    (lo, hi) = (lo.min(centre - r), hi.max(centre + r));
+                    out.sprites.push(k);
+                }
+                out.runs.push((lo, hi, out.sprites.len() as u32));
+            }
+        }
+        out
+    }
 }
 
 /// An overcast's closed floor ([`Cloud::floor_slab_m`]) as a box from the cloud's centre
@@ -340,6 +398,18 @@ pub fn distance_m(cloud: &Cloud, p: DVec3) -> f64 {
 /// inside `cloud`: the union of its cores (and floor slab) above its base, sorted and merged,
 /// into `out` (cleared first).
 pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
+    segment_in_runs(cloud, None, a, b, out);
+}
+
+/// [`segment`], the cloud's cores looked at run by run where it has `runs` ([`CoreRuns`]):
+/// a run whose bounds the segment misses is passed over whole. The same stretches.
+pub fn segment_in_runs(
+    cloud: &Cloud,
+    runs: Option<&CoreRuns>,
+    a: DVec3,
+    b: DVec3,
+    out: &mut Vec<(f64, f64)>,
+) {
     out.clear();
     let floor = f64::from(cloud.floor_m);
     // The part of the segment above the base.
@@ -370,7 +440,7 @@ pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
     }
     let d = b - a;
     let dd = d.length_squared().max(1e-12);
-    for (mut core, rotation_deg) in unturned_cores(cloud) {
+    let mut visit = |(mut core, rotation_deg): (SpriteCore, f32)| {
         // Most of a cloud's cores lie off a line that crosses it: passed over on their
         // distance from the line, before the ellipsoid is asked.
         // (On a bound of its reach first: the reach's hypotenuse is asked only of the cores
@@ -378,11 +448,11 @@ pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
         let off = (core.centre_m - a).cross(d).length_squared();
         let bound = core.reach_bound_m();
         if off > bound * bound * dd {
-            continue;
+            return;
         }
         let reach = core.reach_m();
         if off > reach * reach * dd {
-            continue;
+            return;
         }
         if cloud.flat {
             core.turn(rotation_deg);
@@ -393,6 +463,27 @@ pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
                 .drain(..)
                 .map(|(t0, t1)| (t0.max(above_from), t1.min(above_to))),
         );
+    };
+    match runs {
+        // A run the segment passes by holds no core it enters (each lies within its reach of
+        // its centre, and the run's bounds hold those spheres and a metre): the stretches are
+        // the same, found in another order, and merged the same.
+        Some(runs) if !runs.runs.is_empty() => {
+            let mut from = 0;
+            for &(lo, hi, to) in &runs.runs {
+                let run = &runs.sprites[from as usize..to as usize];
+                from = to;
+                if super::boxes::slab(a, b, lo, hi).is_none() {
+                    continue;
+                }
+                for &k in run {
+                    if let Some(core) = unturned_core(cloud, &cloud.sprites[k as usize]) {
+                        visit(core);
+                    }
+                }
+            }
+        }
+        _ => unturned_cores(cloud).for_each(visit),
     }
     out.extend(
         spans

@@ -434,7 +434,9 @@ impl<'a> CloudProbe<'a> {
             };
             // The box is entered: the cloud's cores say where the line is in cloud.
             let cloud = &block.block.clouds[bx.cloud];
-            core::segment(cloud, qa - cloud.centre_m, qb - cloud.centre_m, &mut inside);
+            let runs = block.boxes.runs.get(bx.cloud).and_then(|r| r.as_deref());
+            let (a, b) = (qa - cloud.centre_m, qb - cloud.centre_m);
+            core::segment_in_runs(cloud, runs, a, b, &mut inside);
             let mut entry: Option<f64> = None;
             let mut depth_here = 0.0;
             for &(t0, t1) in &inside {

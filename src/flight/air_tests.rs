@@ -427,3 +427,47 @@ fn the_first_cloud_over_the_bands_is_the_nearest_of_each_bands_own() {
     assert!(hits > lines / 10, "{hits} of {lines}");
     assert!(upper_first > 0, "{upper_first} lines");
 }
+
+/// A cloud of many cores looked at run by run ([`crate::clouds::core::CoreRuns`]) gives the
+/// stretches of looking at every core, to the bit: lines through the boxes of the real
+/// overcast at San Antonio and the cumulus off Los Angeles, at every angle.
+#[test]
+fn a_clouds_cores_in_runs_give_the_stretches_of_every_core() {
+    use crate::clouds::core::{CoreRuns, segment, segment_in_runs};
+    let mut checked = 0;
+    for (lat, lon) in [(29.4270, -98.6080), (34.02, -118.47)] {
+        let w = world(REAL, lat, lon, true);
+        for field in w.living_fields() {
+            for (_, g) in field.blocks().take(6) {
+                for (k, cloud) in g.block.clouds.iter().enumerate() {
+                    let Some(bx) = g.boxes.boxes.iter().find(|b| b.cloud == k) else {
+                        continue;
+                    };
+                    let runs = CoreRuns::of(cloud);
+                    if runs == CoreRuns::default() {
+                        continue;
+                    }
+                    assert_eq!(g.boxes.runs[k].as_deref(), Some(&runs));
+                    let (c, h) = (bx.centre_m - cloud.centre_m, bx.half_m);
+                    for n in 0..40 {
+                        let u = f64::from(n) * 0.61803;
+                        let dir = DVec3::new(u.cos(), u.sin(), (u * 2.3).sin() * 0.6);
+                        let across = DVec3::new(
+                            h.x * ((u * 7.1).sin() * 0.9),
+                            h.y * ((u * 5.3).cos() * 0.9),
+                            h.z * ((u * 3.7).sin() * 0.9),
+                        );
+                        let reach = h.length() * 1.5;
+                        let (a, b) = (c + across - dir * reach, c + across + dir * reach);
+                        let (mut want, mut got) = (Vec::new(), Vec::new());
+                        segment(cloud, a, b, &mut want);
+                        segment_in_runs(cloud, Some(&runs), a, b, &mut got);
+                        assert_eq!(got, want, "{a} to {b}");
+                        checked += usize::from(!want.is_empty());
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 100, "{checked} lines in cloud");
+}
