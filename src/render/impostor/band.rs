@@ -80,30 +80,33 @@ pub fn screen_rows_ndc(band_rad: (f64, f64), inv_view_proj: Mat4) -> Option<(f32
         (far.truncate() / far.w).as_dvec3().normalize_or_zero()
     };
     let ndc = |k: u32, n: u32| -1.0 + 2.0 * k as f32 / n as f32;
-    // Each grid point's ray with its elevation, worked out once (four cells share a corner).
-    let grid: Vec<Vec<Corner>> = (0..=rows)
-        .map(|j| {
-            (0..=cols)
-                .map(|i| {
-                    let r = ray(ndc(i, cols), ndc(j, rows));
-                    (r, r.z.clamp(-1.0, 1.0).asin())
-                })
-                .collect()
-        })
+    let side = cols as usize + 1;
+    // Each grid point's ray, row after row, and its elevation once a cell asks for it (four
+    // cells share a corner; a row of cells the band is far from asks none).
+    let rays: Vec<DVec3> = (0..=rows)
+        .flat_map(|j| (0..=cols).map(move |i| ray(ndc(i, cols), ndc(j, rows))))
         .collect();
+    let mut elevations: Vec<Option<f64>> = vec![None; rays.len()];
     let mut found: Option<(f32, f32)> = None;
     for j in 0..rows as usize {
+        let points = &rays[j * side..(j + 2) * side];
+        if row_is_off(band_rad, points, side) {
+            continue;
+        }
+        let mut corner = |k: usize| -> Corner {
+            let r = rays[k];
+            (r, *elevations[k].get_or_insert_with(|| elevation(r.z)))
+        };
         // One cell of a row that meets the band is enough: the row is in.
-        let meets = (0..cols as usize).any(|i| {
-            cell_meets(
-                band_rad,
-                [
-                    grid[j][i],
-                    grid[j][i + 1],
-                    grid[j + 1][i],
-                    grid[j + 1][i + 1],
-                ],
-            )
+        let meets = (0..side - 1).any(|i| {
+            let at = j * side + i;
+            let c = [
+                corner(at),
+                corner(at + 1),
+                corner(at + side),
+                corner(at + side + 1),
+            ];
+            cell_meets(band_rad, c)
         });
         if meets {
             let (y0, y1) = (ndc(j as u32, rows), ndc(j as u32 + 1, rows));
@@ -111,6 +114,44 @@ pub fn screen_rows_ndc(band_rad: (f64, f64), inv_view_proj: Mat4) -> Option<(f32
         }
     }
     found
+}
+
+/// The elevation of a unit ray whose up component is `z`, radians.
+fn elevation(z: f64) -> f64 {
+    z.clamp(-1.0, 1.0).asin()
+}
+
+/// Whether no cell of a row of [`screen_rows_ndc`]'s grid can meet the band, told from the
+/// row's lowest and highest ray and its longest diagonal chord alone (two arc sines a row, not
+/// one a point): then [`cell_meets`] is false for each of its cells, each of which lies within
+/// those elevations and has a diagonal within that bound (a billionth of a radian more against
+/// the arc sine's rounding). `points`: the row's two lines of `side` unit rays.
+fn row_is_off(band_rad: (f64, f64), points: &[DVec3], side: usize) -> bool {
+    let unit = |r: &DVec3| r.is_finite() && (r.length_squared() - 1.0).abs() < 1e-12;
+    if !points.iter().all(unit) {
+        return false;
+    }
+    let lowest = elevation(points.iter().map(|r| r.z).fold(f64::MAX, f64::min));
+    let highest = elevation(points.iter().map(|r| r.z).fold(f64::MIN, f64::max));
+    let chord = (0..side - 1)
+        .map(|i| {
+            let (sw, se, nw, ne) = (
+                points[i],
+                points[i + 1],
+                points[side + i],
+                points[side + i + 1],
+            );
+            (sw - ne).length().max((se - nw).length())
+        })
+        .fold(0.0, f64::max);
+    let half = 0.5 * diagonal_bound(chord) + 1e-9;
+    lowest - half > band_rad.1 || highest + half < band_rad.0
+}
+
+/// At least the angle between two unit rays `chord` apart (pi/2 times the chord), with a margin
+/// for the arc cosine's rounding near 0.
+fn diagonal_bound(chord: f64) -> f64 {
+    chord * std::f64::consts::FRAC_PI_2 * (1.0 + 1e-9) + 1e-6
 }
 
 /// A grid point of [`screen_rows_ndc`]: its ray (unit, or zero) and the ray's elevation.
@@ -149,8 +190,7 @@ fn cell_meets(band_rad: (f64, f64), c: [Corner; 4]) -> bool {
         return true;
     }
     let chord = (c[0].0 - c[3].0).length().max((c[1].0 - c[2].0).length());
-    let bound = chord * std::f64::consts::FRAC_PI_2 * (1.0 + 1e-9) + 1e-6;
-    if !widened(0.5 * bound) {
+    if !widened(0.5 * diagonal_bound(chord)) {
         return false;
     }
     exact()
