@@ -116,6 +116,9 @@ pub struct GenerationBoxes {
     pub hi_m: DVec3,
     /// Whether any box is a cumulonimbus's (the air data looks farther for those).
     pub has_cumulonimbus: bool,
+    /// Per cloud of the generation (by its index), its cores in runs where it has many
+    /// ([`super::core::CoreRuns`]; `None` for few).
+    pub runs: Vec<Option<Box<super::core::CoreRuns>>>,
 }
 
 impl GenerationBoxes {
@@ -133,6 +136,12 @@ impl GenerationBoxes {
             lo = lo.min((b.centre_m - b.half_m).min(b.cloud_centre_m - r));
             hi = hi.max((b.centre_m + b.half_m).max(b.cloud_centre_m + r));
         }
+        let runs = (clouds.iter())
+            .map(|c| {
+                let runs = super::core::CoreRuns::of(c);
+                (runs != super::core::CoreRuns::default()).then(|| Box::new(runs))
+            })
+            .collect();
         Self {
             has_cumulonimbus: boxes
                 .iter()
@@ -140,6 +149,7 @@ impl GenerationBoxes {
             boxes,
             lo_m: lo,
             hi_m: hi,
+            runs,
         }
     }
 

@@ -85,31 +85,57 @@ impl SpriteCore {
         rotation_deg: f32,
         flat: bool,
     ) -> Self {
-        let (w, h) = (f64::from(width_m), f64::from(height_m));
-        let (across, up) = if flat { (h, w.min(h)) } else { (w, h) };
+        let mut core = Self::unturned(offset_m, width_m, height_m, flat);
         // A camera-facing sprite's core is round across: its turn is nothing to it (and a sine
         // and cosine a sprite were most of a line of sight's time).
-        let along = if flat {
-            DVec2::from_angle(f64::from(rotation_deg).to_radians())
-        } else {
-            DVec2::X
-        };
+        if flat {
+            core.turn(rotation_deg);
+        }
+        core
+    }
+
+    /// [`Self::new`] with its first axis along east whatever the sprite's turn: a camera-facing
+    /// sprite's core, or a flat one's before [`Self::turn`] (its centre and reach are the
+    /// same either way).
+    fn unturned(offset_m: [f32; 3], width_m: f32, height_m: f32, flat: bool) -> Self {
+        let (w, h) = (f64::from(width_m), f64::from(height_m));
+        let (across, up) = if flat { (h, w.min(h)) } else { (w, h) };
         Self {
             centre_m: DVec3::from_array(offset_m.map(f64::from)),
-            along,
+            along: DVec2::X,
             semi_axes_m: DVec3::new(w, across, up) * CORE_HALF_EXTENT,
             floor_m: None,
         }
     }
 
+    /// Turns a flat sprite's core `rotation_deg` (its first axis along that bearing from east).
+    fn turn(&mut self, rotation_deg: f32) {
+        self.along = DVec2::from_angle(f64::from(rotation_deg).to_radians());
+    }
+
     /// How far from its centre any of the core (its column included) reaches, metres: a
     /// column's bottom rim lies its depth down and its horizontal radius out.
-    fn reach_m(&self) -> f64 {
+    pub(super) fn reach_m(&self) -> f64 {
         let r = self.semi_axes_m.max_element();
         match self.floor_m {
             Some(floor) => {
                 let across = self.semi_axes_m.x.max(self.semi_axes_m.y);
                 r.max(across.hypot(self.centre_m.z - floor))
+            }
+            None => r,
+        }
+    }
+
+    /// At least [`Self::reach_m`], without its square root: a column's depth and radius added
+    /// (never less than their hypotenuse; widened by a millionth of a millionth against the
+    /// hypotenuse's rounding). A line farther from the centre than this is farther than the
+    /// reach too.
+    fn reach_bound_m(&self) -> f64 {
+        let r = self.semi_axes_m.max_element();
+        match self.floor_m {
+            Some(floor) => {
+                let across = self.semi_axes_m.x.max(self.semi_axes_m.y);
+                r.max((across + (self.centre_m.z - floor).abs()) * (1.0 + 1e-12))
             }
             None => r,
         }
@@ -218,6 +244,79 @@ pub fn cores(cloud: &Cloud) -> impl Iterator<Item = SpriteCore> + '_ {
     })
 }
 
+/// [`cores`] with a flat cloud's cores not turned yet, each with its sprite's turn: a line of
+/// sight passes most of a cloud's cores by on their centre and reach, which the turn does not
+/// change, and turns (a sine and a cosine) only those it comes near. Turned, each is the core
+/// [`cores`] gives.
+fn unturned_cores(cloud: &Cloud) -> impl Iterator<Item = (SpriteCore, f32)> + '_ {
+    cloud.sprites.iter().filter_map(|s| unturned_core(cloud, s))
+}
+
+/// One sprite's core of [`unturned_cores`] (`None` for rain or snow).
+fn unturned_core(cloud: &Cloud, s: &Sprite) -> Option<(SpriteCore, f32)> {
+    (!s.precipitation).then(|| {
+        let mut core = SpriteCore::unturned(s.offset_m, s.width_m, s.height_m, cloud.flat);
+        if s.base {
+            core.widen_to_base();
+            core.stand_on(f64::from(cloud.floor_m));
+        }
+        (core, s.rotation_deg)
+    })
+}
+
+/// Cores a run of [`CoreRuns`] holds at most.
+const RUN_CORES: usize = 8;
+
+/// A cloud with more cores than this has them in runs ([`CoreRuns`]); fewer are looked at one
+/// by one.
+const RUNS_FROM: usize = 24;
+
+/// A cloud's cores in runs of neighbours, each with the bounds of its cores' reach: a line of
+/// sight that passes a run's bounds by enters none of its cores and looks at none of them (a
+/// deck's cloud has hundreds of sprites, a line crosses a few). Made once for a generation, with
+/// its boxes, off the frame thread; none for a cloud of few cores.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CoreRuns {
+    /// The cores' sprites (indices into the cloud's), run after run.
+    sprites: Vec<u32>,
+    /// Per run: the lowest and highest corner of the spheres its cores reach (and a metre),
+    /// from the cloud's centre, and where its sprites end in `sprites`.
+    runs: Vec<(DVec3, DVec3, u32)>,
+}
+
+impl CoreRuns {
+    /// The runs of `cloud`'s cores: in strips west to east, each south to north, cut every
+    /// [`RUN_CORES`]; empty for [`RUNS_FROM`] cores or fewer.
+    pub fn of(cloud: &Cloud) -> Self {
+        let mut cores: Vec<(u32, DVec3, f64)> = (cloud.sprites.iter().enumerate())
+            .filter_map(|(k, s)| {
+                unturned_core(cloud, s).map(|(c, _)| (k as u32, c.centre_m, c.reach_m()))
+            })
+            .collect();
+        if cores.len() <= RUNS_FROM {
+            return Self::default();
+        }
+        cores.sort_by(|x, y| x.1.x.total_cmp(&y.1.x));
+        // Strips of about as many runs as there are strips.
+        let runs = cores.len().div_ceil(RUN_CORES);
+        let strip = (runs as f64).sqrt().ceil() as usize * RUN_CORES;
+        let mut out = Self::default();
+        for strip in cores.chunks_mut(strip) {
+            strip.sort_by(|x, y| x.1.y.total_cmp(&y.1.y));
+            for run in strip.chunks(RUN_CORES) {
+                let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
+                for &(k, centre, reach) in run {
+                    let r = DVec3::splat(reach + 1.0);
+                    (lo, hi) = (lo.min(centre - r), hi.max(centre + r));
+                    out.sprites.push(k);
+                }
+                out.runs.push((lo, hi, out.sprites.len() as u32));
+            }
+        }
+        out
+    }
+}
+
 /// An overcast's closed floor ([`Cloud::floor_slab_m`]) as a box from the cloud's centre
 /// (lowest corner, highest corner), over a floor at `floor_m`; `None` for none.
 pub fn floor_slab(floor_m: f64, slab_m: [f32; 2]) -> Option<(DVec3, DVec3)> {
@@ -299,6 +398,18 @@ pub fn distance_m(cloud: &Cloud, p: DVec3) -> f64 {
 /// inside `cloud`: the union of its cores (and floor slab) above its base, sorted and merged,
 /// into `out` (cleared first).
 pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
+    segment_in_runs(cloud, None, a, b, out);
+}
+
+/// [`segment`], the cloud's cores looked at run by run where it has `runs` ([`CoreRuns`]):
+/// a run whose bounds the segment misses is passed over whole. The same stretches.
+pub fn segment_in_runs(
+    cloud: &Cloud,
+    runs: Option<&CoreRuns>,
+    a: DVec3,
+    b: DVec3,
+    out: &mut Vec<(f64, f64)>,
+) {
     out.clear();
     let floor = f64::from(cloud.floor_m);
     // The part of the segment above the base.
@@ -329,12 +440,22 @@ pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
     }
     let d = b - a;
     let dd = d.length_squared().max(1e-12);
-    for core in cores(cloud) {
+    let mut visit = |(mut core, rotation_deg): (SpriteCore, f32)| {
         // Most of a cloud's cores lie off a line that crosses it: passed over on their
         // distance from the line, before the ellipsoid is asked.
+        // (On a bound of its reach first: the reach's hypotenuse is asked only of the cores
+        // the bound leaves near; a core the bound passes over the reach passes over too.)
+        let off = (core.centre_m - a).cross(d).length_squared();
+        let bound = core.reach_bound_m();
+        if off > bound * bound * dd {
+            return;
+        }
         let reach = core.reach_m();
-        if (core.centre_m - a).cross(d).length_squared() > reach * reach * dd {
-            continue;
+        if off > reach * reach * dd {
+            return;
+        }
+        if cloud.flat {
+            core.turn(rotation_deg);
         }
         core.segment_into(a, b, &mut spans);
         out.extend(
@@ -342,6 +463,27 @@ pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
                 .drain(..)
                 .map(|(t0, t1)| (t0.max(above_from), t1.min(above_to))),
         );
+    };
+    match runs {
+        // A run the segment passes by holds no core it enters (each lies within its reach of
+        // its centre, and the run's bounds hold those spheres and a metre): the stretches are
+        // the same, found in another order, and merged the same.
+        Some(runs) if !runs.runs.is_empty() => {
+            let mut from = 0;
+            for &(lo, hi, to) in &runs.runs {
+                let run = &runs.sprites[from as usize..to as usize];
+                from = to;
+                if super::boxes::slab(a, b, lo, hi).is_none() {
+                    continue;
+                }
+                for &k in run {
+                    if let Some(core) = unturned_core(cloud, &cloud.sprites[k as usize]) {
+                        visit(core);
+                    }
+                }
+            }
+        }
+        _ => unturned_cores(cloud).for_each(visit),
     }
     out.extend(
         spans
@@ -455,5 +597,39 @@ mod tests {
             &mut spans,
         );
         assert_eq!(spans.len(), 1);
+    }
+
+    /// A line of sight turns a flat cloud's cores only once it is near them: turned, they
+    /// are the cores every other probe asks, base sprites and rain among the sprites too.
+    #[test]
+    fn the_cores_turned_late_are_the_cores() {
+        for flat in [false, true] {
+            let mut c = cube_cloud(DVec3::ZERO, 100.0, CloudType::Stratus);
+            c.flat = flat;
+            c.floor_m = -400.0;
+            let first = c.sprites[0];
+            c.sprites = (0..9)
+                .map(|k| {
+                    let mut s = first;
+                    s.offset_m = [40.0 * k as f32, -25.0 * k as f32, 10.0 * (k % 3) as f32];
+                    s.width_m = 200.0 + 30.0 * k as f32;
+                    s.height_m = 150.0 + 10.0 * k as f32;
+                    s.rotation_deg = 37.0 * k as f32;
+                    s.base = k % 2 == 0;
+                    s.precipitation = k == 4;
+                    s
+                })
+                .collect();
+            let late: Vec<SpriteCore> = unturned_cores(&c)
+                .map(|(mut core, rotation_deg)| {
+                    if flat {
+                        core.turn(rotation_deg);
+                    }
+                    core
+                })
+                .collect();
+            assert_eq!(late, cores(&c).collect::<Vec<_>>());
+            assert_eq!(late.len(), 8);
+        }
     }
 }

@@ -369,6 +369,27 @@ impl<'a> CloudProbe<'a> {
         b: DVec3,
         whole: bool,
         enough: f64,
+        spans: Option<&mut Vec<Span>>,
+    ) -> Option<SightHit> {
+        self.sight_before(a, b, (whole, f64::INFINITY), enough, spans)
+    }
+
+    /// [`Self::first_cloud`] told that a cloud was met at t = `before` along the segment
+    /// already (another drift band's): the clouds entered at or after it are passed over. The
+    /// first cloud it returns, when it is met before `before`, is [`Self::first_cloud`]'s but
+    /// for its `total_optical_depth` (fewer clouds looked at); else it is met at or after
+    /// `before`, or `None`.
+    pub(super) fn first_cloud_before(&self, a: DVec3, b: DVec3, before: f64) -> Option<SightHit> {
+        self.sight_before(a, b, (false, before), f64::INFINITY, None)
+    }
+
+    /// [`Self::sight`] with the walk's `(whole, before)` ([`FieldSight::crossed_before`]).
+    fn sight_before(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        (whole, before): (bool, f64),
+        enough: f64,
         mut spans: Option<&mut Vec<Span>>,
     ) -> Option<SightHit> {
         let (qa, qb) = (self.air_point(a), self.air_point(b));
@@ -399,7 +420,7 @@ impl<'a> CloudProbe<'a> {
         // line are mostly of the same generation).
         let mut last: Option<(u64, Option<&FieldBlock>)> = None;
         let mut inside = Vec::new();
-        sight.crossed(qa, qb, whole, |(index, serial), bx, _, _| {
+        sight.crossed_before(qa, qb, whole, before, |(index, serial), bx, _, _| {
             let block = match last {
                 Some((at, block)) if at == serial => block,
                 _ => {
@@ -413,7 +434,9 @@ impl<'a> CloudProbe<'a> {
             };
             // The box is entered: the cloud's cores say where the line is in cloud.
             let cloud = &block.block.clouds[bx.cloud];
-            core::segment(cloud, qa - cloud.centre_m, qb - cloud.centre_m, &mut inside);
+            let runs = block.boxes.runs.get(bx.cloud).and_then(|r| r.as_deref());
+            let (a, b) = (qa - cloud.centre_m, qb - cloud.centre_m);
+            core::segment_in_runs(cloud, runs, a, b, &mut inside);
             let mut entry: Option<f64> = None;
             let mut depth_here = 0.0;
             for &(t0, t1) in &inside {

@@ -103,11 +103,32 @@ impl<'a> BandedProbe<'a> {
         depth
     }
 
-    /// [`CloudProbe::first_cloud`] of the band whose first cloud is nearest.
+    /// [`CloudProbe::first_cloud`] of the band whose first cloud is nearest (the earlier
+    /// band's on a tie). A band after one that met a cloud walks only the part of the segment
+    /// before it ([`CloudProbe::first_cloud_before`]); where it meets a nearer cloud there, it
+    /// walks again as [`CloudProbe::first_cloud`] does, so the hit (its `total_optical_depth`
+    /// included) is the one each band's own walk gives.
     pub fn first_cloud(&self, a: DVec3, b: DVec3) -> Option<SightHit> {
-        self.along(a, b)
-            .filter_map(|probe| probe.first_cloud(a, b))
-            .reduce(|x, y| nearest_hit(Some(x), y))
+        let length = (b - a).length();
+        let mut first: Option<SightHit> = None;
+        for probe in self.along(a, b) {
+            let hit = match &first {
+                Some(so_far) if length > 0.0 => {
+                    // A little past it: each band's t comes from its own drifted segment, whose
+                    // length can differ from this one's in the last bit.
+                    let before = so_far.distance_m / length * (1.0 + 1e-9) + 1e-12;
+                    match probe.first_cloud_before(a, b, before) {
+                        Some(h) if h.distance_m < so_far.distance_m => probe.first_cloud(a, b),
+                        _ => None,
+                    }
+                }
+                _ => probe.first_cloud(a, b),
+            };
+            if let Some(hit) = hit {
+                first = Some(nearest_hit(first, hit));
+            }
+        }
+        first
     }
 }
 

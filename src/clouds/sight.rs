@@ -261,11 +261,27 @@ impl FieldSight {
     /// first: `hit((block, serial), box, t in, t out)` says whether it counts and whether the
     /// walk has met enough. With `whole` false the walk stops once no box left can be entered
     /// before the nearest counted one.
+    #[cfg(test)]
     pub(super) fn crossed(
         &mut self,
         a: DVec3,
         b: DVec3,
         whole: bool,
+        hit: impl FnMut((BlockIndex, u64), &CloudBox, f64, f64) -> Met,
+    ) {
+        self.crossed_before(a, b, whole, f64::INFINITY, hit);
+    }
+
+    /// [`Self::crossed`], the walk that wants only the first cloud (`whole` false) told that
+    /// one was met at t = `before` already (another drift band's): a box entered at or after it
+    /// is passed over, as one entered after a counted box is. A box entered before it is met as
+    /// without it, so the first cloud met before `before` is the same.
+    pub(super) fn crossed_before(
+        &mut self,
+        a: DVec3,
+        b: DVec3,
+        whole: bool,
+        before: f64,
         mut hit: impl FnMut((BlockIndex, u64), &CloudBox, f64, f64) -> Met,
     ) {
         self.stamp = self.stamp.wrapping_add(1);
@@ -280,6 +296,9 @@ impl FieldSight {
         }
         let stamp = self.stamp;
         let mut walk = Walk::new(whole);
+        if !whole {
+            walk.best = before;
+        }
         let cell_m = self.cell_m;
         let tiles = &mut self.tiles;
         self.top.walk(a, b, 0.0, 1.0, |list, _, cell_out| {

@@ -374,3 +374,100 @@ fn the_weather_kept_for_a_point_is_the_fields_and_goes_with_a_new_field() {
         la.air_at(there.extend(500.0), UP).temperature_c
     );
 }
+
+/// The first cloud of a line of sight over several drift bands is the nearest of each band's
+/// own first cloud (the earlier band's on a tie), to the bit, `total_optical_depth` included:
+/// a band after one that met a cloud walks only up to it, and again whole where it met a
+/// nearer one. Fans of lines on the real reports off Los Angeles (FEW025 SCT040, two bands
+/// and more), from under, between and over the layers.
+#[test]
+fn the_first_cloud_over_the_bands_is_the_nearest_of_each_bands_own() {
+    use crate::clouds::probe::CloudProbe;
+    let w = world(REAL, 34.02, -118.47, true);
+    let fields: Vec<_> = w.living_fields().collect();
+    let clouded = fields.iter().filter(|f| f.has_clouds()).count();
+    assert!(clouded >= 2, "{clouded} bands with clouds");
+    let settings = &w.air.settings.in_cloud;
+    let probes: Vec<CloudProbe<'_>> = (fields.iter().zip(&w.air.caches))
+        .map(|(f, c)| CloudProbe::new(f, c, settings))
+        .collect();
+    let (mut lines, mut hits, mut upper_first) = (0, 0, 0);
+    for alt_m in [300.0, 800.0, 1_100.0, 1_700.0, 2_500.0, 4_000.0] {
+        for (x, y) in [(0.0, 0.0), (3_000.0, -2_000.0), (-5_000.0, 4_000.0)] {
+            let at = DVec3::new(x, y, alt_m);
+            for k in 0..96 {
+                let heading = (f64::from(k % 16) * 22.5 + 7.0).to_radians();
+                let pitch = (-30.0 + f64::from(k / 16) * 12.0_f64).to_radians();
+                let dir = DVec3::new(
+                    heading.sin() * pitch.cos(),
+                    heading.cos() * pitch.cos(),
+                    pitch.sin(),
+                );
+                let to = at + dir * 12_000.0;
+                let each: Vec<Option<SightHit>> =
+                    probes.iter().map(|p| p.first_cloud(at, to)).collect();
+                let want = each
+                    .iter()
+                    .flatten()
+                    .cloned()
+                    .reduce(|x, y| if x.distance_m <= y.distance_m { x } else { y });
+                let got = w.first_cloud(at, to);
+                assert_eq!(got, want, "from {at} towards {dir}");
+                lines += 1;
+                hits += usize::from(got.is_some());
+                let winner = each
+                    .iter()
+                    .position(|h| h.is_some() && h.as_ref() == want.as_ref());
+                let others = each.iter().filter(|h| h.is_some()).count();
+                upper_first += usize::from(others >= 2 && winner.is_some_and(|k| k > 0));
+            }
+        }
+    }
+    // The fans meet clouds, and some lines meet an upper band's cloud before a lower one's.
+    assert!(hits > lines / 10, "{hits} of {lines}");
+    assert!(upper_first > 0, "{upper_first} lines");
+}
+
+/// A cloud of many cores looked at run by run ([`crate::clouds::core::CoreRuns`]) gives the
+/// stretches of looking at every core, to the bit: lines through the boxes of the real
+/// overcast at San Antonio and the cumulus off Los Angeles, at every angle.
+#[test]
+fn a_clouds_cores_in_runs_give_the_stretches_of_every_core() {
+    use crate::clouds::core::{CoreRuns, segment, segment_in_runs};
+    let mut checked = 0;
+    for (lat, lon) in [(29.4270, -98.6080), (34.02, -118.47)] {
+        let w = world(REAL, lat, lon, true);
+        for field in w.living_fields() {
+            for (_, g) in field.blocks().take(6) {
+                for (k, cloud) in g.block.clouds.iter().enumerate() {
+                    let Some(bx) = g.boxes.boxes.iter().find(|b| b.cloud == k) else {
+                        continue;
+                    };
+                    let runs = CoreRuns::of(cloud);
+                    if runs == CoreRuns::default() {
+                        continue;
+                    }
+                    assert_eq!(g.boxes.runs[k].as_deref(), Some(&runs));
+                    let (c, h) = (bx.centre_m - cloud.centre_m, bx.half_m);
+                    for n in 0..40 {
+                        let u = f64::from(n) * 0.61803;
+                        let dir = DVec3::new(u.cos(), u.sin(), (u * 2.3).sin() * 0.6);
+                        let across = DVec3::new(
+                            h.x * ((u * 7.1).sin() * 0.9),
+                            h.y * ((u * 5.3).cos() * 0.9),
+                            h.z * ((u * 3.7).sin() * 0.9),
+                        );
+                        let reach = h.length() * 1.5;
+                        let (a, b) = (c + across - dir * reach, c + across + dir * reach);
+                        let (mut want, mut got) = (Vec::new(), Vec::new());
+                        segment(cloud, a, b, &mut want);
+                        segment_in_runs(cloud, Some(&runs), a, b, &mut got);
+                        assert_eq!(got, want, "{a} to {b}");
+                        checked += usize::from(!want.is_empty());
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 100, "{checked} lines in cloud");
+}

@@ -80,35 +80,120 @@ pub fn screen_rows_ndc(band_rad: (f64, f64), inv_view_proj: Mat4) -> Option<(f32
         (far.truncate() / far.w).as_dvec3().normalize_or_zero()
     };
     let ndc = |k: u32, n: u32| -1.0 + 2.0 * k as f32 / n as f32;
-    let grid: Vec<Vec<DVec3>> = (0..=rows)
-        .map(|j| {
-            (0..=cols)
-                .map(|i| ray(ndc(i, cols), ndc(j, rows)))
-                .collect()
-        })
+    let side = cols as usize + 1;
+    // Each grid point's ray, row after row, and its elevation once a cell asks for it (four
+    // cells share a corner; a row of cells the band is far from asks none).
+    let rays: Vec<DVec3> = (0..=rows)
+        .flat_map(|j| (0..=cols).map(move |i| ray(ndc(i, cols), ndc(j, rows))))
         .collect();
+    let mut elevations: Vec<Option<f64>> = vec![None; rays.len()];
     let mut found: Option<(f32, f32)> = None;
     for j in 0..rows as usize {
-        for i in 0..cols as usize {
-            let corners = [
-                grid[j][i],
-                grid[j][i + 1],
-                grid[j + 1][i],
-                grid[j + 1][i + 1],
+        let points = &rays[j * side..(j + 2) * side];
+        if row_is_off(band_rad, points, side) {
+            continue;
+        }
+        let mut corner = |k: usize| -> Corner {
+            let r = rays[k];
+            (r, *elevations[k].get_or_insert_with(|| elevation(r.z)))
+        };
+        // One cell of a row that meets the band is enough: the row is in.
+        let meets = (0..side - 1).any(|i| {
+            let at = j * side + i;
+            let c = [
+                corner(at),
+                corner(at + 1),
+                corner(at + side),
+                corner(at + side + 1),
             ];
-            let diagonal = corners[0]
-                .angle_between(corners[3])
-                .max(corners[1].angle_between(corners[2]));
-            let elevations = corners.map(|c| c.z.clamp(-1.0, 1.0).asin());
-            let low = elevations.iter().copied().fold(f64::MAX, f64::min) - 0.5 * diagonal;
-            let high = elevations.iter().copied().fold(f64::MIN, f64::max) + 0.5 * diagonal;
-            if low <= band_rad.1 && high >= band_rad.0 {
-                let (y0, y1) = (ndc(j as u32, rows), ndc(j as u32 + 1, rows));
-                found = Some(found.map_or((y0, y1), |(a, b)| (a.min(y0), b.max(y1))));
-            }
+            cell_meets(band_rad, c)
+        });
+        if meets {
+            let (y0, y1) = (ndc(j as u32, rows), ndc(j as u32 + 1, rows));
+            found = Some(found.map_or((y0, y1), |(a, b)| (a.min(y0), b.max(y1))));
         }
     }
     found
+}
+
+/// The elevation of a unit ray whose up component is `z`, radians.
+fn elevation(z: f64) -> f64 {
+    z.clamp(-1.0, 1.0).asin()
+}
+
+/// Whether no cell of a row of [`screen_rows_ndc`]'s grid can meet the band, told from the
+/// row's lowest and highest ray and its longest diagonal chord alone (two arc sines a row, not
+/// one a point): then [`cell_meets`] is false for each of its cells, each of which lies within
+/// those elevations and has a diagonal within that bound (a billionth of a radian more against
+/// the arc sine's rounding). `points`: the row's two lines of `side` unit rays.
+fn row_is_off(band_rad: (f64, f64), points: &[DVec3], side: usize) -> bool {
+    let unit = |r: &DVec3| r.is_finite() && (r.length_squared() - 1.0).abs() < 1e-12;
+    if !points.iter().all(unit) {
+        return false;
+    }
+    let lowest = elevation(points.iter().map(|r| r.z).fold(f64::MAX, f64::min));
+    let highest = elevation(points.iter().map(|r| r.z).fold(f64::MIN, f64::max));
+    let chord = (0..side - 1)
+        .map(|i| {
+            let (sw, se, nw, ne) = (
+                points[i],
+                points[i + 1],
+                points[side + i],
+                points[side + i + 1],
+            );
+            (sw - ne).length().max((se - nw).length())
+        })
+        .fold(0.0, f64::max);
+    let half = 0.5 * diagonal_bound(chord) + 1e-9;
+    lowest - half > band_rad.1 || highest + half < band_rad.0
+}
+
+/// At least the angle between two unit rays `chord` apart (pi/2 times the chord), with a margin
+/// for the arc cosine's rounding near 0.
+fn diagonal_bound(chord: f64) -> f64 {
+    chord * std::f64::consts::FRAC_PI_2 * (1.0 + 1e-9) + 1e-6
+}
+
+/// A grid point of [`screen_rows_ndc`]: its ray (unit, or zero) and the ray's elevation.
+type Corner = (DVec3, f64);
+
+/// Whether a cell of [`screen_rows_ndc`]'s grid, corners (south-west, south-east, north-west,
+/// north-east) `c`, meets the band: the elevations of its corners widened by half its diagonal
+/// (the larger angle between opposite corners) reach it. The diagonal (two arc cosines, most of
+/// the search's time) is asked only where the answer depends on it: the corners' elevations
+/// alone reaching the band meet it (the diagonal only widens them), and where even a bound on
+/// the diagonal leaves them short they do not (between unit rays it is at most pi/2 times
+/// their chord, plus a margin for the arc cosine's rounding near 0). The same answer as
+/// widening every cell by its diagonal.
+fn cell_meets(band_rad: (f64, f64), c: [Corner; 4]) -> bool {
+    let lowest = c.iter().map(|c| c.1).fold(f64::MAX, f64::min);
+    let highest = c.iter().map(|c| c.1).fold(f64::MIN, f64::max);
+    let widened = |half_diagonal: f64| {
+        lowest - half_diagonal <= band_rad.1 && highest + half_diagonal >= band_rad.0
+    };
+    let exact = || {
+        widened(
+            0.5 * c[0]
+                .0
+                .angle_between(c[3].0)
+                .max(c[1].0.angle_between(c[2].0)),
+        )
+    };
+    // The shortcuts hold for unit rays (a zero ray's diagonal is not a number: no shortcut).
+    let unit = c
+        .iter()
+        .all(|c| c.0.is_finite() && (c.0.length_squared() - 1.0).abs() < 1e-12);
+    if !unit {
+        return exact();
+    }
+    if widened(0.0) {
+        return true;
+    }
+    let chord = (c[0].0 - c[3].0).length().max((c[1].0 - c[2].0).length());
+    if !widened(0.5 * diagonal_bound(chord)) {
+        return false;
+    }
+    exact()
 }
 
 /// The band that holds both `a` and `b`.
@@ -212,5 +297,81 @@ mod tests {
         // Straight up: no row.
         assert_eq!(screen_rows_ndc((1.2, 1.3), inv), None);
         assert_eq!(union((0.0, 0.1), (-0.2, 0.05)), (-0.2, 0.1));
+    }
+
+    /// [`screen_rows_ndc`] as it was written first: every cell widened by its diagonal.
+    fn rows_every_cell(band_rad: (f64, f64), inv_view_proj: Mat4) -> Option<(f32, f32)> {
+        let (rows, cols) = GRID;
+        let ray = |x: f32, y: f32| {
+            let far = inv_view_proj * Vec4::new(x, y, 0.5, 1.0);
+            (far.truncate() / far.w).as_dvec3().normalize_or_zero()
+        };
+        let ndc = |k: u32, n: u32| -1.0 + 2.0 * k as f32 / n as f32;
+        let grid: Vec<Vec<DVec3>> = (0..=rows)
+            .map(|j| {
+                (0..=cols)
+                    .map(|i| ray(ndc(i, cols), ndc(j, rows)))
+                    .collect()
+            })
+            .collect();
+        let mut found: Option<(f32, f32)> = None;
+        for j in 0..rows as usize {
+            for i in 0..cols as usize {
+                let corners = [
+                    grid[j][i],
+                    grid[j][i + 1],
+                    grid[j + 1][i],
+                    grid[j + 1][i + 1],
+                ];
+                let diagonal = corners[0]
+                    .angle_between(corners[3])
+                    .max(corners[1].angle_between(corners[2]));
+                let elevations = corners.map(|c| c.z.clamp(-1.0, 1.0).asin());
+                let low = elevations.iter().copied().fold(f64::MAX, f64::min) - 0.5 * diagonal;
+                let high = elevations.iter().copied().fold(f64::MIN, f64::max) + 0.5 * diagonal;
+                if low <= band_rad.1 && high >= band_rad.0 {
+                    let (y0, y1) = (ndc(j as u32, rows), ndc(j as u32 + 1, rows));
+                    found = Some(found.map_or((y0, y1), |(a, b)| (a.min(y0), b.max(y1))));
+                }
+            }
+        }
+        found
+    }
+
+    /// The search that asks a cell's diagonal only where the answer depends on it finds the
+    /// rows of widening every cell, to the bit, over pitches, headings, fields of view and
+    /// bands (narrow, wide, at a cell's edge, out of view).
+    #[test]
+    fn the_rows_are_those_of_widening_every_cell() {
+        let mut checked = 0;
+        for pitch in [-89.0, -30.0, -3.0, 0.0, 2.5, 12.0, 45.0, 89.0] {
+            for heading in [0.0, 37.0, 90.0, 211.0] {
+                for (fov, aspect) in [(60.0, 16.0 / 9.0), (30.0, 1.0), (90.0, 2.4)] {
+                    let camera = crate::render::camera::Camera {
+                        position_m: DVec3::ZERO,
+                        heading_deg: heading,
+                        pitch_deg: pitch,
+                        fov_y_deg: fov,
+                        aspect,
+                        near_m: 2.0,
+                        far_m: 160_000.0,
+                    };
+                    let inv = camera.view_proj_relative().inverse();
+                    for k in 0..40 {
+                        let lo = -0.8 + 0.04 * f64::from(k) + 0.0013 * f64::from(k % 7);
+                        for width in [0.0, 0.001, 0.02, 0.1, 0.5] {
+                            let band = (lo, lo + width);
+                            assert_eq!(
+                                screen_rows_ndc(band, inv),
+                                rows_every_cell(band, inv),
+                                "pitch {pitch} heading {heading} fov {fov} band {band:?}"
+                            );
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 8 * 4 * 3 * 40 * 5);
     }
 }
