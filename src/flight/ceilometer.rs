@@ -154,9 +154,10 @@ pub struct CoverBins {
 impl CoverBins {
     /// Bins centred between the covers a report is drawn with (`oktas`, the field's
     /// `[oktas]`): each class up to halfway to the next, so that a layer drawn at its class's
-    /// cover reads that class whichever way the readings toss it.
+    /// cover reads that class unless the readings toss it more than halfway to a neighbour's.
     pub fn centred_on(oktas: &PerCover) -> Self {
-        let halfway = |a: f64, b: f64| (a + b) / 16.0;
+        // Halfway between two covers, oktas, as a share of the sky (eighths).
+        let halfway = |a: f64, b: f64| (a + b) / 2.0 / 8.0;
         Self {
             few_max: halfway(oktas.few, oktas.sct),
             sct_max: halfway(oktas.sct, oktas.bkn),
@@ -363,6 +364,30 @@ mod tests {
         let spread: Vec<Vec<f64>> = (0..40).map(|k| vec![3_000.0 + 10.0 * k as f64]).collect();
         let refs: Vec<&[f64]> = spread.iter().map(Vec::as_slice).collect();
         assert_eq!(summarize(&readings(&refs), &CoverBins::default()).len(), 1);
+    }
+
+    #[test]
+    fn the_covers_part_halfway_between_the_drawn_ones() {
+        let bins = |few, sct, bkn, ovc| CoverBins::centred_on(&PerCover { few, sct, bkn, ovc });
+        // FlightGear's 2, 4, 6 and 8 oktas part at 3/8, 5/8 and 7/8; the shipped SCT of 3.5
+        // moves the edges around it down a quarter okta.
+        let flightgear = bins(2.0, 4.0, 6.0, 8.0);
+        assert_eq!(
+            [flightgear.few_max, flightgear.sct_max, flightgear.bkn_max],
+            [0.375, 0.625, 0.875]
+        );
+        let shipped = CoverBins::default();
+        assert_eq!(shipped, bins(2.0, 3.5, 6.0, 8.0));
+        assert_eq!(
+            [shipped.few_max, shipped.sct_max, shipped.bkn_max],
+            [2.75 / 8.0, 4.75 / 8.0, 0.875]
+        );
+        // 24 of 40 readings: SCT by FlightGear's covers, BKN by the shipped ones.
+        assert_eq!(flightgear.cover_of(0.6), Some(Cover::Sct));
+        assert_eq!(shipped.cover_of(0.6), Some(Cover::Bkn));
+        assert_eq!(shipped.cover_of(0.05), None);
+        assert_eq!(shipped.cover_of(0.3), Some(Cover::Few));
+        assert_eq!(shipped.cover_of(0.9), Some(Cover::Ovc));
     }
 
     #[test]
