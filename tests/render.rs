@@ -1551,7 +1551,10 @@ fn ring_rebuilds_do_not_pop() {
 /// paper's overdraw again): the Cb line 0.044 a channel from before, the others under 0.017.
 /// The cumulus field from below was kept again when a run of FEW or SCT layers came to step down
 /// within its class (KLAX's `FEW025 FEW060 SCT160 SCT250`: the lower layers less cover):
-/// 0.0101 a channel from before.
+/// 0.0101 a channel from before. The cumulus fields and the deck from above were kept again
+/// when SCT came to be drawn at 3.5 oktas with denser scattered humilis heaps (0.018, 0.029
+/// and 0.010 a channel over the whole frame from before; the Cb line and the deck from below
+/// unchanged).
 #[test]
 fn gpu_sprites_draw_the_frames_of_the_cpu_path() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("reference");
