@@ -286,7 +286,7 @@ pub struct CoreRuns {
 
 impl CoreRuns {
     /// The runs of `cloud`'s cores: in strips west to east, each south to north, cut every
-    /// [`RUN_CORES`]; empty for [`RUNS_FROM`] cores or fewer.
+    /// `RUN_CORES` (8); empty for `RUNS_FROM` (24) cores or fewer.
     pub fn of(cloud: &Cloud) -> Self {
         let mut cores: Vec<(u32, DVec3, f64)> = (cloud.sprites.iter().enumerate())
             .filter_map(|(k, s)| {

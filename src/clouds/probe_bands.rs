@@ -105,7 +105,7 @@ impl<'a> BandedProbe<'a> {
 
     /// [`CloudProbe::first_cloud`] of the band whose first cloud is nearest (the earlier
     /// band's on a tie). A band after one that met a cloud walks only the part of the segment
-    /// before it ([`CloudProbe::first_cloud_before`]); where it meets a nearer cloud there, it
+    /// before it (`CloudProbe::first_cloud_before`); where it meets a nearer cloud there, it
     /// walks again as [`CloudProbe::first_cloud`] does, so the hit (its `total_optical_depth`
     /// included) is the one each band's own walk gives.
     pub fn first_cloud(&self, a: DVec3, b: DVec3) -> Option<SightHit> {
