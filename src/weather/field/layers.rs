@@ -135,7 +135,7 @@ pub(super) fn blend(
             // A layer the summation principle leaves little of its own (`BKN033 BKN041`) keeps
             // what a pilot between the layers sees of it, as far as the sky seen from below
             // stays in the class reported there.
-            let top = class_top_oktas(reported.max(below));
+            let top = class_top_oktas(reported);
             let in_class = own_coverage_oktas(below, top)
                 .unwrap_or(0.0)
                 .max(l.min_coverage_oktas);

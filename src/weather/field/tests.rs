@@ -455,6 +455,31 @@ fn covers_follow_the_summation_principle_and_tops_the_type() {
     assert_eq!(deck.coverage_oktas, 6.0);
 }
 
+/// KNUC's `FEW024 FEW060 FEW180` (2025 file): the minimum cover the lower layers are drawn with
+/// lifts the sky seen from below past FEW's 2 oktas; the top layer's room is still FEW's, the
+/// class reported at its base, not the SCT class the lifts reached.
+#[test]
+fn a_run_of_few_layers_stays_few_from_below() {
+    use crate::weather::block::cover_seen_from_below_oktas;
+    let few_run = vec![
+        layer(Cover::Few, 2400, None),
+        layer(Cover::Few, 6000, None),
+        layer(Cover::Few, 18000, None),
+    ];
+    let f = pair(few_run, vec![layer(Cover::Ovc, 9000, None)]);
+    let layers = f.weather_at_lat_lon(LAT0, 7.5).layers;
+    assert_eq!(layers.len(), 3, "{layers:?}");
+    let few = FieldSettings::default().oktas.few as f32;
+    for l in &layers {
+        let seen = cover_seen_from_below_oktas(&layers, l.base_ft_agl);
+        assert!(
+            (seen - few).abs() <= 1.0,
+            "{seen} oktas seen from below at {} ft: {layers:?}",
+            l.base_ft_agl
+        );
+    }
+}
+
 #[test]
 fn cb_and_tcu_keep_their_own_amount_above_a_deck() {
     use crate::weather::metar::Cover::{Bkn, Few, Sct};
