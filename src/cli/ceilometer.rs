@@ -86,7 +86,7 @@ pub fn run(args: &CeilometerArgs) -> anyhow::Result<()> {
         world.set_winds_aloft(Some(&fb), &table);
     }
     let readings = ceilometer::read(&mut world, at, ground_m, args.minutes, args.every_s)?;
-    let bins = ceilometer::CoverBins::centred_on(&loaded.settings.oktas);
+    let bins = ceilometer::CoverBins::for_covers(&loaded.settings.oktas);
     let layers = ceilometer::summarize(&readings, &bins);
     let ceiling = ceilometer::ceiling_ft(&layers);
     if args.json {

@@ -8,7 +8,7 @@
 //! readings the clouds advance as a flight's do.
 //!
 //! The summary ([`summarize`]), an algorithm of skycast's own after NOAA's ASOS (ASOS User's
-//! Guide, 1998, section 3.9.2), with its cover bins ([`CoverBins`]) centred between the covers
+//! Guide, 1998, section 3.9.2), with its cover bins ([`CoverBins`]) parted between the covers
 //! skycast draws a report with (`[oktas]` of `config/weather_field.toml`: FEW 2, SCT 3.5,
 //! BKN 6, OVC 8), where ASOS's end at fixed eighths (a layer drawn on a bin's edge reads one
 //! class or the next by the toss of 40 readings):
@@ -20,8 +20,10 @@
 //!    5,000 ft, 500 ft to 10,000 ft, 1,000 ft above).
 //! 3. Its cover is what is seen from below up to it (the summation principle): the share of the
 //!    readings with a base at or under the layer's highest. Up to 5% is no layer (a stray
-//!    reading); then FEW, SCT and BKN each up to halfway to the next class's drawn cover (2.75,
-//!    4.75 and 7 oktas with the shipped ones: the last ASOS's 87.5%), more OVC.
+//!    reading); then FEW, SCT and BKN each up to where a share is as likely a toss of the next
+//!    class's drawn cover as of its own (2.70, 4.83 and 7 oktas with the shipped ones: a
+//!    scattered layer's share tosses wider than a broken one's; the last is ASOS's 87.5%),
+//!    more OVC.
 //! 4. A layer that adds no cover over the one below it (the same share) is still reported when
 //!    its own readings are over 5%: a pilot between the two sees it.
 
@@ -152,16 +154,30 @@ pub struct CoverBins {
 }
 
 impl CoverBins {
-    /// Bins centred between the covers a report is drawn with (`oktas`, the field's
-    /// `[oktas]`): each class up to halfway to the next, so that a layer drawn at its class's
-    /// cover reads that class unless the readings toss it more than halfway to a neighbour's.
-    pub fn centred_on(oktas: &PerCover) -> Self {
-        // Halfway between two covers, oktas, as a share of the sky (eighths).
-        let halfway = |a: f64, b: f64| (a + b) / 2.0 / 8.0;
+    /// Bins for the covers a report is drawn with (`oktas`, the field's `[oktas]`). A reading
+    /// is a yes-or-no look, so the share of readings that meets a layer drawn at cover `p`
+    /// tosses about `p` with a spread that goes as `sqrt(p (1 - p))`: a scattered layer's share
+    /// tosses wider than a broken one's. Two neighbouring classes therefore part where a share
+    /// lies as many spreads from the one drawn cover as from the other (the shipped FEW 2 and
+    /// SCT 3.5 oktas at 2.70/8, SCT and BKN 6 at 4.84/8), so that a toss one way is as likely
+    /// as the other. BKN and OVC part halfway (7/8): an overcast is closed from below, its
+    /// readings do not toss, and what it loses is the deck's edge, not a toss.
+    pub fn for_covers(oktas: &PerCover) -> Self {
+        let share = |o: f64| (o / 8.0).clamp(0.0, 1.0);
+        let spread = |p: f64| (p * (1.0 - p)).sqrt();
+        let equal_odds = |a: f64, b: f64| {
+            let (a, b) = (share(a), share(b));
+            let (sa, sb) = (spread(a), spread(b));
+            if sa + sb > 1e-9 {
+                (a * sb + b * sa) / (sa + sb)
+            } else {
+                (a + b) / 2.0
+            }
+        };
         Self {
-            few_max: halfway(oktas.few, oktas.sct),
-            sct_max: halfway(oktas.sct, oktas.bkn),
-            bkn_max: halfway(oktas.bkn, oktas.ovc),
+            few_max: equal_odds(oktas.few, oktas.sct),
+            sct_max: equal_odds(oktas.sct, oktas.bkn),
+            bkn_max: (share(oktas.bkn) + share(oktas.ovc)) / 2.0,
         }
     }
 
@@ -179,9 +195,9 @@ impl CoverBins {
 }
 
 impl Default for CoverBins {
-    /// Centred on the shipped `config/weather_field.toml`'s covers.
+    /// For the shipped `config/weather_field.toml`'s covers.
     fn default() -> Self {
-        Self::centred_on(&FieldSettings::default().oktas)
+        Self::for_covers(&FieldSettings::default().oktas)
     }
 }
 
@@ -367,27 +383,39 @@ mod tests {
     }
 
     #[test]
-    fn the_covers_part_halfway_between_the_drawn_ones() {
-        let bins = |few, sct, bkn, ovc| CoverBins::centred_on(&PerCover { few, sct, bkn, ovc });
-        // FlightGear's 2, 4, 6 and 8 oktas part at 3/8, 5/8 and 7/8; the shipped SCT of 3.5
-        // moves the edges around it down a quarter okta.
+    fn the_covers_part_where_a_toss_either_way_is_as_likely() {
+        let bins = |few, sct, bkn, ovc| CoverBins::for_covers(&PerCover { few, sct, bkn, ovc });
+        let near =
+            |got: [f64; 3], want: [f64; 3]| got.iter().zip(want).all(|(g, w)| (g - w).abs() < 1e-4);
+        // FlightGear's 2, 4, 6 and 8 oktas: a scattered half of the sky tosses wider than a
+        // quarter or three quarters, so its edges lie out from halfway (3/8 and 5/8) towards
+        // FEW's and BKN's covers, a share of the one as many spreads as of the other off.
         let flightgear = bins(2.0, 4.0, 6.0, 8.0);
-        assert_eq!(
-            [flightgear.few_max, flightgear.sct_max, flightgear.bkn_max],
-            [0.375, 0.625, 0.875]
+        let spread = |p: f64| (p * (1.0 - p)).sqrt();
+        let (quarter, half) = (spread(0.25), spread(0.5));
+        assert!(
+            ((flightgear.few_max - 0.25) / quarter - (0.5 - flightgear.few_max) / half).abs()
+                < 1e-9
         );
+        assert!(near(
+            [flightgear.few_max, flightgear.sct_max, flightgear.bkn_max],
+            [0.3660, 0.6340, 0.875]
+        ));
         let shipped = CoverBins::default();
         assert_eq!(shipped, bins(2.0, 3.5, 6.0, 8.0));
-        assert_eq!(
+        assert!(near(
             [shipped.few_max, shipped.sct_max, shipped.bkn_max],
-            [2.75 / 8.0, 4.75 / 8.0, 0.875]
-        );
-        // 24 of 40 readings: SCT by FlightGear's covers, BKN by the shipped ones.
-        assert_eq!(flightgear.cover_of(0.6), Some(Cover::Sct));
-        assert_eq!(shipped.cover_of(0.6), Some(Cover::Bkn));
+            [2.6991 / 8.0, 4.8348 / 8.0, 0.875]
+        ));
+        // 24 of 40 readings: 0.33 of SCT's spread over its 0.44 (3.5 oktas), 0.35 of BKN's
+        // under its 0.75 (6 oktas): SCT (halfway, 0.59, made it BKN).
+        assert_eq!(shipped.cover_of(0.6), Some(Cover::Sct));
+        assert_eq!(shipped.cover_of(0.625), Some(Cover::Bkn));
         assert_eq!(shipped.cover_of(0.05), None);
         assert_eq!(shipped.cover_of(0.3), Some(Cover::Few));
         assert_eq!(shipped.cover_of(0.9), Some(Cover::Ovc));
+        // A sky drawn clear against one drawn closed: neither tosses, halfway.
+        assert_eq!(bins(0.0, 8.0, 8.0, 8.0).few_max, 0.5);
     }
 
     #[test]

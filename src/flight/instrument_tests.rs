@@ -524,7 +524,7 @@ fn class(cover: crate::weather::metar::Cover) -> i32 {
 /// it gives back
 /// (base within max(100 ft, 10%), cover class within one) and the ceilings (both none, or within
 /// the same), as shares.
-fn ceilometer_round_trip(stations: usize, seed: u64) -> RoundTrip {
+fn ceilometer_round_trip(stations: usize, seed: u64, set: StationSet) -> RoundTrip {
     use crate::flight::ceilometer;
     use crate::weather::metar::Cover;
     let input = WeatherInput::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(REAL), None)
@@ -536,7 +536,7 @@ fn ceilometer_round_trip(stations: usize, seed: u64) -> RoundTrip {
     let (mut layers, mut layers_met, mut ceilings_met, mut done) = (0, 0, 0, 0);
     let mut calm = (0, 0);
     let mut seen = std::collections::HashSet::new();
-    for report in file.reports.iter().step_by(3) {
+    for report in file.reports.iter().skip(set as usize).step_by(3) {
         if done >= stations {
             break;
         }
@@ -634,6 +634,16 @@ fn ceilometer_round_trip(stations: usize, seed: u64) -> RoundTrip {
     }
 }
 
+/// Which of the bulk file's reports a round trip reads: every third, from the first or the
+/// second (two sets of stations, one to check what was measured on the other).
+#[derive(Clone, Copy)]
+enum StationSet {
+    /// The first report and every third after it.
+    First = 0,
+    /// The second and every third after it.
+    Second = 1,
+}
+
 /// What [`ceilometer_round_trip`] gives back.
 struct RoundTrip {
     /// The share of the reported layers given back.
@@ -664,32 +674,27 @@ impl RoundTrip {
     }
 }
 
-/// The ceilometer's round trip at 40 cloudy stations of the real bulk file: measured 0.969 of
-/// the reported layers and 0.900 of the ceilings (the 200-station figures in the book:
+/// The ceilometer's round trip at 40 cloudy stations of the real bulk file: measured 0.953 of
+/// the reported layers and 0.925 of the ceilings (the 200-station figures in the book:
 /// `cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`). Held to 0.85 and
 /// 0.85 against a fall; what is missing is in the book's "What is still not right": 40 readings
 /// along a few kilometres of clouds a kilometre or two wide still toss a layer's cover a class
 /// either way now and then.
 #[test]
 fn a_ceilometer_under_the_drifting_clouds_reads_the_reports_back() {
-    let trip = ceilometer_round_trip(40, WorldSettings::default().seed);
+    let trip = ceilometer_round_trip(40, WorldSettings::default().seed, StationSet::First);
     trip.print();
     assert_eq!(trip.stations, 40);
     assert!(trip.layers >= 0.85 && trip.ceilings >= 0.85);
 }
 
-/// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations, with the
-/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.946-0.962 of the layers
-/// and 0.930-0.960 of the ceilings (0.954 and 0.948 on average; the shipped seed's 0.952 and
-/// 0.960); at the stations with a calm or variable wind 60-65 of 69 layers, at the others
-/// 233-237 of 243 (`cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`).
-#[test]
-#[ignore]
-fn ceilometer_round_trip_at_200() {
+/// The round trip at 200 stations of `set` with the clouds of four seeds: the mean shares of
+/// the layers and the ceilings given back.
+fn round_trip_over_four_seeds(set: StationSet) -> (f64, f64) {
     let trips: Vec<RoundTrip> = [WorldSettings::default().seed, 1, 2, 3]
         .into_iter()
         .map(|seed| {
-            let trip = ceilometer_round_trip(200, seed);
+            let trip = ceilometer_round_trip(200, seed, set);
             eprint!("seed {seed}: ");
             trip.print();
             assert_eq!(trip.stations, 200);
@@ -699,7 +704,31 @@ fn ceilometer_round_trip_at_200() {
     let mean = |f: fn(&RoundTrip) -> f64| trips.iter().map(f).sum::<f64>() / trips.len() as f64;
     let (layers, ceilings) = (mean(|t| t.layers), mean(|t| t.ceilings));
     eprintln!("mean over the seeds: layers {layers:.3}, ceilings {ceilings:.3}");
-    assert!(layers >= 0.95 && ceilings >= 0.94);
+    (layers, ceilings)
+}
+
+/// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations, with the
+/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.946-0.962 of the layers
+/// and 0.945-0.975 of the ceilings (0.954 and 0.957 on average; the shipped seed's 0.952 and
+/// 0.960); at the stations with a calm or variable wind 60-65 of 69 layers, at the others
+/// 233-237 of 243 (`cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn ceilometer_round_trip_at_200() {
+    let (layers, ceilings) = round_trip_over_four_seeds(StationSet::First);
+    assert!(layers >= 0.95 && ceilings >= 0.95);
+}
+
+/// [`ceilometer_round_trip_at_200`] over 200 other stations (the file's second report and
+/// every third after it), which no setting was measured on: 0.929-0.947 of the layers and
+/// 0.915-0.935 of the ceilings (0.938 and 0.928 on average; the shipped seed's 0.929 and 0.930);
+/// at the stations with a calm or variable wind 62-65 of 72 layers, at the others 236-242 of 251
+/// (`cargo test --lib ceilometer_round_trip_at_200_other_stations -- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn ceilometer_round_trip_at_200_other_stations() {
+    let (layers, ceilings) = round_trip_over_four_seeds(StationSet::Second);
+    assert!(layers >= 0.92 && ceilings >= 0.91);
 }
 
 /// The clouds drift with the wind the air data reports at their height: over real reports (and
