@@ -25,16 +25,20 @@ fn host(table: TimeOfDayTable) -> DemoHost {
     host_with_sheet(table, sheet)
 }
 
-/// [`host`] with the sprite sheet `sheet`.
+/// [`host`] with the sprite sheet `sheet`. Every cloud of a block in view is built, those out
+/// of view too (`cull_out_of_view` off): these tests read every sprite's corners back, and the
+/// lines of clouds they draw reach past the narrow view's sides.
 fn host_with_sheet(table: TimeOfDayTable, sheet: SpriteSheet) -> DemoHost {
     let ground = HeightField::from_fn(DVec2::ZERO, 20_000.0, 9, |_| 0.0);
+    let mut settings = RenderSettings::default();
+    settings.clouds.cull_out_of_view = false;
     DemoHost::new(
         64,
         36,
         &ground,
         SkyConfig {
             targets: headless::TARGETS,
-            settings: RenderSettings::default(),
+            settings,
             time_of_day: table,
             sheet,
         },

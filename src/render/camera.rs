@@ -86,6 +86,13 @@ impl Frustum {
             .iter()
             .all(|p| p.truncate().dot(centre) + p.w >= -radius)
     }
+
+    /// Whether a sphere (`centre` relative to the eye, metres) lies wholly inside the frustum.
+    pub fn holds_sphere(&self, centre: Vec3, radius: f32) -> bool {
+        self.planes
+            .iter()
+            .all(|p| p.truncate().dot(centre) + p.w >= radius)
+    }
 }
 
 #[cfg(test)]

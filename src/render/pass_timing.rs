@@ -15,7 +15,8 @@ pub(super) const STAMPS: u32 = 7;
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct PassTimes {
     /// The compute passes before the drawing: the patch of changed sprite orders and the corner
-    /// build (of the first chunk, when the view needs several).
+    /// build of the view's first chunk (of 32,768 sprites; the corners of a larger view's later
+    /// chunks are built between their draws, in [`Self::sprites_ms`]).
     pub build_ms: f64,
     /// At full resolution the sky background; below it the farthest-depth downsample.
     pub background_ms: f64,
@@ -24,7 +25,8 @@ pub struct PassTimes {
     pub far_field_ms: f64,
     /// The impostor ring's full-screen pass, with the distant storm cells drawn behind it.
     pub ring_ms: f64,
-    /// The sprites (with the corner builds of any later chunks) and the in-cloud fog.
+    /// The sprites (with the corner builds of a large view's chunks after the first) and the
+    /// in-cloud fog.
     pub sprites_ms: f64,
     /// Below full resolution the composite over the host's colour (with the sky background);
     /// 0 at full resolution.

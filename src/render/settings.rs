@@ -257,6 +257,7 @@ mod tests {
                 !l.starts_with("upright_fade")
                     && !l.starts_with("resolution_scale")
                     && !l.starts_with("far_fade_fraction")
+                    && !l.starts_with("cull_out_of_view")
                     && !l.starts_with("layer_turn")
                     && !l.starts_with("max_sorted")
                     && !l.starts_with("max_uploaded")

@@ -77,8 +77,8 @@ impl Sky {
             }
         };
         // The patch of changed orders, then the sky, the ring, the sprites a chunk at a time
-        // (each built just before it is drawn; one pass when they fit one chunk), the in-cloud
-        // fog.
+        // (the first built before the sky, each later one just before it is drawn; one pass
+        // when they fit one chunk), the in-cloud fog.
         let timer = self.pass_timer.as_ref();
         let stamp = |encoder: &mut wgpu::CommandEncoder, at: Stamp| {
             if let Some(timer) = timer {
@@ -101,10 +101,11 @@ impl Sky {
         let parts: Vec<(u32, u32, u32)> = view_group
             .map(|_| chunks(v.sprites_to_draw).collect())
             .unwrap_or_default();
-        if parts.len() == 1
-            && let Some(group) = view_group
-        {
-            let (c, _, n) = parts[0];
+        // The first chunk is built here, before the background, the far field and the ring
+        // (none of which reads the corners): with one chunk the distant cells drawn behind the
+        // ring need it, and with several the timed build holds a chunk's build either way, not
+        // nothing (the later chunks are built between their draws, in the sprites' time).
+        if let (Some(&(c, _, n)), Some(group)) = (parts.first(), view_group) {
             self.sprites.record_build(encoder, group, (c, n));
         }
         // Below full resolution the clouds go to the cloud target, composited at the end with
@@ -180,8 +181,8 @@ impl Sky {
             stamp(encoder, Stamp::Ring);
             pass = self.clouds_pass_again(encoder, offscreen.as_ref(), colour_view, &frame_group);
         }
-        for &(c, _, n) in &parts {
-            if parts.len() > 1 {
+        for (i, &(c, _, n)) in parts.iter().enumerate() {
+            if i > 0 {
                 drop(pass);
                 if let Some(group) = view_group {
                     self.sprites.record_build(encoder, group, (c, n));

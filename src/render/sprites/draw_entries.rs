@@ -6,10 +6,10 @@
 //!
 //! No wgpu calls.
 
-use bytemuck::Zeroable;
 use glam::DVec3;
 
 use super::resident::Resident;
+use crate::render::camera::Frustum;
 use crate::render::gpu_types::{GpuDrawBlock, GpuListCloud};
 use crate::render::scene::Fade;
 
@@ -67,15 +67,14 @@ struct Merged {
     drawn: bool,
 }
 
-/// A run of one block's clouds in a group's merge: which block of the group, the part of its
-/// list (from `start`, `len` clouds) and their sprites. A frame that keeps the merge reads
-/// only these, none of the block's list.
+/// A run of one block's clouds in a group's merge: which block of the group and the part of
+/// its list (from `start`, `len` clouds). A frame that keeps the merge reads only these and
+/// the sprite counts at their ends, none of the block's clouds (but across the view's edge).
 #[derive(Debug, Clone, Copy)]
 struct Run {
     member: u8,
     start: u32,
     len: u32,
-    sprites: u32,
 }
 
 /// A block of a draw list: its squared distance from the view's eye, the block, and its drawn
@@ -134,6 +133,106 @@ impl<'a> Listed<'a> {
     }
 }
 
+/// What of a view a draw list keeps to: its frustum (relative to the eye), and the Earth's
+/// radius at the eye (0: the flat frame) the sprite shader bends the clouds by. A cloud whose
+/// every quad lies wholly outside the frustum gives the frame no fragment, but its sprites
+/// would still be built and their corners shaded and clipped, a cost per sprite that on the
+/// software rasteriser is most of a sprite's; a block across the frustum's edge (the ones
+/// under and beside the eye) is drawn without its clouds out of view.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Sight<'a> {
+    pub frustum: &'a Frustum,
+    pub earth_radius_m: f32,
+}
+
+/// `sqrt(2) - 1`: a quad of half sides `a` and `b` (at most `h`, its sprite's half side: a
+/// pancake's height grows at most to its width) reaches `sqrt(a^2 + b^2) <= sqrt(2) h` from its
+/// centre, where a cloud's radius counts `h`.
+const CORNER_REACH: f32 = std::f32::consts::SQRT_2 - 1.0;
+
+impl Sight<'_> {
+    /// How far the shader's bending of the flat frame onto the round Earth (`earth_curved` in
+    /// `shaders/shared/frame.wgsl`) moves a point within `reach_m` of the eye and `height_m`
+    /// above or below it, at most, metres (the drop `s^2 / 2R` and the stretch `s |z| / R`,
+    /// rounded up, plus a metre for f32).
+    fn bend_m(&self, reach_m: f32, height_m: f32) -> f32 {
+        if self.earth_radius_m <= 0.0 {
+            return 1.0;
+        }
+        let r = self.earth_radius_m;
+        reach_m * (reach_m + height_m.abs()) / r + 1.0
+    }
+
+    /// Whether a sphere (relative to the eye) lies wholly inside the frustum.
+    fn holds(&self, centre: glam::Vec3, radius_m: f32) -> bool {
+        let r = radius_m + self.bend_m(centre.length() + radius_m, centre.z.abs() + radius_m);
+        self.frustum.holds_sphere(centre, r)
+    }
+
+    /// Whether any of a cloud's quads (its centre relative to the eye, its radius and its
+    /// largest sprite's half side) can reach into the frustum.
+    fn sees_cloud(&self, centre: glam::Vec3, radius_m: f32, half_side_m: f32) -> bool {
+        // Widths and heights reach the shader as half floats (a part in 2,048).
+        let reach = (radius_m + CORNER_REACH * half_side_m) * 1.001 + 1.0;
+        let r = reach + self.bend_m(centre.length() + reach, centre.z.abs() + reach);
+        self.frustum.sees_sphere(centre, r)
+    }
+}
+
+impl Listed<'_> {
+    /// The entries of the clouds `part` of its list that `sight` can see (all of them for a
+    /// distant block, or one wholly in view): a run of clouds in view an entry, from sprite
+    /// `total` on, which it advances.
+    fn push_seen(
+        &self,
+        part: std::ops::Range<usize>,
+        (eye_m, sight): (DVec3, Option<&Sight>),
+        total: &mut u32,
+        out: &mut Vec<GpuDrawBlock>,
+    ) {
+        let sprites =
+            |p: &std::ops::Range<usize>| self.sprites_before(p.end) - self.sprites_before(p.start);
+        let whole = |out: &mut Vec<GpuDrawBlock>, total: &mut u32, p: std::ops::Range<usize>| {
+            if p.is_empty() {
+                return;
+            }
+            let n = sprites(&p);
+            out.push(self.entry(p, eye_m, *total));
+            *total += n;
+        };
+        let centre = (self.r.centre_m() - eye_m).as_vec3();
+        let Some(sight) = sight.filter(|s| {
+            !self.r.distant && !s.holds(centre, self.r.radius_m as f32 * (1.0 + CORNER_REACH))
+        }) else {
+            whole(out, total, part);
+            return;
+        };
+        let start = self.r.place.as_ref().map_or(0, |p| p.1.start);
+        let at = self.r.motion.offset_m - eye_m;
+        let mut run = part.start..part.start;
+        for k in part.clone() {
+            let seen = self
+                .r
+                .clouds
+                .get(self.list[k].cloud.wrapping_sub(start) as usize)
+                .is_none_or(|c| {
+                    sight.sees_cloud(
+                        (c.centre_m + at).as_vec3(),
+                        c.radius_m,
+                        c.largest_half_side_m,
+                    )
+                });
+            if seen {
+                run.end = k + 1;
+            } else {
+                whole(out, total, run);
+                run = k + 1..k + 1;
+            }
+        }
+        whole(out, total, run);
+    }
+}
+
 /// The draw list of `order` (back to front, distant blocks first, seen from `eye_m`): one
 /// entry for each block, except where the eye is close to the plane that decides the order of
 /// two neighbouring deck blocks. Drawn whole, one after the other, their overlapping sprites along
@@ -144,7 +243,7 @@ impl<'a> Listed<'a> {
 /// list). `seams` keeps the merges from frame to frame. Returns the sprites.
 pub(super) fn draw_entries(
     order: &[Listed],
-    eye_m: DVec3,
+    (eye_m, sight): (DVec3, Option<&Sight>),
     seams: &mut Seams,
     out: &mut Vec<GpuDrawBlock>,
 ) -> u32 {
@@ -153,8 +252,7 @@ pub(super) fn draw_entries(
         // The eye is near no plane between two neighbours.
         seams.kept.clear();
         for b in order {
-            out.push(b.entry(0..b.list.len(), eye_m, total));
-            total += b.sprites;
+            b.push_seen(0..b.list.len(), (eye_m, sight), &mut total, out);
         }
         return total;
     };
@@ -168,8 +266,7 @@ pub(super) fn draw_entries(
     for (i, b) in order.iter().enumerate() {
         let group = groups[i] as usize;
         if sizes[group] == 1 {
-            out.push(b.entry(0..b.list.len(), eye_m, total));
-            total += b.sprites;
+            b.push_seen(0..b.list.len(), (eye_m, sight), &mut total, out);
             continue;
         } else if group != i {
             // A group is drawn where its farthest block (its first) is, and skipped after.
@@ -202,21 +299,11 @@ pub(super) fn draw_entries(
         };
         let merged = &mut seams.kept[at];
         merged.drawn = true;
-        // Each block's entry once; each run is it with its part of the list.
-        let mut whole = [GpuDrawBlock::zeroed(); MAX_INTERLEAVED];
-        for (w, b) in whole.iter_mut().zip(&members) {
-            *w = b.entry(0..0, eye_m, 0);
+        // Each run is its block's entry with its part of the list.
+        for run in &merged.runs {
+            let part = run.start as usize..(run.start + run.len) as usize;
+            members[run.member as usize].push_seen(part, (eye_m, sight), &mut total, out);
         }
-        out.extend(merged.runs.iter().map(|run| {
-            let first = total;
-            total += run.sprites;
-            GpuDrawBlock {
-                first,
-                list_base: whole[run.member as usize].list_base + run.start,
-                list_len: run.len,
-                ..whole[run.member as usize]
-            }
-        }));
     }
     seams.kept.retain(|m| m.drawn);
     total
@@ -333,12 +420,11 @@ fn interleave(members: &[Listed], eye_m: DVec3, d2: &mut Vec<f64>) -> Vec<Run> {
             end += 1;
         }
         heads[m] = end;
-        let (b, part) = (&members[m], start - from[m]..end - from[m]);
+        let part = start - from[m]..end - from[m];
         runs.push(Run {
             member: m as u8,
             start: part.start as u32,
             len: part.len() as u32,
-            sprites: b.sprites_before(part.end) - b.sprites_before(part.start),
         });
     }
 }

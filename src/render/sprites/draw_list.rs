@@ -16,7 +16,7 @@ use std::collections::HashMap;
 
 use glam::{DVec3, Vec3};
 
-use super::draw_entries::{LIST_SERIAL, Listed, draw_entries};
+use super::draw_entries::{LIST_SERIAL, Listed, Sight, draw_entries};
 pub(in crate::render) use super::draw_entries::{Seams, distant_sprites, fade_code};
 use super::resident::{BlockCheck, CloudState, Resident};
 use super::settings::VertexCacheSettings;
@@ -426,7 +426,11 @@ pub(in crate::render) fn main_view(
         stats.clouds_drawn += r.list.len() as u32;
     }
     locks.end();
-    let total = draw_entries(&order, camera_m, seams, out);
+    let sight = settings.clouds.cull_out_of_view.then(|| Sight {
+        frustum,
+        earth_radius_m: settings.earth.camera_radius_m(camera_m.z),
+    });
+    let total = draw_entries(&order, (camera_m, sight.as_ref()), seams, out);
     stats.sprites_drawn = total;
     stats.cache_hit_rate = if stats.clouds_drawn == 0 {
         1.0

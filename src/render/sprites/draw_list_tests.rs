@@ -306,6 +306,15 @@ fn drawn_clouds(blocks: &Blocks, out: &[GpuDrawBlock], eye_m: DVec3) -> Vec<(u32
 /// The draw list of every block of `blocks` seen from `eye_m`, back to front as the sky camera
 /// orders them: its sprites and entries.
 fn entries_of(blocks: &Blocks, eye_m: DVec3, seams: &mut Seams) -> (u32, Vec<GpuDrawBlock>) {
+    entries_seen(blocks, (eye_m, None), seams)
+}
+
+/// [`entries_of`] keeping to what `sight` sees.
+fn entries_seen(
+    blocks: &Blocks,
+    (eye_m, sight): (DVec3, Option<&Sight>),
+    seams: &mut Seams,
+) -> (u32, Vec<GpuDrawBlock>) {
     let mut order: Vec<(f64, &Resident)> = blocks
         .values()
         .map(|r| ((r.centre_m() - eye_m).length_squared(), r))
@@ -316,7 +325,7 @@ fn entries_of(blocks: &Blocks, eye_m: DVec3, seams: &mut Seams) -> (u32, Vec<Gpu
         .map(|&(d2, r)| Listed::resident(d2, r))
         .collect();
     let mut out = Vec::new();
-    let total = draw_entries(&listed, eye_m, seams, &mut out);
+    let total = draw_entries(&listed, (eye_m, sight), seams, &mut out);
     (total, out)
 }
 
@@ -390,4 +399,75 @@ fn a_merge_is_kept_while_the_blocks_lists_are_and_made_anew_when_one_is_sorted_a
     assert_eq!(entries(&blocks, there, &mut seams), made_here);
     blocks.values_mut().next().unwrap().list_serial = 7;
     assert_eq!(entries(&blocks, there, &mut seams), made_there);
+}
+
+/// Clouds out of view are left out of the draw list, the others kept in their order: a
+/// camera looking north-east over the two blocks sees some of their 32 clouds. Every cloud
+/// left out has each of its sprites' quads (any facing, a corner at most `sqrt(2)` half sides
+/// from the sprite's centre) wholly outside the view; every one kept reaches into it (the
+/// bound is not far from the quads); the entries' sprites follow on; and the clouds drawn are
+/// drawn in the order they are drawn without the culling, interleaved along the seam or not.
+#[test]
+fn clouds_wholly_out_of_view_are_left_out_and_the_rest_keep_their_order() {
+    use crate::render::camera::Camera;
+    for (eye, deck) in [
+        (DVec3::new(0.0, 0.0, 3000.0), true),
+        (DVec3::new(-2000.0, 0.0, 3000.0), true),
+        (DVec3::new(0.0, 0.0, 3000.0), false),
+    ] {
+        let camera = Camera {
+            position_m: eye,
+            heading_deg: 30.0,
+            pitch_deg: -25.0,
+            fov_y_deg: 30.0,
+            aspect: 1.0,
+            near_m: 1.0,
+            far_m: 100_000.0,
+        };
+        let frustum = camera.frustum_relative();
+        let blocks = two_blocks(eye, deck);
+        let (all, whole) = entries_of(&blocks, eye, &mut Seams::default());
+        for earth_radius_m in [0.0, 6.371e6] {
+            let sight = Sight {
+                frustum: &frustum,
+                earth_radius_m,
+            };
+            let (total, out) = entries_seen(&blocks, (eye, Some(&sight)), &mut Seams::default());
+            let drawn = drawn_clouds(&blocks, &out, eye);
+            let kept: Vec<u32> = drawn.iter().map(|c| c.0).collect();
+            let in_order: Vec<u32> = drawn_clouds(&blocks, &whole, eye)
+                .iter()
+                .map(|c| c.0)
+                .filter(|c| kept.contains(c))
+                .collect();
+            assert_eq!(kept, in_order, "camera {eye}");
+            assert!(total < all && total > 0, "camera {eye}: {total} of {all}");
+            assert_eq!(total, kept.len() as u32 * 40, "camera {eye}");
+            for w in out.windows(2) {
+                assert!(w[1].first > w[0].first, "camera {eye}");
+            }
+            for r in blocks.values() {
+                for (state, cloud) in r.clouds.iter().zip(&r.block.clouds) {
+                    let quads_seen = cloud.sprites.iter().any(|s| {
+                        let centre = (cloud.centre_m - eye).as_vec3() + s.offset_m;
+                        let reach = 0.5 * std::f32::consts::SQRT_2 * s.width_m.max(s.height_m);
+                        frustum.sees_sphere(centre, reach)
+                    });
+                    let sphere = (cloud.centre_m - eye).as_vec3();
+                    let near_view = frustum.sees_sphere(sphere, 1.5 * state.radius_m);
+                    let drawn = kept.contains(&state.cloud_slot);
+                    assert!(
+                        drawn || !quads_seen,
+                        "camera {eye}: cloud {} left out",
+                        state.cloud_slot
+                    );
+                    assert!(
+                        !drawn || near_view,
+                        "camera {eye}: cloud {} drawn",
+                        state.cloud_slot
+                    );
+                }
+            }
+        }
+    }
 }

@@ -57,6 +57,16 @@ pub struct CloudSettings {
     /// layer dissolves there instead of ending in a line across the sky. 0: no fade.
     #[serde(default = "default_far_fade_fraction")]
     pub far_fade_fraction: f32,
+    /// Leave the clouds wholly out of view out of the view's draw list (a block across the
+    /// view's edge drawn without them): the frame is the same, their sprites are not built
+    /// nor drawn. False builds and draws every cloud of a block in view (tests that read every
+    /// sprite's corners back).
+    #[serde(default = "default_cull_out_of_view")]
+    pub cull_out_of_view: bool,
+}
+
+fn default_cull_out_of_view() -> bool {
+    true
 }
 
 fn default_layer_turn_start_deg() -> f32 {
