@@ -420,7 +420,7 @@ impl<'a> CloudProbe<'a> {
         // line are mostly of the same generation).
         let mut last: Option<(u64, Option<&FieldBlock>)> = None;
         let mut inside = Vec::new();
-        sight.crossed_before(qa, qb, whole, before, |(index, serial), bx, _, _| {
+        sight.crossed_before(qa, qb, whole, before, |(index, serial), bx, table, _, _| {
             let block = match last {
                 Some((at, block)) if at == serial => block,
                 _ => {
@@ -434,9 +434,20 @@ impl<'a> CloudProbe<'a> {
             };
             // The box is entered: the cloud's cores say where the line is in cloud.
             let cloud = &block.block.clouds[bx.cloud];
-            let runs = block.boxes.runs.get(bx.cloud).and_then(|r| r.as_deref());
+            // Its cores as the table lays them out, made the first time a line enters the box.
+            let table = table.get_or_insert_with(|| {
+                let runs = block.boxes.runs.get(bx.cloud).and_then(|r| r.as_deref());
+                Box::new(core::CoreTable::of(cloud, runs))
+            });
             let (a, b) = (qa - cloud.centre_m, qb - cloud.centre_m);
-            core::segment_in_runs(cloud, runs, a, b, &mut inside);
+            #[cfg(test)]
+            if STRAIGHT.get() {
+                core::segment(cloud, a, b, &mut inside);
+            } else {
+                core::segment_in_table(cloud, table, a, b, &mut inside);
+            }
+            #[cfg(not(test))]
+            core::segment_in_table(cloud, table, a, b, &mut inside);
             let mut entry: Option<f64> = None;
             let mut depth_here = 0.0;
             for &(t0, t1) in &inside {
@@ -474,6 +485,14 @@ impl<'a> CloudProbe<'a> {
             crossings: Vec::new(),
         })
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Whether this thread's lines of sight ask each cloud's sprites for its cores one by one
+    /// (`core::segment`, the straightforward path) instead of its core table: the tests that
+    /// the table gives every answer to the bit.
+    pub(crate) static STRAIGHT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// A stretch of one cloud's cores along a line of sight: t in, t out, optical depth, type.

@@ -21,6 +21,7 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3};
 
 use super::boxes::{CloudBox, GenerationBoxes, slab};
+use super::core::CoreTable;
 use crate::weather::{BLOCK_SIZE_M, BlockIndex};
 
 /// Blocks a side of a tile of [`FieldSight`]: 16 km, so a 10 km line crosses a tile or two and
@@ -88,6 +89,9 @@ struct Part {
     first: usize,
     /// Per box: the stamp of the last line of sight that tested it.
     seen: Vec<u32>,
+    /// Per box: its cloud's cores laid out for lines of sight, made the first time a line
+    /// enters the box (and dropped with the part).
+    tables: Vec<Option<Box<CoreTable>>>,
 }
 
 /// The most parts a tile has: one more is built with all the others, whole.
@@ -177,6 +181,7 @@ impl Tile {
         );
         self.parts.push(Part {
             seen: vec![0; boxes.len()],
+            tables: vec![None; boxes.len()],
             boxes,
             first,
         });
@@ -267,22 +272,25 @@ impl FieldSight {
         a: DVec3,
         b: DVec3,
         whole: bool,
-        hit: impl FnMut((BlockIndex, u64), &CloudBox, f64, f64) -> Met,
+        mut hit: impl FnMut((BlockIndex, u64), &CloudBox, f64, f64) -> Met,
     ) {
-        self.crossed_before(a, b, whole, f64::INFINITY, hit);
+        self.crossed_before(a, b, whole, f64::INFINITY, |m, bx, _, t0, t1| {
+            hit(m, bx, t0, t1)
+        });
     }
 
     /// [`Self::crossed`], the walk that wants only the first cloud (`whole` false) told that
     /// one was met at t = `before` already (another drift band's): a box entered at or after it
     /// is passed over, as one entered after a counted box is. A box entered before it is met as
-    /// without it, so the first cloud met before `before` is the same.
+    /// without it, so the first cloud met before `before` is the same. `hit` is also handed the
+    /// box's slot for its cloud's core table, empty until it fills it.
     pub(super) fn crossed_before(
         &mut self,
         a: DVec3,
         b: DVec3,
         whole: bool,
         before: f64,
-        mut hit: impl FnMut((BlockIndex, u64), &CloudBox, f64, f64) -> Met,
+        mut hit: impl FnMut((BlockIndex, u64), &CloudBox, &mut Option<Box<CoreTable>>, f64, f64) -> Met,
     ) {
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
@@ -318,10 +326,11 @@ impl FieldSight {
                 let members = &tile.members;
                 for part in &mut tile.parts {
                     let first = part.first;
+                    let scratch = (&mut part.seen[..], &mut part.tables[..], stamp);
                     part.boxes
-                        .crossed(a, b, &mut walk, &mut part.seen, stamp, |g, bx, t0, t1| {
+                        .crossed(a, b, &mut walk, scratch, |g, bx, table, t0, t1| {
                             let m = &members[first + g];
-                            hit((m.0, m.1), bx, t0, t1)
+                            hit((m.0, m.1), bx, table, t0, t1)
                         });
                     if walk.enough {
                         return false;
@@ -410,15 +419,14 @@ impl SightBoxes {
     /// left can be entered before the nearest counted one (`walk` carries that entry from the
     /// grids walked before). `seen` is scratch, one entry per box, and `stamp` a number it does
     /// not hold yet (a box is tested the first time a cell lists it, and marked with the stamp:
-    /// a big box is listed in many cells).
+    /// a big box is listed in many cells); `tables` holds a slot per box that `hit` is handed.
     fn crossed(
         &self,
         a: DVec3,
         b: DVec3,
         walk: &mut Walk,
-        seen: &mut [u32],
-        stamp: u32,
-        mut hit: impl FnMut(usize, &CloudBox, f64, f64) -> Met,
+        (seen, tables, stamp): (&mut [u32], &mut [Option<Box<CoreTable>>], u32),
+        mut hit: impl FnMut(usize, &CloudBox, &mut Option<Box<CoreTable>>, f64, f64) -> Met,
     ) {
         let Some((from, to)) = slab(a, b, self.lo_m, self.hi_m) else {
             return;
@@ -449,7 +457,7 @@ impl SightBoxes {
                     }
                     let (g, k) = self.owners[index];
                     let bx = &self.generations[g as usize].boxes[k as usize];
-                    match hit(g as usize, bx, t0, t1) {
+                    match hit(g as usize, bx, &mut tables[index], t0, t1) {
                         Met::Passed => {}
                         Met::Counted(entry) => walk.best = walk.best.min(entry),
                         Met::Enough => {
