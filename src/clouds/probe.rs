@@ -56,6 +56,9 @@ struct CacheState {
     /// field), and whether the membership changed since they were brought up to it.
     sight: Option<FieldSight>,
     sight_behind: bool,
+    /// A line of sight's stretches inside a cloud's cores, kept for the next line (an
+    /// allocation a line saved).
+    inside: Vec<(f64, f64)>,
 }
 
 #[derive(Debug)]
@@ -419,7 +422,7 @@ impl<'a> CloudProbe<'a> {
         // The generation of the last box met and its phase now (a box's neighbours along the
         // line are mostly of the same generation).
         let mut last: Option<(u64, Option<&FieldBlock>)> = None;
-        let mut inside = Vec::new();
+        let mut inside = std::mem::take(&mut state.inside);
         sight.crossed_before(qa, qb, whole, before, |(index, serial), bx, table, _, _| {
             let block = match last {
                 Some((at, block)) if at == serial => block,
@@ -476,6 +479,7 @@ impl<'a> CloudProbe<'a> {
                 Met::Counted(t0)
             }
         });
+        state.inside = inside;
         first.map(|(t, depth, cloud_type)| SightHit {
             distance_m: t * length,
             point_m: a.lerp(b, t),
