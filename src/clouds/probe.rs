@@ -19,6 +19,10 @@
 //! ([`super::field::FieldBlock::boxes`]). A point query looks only at the blocks within reach of
 //! the point, and skips a block whose clouds' bounds are out of reach; a line of sight walks the
 //! field's boxes in tiles (`clouds::sight`), a tile built again when a generation joins it.
+//! Inside a box a line reads the cloud's cores from a table laid out for it (centres and
+//! bounds of reach side by side, each core's reach and turn worked out once), made the first
+//! time a line enters the box and kept with the tile: the same stretches, to the bit, as
+//! asking the sprites.
 //! Positions are ground metres (east, north, up MSL); the field's drift is taken off to find the
 //! clouds.
 
