@@ -22,6 +22,10 @@ use glam::{DVec2, DVec3};
 
 use super::block::{Cloud, Sprite};
 
+#[path = "core_table.rs"]
+mod table;
+pub(crate) use table::{CoreTable, segment_in_table};
+
 /// A sprite's dense core reaches this fraction of its full width (and height) from its centre.
 pub const CORE_HALF_EXTENT: f64 = 0.35;
 /// A base sprite's core reaches this fraction of its full width from its centre: its edge.

@@ -19,6 +19,10 @@
 //! ([`super::field::FieldBlock::boxes`]). A point query looks only at the blocks within reach of
 //! the point, and skips a block whose clouds' bounds are out of reach; a line of sight walks the
 //! field's boxes in tiles (`clouds::sight`), a tile built again when a generation joins it.
+//! Inside a box a line reads the cloud's cores from a table laid out for it (centres and
+//! bounds of reach side by side, each core's reach and turn worked out once), made the first
+//! time a line enters the box and kept with the tile: the same stretches, to the bit, as
+//! asking the sprites.
 //! Positions are ground metres (east, north, up MSL); the field's drift is taken off to find the
 //! clouds.
 
@@ -56,6 +60,9 @@ struct CacheState {
     /// field), and whether the membership changed since they were brought up to it.
     sight: Option<FieldSight>,
     sight_behind: bool,
+    /// A line of sight's stretches inside a cloud's cores, kept for the next line (an
+    /// allocation a line saved).
+    inside: Vec<(f64, f64)>,
 }
 
 #[derive(Debug)]
@@ -419,8 +426,8 @@ impl<'a> CloudProbe<'a> {
         // The generation of the last box met and its phase now (a box's neighbours along the
         // line are mostly of the same generation).
         let mut last: Option<(u64, Option<&FieldBlock>)> = None;
-        let mut inside = Vec::new();
-        sight.crossed_before(qa, qb, whole, before, |(index, serial), bx, _, _| {
+        let mut inside = std::mem::take(&mut state.inside);
+        sight.crossed_before(qa, qb, whole, before, |(index, serial), bx, table, _, _| {
             let block = match last {
                 Some((at, block)) if at == serial => block,
                 _ => {
@@ -434,9 +441,20 @@ impl<'a> CloudProbe<'a> {
             };
             // The box is entered: the cloud's cores say where the line is in cloud.
             let cloud = &block.block.clouds[bx.cloud];
-            let runs = block.boxes.runs.get(bx.cloud).and_then(|r| r.as_deref());
+            // Its cores as the table lays them out, made the first time a line enters the box.
+            let table = table.get_or_insert_with(|| {
+                let runs = block.boxes.runs.get(bx.cloud).and_then(|r| r.as_deref());
+                Box::new(core::CoreTable::of(cloud, runs))
+            });
             let (a, b) = (qa - cloud.centre_m, qb - cloud.centre_m);
-            core::segment_in_runs(cloud, runs, a, b, &mut inside);
+            #[cfg(test)]
+            if STRAIGHT.get() {
+                core::segment(cloud, a, b, &mut inside);
+            } else {
+                core::segment_in_table(cloud, table, a, b, &mut inside);
+            }
+            #[cfg(not(test))]
+            core::segment_in_table(cloud, table, a, b, &mut inside);
             let mut entry: Option<f64> = None;
             let mut depth_here = 0.0;
             for &(t0, t1) in &inside {
@@ -465,6 +483,7 @@ impl<'a> CloudProbe<'a> {
                 Met::Counted(t0)
             }
         });
+        state.inside = inside;
         first.map(|(t, depth, cloud_type)| SightHit {
             distance_m: t * length,
             point_m: a.lerp(b, t),
@@ -474,6 +493,14 @@ impl<'a> CloudProbe<'a> {
             crossings: Vec::new(),
         })
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Whether this thread's lines of sight ask each cloud's sprites for its cores one by one
+    /// (`core::segment`, the straightforward path) instead of its core table: the tests that
+    /// the table gives every answer to the bit.
+    pub(crate) static STRAIGHT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// A stretch of one cloud's cores along a line of sight: t in, t out, optical depth, type.

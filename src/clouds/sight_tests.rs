@@ -51,6 +51,7 @@ fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
         let sight = SightBoxes::of(generations.clone(), cell_m);
         assert_eq!(sight.len(), 300);
         let mut seen = vec![0; sight.len()];
+        let mut tables = vec![None; sight.len()];
         for k in 0..3_000 {
             let mut a = DVec3::new(
                 rand() * 16_000.0 - 4_000.0,
@@ -86,9 +87,8 @@ fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
                 a,
                 b,
                 &mut Walk::new(true),
-                &mut seen,
-                stamp,
-                |g, bx, t0, _| {
+                (&mut seen, &mut tables, stamp),
+                |g, bx, _, t0, _| {
                     met.push((t0, g, bx.cloud));
                     Met::Counted(t0)
                 },
@@ -102,9 +102,8 @@ fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
                 a,
                 b,
                 &mut Walk::new(true),
-                &mut seen,
-                stamp,
-                |_, _, _, _| {
+                (&mut seen, &mut tables, stamp),
+                |_, _, _, _, _| {
                     walked += 1;
                     Met::Enough
                 },
@@ -117,9 +116,8 @@ fn the_grid_meets_every_box_a_segment_enters_once_and_the_nearest_first() {
                 a,
                 b,
                 &mut Walk::new(false),
-                &mut seen,
-                stamp,
-                |_, _, t0, _| {
+                (&mut seen, &mut tables, stamp),
+                |_, _, _, t0, _| {
                     first = first.min(t0);
                     Met::Counted(t0)
                 },

@@ -471,3 +471,124 @@ fn a_clouds_cores_in_runs_give_the_stretches_of_every_core() {
     }
     assert!(checked > 100, "{checked} lines in cloud");
 }
+
+/// A small deterministic generator for the tests' random lines (a 64-bit LCG's high bits).
+fn uniform(state: &mut u64) -> f64 {
+    *state = state
+        .wrapping_mul(6_364_136_223_846_793_005)
+        .wrapping_add(1_442_695_040_888_963_407);
+    (*state >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// A cloud's core table gives the stretches of asking every core of its sprites, to the bit:
+/// random segments through, into, out of and past the boxes of every cloud of the real overcast
+/// at San Antonio, the cumulus off Los Angeles and the thunderstorm theme's cells and anvils
+/// (level, upright and short ones among them), with and without the cloud's runs.
+#[test]
+fn a_clouds_core_table_gives_the_stretches_of_every_core() {
+    use crate::clouds::core::{CoreTable, segment, segment_in_table};
+    let mut state = 7u64;
+    let (mut checked, mut in_cloud) = (0, 0);
+    let places = [
+        (REAL, 29.4270, -98.6080),
+        (REAL, 34.02, -118.47),
+        ("weather/themes/thunderstorm_cells.toml", 34.02, -118.47),
+    ];
+    for (file, lat, lon) in places {
+        let w = world(file, lat, lon, true);
+        for field in w.living_fields() {
+            for (_, g) in field.blocks().take(8) {
+                for bx in &g.boxes.boxes {
+                    let cloud = &g.block.clouds[bx.cloud];
+                    let runs = g.boxes.runs[bx.cloud].as_deref();
+                    let table = CoreTable::of(cloud, runs);
+                    let (c, h) = (bx.centre_m - cloud.centre_m, bx.half_m);
+                    for n in 0..24 {
+                        let mut r = || uniform(&mut state) * 2.0 - 1.0;
+                        let a = c + DVec3::new(r(), r(), r()) * h * 1.3;
+                        let b = match n % 4 {
+                            // Level, upright, short, and any.
+                            0 => a + DVec3::new(r(), r(), 0.0) * h.length() * 2.0,
+                            1 => a + DVec3::Z * r() * h.z * 3.0,
+                            2 => a + DVec3::new(r(), r(), r()) * 50.0,
+                            _ => c + DVec3::new(r(), r(), r()) * h * 1.3,
+                        };
+                        let (mut want, mut got) = (Vec::new(), Vec::new());
+                        segment(cloud, a, b, &mut want);
+                        segment_in_table(cloud, &table, a, b, &mut got);
+                        assert_eq!(got, want, "{a} to {b}");
+                        checked += 1;
+                        in_cloud += usize::from(!want.is_empty());
+                    }
+                }
+            }
+        }
+    }
+    assert!(in_cloud > 1000, "{in_cloud} of {checked} segments in cloud");
+}
+
+/// Every answer of the lines of sight through the core tables is that of asking each cloud's
+/// sprites for its cores one by one, to the bit: first clouds, every cloud along a line and the
+/// sun's optical depth, from points in, under and over the real overcast, the cumulus and the
+/// thunderstorm theme, along random lines of up to 10 km (each asked twice, the tables made by
+/// the first).
+#[test]
+fn the_lines_of_sight_through_the_core_tables_are_those_through_the_cores() {
+    use crate::clouds::probe::STRAIGHT;
+    let mut state = 11u64;
+    let (mut lines, mut hits) = (0, 0);
+    let places = [
+        (REAL, 29.4270, -98.6080),
+        (REAL, 34.02, -118.47),
+        ("weather/themes/thunderstorm_cells.toml", 34.02, -118.47),
+    ];
+    for (file, lat, lon) in places {
+        let w = world(file, lat, lon, true);
+        // The clouds' boxes' centres, ground frame: half the lines are aimed at one.
+        let mut centres = Vec::new();
+        for field in w.living_fields() {
+            let d = field.drift_m();
+            for (_, g) in field.blocks() {
+                centres.extend(g.boxes.boxes.iter().map(|b| b.centre_m + d.extend(0.0)));
+            }
+        }
+        for n in 0..150 {
+            let mut r = || uniform(&mut state);
+            let a = DVec3::new(
+                (r() - 0.5) * 12_000.0,
+                (r() - 0.5) * 12_000.0,
+                200.0 + r() * 4_000.0,
+            );
+            let (heading, pitch) = (r() * std::f64::consts::TAU, (r() - 0.4) * 0.8);
+            let mut dir = DVec3::new(
+                heading.sin() * pitch.cos(),
+                heading.cos() * pitch.cos(),
+                pitch.sin(),
+            );
+            let mut b = a + dir * (500.0 + r() * 9_500.0);
+            if n % 2 == 0 && !centres.is_empty() {
+                // Through the box's centre and on (or stopping short of it, inside).
+                let at = centres[(r() * centres.len() as f64) as usize % centres.len()];
+                dir = (at - a).normalize_or(dir);
+                b = at + dir * (r() - 0.2) * 3_000.0;
+            }
+            let ask = |straight: bool| {
+                STRAIGHT.set(straight);
+                let answers = (
+                    w.first_cloud(a, b),
+                    w.line_of_sight(a, b),
+                    w.sun_occlusion(a, dir).to_bits(),
+                );
+                STRAIGHT.set(false);
+                answers
+            };
+            // Compared as printed: every bit of every number (-0 and 0, NaN) counts.
+            let want = format!("{:?}", ask(true));
+            assert_eq!(format!("{:?}", ask(false)), want, "{a} to {b}");
+            assert_eq!(format!("{:?}", ask(false)), want, "{a} to {b}, again");
+            lines += 1;
+            hits += usize::from(!want.starts_with("(None"));
+        }
+    }
+    assert!(hits > lines / 3, "{hits} of {lines} lines meet a cloud");
+}
