@@ -170,8 +170,9 @@ impl Sight<'_> {
     }
 
     /// Whether any of a cloud's quads (its centre relative to the eye, its radius and its
-    /// largest sprite's half side) can reach into the frustum.
-    fn sees_cloud(&self, centre: glam::Vec3, radius_m: f32, half_side_m: f32) -> bool {
+    /// largest sprite's half side) can reach into the frustum; or a block's, its radius over
+    /// all its clouds.
+    pub(super) fn sees_cloud(&self, centre: glam::Vec3, radius_m: f32, half_side_m: f32) -> bool {
         // Widths and heights reach the shader as half floats (a part in 2,048).
         let reach = (radius_m + CORNER_REACH * half_side_m) * 1.001 + 1.0;
         let r = reach + self.bend_m(centre.length() + reach, centre.z.abs() + reach);

@@ -333,6 +333,17 @@ pub(in crate::render) struct Copies<'a> {
     pub dirty_lists: &'a mut Vec<std::ops::Range<u32>>,
 }
 
+/// Whether any of a block's quads can reach into the view `sight` looks through from
+/// `camera_m`: its clouds' sphere grown by its largest quad's corner reach and the shader's
+/// bending onto the round Earth.
+pub(super) fn block_in_view(r: &Resident, camera_m: DVec3, sight: &Sight) -> bool {
+    sight.sees_cloud(
+        (r.centre_m() - camera_m).as_vec3(),
+        r.radius_m as f32,
+        r.largest_half_side_m,
+    )
+}
+
 /// The sky camera's frame: fills `out` with the draw list of the view's `near` blocks (the ids
 /// its impostor ring leaves to the sprites) that are placed and in view (`frustum`: nothing of
 /// a block wholly outside it is built or drawn), looks again at the blocks whose slack is used
@@ -352,12 +363,18 @@ pub(in crate::render) fn main_view(
 ) -> Inside {
     // A block out of view is not looked at again either: its slack check catches up with the
     // camera the frame it comes into view. Only the view's near blocks are looked up, not the
-    // thousands held (most of them in the ring).
+    // thousands held (most of them in the ring). A block is out of view only when its quads'
+    // corners and the shader's bending onto the round Earth keep out of it too, as a cloud's
+    // are (`Sight::sees_cloud`): a block showing a corner at the view's edge is drawn.
+    let seen_by = Sight {
+        frustum,
+        earth_radius_m: settings.earth.camera_radius_m(camera_m.z),
+    };
     let mut order: Vec<(bool, f64, &Resident)> = near
         .iter()
         .filter_map(|id| blocks.get(id))
         .filter(|r| r.uploaded)
-        .filter(|r| frustum.sees_sphere((r.centre_m() - camera_m).as_vec3(), r.radius_m as f32))
+        .filter(|r| block_in_view(r, camera_m, &seen_by))
         .map(|r| (r.distant, (r.centre_m() - camera_m).length_squared(), r))
         .collect();
     // Distant blocks (storm cells beyond the field) first: drawn behind the ring. The keys are
@@ -426,11 +443,8 @@ pub(in crate::render) fn main_view(
         stats.clouds_drawn += r.list.len() as u32;
     }
     locks.end();
-    let sight = settings.clouds.cull_out_of_view.then(|| Sight {
-        frustum,
-        earth_radius_m: settings.earth.camera_radius_m(camera_m.z),
-    });
-    let total = draw_entries(&order, (camera_m, sight.as_ref()), seams, out);
+    let sight = settings.clouds.cull_out_of_view.then_some(&seen_by);
+    let total = draw_entries(&order, (camera_m, sight), seams, out);
     stats.sprites_drawn = total;
     stats.cache_hit_rate = if stats.clouds_drawn == 0 {
         1.0

@@ -471,3 +471,61 @@ fn clouds_wholly_out_of_view_are_left_out_and_the_rest_keep_their_order() {
         }
     }
 }
+
+/// A block whose clouds' sphere lies just outside the view but whose quads' corners (up to
+/// `sqrt(2)` half sides from a sprite's centre, the sphere counting one) reach into it is in
+/// view: culled, its corner would pop in at the view's edge. One farther out than the corners
+/// reach is not.
+#[test]
+fn a_block_showing_only_its_quads_corners_at_the_views_edge_is_in_view() {
+    use crate::render::camera::Camera;
+    let eye = DVec3::new(0.0, 0.0, 3000.0);
+    // Looking east: the block north-west of the eye is out of view.
+    let camera = Camera {
+        position_m: eye,
+        heading_deg: 90.0,
+        pitch_deg: 0.0,
+        fov_y_deg: 30.0,
+        aspect: 1.0,
+        near_m: 1.0,
+        far_m: 100_000.0,
+    };
+    let frustum = camera.frustum_relative();
+    let mut blocks = two_blocks(eye, false);
+    let r = blocks.get_mut(&1).expect("block 1");
+    let centre = (r.centre_m() - eye).as_vec3();
+    // How far its centre lies outside the view: the least sphere the frustum sees.
+    let (mut lo, mut hi) = (0.0f32, 20_000.0f32);
+    assert!(!frustum.sees_sphere(centre, lo) && frustum.sees_sphere(centre, hi));
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if frustum.sees_sphere(centre, mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let outside_m = hi;
+    let half_side = r.largest_half_side_m;
+    assert_eq!(half_side, 200.0);
+    let corner_reach = (std::f32::consts::SQRT_2 - 1.0) * half_side;
+    for earth_radius_m in [0.0, 6.371e6] {
+        let sight = Sight {
+            frustum: &frustum,
+            earth_radius_m,
+        };
+        // The sphere 50 m short of the view, the corners 33 m into it.
+        r.radius_m = f64::from(outside_m - 50.0);
+        assert!(!frustum.sees_sphere(centre, r.radius_m as f32));
+        assert!(
+            block_in_view(r, eye, &sight),
+            "earth radius {earth_radius_m}"
+        );
+        // The corners, and the bend, short of it too.
+        r.radius_m = f64::from(outside_m - corner_reach - 100.0);
+        assert!(
+            !block_in_view(r, eye, &sight),
+            "earth radius {earth_radius_m}"
+        );
+    }
+}

@@ -80,6 +80,9 @@ pub(in crate::render) struct Resident {
     /// it and a neighbour (the draw list interleaves the clouds of two deck blocks whose order
     /// the camera is that close to deciding).
     pub largest_cloud_m: f64,
+    /// The largest half side of its sprites, metres: how far a quad's corner reaches past the
+    /// cloud radius that counts only the half side (`sqrt(2) - 1` of it).
+    pub largest_half_side_m: f32,
     /// Whether it holds a deck (a layer's cells on the lattice, `sunlit_depth_m` set): clouds
     /// side by side up to its sides, which overlap a neighbouring deck's all along the boundary.
     pub deck: bool,
@@ -151,6 +154,10 @@ impl Resident {
             .map(|c| (c.centre_m - block.centre_m).length() + c.radius_m as f64)
             .fold(0.0, f64::max);
         let largest_cloud_m = clouds.iter().map(|c| c.radius_m as f64).fold(0.0, f64::max);
+        let largest_half_side_m = clouds
+            .iter()
+            .map(|c| c.largest_half_side_m)
+            .fold(0.0, f32::max);
         let deck = block.clouds.iter().any(|c| c.sunlit_depth_m > 0.0);
         let z_span_m = clouds
             .iter()
@@ -165,6 +172,7 @@ impl Resident {
             motion,
             radius_m,
             largest_cloud_m,
+            largest_half_side_m,
             deck,
             z_span_m,
             list: Vec::new(),
