@@ -159,7 +159,7 @@ impl CoverBins {
     /// tosses about `p` with a spread that goes as `sqrt(p (1 - p))`: a scattered layer's share
     /// tosses wider than a broken one's. Two neighbouring classes therefore part where a share
     /// lies as many spreads from the one drawn cover as from the other (the shipped FEW 2 and
-    /// SCT 3.5 oktas at 2.70/8, SCT and BKN 6 at 4.84/8), so that a toss one way is as likely
+    /// SCT 3.5 oktas at 2.70/8, SCT and BKN 6 at 4.83/8), so that a toss one way is as likely
     /// as the other. BKN and OVC part halfway (7/8): an overcast is closed from below, its
     /// readings do not toss, and what it loses is the deck's edge, not a toss.
     pub fn for_covers(oktas: &PerCover) -> Self {
