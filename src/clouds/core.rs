@@ -405,6 +405,26 @@ pub fn segment(cloud: &Cloud, a: DVec3, b: DVec3, out: &mut Vec<(f64, f64)>) {
     segment_in_runs(cloud, None, a, b, out);
 }
 
+/// The part of the segment `a`..`b` (as fractions of it) above a cloud's base at `floor` m;
+/// `None` where none of it is.
+fn above_floor(a: DVec3, b: DVec3, floor: f64) -> Option<(f64, f64)> {
+    let dz = b.z - a.z;
+    let (from, to) = if dz.abs() < 1e-12 {
+        if a.z < floor {
+            return None;
+        }
+        (0.0, 1.0)
+    } else {
+        let t = (floor - a.z) / dz;
+        if dz > 0.0 {
+            (t.max(0.0), 1.0)
+        } else {
+            (0.0, t.min(1.0))
+        }
+    };
+    (from < to).then_some((from, to))
+}
+
 /// [`segment`], the cloud's cores looked at run by run where it has `runs` ([`CoreRuns`]):
 /// a run whose bounds the segment misses is passed over whole. The same stretches.
 pub fn segment_in_runs(
@@ -416,26 +436,9 @@ pub fn segment_in_runs(
 ) {
     out.clear();
     let floor = f64::from(cloud.floor_m);
-    // The part of the segment above the base.
-    let (above_from, above_to) = {
-        let dz = b.z - a.z;
-        if dz.abs() < 1e-12 {
-            if a.z < floor {
-                return;
-            }
-            (0.0, 1.0)
-        } else {
-            let t = (floor - a.z) / dz;
-            if dz > 0.0 {
-                (t.max(0.0), 1.0)
-            } else {
-                (0.0, t.min(1.0))
-            }
-        }
-    };
-    if above_from >= above_to {
+    let Some((above_from, above_to)) = above_floor(a, b, floor) else {
         return;
-    }
+    };
     let mut spans = Vec::with_capacity(2);
     if let Some((lo, hi)) = floor_slab(floor, cloud.floor_slab_m)
         && let Some(span) = super::boxes::slab(a, b, lo, hi)

@@ -12,7 +12,7 @@
 
 use glam::DVec3;
 
-use super::{CoreRuns, SpriteCore, floor_slab, merge, unturned_core};
+use super::{CoreRuns, SpriteCore, above_floor, floor_slab, merge, unturned_core};
 use crate::clouds::block::Cloud;
 use crate::clouds::boxes::slab;
 
@@ -101,26 +101,9 @@ pub(crate) fn segment_in_table(
 ) {
     out.clear();
     let floor = f64::from(cloud.floor_m);
-    // The part of the segment above the base.
-    let (above_from, above_to) = {
-        let dz = b.z - a.z;
-        if dz.abs() < 1e-12 {
-            if a.z < floor {
-                return;
-            }
-            (0.0, 1.0)
-        } else {
-            let t = (floor - a.z) / dz;
-            if dz > 0.0 {
-                (t.max(0.0), 1.0)
-            } else {
-                (0.0, t.min(1.0))
-            }
-        }
-    };
-    if above_from >= above_to {
+    let Some((above_from, above_to)) = above_floor(a, b, floor) else {
         return;
-    }
+    };
     let clamp = |(t0, t1): (f64, f64)| (t0.max(above_from), t1.min(above_to));
     if let Some((lo, hi)) = floor_slab(floor, cloud.floor_slab_m)
         && let Some(span) = slab(a, b, lo, hi)

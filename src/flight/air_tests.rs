@@ -480,6 +480,14 @@ fn uniform(state: &mut u64) -> f64 {
     (*state >> 11) as f64 / (1u64 << 53) as f64
 }
 
+/// The skies the core tables are checked over (file, latitude, longitude): the real overcast at
+/// San Antonio, the cumulus off Los Angeles and the thunderstorm theme's cells and anvils.
+const CORE_TABLE_SKIES: [(&str, f64, f64); 3] = [
+    (REAL, 29.4270, -98.6080),
+    (REAL, 34.02, -118.47),
+    ("weather/themes/thunderstorm_cells.toml", 34.02, -118.47),
+];
+
 /// A cloud's core table gives the stretches of asking every core of its sprites, to the bit:
 /// random segments through, into, out of and past the boxes of every cloud of the real overcast
 /// at San Antonio, the cumulus off Los Angeles and the thunderstorm theme's cells and anvils
@@ -489,12 +497,7 @@ fn a_clouds_core_table_gives_the_stretches_of_every_core() {
     use crate::clouds::core::{CoreTable, segment, segment_in_table};
     let mut state = 7u64;
     let (mut checked, mut in_cloud) = (0, 0);
-    let places = [
-        (REAL, 29.4270, -98.6080),
-        (REAL, 34.02, -118.47),
-        ("weather/themes/thunderstorm_cells.toml", 34.02, -118.47),
-    ];
-    for (file, lat, lon) in places {
+    for (file, lat, lon) in CORE_TABLE_SKIES {
         let w = world(file, lat, lon, true);
         for field in w.living_fields() {
             for (_, g) in field.blocks().take(8) {
@@ -537,12 +540,7 @@ fn the_lines_of_sight_through_the_core_tables_are_those_through_the_cores() {
     use crate::clouds::probe::STRAIGHT;
     let mut state = 11u64;
     let (mut lines, mut hits) = (0, 0);
-    let places = [
-        (REAL, 29.4270, -98.6080),
-        (REAL, 34.02, -118.47),
-        ("weather/themes/thunderstorm_cells.toml", 34.02, -118.47),
-    ];
-    for (file, lat, lon) in places {
+    for (file, lat, lon) in CORE_TABLE_SKIES {
         let w = world(file, lat, lon, true);
         // The clouds' boxes' centres, ground frame: half the lines are aimed at one.
         let mut centres = Vec::new();
