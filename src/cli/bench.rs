@@ -13,8 +13,11 @@
 //! real flight rebuilds the ring every 15% of its radius (3 km at 20 km: 25 s at 120 m/s, some
 //! 1,500 frames at 60 a second, 8 of them rendering an impostor); between samples the camera
 //! jumps hundreds of metres, so at each sample the ring is brought up to date first (the rebuild
-//! frames and the crossfade, timed on their own) and then one steady frame is timed, as most of
-//! a real flight's frames are.
+//! frames and the crossfade, timed on their own), and the cloud shadow map too (its scrolled
+//! strips and the blocks that came into its range, a budget a frame: the first sample's whole
+//! sky takes a few hundred frames), and then one steady frame is timed, as most of a real
+//! flight's frames are: one that draws neither. The frames at a sample after its first take a
+//! frame's sky time (1/60 s), so the clouds are the same at each sample with the ring on or off.
 //!
 //! Out: one table on standard output headed by the adapter's name (scenario, block overdraw,
 //! ring on or off, cloud scale, median and p95 of the steady frames' milliseconds, the sky's
@@ -58,8 +61,13 @@ const ON_REQUEST: &str = "storm";
 const PATH_LENGTH_M: f64 = 12_000.0;
 const CRUISE_FT_AGL: f64 = 5_000.0;
 const PITCH_DEG: f64 = -3.0;
-/// Cruise speed, metres a second: sets the simulated time step between frames.
+/// Cruise speed, metres a second: sets the simulated time from one sample to the next.
 const SPEED_M_S: f64 = 120.0;
+/// The sky time of each frame after a sample's first (a frame at 60 a second): the frames that
+/// bring the ring and the shadow map up to date at a sample take the time a host's frames take,
+/// so the sky (its clouds' forming and drift) is the same at each sample with the ring on or
+/// off, however many frames each needed.
+const FRAME_DT_S: f64 = 1.0 / 60.0;
 
 /// Flags of `skycast bench`.
 #[derive(Debug, Args)]
@@ -409,10 +417,12 @@ fn fly(
         .collect())
 }
 
-/// Draws frames at one sample until the ring is up to date there (the frames that sort its
-/// orders a budget at a time, 8 rebuild frames and a crossfade at most, plus slack); the last is
-/// the steady one. False when the frames were timed
-/// by the wall clock (no GPU timestamps).
+/// Draws frames at one sample until the ring and the shadow map are up to date there (the
+/// frames that sort the ring's orders a budget at a time, 8 rebuild frames and a crossfade at
+/// most; the map's strips, patches and arriving blocks, a budget a frame), 512 at most; the
+/// last, which draws neither, is the steady one, as most of a flight's frames are. The first
+/// frame's sky time is the flight from the last sample, the others' a frame's. False when the
+/// frames were timed by the wall clock (no GPU timestamps).
 fn draw_to_steady(
     host: &mut DemoHost,
     (p, distance_m): (DVec3, f64),
@@ -421,8 +431,9 @@ fn draw_to_steady(
 ) -> anyhow::Result<bool> {
     let camera = host.camera(p, 90.0, PITCH_DEG);
     let mut timestamps = true;
-    for _ in 0..512 {
+    for frame in 0..512 {
         let start = Instant::now();
+        let dt_s = if frame == 0 { dt_s } else { FRAME_DT_S };
         let stats = host.draw(&camera, sun, dt_s, visibility_m)?;
         let (frame_ms, sky_ms) = match host.last_gpu_split_ms() {
             Some([ground, sky]) => (ground + sky, sky),
@@ -436,7 +447,8 @@ fn draw_to_steady(
         };
         let steady = stats.impostors_rebuilt == 0
             && stats.crossfade_weight == 0.0
-            && stats.ring_sprites_sorted == 0;
+            && stats.ring_sprites_sorted == 0
+            && !stats.shadow_redrawn;
         records.push(FrameRecord {
             steady,
             distance_m,

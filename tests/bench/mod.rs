@@ -135,7 +135,8 @@ fn bench_command_writes_table_csv_and_plot() {
     );
 
     // One steady frame a sample; before it, with impostors, the frames that rebuild the ring
-    // (the 6 km steps are past 15% of the 20 km ring radius), timed as the rebuild column.
+    // (the 6 km steps are past 15% of the 20 km ring radius), timed as the rebuild column, and
+    // the frames that bring the shadow map up to date.
     let frame_table = Table::read(&dir.join("frames.csv"));
     let frames = &frame_table.rows;
     let at =
@@ -155,10 +156,21 @@ fn bench_command_writes_table_csv_and_plot() {
         .filter(|f| at(f, "impostors_rebuilt").parse::<u32>().unwrap() > 0)
         .count();
     assert!(rebuilt >= 2 * 3 * 8, "{rebuilt} rebuild frames");
+    // A steady frame draws nothing into the cloud shadow map; without the ring, only the frames
+    // that draw into it (strips, arriving blocks) come before the steady one.
+    let draws_map =
+        |f: &csv::StringRecord| at(f, "shadow_sprites") != "0" || at(f, "shadow_texels") != "0";
     assert!(
         frames
             .iter()
-            .all(|f| at(f, "impostors") == "on" || at(f, "steady") == "yes")
+            .filter(|f| at(f, "steady") == "yes")
+            .all(|f| !draws_map(f))
+    );
+    assert!(
+        frames
+            .iter()
+            .filter(|f| at(f, "impostors") == "off" && at(f, "steady") == "no")
+            .all(draws_map)
     );
     // The cloud target's memory is in the frames: 32 x 18 texels of 8 + 2 + 4 bytes at 1/2,
     // none at 1.
