@@ -522,6 +522,10 @@ struct BoxGrid {
     cells: Vec<GridCell>,
     /// Box indices, cell after cell.
     items: Vec<u32>,
+    /// The lowest bottom and highest top of all its boxes, metres: a segment is walked only
+    /// over the part of it between them (a line of sight above or below a drift band's
+    /// layers crosses none of its cells).
+    heights_m: [f64; 2],
 }
 
 /// One cell of a [`BoxGrid`].
@@ -596,6 +600,11 @@ impl BoxGrid {
                 }
             }
         }
+        let heights_m = heights_m
+            .iter()
+            .fold([f64::INFINITY, f64::NEG_INFINITY], |[b, t], h| {
+                [b.min(h[0]), t.max(h[1])]
+            });
         Self {
             origin_m: lo,
             cell_m,
@@ -603,6 +612,7 @@ impl BoxGrid {
             ny,
             cells: grid_cells,
             items,
+            heights_m,
         }
     }
 
@@ -634,7 +644,18 @@ impl BoxGrid {
         ) else {
             return;
         };
-        let (t0, t1) = (t0.max(t_from), t1.min(t_to));
+        // And between the boxes' lowest bottom and highest top (the cells' margin of a metre):
+        // over the rest every cell's list would be passed over as above or below its boxes.
+        let [bottom, top] = [self.heights_m[0] - 1.0, self.heights_m[1] + 1.0];
+        let (z_from, z_to) = if dz.abs() > 1e-12 {
+            let (u, v) = ((bottom - a.z) / dz, (top - a.z) / dz);
+            (u.min(v), u.max(v))
+        } else if (bottom..=top).contains(&a.z) {
+            (f64::NEG_INFINITY, f64::INFINITY)
+        } else {
+            return;
+        };
+        let (t0, t1) = (t0.max(t_from).max(z_from), t1.min(t_to).min(z_to));
         if t0 > t1 {
             return;
         }
