@@ -263,6 +263,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         "far_field_gpu_bytes",
         "shadow_sprites",
         "shadow_texels",
+        "shadow_us",
     ])?;
     let frames = (flight.duration_s() * args.fps).floor() as u64 + 1;
     let dt_s = 1.0 / args.fps;
@@ -389,6 +390,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             stats.far_field_gpu_bytes.to_string(),
             stats.shadow_sprites.to_string(),
             stats.shadow_texels.to_string(),
+            stats.shadow_us.to_string(),
         ])?;
         progress.set_message(format!("{written} written"));
         progress.inc(1);

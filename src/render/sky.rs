@@ -375,7 +375,9 @@ impl Sky {
             // One map for all views (the sun is shared), around the main view's camera.
             let at = (camera.position_m, sun_dir, self.elapsed_s);
             let resident = &self.sprites.resident;
+            let shadows = std::time::Instant::now();
             upload_bytes += (self.shadows).prepare(queue, resident, &light, at, &mut stats);
+            stats.shadow_us = shadows.elapsed().as_micros() as u64;
         }
         // Quad indices and built corners for the largest draw of the frame (the sprites, an
         // impostor's sector, the shadow map's chunk).

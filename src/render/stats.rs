@@ -118,6 +118,11 @@ pub struct FrameStats {
     /// scroll's strips and the rectangles of blocks gone or changing (blocks added to the map
     /// add over it and are not counted; a scroll's copy is not).
     pub shadow_texels: u64,
+    /// CPU time of the cloud shadow map's prepare on the frame thread, microseconds on the wall
+    /// clock (part of `cpu_update_us`): what to draw decided, and for a drawing its draw list,
+    /// cloud lists and uniform written. The submission of a drawing is apart
+    /// (`gpu_wait_us`).
+    pub shadow_us: u64,
     /// CPU time of the host's air-data queries this frame (`SkySystem::air_at`, lines of
     /// sight), microseconds: set by the host that asks (`skycast fly` does), 0 otherwise.
     pub air_us: u64,
