@@ -672,12 +672,30 @@ impl CloudShadows {
         // texel in one gets every sprite that reaches it once, however they overlap); then the
         // blocks that arrived, over the whole map.
         let reach = |r: &Resident| layout::footprint(&frame, r.centre_m() - back, r.radius_m, n);
+        let meets = |f: TexelRect| rects.iter().any(|rect| rect.overlaps(&f));
+        // First on the place the map holds for each block, without reading the block: an upper
+        // band's clouds slip at most `BAND_SLIP_TEXELS` against the map between whole drawings
+        // (`band_slip`), so a block is within twice that of where the map took it in, and a
+        // reach that much wider (and a metre) finds every block the exact test below keeps. A
+        // frame of arrivals alone (no rectangle) reads none.
+        let margin_m = 2.0 * slip::BAND_SLIP_TEXELS * s.texel_m() + 1.0;
         let held = drawing_order(
             self.in_map
-                .keys()
-                .filter_map(|id| blocks.get(id))
+                .iter()
+                .filter(|(_, (c, r, _))| {
+                    !rects.is_empty()
+                        && layout::footprint(&frame, *c, r + margin_m, n).is_some_and(meets)
+                })
+                .filter_map(|(id, _)| blocks.get(id))
                 .filter(|r| is_covered(r, &frame))
-                .filter(|r| reach(r).is_some_and(|f| rects.iter().any(|rect| rect.overlaps(&f)))),
+                .filter(|r| reach(r).is_some_and(meets)),
+        );
+        debug_assert_eq!(
+            held.len(),
+            (self.in_map.keys().filter_map(|id| blocks.get(id)))
+                .filter(|r| is_covered(r, &frame) && reach(r).is_some_and(meets))
+                .count(),
+            "the stored places' reach missed a block that reaches a rectangle"
         );
         self.draws.clear();
         self.lists.clear();
