@@ -635,27 +635,18 @@ impl BoxGrid {
         let (a2, d) = (a.truncate(), (b - a).truncate());
         let dz = b.z - a.z;
         let hi = self.origin_m + DVec2::new(self.nx as f64, self.ny as f64) * self.cell_m;
-        // The part of the segment over the grid.
+        // The part of the segment over the grid and between its boxes' lowest bottom and
+        // highest top (with the cells' margin of a metre): over the rest every cell's list
+        // would be passed over as above or below its boxes.
         let Some((t0, t1)) = slab(
-            a2.extend(0.0),
-            (a2 + d).extend(0.0),
-            self.origin_m.extend(-1.0),
-            hi.extend(1.0),
+            a,
+            b,
+            self.origin_m.extend(self.heights_m[0] - 1.0),
+            hi.extend(self.heights_m[1] + 1.0),
         ) else {
             return;
         };
-        // And between the boxes' lowest bottom and highest top (the cells' margin of a metre):
-        // over the rest every cell's list would be passed over as above or below its boxes.
-        let [bottom, top] = [self.heights_m[0] - 1.0, self.heights_m[1] + 1.0];
-        let (z_from, z_to) = if dz.abs() > 1e-12 {
-            let (u, v) = ((bottom - a.z) / dz, (top - a.z) / dz);
-            (u.min(v), u.max(v))
-        } else if (bottom..=top).contains(&a.z) {
-            (f64::NEG_INFINITY, f64::INFINITY)
-        } else {
-            return;
-        };
-        let (t0, t1) = (t0.max(t_from).max(z_from), t1.min(t_to).min(z_to));
+        let (t0, t1) = (t0.max(t_from), t1.min(t_to));
         if t0 > t1 {
             return;
         }
