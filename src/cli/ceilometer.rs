@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use anyhow::bail;
 use clap::Args;
 use serde::Serialize;
+use skycast::clouds::CloudsConfig;
 use skycast::flight::ceilometer::{self, Layer, Reading};
 use skycast::flight::{World, WorldSettings};
 use skycast::weather::BlockIndex;
@@ -33,6 +34,14 @@ pub struct CeilometerArgs {
     /// into skycast).
     #[arg(long)]
     pub stations: Option<PathBuf>,
+    /// Seed of the cloud generation: the same report drawn with other clouds (the world's
+    /// seed, 2003, unless given).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Clouds settings: the lifecycle and the drift (default: the shipped
+    /// config/clouds.toml, or the one in `--config-dir`).
+    #[arg(long)]
+    pub clouds: Option<PathBuf>,
     /// The winds aloft the clouds drift with.
     #[command(flatten)]
     pub aloft: WindsAloftArgs,
@@ -77,11 +86,17 @@ pub fn run(args: &CeilometerArgs) -> anyhow::Result<()> {
             .ground_elevation_m,
     );
     // The clouds over the point are the field's nearest: a few kilometres of it is enough.
+    let defaults = WorldSettings::default();
     let settings = WorldSettings {
         cloud_radius_m: 6_000.0,
-        ..WorldSettings::default()
+        seed: args.seed.unwrap_or(defaults.seed),
+        ..defaults
     };
     let mut world = World::new(field, &settings);
+    // As `fly` does: the clouds a flight over the same file would meet.
+    if let Some(path) = super::defaults::settings_file(args.clouds.as_deref(), "clouds.toml") {
+        world.set_clouds_config(CloudsConfig::load(&path)?);
+    }
     if let Some((fb, table)) = args.aloft.load(args.stations.as_deref())? {
         world.set_winds_aloft(Some(&fb), &table);
     }

@@ -25,7 +25,7 @@ use super::CloudsError;
 use super::bands::DriftBand;
 use super::block::CloudBlock;
 use super::boxes::GenerationBoxes;
-use super::config::{CloudTypes, CloudsConfig, LifecycleConfig};
+use super::config::{CloudTypes, CloudsConfig};
 use super::generate::{generate_block, generate_block_in_field};
 use super::lifecycle::{Phase, ends_at, phase_at};
 use super::storm::CellCache;
@@ -265,14 +265,14 @@ type PhaseEnds = BTreeSet<(FieldTime, BlockIndex)>;
 impl Slot {
     /// Puts the slot at `index` into `ends` at its generations' first phase end (out of it while
     /// every generation is steady), in place of where it was.
-    fn schedule(&mut self, index: BlockIndex, ends: &mut PhaseEnds, lifecycle: &LifecycleConfig) {
+    fn schedule(&mut self, index: BlockIndex, ends: &mut PhaseEnds) {
         if let Some(t) = self.ends_s.take() {
             ends.remove(&(FieldTime(t), index));
         }
         self.ends_s = self
             .generations
             .iter()
-            .filter_map(|g| ends_at(g.phase, lifecycle))
+            .filter_map(|g| ends_at(g.phase))
             .reduce(f64::min);
         if let Some(t) = self.ends_s {
             ends.insert((FieldTime(t), index));
@@ -311,6 +311,10 @@ struct Slot {
     /// clouds or a generation asked for, so that it is not asked again while its weather stays,
     /// and a layer that the weather brings later forms instead of appearing at once.
     held_empty: bool,
+    /// How long the change asked for last forms and how long the generations it supersedes
+    /// take to go, seconds: the lifecycle's for a change of the weather, quicker for one the
+    /// drift brings ([`LifecycleConfig::spans_for_drift`]).
+    spans_s: (f32, f32),
 }
 
 /// A ground block and the version of the weather a field block over it was asked for with.
@@ -472,6 +476,9 @@ impl CloudField {
             }
         };
         let air_centre = centre_m - self.drift_m;
+        let lifecycle = &self.config.lifecycle;
+        let lifecycle_spans = (lifecycle.formation_s, lifecycle.dissipation_s);
+        let drift_spans = lifecycle.spans_for_drift(self.wind_m_s.length());
         let radius = self.config.field.radius_m;
         let seed = self.config.field.seed;
         let wanted = blocks_within(air_centre, radius);
@@ -521,6 +528,7 @@ impl CloudField {
                         joins: Phase::Steady,
                         ends_s: None,
                         held_empty: true,
+                        spans_s: lifecycle_spans,
                     };
                     self.slots.insert(index, slot);
                 }
@@ -541,21 +549,32 @@ impl CloudField {
                             joins,
                             ends_s: None,
                             held_empty: false,
+                            spans_s: lifecycle_spans,
                         },
                     );
                 }
                 Some(slot) if weather_changed_in(self.band, &slot.weather, &w) => {
+                    // Asked again for the same field version: the air drifted onto ground of
+                    // other weather.
+                    let drifted = matches!((slot.asked, key), (Some(a), Some(k)) if a.1 == k.1);
+                    let spans_s = match drifted {
+                        true => drift_spans,
+                        false => lifecycle_spans,
+                    };
                     let mine = cells_for(self, index);
                     let band = self.band;
                     self.generator
                         .submit_in_field(index, w.clone(), (mine, band), seed);
                     let now = self.time_s;
                     if let Some(slot) = self.slots.get_mut(&index) {
-                        (slot.weather, slot.asked) = (w, key);
+                        (slot.weather, slot.asked, slot.spans_s) = (w, key, spans_s);
                         // A layer came where the band had none: it forms, as a weather change's
                         // new clouds do.
                         if std::mem::take(&mut slot.held_empty) {
-                            slot.joins = Phase::Forming { since_s: now };
+                            slot.joins = Phase::Forming {
+                                since_s: now,
+                                over_s: spans_s.0,
+                            };
                         }
                     }
                 }
@@ -604,20 +623,19 @@ impl CloudField {
     /// still forming after a weather change: then it forms with it, from the latest of their
     /// changes, so a block that joins mid-change does not stand whole among half-formed ones.
     fn joining_phase(&self, index: BlockIndex) -> Phase {
-        let latest_change = (-1..=1)
+        (-1..=1)
             .flat_map(|dj| (-1..=1).map(move |di| BlockIndex::new(index.i + di, index.j + dj)))
             .filter_map(|beside| self.slots.get(&beside)?.generations.last())
             .filter_map(|g| match g.phase {
-                Phase::Forming { since_s } => Some(since_s),
+                Phase::Forming { since_s, .. } => Some((since_s, g.phase)),
                 _ => None,
             })
-            .reduce(f64::max);
-        latest_change.map_or(Phase::Steady, |since_s| Phase::Forming { since_s })
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or(Phase::Steady, |latest| latest.1)
     }
 
     fn take_in(&mut self, finished: Vec<Generated>) {
         let now = self.time_s;
-        let lifecycle = self.config.lifecycle;
         for done in finished {
             let Some(slot) = self.slots.get_mut(&done.index) else {
                 continue;
@@ -625,18 +643,26 @@ impl CloudField {
             if done.weather != slot.weather {
                 continue; // superseded by a newer request
             }
+            let (form_s, go_s) = slot.spans_s;
             let phase = if slot.generations.is_empty() {
                 slot.joins
             } else {
-                Phase::Forming { since_s: now }
+                Phase::Forming {
+                    since_s: now,
+                    over_s: form_s,
+                }
             };
             for g in &mut slot.generations {
                 g.phase = match g.phase {
-                    Phase::Steady => Phase::Dissipating { since_s: now },
+                    Phase::Steady => Phase::Dissipating {
+                        since_s: now,
+                        over_s: go_s,
+                    },
                     // Still forming: back the way it came, from as far as it had formed.
                     Phase::Forming { .. } => Phase::Unforming {
                         since_s: now,
-                        from: super::lifecycle::progress(g.phase, now, &lifecycle),
+                        from: super::lifecycle::progress(g.phase, now),
+                        over_s: form_s,
                     },
                     going => going,
                 };
@@ -655,7 +681,7 @@ impl CloudField {
                 phase,
                 serial: self.next_serial * u64::from(band.count) + u64::from(band.index),
             });
-            slot.schedule(done.index, &mut self.phase_ends, &lifecycle);
+            slot.schedule(done.index, &mut self.phase_ends);
         }
     }
 
@@ -666,7 +692,6 @@ impl CloudField {
         self.time_s += dt_s;
         self.drift_m += self.wind_m_s * dt_s;
         let now = self.time_s;
-        let lifecycle = self.config.lifecycle;
         // Only the blocks a phase of which ends by now; each goes back in at its next end.
         self.ending.clear();
         let mut freed = Vec::new();
@@ -683,7 +708,7 @@ impl CloudField {
             };
             slot.ends_s = None;
             for g in &mut slot.generations {
-                g.phase = phase_at(g.phase, now, &lifecycle);
+                g.phase = phase_at(g.phase, now);
             }
             let before = freed.len();
             freed.extend(slot.generations.extract_if(.., |g| g.phase == Phase::Gone));
@@ -692,7 +717,7 @@ impl CloudField {
                 self.membership += 1;
             }
             // A phase that ends a rounding after `now` is back in the queue for the next call.
-            slot.schedule(index, &mut self.phase_ends, &lifecycle);
+            slot.schedule(index, &mut self.phase_ends);
         }
         self.generator.free_later(freed);
         self.take_finished();

@@ -209,11 +209,8 @@ fn generations_without_clouds_also_go() {
 #[test]
 fn blocks_joining_during_a_weather_change_form_with_their_neighbours() {
     let mut field = changed_field(100.0);
-    let since_s = 100.0;
-    assert_eq!(
-        field.generations(BlockIndex::new(0, 0))[1].phase,
-        Phase::Forming { since_s }
-    );
+    let forming = Phase::forming(100.0, &CloudsConfig::builtin().lifecycle);
+    assert_eq!(field.generations(BlockIndex::new(0, 0))[1].phase, forming);
     // Half-way through the formation the camera has flown a block east: the blocks that
     // join at the rim form from the same moment as those beside them, not whole among them.
     field.advance(60.0);
@@ -230,7 +227,7 @@ fn blocks_joining_during_a_weather_change_form_with_their_neighbours() {
     for index in &joined {
         let gens = field.generations(*index);
         assert_eq!(gens.len(), 1, "{index:?}");
-        assert_eq!(gens[0].phase, Phase::Forming { since_s }, "{index:?}");
+        assert_eq!(gens[0].phase, forming, "{index:?}");
     }
     // Once the change has settled, blocks join formed again.
     field.advance(2_000.0);
@@ -244,6 +241,72 @@ fn blocks_joining_during_a_weather_change_form_with_their_neighbours() {
         .collect();
     assert!(joined.len() >= 3);
     assert!(joined.iter().all(|g| g.phase == Phase::Steady));
+}
+
+/// Air that drifts onto ground of other weather (the same weather version) forms its new
+/// clouds, and lets the old go, while it drifts `drift_change_m`; a new version of the weather
+/// takes the lifecycle's times.
+#[test]
+fn a_change_the_drift_brings_forms_while_the_air_crosses_into_it() {
+    let mut field = small_field();
+    let speed_m_s = 10.0;
+    field.set_drift_velocity(Some(DVec2::new(speed_m_s, 0.0)));
+    // Ground west of the origin at 2 oktas, east of it at 6.
+    let ground = |i: BlockIndex| calm(if i.i < 0 { 2.0 } else { 6.0 });
+    field.update_for(DVec2::ZERO, &ground, 1);
+    field.wait_for_pending();
+    // A block's drift later the air over ground block (-1, 0) is over (0, 0).
+    field.advance(BLOCK_SIZE_M / speed_m_s);
+    field.update_for(DVec2::ZERO, &ground, 1);
+    field.wait_for_pending();
+    let lifecycle = *field.lifecycle();
+    let crossing_s = lifecycle.drift_change_m / speed_m_s as f32;
+    assert!(crossing_s < lifecycle.formation_s.min(lifecycle.dissipation_s));
+    let now = field.time_s();
+    let changed: Vec<&[FieldBlock]> = field
+        .blocks()
+        .map(|(i, _)| field.generations(i))
+        .filter(|g| g.len() == 2)
+        .collect();
+    assert!(changed.len() >= 3, "{} blocks changed", changed.len());
+    for gens in &changed {
+        let (old, new) = (gens[0].phase, gens[1].phase);
+        assert_eq!(
+            (old, new),
+            (
+                Phase::Dissipating {
+                    since_s: now,
+                    over_s: crossing_s
+                },
+                Phase::Forming {
+                    since_s: now,
+                    over_s: crossing_s
+                }
+            )
+        );
+    }
+    // Formed by the time the air is `drift_change_m` into the new ground.
+    field.advance(f64::from(crossing_s) + 0.1);
+    assert!(field.blocks().all(|(i, _)| {
+        field
+            .generations(i)
+            .iter()
+            .all(|g| g.phase == Phase::Steady)
+    }));
+    // Another weather everywhere: a change in time forms over the lifecycle's time.
+    field.update_for(DVec2::ZERO, &|_| calm(4.0), 2);
+    field.wait_for_pending();
+    let now = field.time_s();
+    let mut changed = 0;
+    // (Blocks that joined at the rim just now hold one generation.)
+    for gens in field.blocks().map(|(i, _)| field.generations(i)) {
+        if let [old, new] = gens {
+            assert_eq!(new.phase, Phase::forming(now, &lifecycle));
+            assert_eq!(old.phase, Phase::dissipating(now, &lifecycle));
+            changed += 1;
+        }
+    }
+    assert!(changed > 10, "{changed}");
 }
 
 #[test]

@@ -13,33 +13,60 @@ use serde::{Deserialize, Serialize};
 use super::block::Cloud;
 use super::config::LifecycleConfig;
 
-/// Where a cloud is in its life.
+/// Where a cloud is in its life. A change of the weather in time forms and dissipates over the
+/// lifecycle's `formation_s` and `dissipation_s`; one the drift brings (the air crossing onto
+/// ground of other weather) is quicker ([`LifecycleConfig::spans_for_drift`]), so each phase
+/// carries its own span.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Phase {
-    /// Forming since `since_s` (field time, seconds).
+    /// Forming since `since_s` (field time, seconds) over `over_s`.
     Forming {
         /// Start time, seconds.
         since_s: f64,
+        /// How long it takes to form, seconds.
+        over_s: f32,
     },
     /// Fully formed.
     Steady,
-    /// Dissipating since `since_s` (field time, seconds).
+    /// Dissipating since `since_s` (field time, seconds) over `over_s`.
     Dissipating {
         /// Start time, seconds.
         since_s: f64,
+        /// How long it takes to dissipate, seconds.
+        over_s: f32,
     },
     /// Superseded while still forming: going back the way it formed, from formation progress
-    /// `from` at `since_s` down to nothing at the formation's rate (its outer sprites first, as
-    /// when dissipating). Dissipating from whole instead showed its half-formed clouds whole
-    /// in one frame.
+    /// `from` at `since_s` down to nothing at the rate of a formation over `over_s` (its outer
+    /// sprites first, as when dissipating). Dissipating from whole instead showed its
+    /// half-formed clouds whole in one frame.
     Unforming {
         /// Start time, seconds.
         since_s: f64,
         /// The formation progress it had then, 0..=1.
         from: f32,
+        /// The span of a whole formation at the rate it goes back, seconds.
+        over_s: f32,
     },
     /// Dissipated completely: nothing left to draw.
     Gone,
+}
+
+impl Phase {
+    /// Forming from `since_s` over `config`'s formation time (a change of the weather in time).
+    pub fn forming(since_s: f64, config: &LifecycleConfig) -> Self {
+        Phase::Forming {
+            since_s,
+            over_s: config.formation_s,
+        }
+    }
+
+    /// Dissipating from `since_s` over `config`'s dissipation time.
+    pub fn dissipating(since_s: f64, config: &LifecycleConfig) -> Self {
+        Phase::Dissipating {
+            since_s,
+            over_s: config.dissipation_s,
+        }
+    }
 }
 
 /// Opacity factor of a sprite at formation progress `p` (0..=1).
@@ -66,13 +93,13 @@ pub fn dissipation_alpha(q: f32, radius_fraction: f32, config: &LifecycleConfig)
 
 /// The phase `phase` has reached at `now_s` (what [`apply`] returns, without a cloud): a
 /// generation without clouds still forms, settles, dissipates and goes.
-pub fn phase_at(phase: Phase, now_s: f64, config: &LifecycleConfig) -> Phase {
+pub fn phase_at(phase: Phase, now_s: f64) -> Phase {
     match phase {
-        Phase::Forming { since_s } if now_s - since_s >= config.formation_s as f64 => Phase::Steady,
-        Phase::Dissipating { since_s } if now_s - since_s >= config.dissipation_s as f64 => {
+        Phase::Forming { since_s, over_s } if now_s - since_s >= f64::from(over_s) => Phase::Steady,
+        Phase::Dissipating { since_s, over_s } if now_s - since_s >= f64::from(over_s) => {
             Phase::Gone
         }
-        Phase::Unforming { .. } if progress(phase, now_s, config) <= 0.0 => Phase::Gone,
+        Phase::Unforming { .. } if progress(phase, now_s) <= 0.0 => Phase::Gone,
         other => other,
     }
 }
@@ -80,26 +107,34 @@ pub fn phase_at(phase: Phase, now_s: f64, config: &LifecycleConfig) -> Phase {
 /// The field time at which `phase` ends by itself (where [`phase_at`] moves it on: forming
 /// becomes steady, dissipating or unforming becomes gone); `None` for Steady and Gone, which
 /// last until something else changes them.
-pub fn ends_at(phase: Phase, config: &LifecycleConfig) -> Option<f64> {
+pub fn ends_at(phase: Phase) -> Option<f64> {
     match phase {
-        Phase::Forming { since_s } => Some(since_s + f64::from(config.formation_s)),
-        Phase::Dissipating { since_s } => Some(since_s + f64::from(config.dissipation_s)),
-        Phase::Unforming { since_s, from } => {
-            Some(since_s + f64::from(from) * f64::from(config.formation_s))
+        Phase::Forming { since_s, over_s } | Phase::Dissipating { since_s, over_s } => {
+            Some(since_s + f64::from(over_s))
         }
+        Phase::Unforming {
+            since_s,
+            from,
+            over_s,
+        } => Some(since_s + f64::from(from) * f64::from(over_s)),
         Phase::Steady | Phase::Gone => None,
     }
 }
 
 /// Progress of a formation or dissipation at field time `now_s`, 0..=1 (1 for Steady and Gone);
 /// of an unforming generation, the formation progress it is back at.
-pub fn progress(phase: Phase, now_s: f64, config: &LifecycleConfig) -> f32 {
+pub fn progress(phase: Phase, now_s: f64) -> f32 {
     let frac = |since_s: f64, span_s: f32| ((now_s - since_s) / span_s as f64).clamp(0.0, 1.0);
     match phase {
-        Phase::Forming { since_s } => frac(since_s, config.formation_s) as f32,
-        Phase::Dissipating { since_s } => frac(since_s, config.dissipation_s) as f32,
-        Phase::Unforming { since_s, from } => {
-            let back = ((now_s - since_s) / config.formation_s as f64).max(0.0);
+        Phase::Forming { since_s, over_s } | Phase::Dissipating { since_s, over_s } => {
+            frac(since_s, over_s) as f32
+        }
+        Phase::Unforming {
+            since_s,
+            from,
+            over_s,
+        } => {
+            let back = ((now_s - since_s) / over_s as f64).max(0.0);
             (from as f64 - back).clamp(0.0, 1.0) as f32
         }
         Phase::Steady | Phase::Gone => 1.0,
@@ -109,7 +144,7 @@ pub fn progress(phase: Phase, now_s: f64, config: &LifecycleConfig) -> f32 {
 /// The opacity factor of a sprite at `radius_fraction` in a cloud of phase `phase` at field time
 /// `now_s` (what [`apply`] sets; the renderer works the same out on the GPU).
 pub fn alpha_at(phase: Phase, now_s: f64, radius_fraction: f32, config: &LifecycleConfig) -> f32 {
-    let p = progress(phase, now_s, config);
+    let p = progress(phase, now_s);
     match phase {
         Phase::Steady => 1.0,
         Phase::Gone => 0.0,
@@ -133,22 +168,22 @@ pub fn apply(cloud: &mut Cloud, phase: Phase, now_s: f64, config: &LifecycleConf
             cloud.sprites.iter_mut().for_each(|s| s.alpha_morph = 0.0);
             Phase::Gone
         }
-        Phase::Forming { since_s } => {
-            let p = ((now_s - since_s) / config.formation_s as f64).clamp(0.0, 1.0) as f32;
+        Phase::Forming { .. } => {
+            let p = progress(phase, now_s);
             for s in &mut cloud.sprites {
                 s.alpha_morph = formation_alpha(p, s.radius_fraction, config);
             }
             if p >= 1.0 { Phase::Steady } else { phase }
         }
-        Phase::Dissipating { since_s } => {
-            let q = ((now_s - since_s) / config.dissipation_s as f64).clamp(0.0, 1.0) as f32;
+        Phase::Dissipating { .. } => {
+            let q = progress(phase, now_s);
             for s in &mut cloud.sprites {
                 s.alpha_morph = dissipation_alpha(q, s.radius_fraction, config);
             }
             if q >= 1.0 { Phase::Gone } else { phase }
         }
         Phase::Unforming { .. } => {
-            let p = progress(phase, now_s, config);
+            let p = progress(phase, now_s);
             for s in &mut cloud.sprites {
                 s.alpha_morph = formation_alpha(p, s.radius_fraction, config);
             }
@@ -232,7 +267,7 @@ mod tests {
         let c = config();
         let mut cloud = a_cloud();
         let (f, d) = (c.formation_s as f64, c.dissipation_s as f64);
-        let forming = Phase::Forming { since_s: 100.0 };
+        let forming = Phase::forming(100.0, &c);
         assert_eq!(apply(&mut cloud, forming, 100.0 + 0.3 * f, &c), forming);
         for s in &cloud.sprites {
             let want = formation_alpha(0.3, s.radius_fraction, &c);
@@ -253,7 +288,7 @@ mod tests {
         assert_eq!(apply(&mut cloud, forming, 99.0 + f, &c), forming);
         assert_eq!(apply(&mut cloud, forming, 100.0 + f, &c), Phase::Steady);
         assert!(cloud.sprites.iter().all(|s| s.alpha_morph == 1.0));
-        let dissipating = Phase::Dissipating { since_s: 100.0 };
+        let dissipating = Phase::dissipating(100.0, &c);
         assert_eq!(
             apply(&mut cloud, dissipating, 100.0 + 0.6 * d, &c),
             dissipating
@@ -279,34 +314,46 @@ mod tests {
     fn a_phase_ends_where_phase_at_moves_it_on() {
         let c = config();
         for phase in [
-            Phase::Forming { since_s: 100.0 },
-            Phase::Dissipating { since_s: 100.0 },
+            Phase::forming(100.0, &c),
+            Phase::dissipating(100.0, &c),
             Phase::Unforming {
                 since_s: 100.0,
                 from: 0.4,
+                over_s: c.formation_s,
+            },
+            // A drift's change, quicker than the lifecycle's.
+            Phase::Forming {
+                since_s: 100.0,
+                over_s: 45.0,
             },
         ] {
-            let end = ends_at(phase, &c).expect("a fading phase ends");
+            let end = ends_at(phase).expect("a fading phase ends");
             assert!(end > 100.0, "{phase:?} ends at {end}");
-            assert_eq!(phase_at(phase, end - 0.01, &c), phase, "{phase:?}");
-            assert_ne!(phase_at(phase, end + 1e-6, &c), phase, "{phase:?}");
+            assert_eq!(phase_at(phase, end - 0.01), phase, "{phase:?}");
+            assert_ne!(phase_at(phase, end + 1e-6), phase, "{phase:?}");
         }
-        assert_eq!(ends_at(Phase::Steady, &c), None);
-        assert_eq!(ends_at(Phase::Gone, &c), None);
+        assert_eq!(ends_at(Phase::Steady), None);
+        assert_eq!(ends_at(Phase::Gone), None);
     }
 
     #[test]
     fn progress_runs_from_the_phase_start_to_its_end() {
         let c = config();
         let (f, d) = (c.formation_s as f64, c.dissipation_s as f64);
-        let forming = Phase::Forming { since_s: 100.0 };
-        assert_eq!(progress(forming, 100.0, &c), 0.0);
-        assert_eq!(progress(forming, 100.0 + 0.25 * f, &c), 0.25);
-        assert_eq!(progress(forming, 100.0 + 2.0 * f, &c), 1.0);
-        let dissipating = Phase::Dissipating { since_s: 100.0 };
-        assert_eq!(progress(dissipating, 100.0 + 0.5 * d, &c), 0.5);
-        assert_eq!(progress(Phase::Steady, 0.0, &c), 1.0);
-        assert_eq!(progress(Phase::Gone, 0.0, &c), 1.0);
+        let forming = Phase::forming(100.0, &c);
+        assert_eq!(progress(forming, 100.0), 0.0);
+        assert_eq!(progress(forming, 100.0 + 0.25 * f), 0.25);
+        assert_eq!(progress(forming, 100.0 + 2.0 * f), 1.0);
+        let dissipating = Phase::dissipating(100.0, &c);
+        assert_eq!(progress(dissipating, 100.0 + 0.5 * d), 0.5);
+        assert_eq!(progress(Phase::Steady, 0.0), 1.0);
+        assert_eq!(progress(Phase::Gone, 0.0), 1.0);
+        // Each phase by its own span, whatever the lifecycle's.
+        let quick = Phase::Dissipating {
+            since_s: 100.0,
+            over_s: 40.0,
+        };
+        assert_eq!(progress(quick, 110.0), 0.25);
     }
 
     #[test]

@@ -214,13 +214,13 @@ pub fn lifecycle_strip(
         .iter()
         .map(|&p| {
             (
-                Phase::Forming { since_s: 0.0 },
+                Phase::forming(0.0, lifecycle),
                 p as f64 * lifecycle.formation_s as f64,
             )
         })
         .chain(dissipating.iter().map(|&q| {
             (
-                Phase::Dissipating { since_s: 0.0 },
+                Phase::dissipating(0.0, lifecycle),
                 q as f64 * lifecycle.dissipation_s as f64,
             )
         }))

@@ -591,10 +591,14 @@ fn ceilometer_round_trip(stations: usize, seed: u64, set: StationSet) -> RoundTr
         let is_calm = r
             .wind
             .is_none_or(|w| w.speed_kt.unwrap_or(0.0) <= 3.0 || w.dir_deg.is_none());
+        let mut missed = Vec::new();
         for (cover, base) in groups.iter().filter(|g| g.1 <= first_ovc) {
             let met = found
                 .iter()
                 .any(|l| near(l.base_ft, *base) && (class(l.cover) - class(*cover)).abs() <= 1);
+            if !met {
+                missed.push((*cover, *base));
+            }
             layers += 1;
             layers_met += usize::from(met);
             if is_calm {
@@ -607,22 +611,25 @@ fn ceilometer_round_trip(stations: usize, seed: u64, set: StationSet) -> RoundTr
             .find(|g| matches!(g.0, Cover::Bkn | Cover::Ovc))
             .map(|g| g.1);
         let ours = ceilometer::ceiling_ft(&found);
+        let ceiling_met = match (reported, ours) {
+            (None, None) => true,
+            (Some(a), Some(b)) => near(b, a),
+            _ => false,
+        };
         if std::env::var_os("SKYCAST_DEBUG_CEILOMETER").is_some() {
             eprintln!(
-                "{} {:?} -> {:?}",
+                "{} wind {:?} {:?} -> {:?} missed {missed:?}{}",
                 r.station,
+                r.wind.map(|w| (w.dir_deg, w.speed_kt)),
                 groups,
                 found
                     .iter()
                     .map(|l| format!("{} {:.2}", l.group(), l.seen_share))
-                    .collect::<Vec<_>>()
+                    .collect::<Vec<_>>(),
+                if ceiling_met { "" } else { " CEILING" }
             );
         }
-        ceilings_met += usize::from(match (reported, ours) {
-            (None, None) => true,
-            (Some(a), Some(b)) => near(b, a),
-            _ => false,
-        });
+        ceilings_met += usize::from(ceiling_met);
         done += 1;
     }
     RoundTrip {
@@ -675,7 +682,7 @@ impl RoundTrip {
 }
 
 /// The ceilometer's round trip at 40 cloudy stations of the real bulk file: measured 0.953 of
-/// the reported layers and 0.925 of the ceilings (the 200-station figures in the book:
+/// the reported layers and 0.950 of the ceilings (the 200-station figures in the book:
 /// `cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`). Held to 0.85 and
 /// 0.85 against a fall; what is missing is in the book's "What is still not right": 40 readings
 /// along a few kilometres of clouds a kilometre or two wide still toss a layer's cover a class
@@ -708,27 +715,32 @@ fn round_trip_over_four_seeds(set: StationSet) -> (f64, f64) {
 }
 
 /// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations, with the
-/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.946-0.962 of the layers
-/// and 0.945-0.975 of the ceilings (0.954 and 0.957 on average; the shipped seed's 0.952 and
-/// 0.960); at the stations with a calm or variable wind 60-65 of 69 layers, at the others
-/// 233-237 of 243 (`cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`).
+/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.942-0.958 of the layers
+/// and 0.950-0.975 of the ceilings (0.948 and 0.962 on average; the shipped seed's 0.942 and
+/// 0.970); at the stations with a calm or variable wind 59-64 of 69 layers, at the others
+/// 231-236 of 243 (`cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`;
+/// `SKYCAST_DEBUG_CEILOMETER=1` prints each station's read and what it missed). Since a change
+/// the drift brings forms while the air crosses a kilometre, the ceilings come back more often
+/// (0.957 before) and the layers over a broken one less (0.954): the lower layers are as closed
+/// as reported, so fewer readings see through them.
 #[test]
 #[ignore]
 fn ceilometer_round_trip_at_200() {
     let (layers, ceilings) = round_trip_over_four_seeds(StationSet::First);
-    assert!(layers >= 0.95 && ceilings >= 0.95);
+    assert!(layers >= 0.94 && ceilings >= 0.95);
 }
 
 /// [`ceilometer_round_trip_at_200`] over 200 other stations (the file's second report and
-/// every third after it), which no setting was measured on: 0.929-0.947 of the layers and
-/// 0.915-0.935 of the ceilings (0.938 and 0.928 on average; the shipped seed's 0.929 and 0.930);
-/// at the stations with a calm or variable wind 62-65 of 72 layers, at the others 236-242 of 251
+/// every third after it), which no setting was measured on: 0.932-0.947 of the layers and
+/// 0.920-0.955 of the ceilings (0.938 and 0.940 on average, 0.928 before the drift's quicker
+/// changes; the shipped seed's 0.932 and 0.935); at the stations with a calm or variable wind
+/// 63-65 of 72 layers, at the others 236-241 of 251
 /// (`cargo test --lib ceilometer_round_trip_at_200_other_stations -- --ignored --nocapture`).
 #[test]
 #[ignore]
 fn ceilometer_round_trip_at_200_other_stations() {
     let (layers, ceilings) = round_trip_over_four_seeds(StationSet::Second);
-    assert!(layers >= 0.92 && ceilings >= 0.91);
+    assert!(layers >= 0.93 && ceilings >= 0.93);
 }
 
 /// The clouds drift with the wind the air data reports at their height: over real reports (and

@@ -10,7 +10,6 @@ use std::collections::{HashMap, HashSet};
 use glam::{DVec2, DVec3};
 
 use crate::clouds::CloudField;
-use crate::clouds::config::LifecycleConfig;
 use crate::clouds::field::FieldBlock;
 use crate::clouds::lifecycle::{Phase, phase_at, progress};
 use crate::render::scene::{BandOffsets, BlockMotion, Fade, SkyBlock, SkyCloud};
@@ -169,7 +168,6 @@ impl BandClouds {
     fn walk(&mut self, offset_m: DVec3, h: &HandOver, update: &mut SkyUpdate) -> Option<Walk> {
         let living = self;
         let now = living.field.time_s();
-        let lifecycle = *living.field.lifecycle();
         // (Generations still waiting to be handed over are looked for every frame.)
         let same_members =
             living.membership == Some(living.field.membership()) && living.waiting.is_empty();
@@ -186,8 +184,8 @@ impl BandClouds {
             for &(serial, phase, shown) in &living.was_fading {
                 // The phase moves on with time alone (as `CloudField::advance` moves it); one
                 // that ended (gone) would have changed the membership.
-                let phase = phase_at(phase, now, &lifecycle);
-                let fade = fade_of(phase, None, now, &lifecycle);
+                let phase = phase_at(phase, now);
+                let fade = fade_of(phase, None, now);
                 // Told only when it has moved on a step: a weather change's thousand forming
                 // generations were a thousand look-ups of the sky's blocks every frame.
                 let step = fade_step(serial, fade);
@@ -242,7 +240,7 @@ impl BandClouds {
             if arrival.is_none() && !living.arriving.is_empty() {
                 living.arriving.remove(&fb.serial);
             }
-            let fade = fade_of(fb.phase, arrival, now, &lifecycle);
+            let fade = fade_of(fb.phase, arrival, now);
             if fade != Fade::Steady {
                 let step = fade_step(fb.serial, fade);
                 // Told only when it has moved on a step since the last frame, as when nothing
@@ -274,7 +272,6 @@ impl BandClouds {
     ) {
         let living = self;
         let now = living.field.time_s();
-        let lifecycle = *living.field.lifecycle();
         let (fade_in, ring_m) = (h.fade_in, h.ring_m);
         let count = walk.count;
         let joined = &mut update.came;
@@ -301,7 +298,7 @@ impl BandClouds {
                 living.arriving.insert(serial, now);
                 0.0
             });
-            let fade = fade_of(fb.phase, arrival, now, &lifecycle);
+            let fade = fade_of(fb.phase, arrival, now);
             if arrives {
                 // Its fade, kept with the others' (it was steady in the walk).
                 let step = fade_step(serial, fade);
@@ -381,18 +378,11 @@ pub(super) fn fade_step(serial: u64, fade: Fade) -> FadeStep {
 
 /// How a generation in `phase` is drawn at field time `now_s`: forming, dissipating or steady,
 /// or fading in by `arrival` (0..1) as it arrives.
-pub(super) fn fade_of(
-    phase: Phase,
-    arrival: Option<f32>,
-    now_s: f64,
-    lifecycle: &LifecycleConfig,
-) -> Fade {
+pub(super) fn fade_of(phase: Phase, arrival: Option<f32>, now_s: f64) -> Fade {
     match phase {
         Phase::Steady => arrival.map_or(Fade::Steady, Fade::Forming),
-        Phase::Forming { .. } | Phase::Unforming { .. } => {
-            Fade::Forming(progress(phase, now_s, lifecycle))
-        }
-        Phase::Dissipating { .. } => Fade::Dissipating(progress(phase, now_s, lifecycle)),
+        Phase::Forming { .. } | Phase::Unforming { .. } => Fade::Forming(progress(phase, now_s)),
+        Phase::Dissipating { .. } => Fade::Dissipating(progress(phase, now_s)),
         Phase::Gone => Fade::Dissipating(1.0),
     }
 }
@@ -415,12 +405,12 @@ mod tests {
     #[test]
     fn a_fade_is_handed_over_a_step_at_a_time_and_never_lags_a_step() {
         let lifecycle = crate::clouds::config::CloudsConfig::builtin().lifecycle;
-        let phase = Phase::Forming { since_s: 0.0 };
+        let phase = Phase::forming(0.0, &lifecycle);
         let frames = (f64::from(lifecycle.formation_s) * 60.0) as usize;
         let (mut told, mut shown, mut shown_step) = (0, Fade::Forming(0.0), (9, 0));
         for k in 0..=frames {
             let now = k as f64 / 60.0;
-            let fade = fade_of(phase_at(phase, now, &lifecycle), None, now, &lifecycle);
+            let fade = fade_of(phase_at(phase, now), None, now);
             let step = fade_step(7, fade);
             if step != shown_step {
                 (told, shown, shown_step) = (told + 1, fade, step);
@@ -440,7 +430,7 @@ mod tests {
     #[test]
     fn generations_that_fade_together_step_in_different_frames() {
         let lifecycle = crate::clouds::config::CloudsConfig::builtin().lifecycle;
-        let phase = Phase::Forming { since_s: 0.0 };
+        let phase = Phase::forming(0.0, &lifecycle);
         let serials: Vec<u64> = (1000..2000).collect();
         let mut last: Vec<FadeStep> = serials
             .iter()
@@ -450,7 +440,7 @@ mod tests {
         let (mut most, mut all) = (0, 0);
         for k in 1..=600 {
             let now = k as f64 / 10.0;
-            let fade = fade_of(phase_at(phase, now, &lifecycle), None, now, &lifecycle);
+            let fade = fade_of(phase_at(phase, now), None, now);
             let mut told = 0;
             for (s, l) in serials.iter().zip(&mut last) {
                 let step = fade_step(*s, fade);

@@ -498,12 +498,14 @@ impl World {
         for (velocity, field) in velocities.iter_mut().zip(self.living_fields()) {
             *velocity = self.drift_velocity(ground_m, field.band());
         }
-        let weather_field = &self.field;
+        let (weather_field, version) = (&self.field, self.field_version);
         if let Some(living) = self.living.as_mut() {
             for (band, velocity) in living.bands.iter_mut().zip(velocities) {
                 band.field.set_drift_velocity(velocity);
+                // With the field's version, as a flight asks: a block of air asked again at
+                // the same version drifted onto other ground (quicker to change).
                 band.field
-                    .update(ground_m, &|i| weather_field.block_weather(i));
+                    .update_for(ground_m, &|i| weather_field.block_weather(i), version);
                 band.field.wait_for_pending();
                 band.field.advance(dt_s);
             }
