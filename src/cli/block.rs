@@ -60,7 +60,7 @@ pub fn run(args: &BlockArgs) -> anyhow::Result<()> {
         Some(path) => CloudsConfig::load(&path)?,
         None => CloudsConfig::builtin(),
     };
-    let loaded = load(&args.weather, None, args.stations.as_deref(), None, None)?;
+    let loaded = load(&args.weather, None, args.stations.as_deref(), None, None)?.usable()?;
     let (lat, lon) = args.at;
     let at = at_block(&loaded, lat, lon);
     let block = generate_block(at.block, &at.weather, config.field.seed, &types);

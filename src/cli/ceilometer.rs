@@ -76,7 +76,7 @@ pub fn run(args: &CeilometerArgs) -> anyhow::Result<()> {
     if !(args.every_s >= 1.0 && args.every_s <= args.minutes * 60.0) {
         bail!("--every-s must be at least 1 and at most --minutes");
     }
-    let loaded = load(&args.file, None, args.stations.as_deref(), None, None)?;
+    let loaded = load(&args.file, None, args.stations.as_deref(), None, None)?.usable()?;
     let (lat, lon) = args.at;
     let (frame, at) = ceilometer::frame_centred_on(lat, lon);
     let field = loaded.input.field(frame, &loaded.settings, &loaded.rule);

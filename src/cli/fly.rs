@@ -136,7 +136,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         args.stations.as_deref(),
         None,
         None,
-    )?;
+    )?
+    .usable()?;
     let start_unix_s = time_or_default(args.time)?;
     super::model::warn_if_far_in_time(&loaded.input, start_unix_s);
     let field = loaded

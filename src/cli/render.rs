@@ -317,7 +317,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         args.stations.as_deref(),
         None,
         None,
-    )?;
+    )?
+    .usable()?;
     let unix_s = time_or_default(args.time)?;
     super::model::warn_if_far_in_time(&loaded.input, unix_s);
     let field = loaded

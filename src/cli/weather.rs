@@ -228,6 +228,18 @@ pub struct Loaded {
     pub rule: CloudTypeRule,
 }
 
+impl Loaded {
+    /// Itself if it holds weather to draw a sky from: a report file none of whose reports could
+    /// be placed or decoded is an error naming what was skipped (a command that draws would
+    /// show an empty sky; `skycast weather` lists such a file instead).
+    pub fn usable(self) -> anyhow::Result<Self> {
+        Ok(Self {
+            input: self.input.usable()?,
+            ..self
+        })
+    }
+}
+
 /// Loads the file (with the station table) and the model under it if `model` names one, the rule
 /// and the settings.
 pub fn load(

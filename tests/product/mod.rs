@@ -91,12 +91,62 @@ fn a_config_dir_replaces_the_built_in_files_by_name() {
         assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
         assert!(stderr(&o).contains("weather_field.toml"), "{}", stderr(&o));
     }
+    // The ceilometer reads the folder's clouds settings, as `fly` does.
+    std::fs::remove_file(dir.join("weather_field.toml")).expect("remove");
+    std::fs::write(dir.join("clouds.toml"), "[lifecycle]\nformation_s = -1\n").expect("write");
+    let o = skycast_in(
+        &dir,
+        &[
+            "--config-dir",
+            dir_arg,
+            "ceilometer",
+            &bulk_file(),
+            "--at",
+            "51.47,-0.46",
+            "--minutes",
+            "1",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("clouds.toml"), "{}", stderr(&o));
+    std::fs::remove_file(dir.join("clouds.toml")).expect("remove");
     // A file the folder lacks stays built in; a folder that is not there is refused.
     let o = skycast_in(&dir, &args, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let o = skycast_in(&dir, &["--config-dir", "no/such/folder", "types"], &[]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("not a folder"), "{}", stderr(&o));
+}
+
+/// A report file none of whose reports can be placed (a station the table lacks) is one error
+/// naming the file and why, with exit 2, for every command that draws from it: an empty sky
+/// read like a clear report (the ceilometer read `SKC`).
+#[test]
+fn a_report_file_that_places_no_report_is_one_clear_error() {
+    let dir = elsewhere("unplaced");
+    let file = dir.join("unknown.txt");
+    std::fs::write(
+        &file,
+        "XXQQ 272215Z AUTO 23023KT 10SM OVC095 01/M13 A2935\n",
+    )
+    .expect("write");
+    let file = file.to_str().expect("utf-8 temp path");
+    for args in [
+        &["ceilometer", file, "--at", "44.67,-74.94", "--minutes", "1"][..],
+        &["block", "--weather", file, "--at", "44.67,-74.94"][..],
+    ] {
+        let o = skycast_in(&dir, args, &[]);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert!(
+            err.contains("unknown.txt: no usable report") && err.contains("without a position"),
+            "{args:?}: {err}"
+        );
+    }
+    // `skycast weather` lists such a file rather than refusing it.
+    let o = skycast_in(&dir, &["weather", file], &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 /// Mesa's OpenGL driver (llvmpipe through EGL) cannot keep the host's depth as a read-only

@@ -126,7 +126,8 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         args.stations.as_deref(),
         None,
         None,
-    )?;
+    )?
+    .usable()?;
     let field = loaded
         .input
         .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);
