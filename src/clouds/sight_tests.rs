@@ -282,3 +282,24 @@ fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
     assert_eq!(parts, [11, 12, 13, 10]);
     check(&mut sight, &left, &gone, &mut rand, 30_000);
 }
+
+/// The cells' heights rounded to `f32` hold the heights they round: the bottom at or below,
+/// the top at or above, one `f32` step at most away (so a cell the walk passes over on them is
+/// one it passes over on its own heights), the infinities of an empty cell kept.
+#[test]
+fn a_cells_rounded_heights_hold_its_own() {
+    let mut rand = xorshift(0x1234_5678_9abc_def1u64);
+    for k in 0..20_000 {
+        let x = match k % 4 {
+            0 => (rand() - 0.3) * 20_000.0,
+            1 => (rand() * 20_000.0).round(),
+            2 => f64::from((rand() * 15_000.0) as f32),
+            _ => (rand() - 0.5) * 1e-3,
+        };
+        let (down, up) = (down_f32(x), up_f32(x));
+        assert!(f64::from(down) <= x && x <= f64::from(up), "{x}");
+        assert!(f64::from(down.next_up()) > x && f64::from(up.next_down()) < x || down == up);
+    }
+    assert_eq!(down_f32(f64::INFINITY), f32::INFINITY);
+    assert_eq!(up_f32(f64::NEG_INFINITY), f32::NEG_INFINITY);
+}
