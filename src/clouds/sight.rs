@@ -328,6 +328,7 @@ impl FieldSight {
             walk.best = before;
         }
         let cell_m = self.cell_m;
+        let cull = Cull::new(a, b);
         let (tiles, heads) = (&mut self.tiles, &mut self.heads);
         self.top
             .walk(a, b, (0.0, 1.0), walk.horizon(), |list, _, _| {
@@ -338,10 +339,10 @@ impl FieldSight {
                     }
                     head.walked = stamp;
                     // The grid cell lists every tile its square overlaps: only one whose bounds
-                    // the segment enters (soon enough) is built and walked.
-                    match slab(a, b, head.lo_m, head.hi_m) {
-                        Some((t0, _)) if walk.whole || t0 < walk.best => {}
-                        _ => continue,
+                    // the segment may enter (soon enough) is built and walked (its parts test
+                    // their own bounds, which it holds, exactly).
+                    if !cull.may_enter(head.lo_m, head.hi_m, walk.horizon()) {
+                        continue;
                     }
                     let tile = &mut tiles[t as usize];
                     tile.build(cell_m);
@@ -488,6 +489,53 @@ impl SightBoxes {
                 walk.horizon()
             });
         }
+    }
+}
+
+/// A segment's reciprocal direction, for a cheap test of the bounds of a tile it may enter:
+/// the slab test with no division ([`slab`]'s six were most of a tile passed over), passing
+/// over only bounds the slab test says it misses, or enters at or after a horizon.
+#[derive(Debug, Clone, Copy)]
+struct Cull {
+    a: DVec3,
+    /// Per axis: 1 over the segment's extent, or none where the slab test takes it as level.
+    inverse: [Option<f64>; 3],
+}
+
+impl Cull {
+    /// How far the t of the entry and exit may lie from the slab test's (a few ulps of numbers
+    /// at most 1; far more than that).
+    const SLACK: f64 = 1e-9;
+
+    fn new(a: DVec3, b: DVec3) -> Self {
+        let d = b - a;
+        // Level as `slab` takes it.
+        let inverse = [0, 1, 2].map(|k| (d[k].abs() >= 1e-12).then(|| 1.0 / d[k]));
+        Self { a, inverse }
+    }
+
+    /// Whether the segment may enter the box `lo..hi` before t = `horizon`: false only where
+    /// [`slab`] finds it misses the box, or enters it at or after `horizon`.
+    fn may_enter(&self, lo: DVec3, hi: DVec3, horizon: f64) -> bool {
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for k in 0..3 {
+            let Some(inverse) = self.inverse[k] else {
+                if self.a[k] < lo[k] || self.a[k] > hi[k] {
+                    return false;
+                }
+                continue;
+            };
+            let (u, v) = ((lo[k] - self.a[k]) * inverse, (hi[k] - self.a[k]) * inverse);
+            let (near, far) = if u < v { (u, v) } else { (v, u) };
+            // Plain comparisons (a NaN leaves the bounds as they were, as `f64::max` does).
+            if near > t0 {
+                t0 = near;
+            }
+            if far < t1 {
+                t1 = far;
+            }
+        }
+        t0 <= t1 + Self::SLACK && t0 - Self::SLACK < horizon
     }
 }
 
@@ -712,9 +760,13 @@ impl BoxGrid {
             let last = next[k] >= t1 || !(0..n[k]).contains(&(cell[k] + step[k]));
             let leave = if last { f64::INFINITY } else { next[k] };
             let c = cell[1] as usize * self.nx + cell[0] as usize;
-            // The heights the segment has over the cell (a metre's margin, as the footprints).
-            let (z0, z1) = (a.z + dz * enter.max(t0), a.z + dz * leave.min(t1));
-            let (below, above) = (z0.max(z1) + 1.0, z0.min(z1) - 1.0);
+            // The heights the segment has over the cell (a metre's margin, as the footprints),
+            // on plain comparisons: `f64::max` and `min` (NaN-aware) were a tenth of the walk,
+            // and none of these is NaN (a NaN height is passed over by neither).
+            let z0 = a.z + dz * if enter > t0 { enter } else { t0 };
+            let z1 = a.z + dz * if leave < t1 { leave } else { t1 };
+            let (low, high) = if z0 < z1 { (z0, z1) } else { (z1, z0) };
+            let (below, above) = (high + 1.0, low - 1.0);
             // Passed over on the rounded heights first: what they pass over, the cell's own do.
             let [bottom, top] = self.spans_m[c];
             if !(below < f64::from(bottom) || above > f64::from(top)) {
