@@ -14,7 +14,7 @@ use glam::DVec3;
 
 use super::{CoreRuns, SpriteCore, above_floor, floor_slab, merge, unturned_core};
 use crate::clouds::block::Cloud;
-use crate::clouds::boxes::slab;
+use crate::clouds::boxes::{Cull, slab};
 
 /// What a line of sight asks of every core it may pass: its centre and the bound of its reach
 /// ([`SpriteCore::reach_bound_m`]), metres from the cloud's centre.
@@ -113,12 +113,15 @@ pub(crate) fn segment_in_table(
     let d = b - a;
     let dd = d.length_squared().max(1e-12);
     let mut from = 0;
+    let cull = Cull::new(a, b);
     for &(lo, hi, to) in &table.groups {
         let group = from as usize..to as usize;
         from = to;
         // A run the segment passes by holds no core it enters (each lies within its reach of
-        // its centre, and the run's bounds hold those spheres and a metre).
-        if table.bounded && slab(a, b, lo, hi).is_none() {
+        // its centre, and the run's bounds hold those spheres and a metre); passed over only
+        // where the slab test would (a run it nearly grazes is looked at, and its cores are
+        // passed over on their own distances).
+        if table.bounded && !cull.may_enter(lo, hi, f64::INFINITY) {
             continue;
         }
         for (near, (core, reach)) in table.near[group.clone()].iter().zip(&table.cores[group]) {

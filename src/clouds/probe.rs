@@ -115,12 +115,11 @@ impl BlockBoxes {
 }
 
 impl BoxCache {
-    /// Forgets the block lists when the field's membership changed, and the tiles too when it
-    /// is another field.
-    fn prune(&self, field: &CloudField) {
-        let Ok(mut state) = self.state.lock() else {
-            return;
-        };
+    /// The cache's state for a query on `field`, locked: the block lists forgotten when the
+    /// field's membership changed, and the tiles too when it is another field. (Pruned by the
+    /// query that reads it, under the one lock: a line of sight per band took two.)
+    fn lock(&self, field: &CloudField) -> Option<std::sync::MutexGuard<'_, CacheState>> {
+        let mut state = self.state.lock().ok()?;
         let key = (std::ptr::from_ref(field) as usize, field.membership());
         if state.key != Some(key) {
             if state.key.is_none_or(|k| k.0 != key.0) {
@@ -130,6 +129,7 @@ impl BoxCache {
             state.blocks.clear();
             state.sight_behind = true;
         }
+        Some(state)
     }
 }
 
@@ -197,7 +197,6 @@ impl<'a> CloudProbe<'a> {
         cache: &'a BoxCache,
         settings: &'a InCloudAirSettings,
     ) -> Self {
-        cache.prune(field);
         Self {
             field,
             cache,
@@ -268,7 +267,7 @@ impl<'a> CloudProbe<'a> {
         let mut out = CloudsAtPoint::default();
         let mut nearest = f64::INFINITY;
         let mut nearest_cb = f64::INFINITY;
-        let Ok(mut guard) = self.cache.state.lock() else {
+        let Some(mut guard) = self.cache.lock(self.field) else {
             return out;
         };
         let state = &mut *guard;
@@ -404,9 +403,7 @@ impl<'a> CloudProbe<'a> {
         let sigma = 3.0 / f64::from(self.settings.visibility_m);
         let cell_m = self.settings.grid_cell_m;
         let field = self.field;
-        let Ok(mut guard) = self.cache.state.lock() else {
-            return None;
-        };
+        let mut guard = self.cache.lock(self.field)?;
         let state = &mut *guard;
         if state.sight.as_ref().is_none_or(|s| s.cell_m() != cell_m) {
             state.sight = Some(FieldSight::new(cell_m));

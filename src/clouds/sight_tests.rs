@@ -282,3 +282,63 @@ fn tiles_meet_what_every_box_meets_and_a_change_builds_only_its_tiles() {
     assert_eq!(parts, [11, 12, 13, 10]);
     check(&mut sight, &left, &gone, &mut rand, 30_000);
 }
+
+/// The cells' heights rounded to `f32` hold the heights they round: the bottom at or below,
+/// the top at or above, one `f32` step at most away (so a cell the walk passes over on them is
+/// one it passes over on its own heights), the infinities of an empty cell kept.
+#[test]
+fn a_cells_rounded_heights_hold_its_own() {
+    let mut rand = xorshift(0x1234_5678_9abc_def1u64);
+    for k in 0..20_000 {
+        let x = match k % 4 {
+            0 => (rand() - 0.3) * 20_000.0,
+            1 => (rand() * 20_000.0).round(),
+            2 => f64::from((rand() * 15_000.0) as f32),
+            _ => (rand() - 0.5) * 1e-3,
+        };
+        let (down, up) = (down_f32(x), up_f32(x));
+        assert!(f64::from(down) <= x && x <= f64::from(up), "{x}");
+        assert!(f64::from(down.next_up()) > x && f64::from(up.next_down()) < x || down == up);
+    }
+    assert_eq!(down_f32(f64::INFINITY), f32::INFINITY);
+    assert_eq!(up_f32(f64::NEG_INFINITY), f32::NEG_INFINITY);
+}
+
+/// The cheap test of a tile's bounds passes over only what the slab test does: on 200,000
+/// random boxes and segments (level, upright and axis-aligned ones among them, some ending on
+/// a box's face), every box the slab test finds entered before the horizon may be entered,
+/// and most it finds missed are passed over.
+#[test]
+fn the_cheap_bounds_test_passes_over_only_what_the_slab_test_does() {
+    let mut rand = xorshift(0x5851_f42d_4c95_7f2du64);
+    let (mut missed, mut passed_over) = (0, 0);
+    for k in 0..200_000 {
+        let lo = DVec3::new(rand() * 20_000.0, rand() * 20_000.0, rand() * 5_000.0);
+        let hi = lo + DVec3::new(rand() * 8_000.0, rand() * 8_000.0, rand() * 3_000.0);
+        let a = DVec3::new(rand() * 30_000.0, rand() * 30_000.0, rand() * 8_000.0) - 5_000.0;
+        let mut b = a + DVec3::new(
+            (rand() - 0.5) * 30_000.0,
+            (rand() - 0.5) * 30_000.0,
+            (rand() - 0.5) * 8_000.0,
+        );
+        match k % 6 {
+            0 => b.z = a.z,
+            1 => b = a.with_z(a.z + 5_000.0),
+            2 => b.y = a.y,
+            // Ending on the box's face: entered at t = 1 to the bit, or nearly.
+            3 => b.x = lo.x,
+            _ => {}
+        }
+        let horizon = if k % 3 == 0 { f64::INFINITY } else { rand() };
+        let cull = Cull::new(a, b);
+        let may = cull.may_enter(lo, hi, horizon);
+        match slab(a, b, lo, hi) {
+            Some((t0, _)) if t0 < horizon => assert!(may, "{k}: {a} to {b}, {lo}..{hi}"),
+            _ => {
+                missed += 1;
+                passed_over += usize::from(!may);
+            }
+        }
+    }
+    assert!(passed_over * 100 > missed * 99, "{passed_over} of {missed}");
+}
