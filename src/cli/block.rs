@@ -11,7 +11,7 @@ use skycast::clouds::preview::{self, PreviewSettings};
 use skycast::clouds::{CloudBlock, CloudTypes, CloudsConfig, TextureSheet, generate_block};
 use skycast::weather::BlockWeather;
 
-use super::weather::{at_block, load, parse_lat_lon};
+use super::weather::{Place, at_block, load, parse_place};
 
 /// Flags of `skycast block`.
 #[derive(Debug, Args)]
@@ -23,9 +23,10 @@ pub struct BlockArgs {
     /// (default: NOAA's table built into skycast).
     #[arg(long)]
     pub stations: Option<PathBuf>,
-    /// Where: latitude,longitude in degrees (the block whose south-west corner is there).
-    #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
-    pub at: (f64, f64),
+    /// Where: latitude,longitude in degrees (the block whose south-west corner is there), or a
+    /// station's ICAO identifier.
+    #[arg(long, value_name = "LAT,LON|ICAO", value_parser = parse_place, allow_hyphen_values = true)]
+    pub at: Place,
     /// Cloud types file (default: the shipped config/cloud_types.toml).
     #[arg(long)]
     pub types: Option<PathBuf>,
@@ -61,7 +62,7 @@ pub fn run(args: &BlockArgs) -> anyhow::Result<()> {
         None => CloudsConfig::builtin(),
     };
     let loaded = load(&args.weather, None, args.stations.as_deref(), None, None)?.usable()?;
-    let (lat, lon) = args.at;
+    let (lat, lon) = args.at.resolve(&loaded, args.stations.as_deref())?;
     let at = at_block(&loaded, lat, lon);
     let block = generate_block(at.block, &at.weather, config.field.seed, &types);
     if args.json {

@@ -13,7 +13,7 @@ use skycast::flight::ceilometer::{self, Layer, Reading};
 use skycast::flight::{World, WorldSettings};
 use skycast::weather::BlockIndex;
 
-use super::weather::{WindsAloftArgs, load, parse_lat_lon};
+use super::weather::{Place, WindsAloftArgs, load, parse_place};
 
 /// Flags of `skycast ceilometer`.
 #[derive(Debug, Args)]
@@ -21,9 +21,10 @@ pub struct CeilometerArgs {
     /// The weather file: metars.cache.csv, a NOAA cycle file, one METAR a line, or a weather
     /// theme (`.toml`).
     pub file: PathBuf,
-    /// Where the ceilometer stands: latitude,longitude in degrees.
-    #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
-    pub at: (f64, f64),
+    /// Where the ceilometer stands: latitude,longitude in degrees, or a station's ICAO
+    /// identifier (where the file places its report).
+    #[arg(long, value_name = "LAT,LON|ICAO", value_parser = parse_place, allow_hyphen_values = true)]
+    pub at: Place,
     /// How long it reads, minutes.
     #[arg(long, default_value_t = 20.0)]
     pub minutes: f64,
@@ -77,7 +78,7 @@ pub fn run(args: &CeilometerArgs) -> anyhow::Result<()> {
         bail!("--every-s must be at least 1 and at most --minutes");
     }
     let loaded = load(&args.file, None, args.stations.as_deref(), None, None)?.usable()?;
-    let (lat, lon) = args.at;
+    let (lat, lon) = args.at.resolve(&loaded, args.stations.as_deref())?;
     let (frame, at) = ceilometer::frame_centred_on(lat, lon);
     let field = loaded.input.field(frame, &loaded.settings, &loaded.rule);
     let ground_m = f64::from(

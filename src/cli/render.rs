@@ -13,7 +13,7 @@ use skycast::shading::{ShadingModel, TimeOfDayTable, sun_position};
 use skycast::weather::{LocalFrame, METRES_PER_FOOT, WeatherField};
 
 use super::defaults;
-use super::weather::{Loaded, load, parse_lat_lon};
+use super::weather::{Loaded, Place, load, parse_place};
 
 /// Flags of `skycast render`.
 #[derive(Debug, Args)]
@@ -29,9 +29,9 @@ pub struct RenderArgs {
     /// (default: NOAA's table built into skycast).
     #[arg(long)]
     pub stations: Option<PathBuf>,
-    /// Camera latitude,longitude, degrees.
-    #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
-    pub at: (f64, f64),
+    /// Camera latitude,longitude, degrees, or a station's ICAO identifier.
+    #[arg(long, value_name = "LAT,LON|ICAO", value_parser = parse_place, allow_hyphen_values = true)]
+    pub at: Place,
     /// Camera altitude, feet above mean sea level.
     #[arg(long, allow_hyphen_values = true)]
     pub alt_ft: f64,
@@ -299,7 +299,6 @@ fn stretch(values: &[f32], from: (u32, u32), to: (u32, u32)) -> Vec<f32> {
 
 /// Runs `skycast render`.
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
-    let (lat, lon) = args.at;
     if !(-2_000.0..=100_000.0).contains(&args.alt_ft) {
         anyhow::bail!("--alt-ft {} is outside -2000..=100000 feet", args.alt_ft);
     }
@@ -319,6 +318,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         None,
     )?
     .usable()?;
+    let (lat, lon) = args.at.resolve(&loaded, args.stations.as_deref())?;
     let unix_s = time_or_default(args.time)?;
     super::model::warn_if_far_in_time(&loaded.input, unix_s);
     let field = loaded

@@ -43,9 +43,10 @@ pub struct WeatherArgs {
     /// (default: NOAA's table built into skycast).
     #[arg(long)]
     pub stations: Option<PathBuf>,
-    /// Also print the interpolated weather of the block at this latitude,longitude (degrees).
-    #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
-    pub at: Option<(f64, f64)>,
+    /// Also print the interpolated weather of the block at this latitude,longitude (degrees),
+    /// or at a station's ICAO identifier.
+    #[arg(long, value_name = "LAT,LON|ICAO", value_parser = parse_place, allow_hyphen_values = true)]
+    pub at: Option<Place>,
     /// With `--at`: the air data at this altitude, feet above mean sea level.
     #[arg(long, value_name = "FT", requires = "at", allow_hyphen_values = true)]
     pub alt_ft: Option<f64>,
@@ -95,6 +96,58 @@ impl WindsAloftArgs {
             },
             defaults::station_table(stations)?,
         )))
+    }
+}
+
+/// Where `--at` puts a command: a latitude and longitude, or a station by its ICAO identifier.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Place {
+    /// Degrees north and east.
+    LatLon(f64, f64),
+    /// An ICAO identifier, upper case.
+    Station(String),
+}
+
+/// `LAT,LON` in degrees, or a station's ICAO identifier (`KOSC`).
+pub fn parse_place(text: &str) -> Result<Place, String> {
+    if text.contains(',') {
+        let (lat, lon) = parse_lat_lon(text)?;
+        return Ok(Place::LatLon(lat, lon));
+    }
+    let id = text.trim();
+    if (3..=4).contains(&id.len()) && id.chars().all(|c| c.is_ascii_alphanumeric()) {
+        return Ok(Place::Station(id.to_ascii_uppercase()));
+    }
+    Err(format!(
+        "`{text}` is neither LAT,LON (for example 51.85,-8.48) nor a station's ICAO identifier \
+         (EGLL)"
+    ))
+}
+
+impl Place {
+    /// Latitude and longitude, degrees: a station's as the loaded file places its report
+    /// (where its ceilometer stood), else as the station table (`stations`, or the built-in
+    /// one) gives it.
+    pub fn resolve(&self, loaded: &Loaded, stations: Option<&Path>) -> anyhow::Result<(f64, f64)> {
+        let id = match self {
+            Place::LatLon(lat, lon) => return Ok((*lat, *lon)),
+            Place::Station(id) => id,
+        };
+        let in_file = loaded
+            .input
+            .reports()
+            .and_then(|file| file.reports.iter().find(|r| r.report.station == *id));
+        if let Some(placed) = in_file {
+            return Ok((placed.position.latitude_deg, placed.position.longitude_deg));
+        }
+        let table = defaults::station_table(stations)?;
+        match table.get(id) {
+            Some(s) => Ok((s.latitude_deg, s.longitude_deg)),
+            None => anyhow::bail!(
+                "--at {id}: no such station in the file or the station table (give LAT,LON, or \
+                 a table with --stations)"
+            ),
+        }
     }
 }
 
@@ -295,15 +348,19 @@ pub fn run(args: &WeatherArgs) -> anyhow::Result<()> {
         args.rule.as_deref(),
         args.field_settings.as_deref(),
     )?;
-    let at = args.at.map(|(lat, lon)| at_block(&loaded, lat, lon));
-    let cells = match (args.at, args.cells_km) {
+    let at_deg = match &args.at {
+        Some(place) => Some(place.resolve(&loaded, args.stations.as_deref())?),
+        None => None,
+    };
+    let at = at_deg.map(|(lat, lon)| at_block(&loaded, lat, lon));
+    let cells = match (at_deg, args.cells_km) {
         (Some((lat, lon)), Some(km)) => Some(cells_near(&loaded, lat, lon, km)),
         _ => None,
     };
     if args.aloft.winds_aloft.is_some() && args.alt_ft.is_none() {
         anyhow::bail!("--winds-aloft is for the air data: give --at and --alt-ft with it");
     }
-    let air = match (args.at, args.alt_ft) {
+    let air = match (at_deg, args.alt_ft) {
         (Some((lat, lon)), Some(alt_ft)) => {
             let settings: AirSettings =
                 defaults::settings(args.air_settings.as_deref(), "air.toml")?;

@@ -149,6 +149,39 @@ fn a_report_file_that_places_no_report_is_one_clear_error() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
+/// `--at` takes a station's ICAO identifier as well as LAT,LON: the ceilometer stands where the
+/// file places the station's report, and an identifier no one knows is one clear error.
+#[test]
+fn at_takes_a_station_identifier() {
+    let dir = elsewhere("at-station");
+    let read = |at: &str| {
+        let o = skycast_in(
+            &dir,
+            &[
+                "ceilometer",
+                &bulk_file(),
+                "--at",
+                at,
+                "--minutes",
+                "2",
+                "--json",
+            ],
+            &[],
+        );
+        assert!(o.status.success(), "{at}: {}", stderr(&o));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    // KPTD's line of the bulk file: 44.6757,-74.9469.
+    assert_eq!(read("kptd"), read("44.6757,-74.9469"));
+    let o = skycast_in(&dir, &["ceilometer", &bulk_file(), "--at", "ZZZZ"], &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--at ZZZZ: no such station"),
+        "{}",
+        stderr(&o)
+    );
+}
+
 /// Mesa's OpenGL driver (llvmpipe through EGL) cannot keep the host's depth as a read-only
 /// attachment while sampling it: the sky says so in one line and exits 2. Where a backend can
 /// draw the sky, the frame is written.

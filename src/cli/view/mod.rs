@@ -41,9 +41,10 @@ pub struct ViewArgs {
     /// (default: NOAA's table built into skycast).
     #[arg(long)]
     pub stations: Option<PathBuf>,
-    /// Start latitude,longitude, degrees (the middle of the area flown).
-    #[arg(long, value_name = "LAT,LON", value_parser = super::weather::parse_lat_lon, allow_hyphen_values = true)]
-    pub at: (f64, f64),
+    /// Start latitude,longitude, degrees (the middle of the area flown), or a station's ICAO
+    /// identifier.
+    #[arg(long, value_name = "LAT,LON|ICAO", value_parser = super::weather::parse_place, allow_hyphen_values = true)]
+    pub at: super::weather::Place,
     /// Start altitude, feet above mean sea level.
     #[arg(long, default_value_t = 3000.0, allow_hyphen_values = true)]
     pub alt_ft: f64,
@@ -104,7 +105,6 @@ without one, `skycast render` draws one frame and `skycast fly` a scripted fligh
 
 /// Runs `skycast view`.
 pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
-    let (lat, lon) = args.at;
     if !(-2_000.0..=100_000.0).contains(&args.alt_ft) {
         anyhow::bail!("--alt-ft {} is outside -2000..=100000 feet", args.alt_ft);
     }
@@ -128,6 +128,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         None,
     )?
     .usable()?;
+    let (lat, lon) = args.at.resolve(&loaded, args.stations.as_deref())?;
     let field = loaded
         .input
         .field(LocalFrame::new(lat, lon), &loaded.settings, &loaded.rule);
