@@ -715,26 +715,25 @@ fn round_trip_over_four_seeds(set: StationSet) -> (f64, f64) {
 }
 
 /// [`a_ceilometer_under_the_drifting_clouds_reads_the_reports_back`] at 200 stations, with the
-/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.942-0.958 of the layers
-/// and 0.950-0.975 of the ceilings (0.948 and 0.962 on average; the shipped seed's 0.942 and
-/// 0.970); at the stations with a calm or variable wind 59-64 of 69 layers, at the others
-/// 231-236 of 243 (`cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`;
-/// `SKYCAST_DEBUG_CEILOMETER=1` prints each station's read and what it missed). Since a change
-/// the drift brings forms while the air crosses a kilometre, the ceilings come back more often
-/// (0.957 before) and the layers over a broken one less (0.954): the lower layers are as closed
-/// as reported, so fewer readings see through them.
+/// clouds of four seeds (a few minutes): the seeds' clouds give back 0.946-0.958 of the layers
+/// and 0.950-0.975 of the ceilings (0.954 and 0.962 on average; the shipped seed's 0.955 and
+/// 0.970); at the stations with a calm or variable wind 60-65 of 69 layers, at the others
+/// 233-236 of 243 (`cargo test --lib ceilometer_round_trip_at_200 -- --ignored --nocapture`;
+/// `SKYCAST_DEBUG_CEILOMETER=1` prints each station's read and what it missed). Since a run of
+/// three BKN layers steps down from 6.75 oktas seen from below (5.25, 6, 6.75, where it was 6,
+/// 6.75 and 7), its third layer comes back more often (0.948 before).
 #[test]
 #[ignore]
 fn ceilometer_round_trip_at_200() {
     let (layers, ceilings) = round_trip_over_four_seeds(StationSet::First);
-    assert!(layers >= 0.94 && ceilings >= 0.95);
+    assert!(layers >= 0.95 && ceilings >= 0.95);
 }
 
 /// [`ceilometer_round_trip_at_200`] over 200 other stations (the file's second report and
-/// every third after it), which no setting was measured on: 0.932-0.947 of the layers and
-/// 0.920-0.955 of the ceilings (0.938 and 0.940 on average, 0.928 before the drift's quicker
-/// changes; the shipped seed's 0.932 and 0.935); at the stations with a calm or variable wind
-/// 63-65 of 72 layers, at the others 236-241 of 251
+/// every third after it), to check what was tuned on the first: 0.935-0.947 of the layers and
+/// 0.915-0.955 of the ceilings (0.941 and 0.938 on average, 0.938 and 0.940 before BKN runs
+/// stepped down; the shipped seed's 0.935 and 0.935); at the stations with a calm or variable wind 63-66 of 72 layers, at the others
+/// 236-243 of 251
 /// (`cargo test --lib ceilometer_round_trip_at_200_other_stations -- --ignored --nocapture`).
 #[test]
 #[ignore]

@@ -288,17 +288,23 @@ fn sky_layers(r: &Report, settings: &FieldSettings) -> Option<Vec<StationLayer>>
     Some(layers)
 }
 
-/// A run of plain layers reported with the same FEW or SCT cover (`SCT033 SCT040 SCT047`):
-/// a METAR's cover is the sky seen from below at each base, and the class's drawn cover
-/// (`[oktas]`, the top of FEW and SCT) leaves nothing for the upper ones to add, yet the
-/// station's ceilometer met each of their bases. Going down the run, each lower layer is seen
-/// `[layers] min_seen_added_oktas` less than the one above, never below halfway to the class
-/// under it, so that each adds what a ceilometer meets through the gaps. (A BKN run has room
-/// up to 7 oktas above its 6: the layers' own rule adds it there.)
+/// A run of plain layers reported with the same cover (`SCT033 SCT040 SCT047`, `BKN025
+/// BKN031 BKN039`): a METAR's cover is the sky seen from below at each base, and the class's
+/// drawn cover (`[oktas]`) leaves the upper ones nothing to add, yet the station's ceilometer
+/// met each of their bases through the gaps of the ones below.
+/// - FEW and SCT: going down the run, each lower layer is seen `[layers] min_seen_added_oktas`
+///   less than the one above, never below halfway to the class under it (the layers' own rule
+///   then lifts each upper one that much over the one below, up to the class's top).
+/// - BKN, whose drawn 6 oktas leave room under the class's top of 7: the run's highest is seen
+///   `min_seen_added_oktas` over BKN's drawn cover (as far as 7), each lower one that much less,
+///   spread evenly where the lowest would fall more than that under BKN's drawn cover
+///   (`BKN025 BKN031 BKN039`: 5.25, 6 and 6.75, where the own rule's 6, 6.75 and 7 left the
+///   third a quarter of an okta; `BKN033 BKN041` stays 6 and 6.75).
 fn spread_within_class(layers: &mut [StationLayer], settings: &FieldSettings) {
     let o = &settings.oktas;
     let step = settings.layers.min_seen_added_oktas;
     let reported: Vec<f64> = layers.iter().map(|l| l.cover_below_oktas).collect();
+    let plain = |l: &StationLayer| l.kind == LayerKind::Plain;
     for i in (0..layers.len().saturating_sub(1)).rev() {
         let floor = if reported[i] == o.few {
             0.5 * o.few
@@ -307,14 +313,45 @@ fn spread_within_class(layers: &mut [StationLayer], settings: &FieldSettings) {
         } else {
             continue;
         };
-        let plain = |l: &StationLayer| l.kind == LayerKind::Plain;
         if !plain(&layers[i]) || !plain(&layers[i + 1]) || reported[i + 1] != reported[i] {
             continue;
         }
         let below_next = layers[i + 1].cover_below_oktas - step;
         layers[i].cover_below_oktas = below_next.max(floor).min(reported[i]);
     }
+    spread_broken_runs(layers, &reported, settings);
 }
+
+/// The BKN part of [`spread_within_class`]: each run of two or more plain layers reported BKN.
+fn spread_broken_runs(layers: &mut [StationLayer], reported: &[f64], settings: &FieldSettings) {
+    let bkn = settings.oktas.bkn;
+    let step = settings.layers.min_seen_added_oktas;
+    let top = (bkn + step).min(BKN_TOP_OKTAS).max(bkn);
+    let broken: Vec<bool> = layers
+        .iter()
+        .zip(reported)
+        .map(|(l, &r)| l.kind == LayerKind::Plain && r == bkn)
+        .collect();
+    let mut start = 0;
+    while start < layers.len() {
+        let mut end = start;
+        while end < layers.len() && broken[end] {
+            end += 1;
+        }
+        let n = end - start;
+        if n >= 2 {
+            let steps = (n - 1) as f64;
+            let low = (top - steps * step).max(bkn - step).min(top);
+            for k in 0..n {
+                layers[start + k].cover_below_oktas = low + (top - low) * k as f64 / steps;
+            }
+        }
+        start = end.max(start + 1);
+    }
+}
+
+/// The most sky seen from below that METAR still calls broken, oktas.
+const BKN_TOP_OKTAS: f64 = 7.0;
 
 #[cfg(test)]
 mod tests {
@@ -343,17 +380,38 @@ mod tests {
         spread_within_class(&mut three, &settings);
         let seen: Vec<f64> = three.iter().map(|l| l.cover_below_oktas).collect();
         assert_eq!(seen, [2.75, 2.75, 3.5]);
-        // BKN has room above; a CB stands apart; other classes stay.
+        // A CB stands apart; other classes stay.
         let mut mixed = [
             layer(plain, 1000.0, 2.0),
             layer(plain, 2000.0, sct),
             layer(LayerKind::Cb, 2500.0, sct),
             layer(plain, 3000.0, 6.0),
-            layer(plain, 4000.0, 6.0),
+            layer(plain, 4000.0, 8.0),
         ];
         let before = mixed;
         spread_within_class(&mut mixed, &settings);
         assert_eq!(mixed, before);
+        // BKN runs step down from 6.75 oktas: EGFF's BKN025 BKN031 BKN039, and a BKN033
+        // BKN041 (as the own rule draws it) over a SCT020 and under an OVC070 (both as they
+        // were).
+        let bkn = settings.oktas.bkn;
+        let mut egff = [
+            layer(plain, 2500.0, bkn),
+            layer(plain, 3100.0, bkn),
+            layer(plain, 3900.0, bkn),
+        ];
+        spread_within_class(&mut egff, &settings);
+        let seen: Vec<f64> = egff.iter().map(|l| l.cover_below_oktas).collect();
+        assert_eq!(seen, [5.25, 6.0, 6.75]);
+        let mut two = [
+            layer(plain, 2000.0, sct),
+            layer(plain, 3300.0, bkn),
+            layer(plain, 4100.0, bkn),
+            layer(plain, 7000.0, 8.0),
+        ];
+        spread_within_class(&mut two, &settings);
+        let seen: Vec<f64> = two.iter().map(|l| l.cover_below_oktas).collect();
+        assert_eq!(seen, [sct, 6.0, 6.75, 8.0]);
     }
     use crate::weather::files::Position;
     use crate::weather::metar::{CloudGroup, PresentWeather, WindGroup};
