@@ -7,10 +7,14 @@
 //! - `air/approach_overcast`: the real bulk METARs at San Antonio, in and above the OVC020 deck;
 //! - `air/cumulonimbus_circle`: the `thunderstorm_cells` theme, 2,000 ft around a storm.
 //!
-//! Each is timed at a few points along its flight (one sample = every point once).
+//! Each is timed at a few points along its flight (one sample = every point once). The
+//! `sight_fan_64_cold` figures time the same fans after each point's caches were flushed
+//! ([`EVICT_BYTES`] written first, untimed), as a frame finds them after the renderer's work:
+//! the flights' `air_thread_us` follow these more than the warm ones.
 
 use std::hint::black_box;
 use std::path::Path;
+use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec3;
@@ -74,6 +78,18 @@ fn sight_fan(world: &World, at_m: DVec3, heading_deg: f64) -> usize {
         .count()
 }
 
+/// Bytes written between two cold fans: more than a core's L2 cache (2 MiB on the build
+/// machine), about what a frame's rendering leaves of the air data's lines.
+const EVICT_BYTES: usize = 8 << 20;
+
+/// Writes every cache line of `buffer` (the previous fan's lines leave the core's caches).
+fn evict(buffer: &mut [u8], round: u8) {
+    for line in buffer.chunks_mut(64) {
+        line[0] = line[0].wrapping_add(round);
+    }
+    black_box(&buffer[..]);
+}
+
 fn bench(c: &mut Criterion) {
     const REAL: &str = "weather/awc-metars-2025-01-27T22Z.cache.csv";
     let sun = DVec3::new(0.3, -0.5, 0.8).normalize();
@@ -110,6 +126,21 @@ fn bench(c: &mut Criterion) {
                 for &(p, h) in &s.poses {
                     black_box(sight_fan(&s.world, black_box(p), h));
                 }
+            })
+        });
+        let mut buffer = vec![0u8; EVICT_BYTES];
+        group.bench_function(format!("{}/sight_fan_64_cold", s.name), |b| {
+            b.iter_custom(|iters| {
+                let mut spent = Duration::ZERO;
+                for round in 0..iters {
+                    for &(p, h) in &s.poses {
+                        evict(&mut buffer, round as u8 | 1);
+                        let start = Instant::now();
+                        black_box(sight_fan(&s.world, black_box(p), h));
+                        spent += start.elapsed();
+                    }
+                }
+                spent
             })
         });
     }

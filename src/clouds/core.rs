@@ -179,10 +179,28 @@ impl SpriteCore {
         }
     }
 
+    /// [`Self::segment`] and [`Self::column_segment`] of the same segment, each end put in the
+    /// core's unit sphere once (the same numbers: a line of sight near a base sprite's core
+    /// asked for its six divisions twice).
+    pub(super) fn segments(&self, a: DVec3, b: DVec3) -> [Option<(f64, f64)>; 2] {
+        let (o, e) = (self.unit(a), self.unit(b));
+        [
+            Self::sphere_segment(o, e),
+            self.column_segment_in_unit(a, b, o.truncate(), e.truncate()),
+        ]
+    }
+
     /// Where the segment is inside the column under a base sprite's core.
     fn column_segment(&self, a: DVec3, b: DVec3) -> Option<(f64, f64)> {
-        let floor = self.floor_m?;
+        self.floor_m?;
         let (o, e) = (self.unit(a).truncate(), self.unit(b).truncate());
+        self.column_segment_in_unit(a, b, o, e)
+    }
+
+    /// [`Self::column_segment`] with the ends' horizontal places in the unit circle, `o` and
+    /// `e` (of [`Self::unit`]).
+    fn column_segment_in_unit(&self, a: DVec3, b: DVec3, o: DVec2, e: DVec2) -> Option<(f64, f64)> {
+        let floor = self.floor_m?;
         // Between the floor and the core's middle.
         let dz = b.z - a.z;
         let (mut t0, mut t1) = if dz.abs() < 1e-12 {
@@ -217,7 +235,11 @@ impl SpriteCore {
     /// Where the segment `a + t (b - a)`, t in 0..=1, is inside the core's ellipsoid: (t in,
     /// t out).
     pub fn segment(&self, a: DVec3, b: DVec3) -> Option<(f64, f64)> {
-        let (o, e) = (self.unit(a), self.unit(b));
+        Self::sphere_segment(self.unit(a), self.unit(b))
+    }
+
+    /// Where the segment from `o` to `e` (in the core's unit sphere) is inside the sphere.
+    fn sphere_segment(o: DVec3, e: DVec3) -> Option<(f64, f64)> {
         let d = e - o;
         let dd = d.length_squared();
         if dd < 1e-18 {

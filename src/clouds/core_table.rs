@@ -15,13 +15,29 @@ use glam::DVec3;
 use super::{CoreRuns, SpriteCore, above_floor, floor_slab, merge, unturned_core};
 use crate::clouds::block::Cloud;
 use crate::clouds::boxes::{Cull, slab};
+use crate::clouds::sight::{down_f32, up_f32};
 
 /// What a line of sight asks of every core it may pass: its centre and the bound of its reach
-/// ([`SpriteCore::reach_bound_m`]), metres from the cloud's centre.
+/// ([`SpriteCore::reach_bound_m`]), then its reach ([`SpriteCore::reach_m`]), metres from the
+/// cloud's centre. The centre is kept as the `f32` it was made from (a sprite's offset), so
+/// that one core is 32 bytes, two to a cache line, the reach among them: read from the core
+/// beside the turn and axes, it was the table's costliest miss on a frame's cold caches.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Near {
-    centre_m: DVec3,
+    centre_m: [f32; 3],
     bound_m: f64,
+    reach_m: f64,
+}
+
+/// A group of a [`CoreTable`]: the lowest and highest corner of its cores' reach (from the
+/// cloud's centre), rounded outward to `f32` (a group a line nearly grazes is looked at, and
+/// its cores passed over on their own distances: the same stretches), and where its cores end
+/// in the table. 28 bytes where three `f64` corners took 56.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Group {
+    lo_m: [f32; 3],
+    hi_m: [f32; 3],
+    end: u32,
 }
 
 /// A cloud's cores for lines of sight, in groups: the runs of [`CoreRuns`] (each with its
@@ -29,14 +45,12 @@ struct Near {
 /// module docs.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct CoreTable {
-    /// Per core: centre and bound of reach.
+    /// Per core: centre, bound of reach and reach.
     near: Vec<Near>,
-    /// Per core, in the order of `near`: the core, turned, and its reach
-    /// ([`SpriteCore::reach_m`]).
-    cores: Vec<(SpriteCore, f64)>,
-    /// Per group: the lowest and highest corner of its cores' reach (from the cloud's centre)
-    /// and where its cores end in `near`.
-    groups: Vec<(DVec3, DVec3, u32)>,
+    /// Per core, in the order of `near`: the core, turned.
+    cores: Vec<SpriteCore>,
+    /// The groups, in the order of `near`.
+    groups: Vec<Group>,
     /// Whether a group is passed over where the segment misses its bounds (the runs'), or looked
     /// at whole (the one group of a cloud without runs, whose box the line entered).
     bounded: bool,
@@ -46,16 +60,12 @@ impl CoreTable {
     /// The table of `cloud`'s cores, grouped as `runs` (the cloud's [`CoreRuns`]) where given.
     pub(crate) fn of(cloud: &Cloud, runs: Option<&CoreRuns>) -> Self {
         // The cores in the order the walk reads them, with the groups' ends.
-        let (order, groups, bounded): (Vec<usize>, Vec<(DVec3, DVec3, u32)>, bool) = match runs {
+        let (order, runs): (Vec<usize>, Option<&CoreRuns>) = match runs {
             Some(runs) if !runs.runs.is_empty() => (
                 runs.sprites.iter().map(|&k| k as usize).collect(),
-                runs.runs.clone(),
-                true,
+                Some(runs),
             ),
-            _ => {
-                let order: Vec<usize> = (0..cloud.sprites.len()).collect();
-                (order, Vec::new(), false)
-            }
+            _ => ((0..cloud.sprites.len()).collect(), None),
         };
         let mut near = Vec::with_capacity(order.len());
         let mut cores = Vec::with_capacity(order.len());
@@ -63,22 +73,35 @@ impl CoreTable {
             let Some((mut core, rotation_deg)) = unturned_core(cloud, &cloud.sprites[k]) else {
                 continue;
             };
+            let centre_m = core.centre_m.as_vec3().to_array();
+            debug_assert_eq!(DVec3::from_array(centre_m.map(f64::from)), core.centre_m);
             near.push(Near {
-                centre_m: core.centre_m,
+                centre_m,
                 bound_m: core.reach_bound_m(),
+                reach_m: core.reach_m(),
             });
-            let reach = core.reach_m();
             if cloud.flat {
                 core.turn(rotation_deg);
             }
-            cores.push((core, reach));
+            cores.push(core);
         }
         // The runs hold only the cores (rain and snow left out), so their ends count the
         // table's entries; without runs, one group of them all.
-        let groups = if bounded {
-            groups
+        let bounded = runs.is_some();
+        let groups = if let Some(runs) = runs {
+            (runs.runs.iter())
+                .map(|&(lo, hi, end)| Group {
+                    lo_m: lo.to_array().map(down_f32),
+                    hi_m: hi.to_array().map(up_f32),
+                    end,
+                })
+                .collect()
         } else {
-            vec![(DVec3::ZERO, DVec3::ZERO, near.len() as u32)]
+            vec![Group {
+                lo_m: [0.0; 3],
+                hi_m: [0.0; 3],
+                end: near.len() as u32,
+            }]
         };
         Self {
             near,
@@ -114,35 +137,38 @@ pub(crate) fn segment_in_table(
     let dd = d.length_squared().max(1e-12);
     let mut from = 0;
     let cull = Cull::new(a, b);
-    for &(lo, hi, to) in &table.groups {
-        let group = from as usize..to as usize;
-        from = to;
+    for group in &table.groups {
+        let cores = from as usize..group.end as usize;
+        from = group.end;
         // A run the segment passes by holds no core it enters (each lies within its reach of
         // its centre, and the run's bounds hold those spheres and a metre); passed over only
         // where the slab test would (a run it nearly grazes is looked at, and its cores are
         // passed over on their own distances).
-        if table.bounded && !cull.may_enter(lo, hi, f64::INFINITY) {
+        if table.bounded && !cull.may_enter(widened(group.lo_m), widened(group.hi_m), f64::INFINITY)
+        {
             continue;
         }
-        for (near, (core, reach)) in table.near[group.clone()].iter().zip(&table.cores[group]) {
+        for (near, core) in table.near[cores.clone()].iter().zip(&table.cores[cores]) {
             // Passed over on the line's distance from the centre: on the bound first, then on
             // the reach (as `segment_in_runs`, the same numbers).
-            let off = (near.centre_m - a).cross(d).length_squared();
+            let off = (widened(near.centre_m) - a).cross(d).length_squared();
             let bound = near.bound_m;
             if off > bound * bound * dd {
                 continue;
             }
-            if off > reach * reach * dd {
+            if off > near.reach_m * near.reach_m * dd {
                 continue;
             }
-            if let Some(span) = core.segment(a, b) {
-                out.push(clamp(span));
-            }
-            if let Some(span) = core.column_segment(a, b) {
+            for span in core.segments(a, b).into_iter().flatten() {
                 out.push(clamp(span));
             }
         }
     }
     out.retain(|(t0, t1)| t0 < t1);
     merge(out);
+}
+
+/// A corner or centre kept as `f32`, in the `f64` the walk works in (exactly).
+fn widened(v: [f32; 3]) -> DVec3 {
+    DVec3::from_array(v.map(f64::from))
 }

@@ -740,13 +740,13 @@ impl BoxGrid {
 }
 
 /// The largest `f32` at or below `x` (infinities kept).
-fn down_f32(x: f64) -> f32 {
+pub(super) fn down_f32(x: f64) -> f32 {
     let f = x as f32;
     if f64::from(f) > x { f.next_down() } else { f }
 }
 
 /// The smallest `f32` at or above `x` (infinities kept).
-fn up_f32(x: f64) -> f32 {
+pub(super) fn up_f32(x: f64) -> f32 {
     let f = x as f32;
     if f64::from(f) < x { f.next_up() } else { f }
 }
