@@ -732,8 +732,8 @@ fn ceilometer_round_trip_at_200() {
 /// [`ceilometer_round_trip_at_200`] over 200 other stations (the file's second report and
 /// every third after it), to check what was tuned on the first: 0.935-0.947 of the layers and
 /// 0.915-0.955 of the ceilings (0.941 and 0.938 on average, 0.938 and 0.940 before BKN runs
-/// stepped down; the shipped seed's 0.935 and 0.935); at the stations with a calm or variable wind 63-66 of 72 layers, at the others
-/// 236-243 of 251
+/// stepped down; the shipped seed's 0.935 and 0.935); at the stations with a calm or variable
+/// wind 63-66 of 72 layers, at the others 236-243 of 251
 /// (`cargo test --lib ceilometer_round_trip_at_200_other_stations -- --ignored --nocapture`).
 #[test]
 #[ignore]

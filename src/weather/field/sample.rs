@@ -319,34 +319,25 @@ fn spread_within_class(layers: &mut [StationLayer], settings: &FieldSettings) {
         let below_next = layers[i + 1].cover_below_oktas - step;
         layers[i].cover_below_oktas = below_next.max(floor).min(reported[i]);
     }
-    spread_broken_runs(layers, &reported, settings);
+    spread_broken_runs(layers, settings);
 }
 
-/// The BKN part of [`spread_within_class`]: each run of two or more plain layers reported BKN.
-fn spread_broken_runs(layers: &mut [StationLayer], reported: &[f64], settings: &FieldSettings) {
+/// The BKN part of [`spread_within_class`]: each run of two or more plain layers reported BKN
+/// (the FEW and SCT part leaves their covers as reported).
+fn spread_broken_runs(layers: &mut [StationLayer], settings: &FieldSettings) {
     let bkn = settings.oktas.bkn;
     let step = settings.layers.min_seen_added_oktas;
     let top = (bkn + step).min(BKN_TOP_OKTAS).max(bkn);
-    let broken: Vec<bool> = layers
-        .iter()
-        .zip(reported)
-        .map(|(l, &r)| l.kind == LayerKind::Plain && r == bkn)
-        .collect();
-    let mut start = 0;
-    while start < layers.len() {
-        let mut end = start;
-        while end < layers.len() && broken[end] {
-            end += 1;
+    let broken = |l: &StationLayer| l.kind == LayerKind::Plain && l.cover_below_oktas == bkn;
+    for run in layers.chunk_by_mut(|a, b| broken(a) && broken(b)) {
+        if run.len() < 2 {
+            continue;
         }
-        let n = end - start;
-        if n >= 2 {
-            let steps = (n - 1) as f64;
-            let low = (top - steps * step).max(bkn - step).min(top);
-            for k in 0..n {
-                layers[start + k].cover_below_oktas = low + (top - low) * k as f64 / steps;
-            }
+        let steps = (run.len() - 1) as f64;
+        let low = (top - steps * step).max(bkn - step);
+        for (k, layer) in run.iter_mut().enumerate() {
+            layer.cover_below_oktas = low + (top - low) * k as f64 / steps;
         }
-        start = end.max(start + 1);
     }
 }
 
