@@ -8,34 +8,47 @@
 //! to this regional wind's gradient wind at the top of the boundary layer, so a calm station
 //! under a moving sky has its clouds move over it, as they do over a real one.
 
-use std::collections::HashMap;
-
 use glam::DVec2;
 
 /// Side of the cells the stations are binned into, metres (a query visits the cells its radius
 /// reaches).
 const CELL_M: f64 = 50_000.0;
 
-/// The stations that report a wind, binned by position.
+/// The stations that report a wind, binned by position: sorted by cell, column then row, so
+/// that the cells of one column a query reaches lie side by side (one binary search a column,
+/// where a hash map was looked up once a cell: 49 lookups a query, half its time).
 #[derive(Debug, Clone, Default)]
 pub(super) struct RegionalWinds {
-    /// Per cell: (station position, wind velocity knots east/north).
-    cells: HashMap<(i64, i64), Vec<(DVec2, DVec2)>>,
+    /// (station position, wind velocity knots east/north), cell after cell, each cell's in
+    /// the order they were given.
+    stations: Vec<(DVec2, DVec2)>,
+    /// Each cell that holds a station, sorted, with its first station in `stations`; then one
+    /// past the last cell, whose start is `stations.len()`.
+    cells: Vec<((i64, i64), usize)>,
 }
 
 impl RegionalWinds {
     /// Bins the stations that report a wind: (position local metres, wind knots east/north).
     pub(super) fn new(stations: impl IntoIterator<Item = (DVec2, Option<[f64; 2]>)>) -> Self {
-        let mut cells: HashMap<(i64, i64), Vec<(DVec2, DVec2)>> = HashMap::new();
-        for (position, wind) in stations {
-            if let Some([east, north]) = wind {
-                cells
-                    .entry(cell_of(position))
-                    .or_default()
-                    .push((position, DVec2::new(east, north)));
+        let mut binned: Vec<((i64, i64), DVec2, DVec2)> = (stations.into_iter())
+            .filter_map(|(position, wind)| {
+                let [east, north] = wind?;
+                Some((cell_of(position), position, DVec2::new(east, north)))
+            })
+            .collect();
+        // Stable: a cell's stations keep their order, and so does the sum of a query.
+        binned.sort_by_key(|b| b.0);
+        let mut cells: Vec<((i64, i64), usize)> = Vec::new();
+        for (k, b) in binned.iter().enumerate() {
+            if cells.last().is_none_or(|c| c.0 != b.0) {
+                cells.push((b.0, k));
             }
         }
-        Self { cells }
+        cells.push(((i64::MAX, i64::MAX), binned.len()));
+        Self {
+            stations: binned.into_iter().map(|(_, p, w)| (p, w)).collect(),
+            cells,
+        }
     }
 
     /// The surface winds within `radius_m` of `point_m`, averaged as vectors (knots east,
@@ -48,9 +61,16 @@ impl RegionalWinds {
         let reach = (radius_m / CELL_M).ceil() as i64;
         let (cx, cy) = cell_of(point_m);
         let (mut sum, mut total) = (DVec2::ZERO, 0.0);
-        for x in cx - reach..=cx + reach {
-            for y in cy - reach..=cy + reach {
-                for &(position, wind) in self.cells.get(&(x, y)).into_iter().flatten() {
+        let occupied = self.cells.len().checked_sub(1)?;
+        for x in cx.saturating_sub(reach)..=cx.saturating_add(reach) {
+            let (lo, hi) = ((x, cy.saturating_sub(reach)), (x, cy.saturating_add(reach)));
+            let first = self.cells[..occupied].partition_point(|c| c.0 < lo);
+            for k in first..occupied {
+                if self.cells[k].0 > hi {
+                    break;
+                }
+                let stations = &self.stations[self.cells[k].1..self.cells[k + 1].1];
+                for &(position, wind) in stations {
                     let d2 = position.distance_squared(point_m) / (radius_m * radius_m);
                     if d2 < 1.0 {
                         let w = (1.0 - d2) * (1.0 - d2);
@@ -97,5 +117,49 @@ mod tests {
         );
         assert_eq!(winds.at(DVec2::new(1.0e7, 0.0), 150_000.0), None);
         assert_eq!(winds.at(DVec2::ZERO, 0.0), None);
+    }
+
+    #[test]
+    fn a_query_sums_the_stations_of_its_cells_column_by_column_as_given() {
+        // Stations scattered over a few hundred kilometres, some without a wind, and the sum
+        // as every cell the radius reaches is visited in turn (column, row, then the stations
+        // as given): the same to the bit.
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let stations: Vec<(DVec2, Option<[f64; 2]>)> = (0..400)
+            .map(|k| {
+                let p = DVec2::new(next() * 600e3 - 300e3, next() * 600e3 - 300e3);
+                let wind = (k % 7 != 0).then(|| [next() * 40.0 - 20.0, next() * 40.0 - 20.0]);
+                (p, wind)
+            })
+            .collect();
+        let winds = RegionalWinds::new(stations.clone());
+        let radius = 150_000.0;
+        for k in 0..50 {
+            let point = DVec2::new(next() * 700e3 - 350e3, next() * 700e3 - 350e3);
+            let (cx, cy) = cell_of(point);
+            let (mut sum, mut total) = (DVec2::ZERO, 0.0);
+            for x in cx - 3..=cx + 3 {
+                for y in cy - 3..=cy + 3 {
+                    for &(position, wind) in &stations {
+                        let Some([e, n]) = wind.filter(|_| cell_of(position) == (x, y)) else {
+                            continue;
+                        };
+                        let d2 = position.distance_squared(point) / (radius * radius);
+                        if d2 < 1.0 {
+                            let w = (1.0 - d2) * (1.0 - d2);
+                            sum += DVec2::new(e, n) * w;
+                            total += w;
+                        }
+                    }
+                }
+            }
+            let expected = (total > 0.0).then(|| sum / total);
+            assert_eq!(winds.at(point, radius), expected, "query {k} at {point:?}");
+        }
+        assert_eq!(RegionalWinds::default().at(DVec2::ZERO, radius), None);
     }
 }
