@@ -155,7 +155,7 @@ impl RingOrders {
             }
             *budget -= state.sprites;
             sorted += state.sprites;
-            let rel = from_m - (state.centre_m + r.motion.offset_m);
+            let rel = from_m - (state.centre_m + r.offset_m());
             // A kept order's buffer is sorted into again.
             let block = self.kept.entry(id).or_default();
             if block.len() < r.clouds.len() {
@@ -199,10 +199,10 @@ impl RingOrders {
             let Some(r) = blocks.get(id).filter(|r| r.place.is_some()) else {
                 continue;
             };
-            let fading = r.motion.fade != Fade::Steady;
+            let fading = r.fade() != Fade::Steady;
             let kept = self.kept.get(id).map_or(&[][..], Vec::as_slice);
             for (ci, (state, cloud)) in r.clouds.iter().zip(&r.block.clouds).enumerate() {
-                let rel = from_m - (state.centre_m + r.motion.offset_m);
+                let rel = from_m - (state.centre_m + r.offset_m());
                 let near_edge = (rel.length() - state.radius_m as f64).max(0.0);
                 if near_edge > draw_m || state.sprites == 0 || state.sprites > when.largest {
                     continue;
@@ -285,7 +285,7 @@ impl RingOrders {
             let Some(r) = blocks.get(&id) else {
                 continue;
             };
-            let offset = r.motion.offset_m;
+            let offset = r.offset_m();
             cloud_order.clear();
             for (ci, state) in r.clouds.iter().enumerate() {
                 let d = (state.centre_m + offset - from_m).length();
@@ -322,7 +322,7 @@ impl RingOrders {
                 });
                 first += sprites;
             }
-            let (fade_kind, fade_progress) = fade_code(r.motion.fade);
+            let (fade_kind, fade_progress) = fade_code(r.fade());
             out.push(GpuDrawBlock {
                 origin_rel: (r.centre_m() - from_m).as_vec3().to_array(),
                 first: total,

@@ -215,7 +215,7 @@ fn assert_slots_hold_orders(
             .unwrap();
         let state = &r.clouds[ci];
         assert_eq!(list.order_base, state.sprite_base, "cloud {}", list.cloud);
-        let rel = (centre - (state.centre_m + r.motion.offset_m)).as_vec3();
+        let rel = (centre - (state.centre_m + r.offset_m())).as_vec3();
         let reference: Vec<u32> = if state.sprites > largest {
             (state.sprite_base..state.sprite_base + state.sprites).collect()
         } else {

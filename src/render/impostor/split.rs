@@ -174,7 +174,7 @@ impl RingPlan {
                         let shown = self.half_faded_m.is_none_or(|half| {
                             (r.centre_m() - st.centre_m).truncate().length() - r.radius_m < half
                         });
-                        whole_new |= shown && r.motion.fade == Fade::Steady;
+                        whole_new |= shown && r.fade() == Fade::Steady;
                     }
                 }
             }
@@ -233,7 +233,7 @@ impl RingPlan {
             .filter(|r| far_ids.contains(&r.block.id))
             .flat_map(|r| {
                 r.clouds.iter().map(move |c| {
-                    let rel_m = c.centre_m + r.motion.offset_m - camera_m;
+                    let rel_m = c.centre_m + r.offset_m() - camera_m;
                     super::band::cloud_elevations_rad(rel_m, f64::from(c.radius_m))
                 })
             })

@@ -116,7 +116,7 @@ impl CloudShadows {
                 (kept.built_for, kept.sprites) = (Some((r.place_serial, stride)), first);
             }
             self.lists.extend_from_slice(&kept.lists);
-            let (fade_kind, fade_progress) = fade_code(r.motion.fade);
+            let (fade_kind, fade_progress) = fade_code(r.fade());
             self.draws.push(GpuDrawBlock {
                 origin_rel: (r.centre_m() - back_m - frame.eye_m).as_vec3().to_array(),
                 first: first + total,
@@ -175,7 +175,7 @@ impl CloudShadows {
             if first == 0 {
                 continue;
             }
-            let (fade_kind, fade_progress) = fade_code(r.motion.fade);
+            let (fade_kind, fade_progress) = fade_code(r.fade());
             self.draws.push(GpuDrawBlock {
                 origin_rel: (r.centre_m() - back_m - frame.eye_m).as_vec3().to_array(),
                 first: total,
@@ -237,7 +237,7 @@ pub(super) fn covered(blocks: &Blocks, frame: &ShadowFrame) -> (IdMap<u64>, Vec<
         .values()
         .filter(|r| is_covered(r, frame))
         .map(|r| {
-            if r.motion.fade != crate::render::Fade::Steady {
+            if r.fade() != crate::render::Fade::Steady {
                 changing.push(r.block.id);
             }
             (r.block.id, r.place_serial)

@@ -34,11 +34,10 @@ impl Sky {
         for block in blocks {
             match self.sprites.resident.blocks.get_mut(&block.id) {
                 Some(r) if r.block == block => {
-                    if r.motion != BlockMotion::default() {
+                    if r.motion() != BlockMotion::default() {
                         let steady = BlockMotion::default();
-                        self.sprites.resident.fades +=
-                            r.motion.fade.kind_changes(steady.fade) as u64;
-                        r.motion = steady;
+                        self.sprites.resident.fades += r.fade().kind_changes(steady.fade) as u64;
+                        r.set_motion(steady);
                         self.sprites.resident.changes += 1;
                     }
                 }
@@ -52,8 +51,8 @@ impl Sky {
     /// in the order [`SkyUpdate`] gives: the blocks that came are moved in (uploaded once, by
     /// the next [`Self::prepare`]), those that went are retired, the fades and the drift set.
     /// Applying is counted in the next frame's [`crate::render::FrameStats::cpu_update_us`]
-    /// when blocks come or go (timed once); a drift and fades alone are one write a block and
-    /// go untimed, as a clock read would cost more. `update.field_cpu` is the host's to count
+    /// when blocks come or go (timed once); a drift (one write for every block) and fades (one
+    /// a fading block) alone go untimed, as a clock read would cost more. `update.field_cpu` is the host's to count
     /// ([`Self::add_field_cpu`], or the frame's stats).
     pub fn apply(&mut self, update: SkyUpdate) {
         let start = update.moves_blocks().then(Stopwatch::start);
@@ -192,9 +191,9 @@ impl Sky {
         match self.sprites.resident.blocks.get_mut(&id) {
             Some(r) => {
                 // What the shadow map watches for (a block moved by other means than the drift).
-                self.sprites.resident.changes += (r.motion.offset_m != motion.offset_m) as u64;
-                self.sprites.resident.fades += r.motion.fade.kind_changes(motion.fade) as u64;
-                r.motion = motion;
+                self.sprites.resident.changes += (r.offset_m() != motion.offset_m) as u64;
+                self.sprites.resident.fades += r.fade().kind_changes(motion.fade) as u64;
+                r.set_motion(motion);
                 true
             }
             None => false,
@@ -208,14 +207,10 @@ impl Sky {
     }
 
     /// Moves every block the sky holds to its drift band's offset (each band of layers drifts
-    /// with the wind at its own height, [`crate::clouds::bands`]): one write a block, no
-    /// lookups, nothing uploaded.
+    /// with the wind at its own height, [`crate::clouds::bands`]): the bands are written once,
+    /// and each block reads its band's offset where it is used; nothing is uploaded.
     pub fn set_band_drifts(&mut self, offsets_m: &crate::render::scene::BandOffsets) {
-        let last = offsets_m.len() - 1;
-        for r in self.sprites.resident.blocks.values_mut() {
-            r.motion.offset_m = offsets_m[usize::from(r.motion.drift_band).min(last)];
-        }
-        self.sprites.resident.drift_m = *offsets_m;
+        self.sprites.resident.set_drift(offsets_m);
         self.shadows.set_drift(offsets_m);
     }
 
@@ -223,8 +218,8 @@ impl Sky {
     pub fn set_block_fade(&mut self, id: u64, fade: crate::render::Fade) -> bool {
         match self.sprites.resident.blocks.get_mut(&id) {
             Some(r) => {
-                self.sprites.resident.fades += r.motion.fade.kind_changes(fade) as u64;
-                r.motion.fade = fade;
+                self.sprites.resident.fades += r.fade().kind_changes(fade) as u64;
+                r.set_fade(fade);
                 true
             }
             None => false,

@@ -105,8 +105,8 @@ impl<'a> Listed<'a> {
     /// (one pass over the list; a cloud not found is infinitely near, drawn last).
     fn clouds_d2(&self, eye_m: DVec3, d2: &mut Vec<f64>) {
         let start = self.r.place.as_ref().map_or(0, |p| p.1.start);
-        let at = self.r.motion.offset_m - eye_m;
-        let clouds = &self.r.clouds;
+        let at = self.r.offset_m() - eye_m;
+        let clouds = &self.r.seen;
         d2.extend(self.list.iter().map(|e| {
             clouds
                 .get(e.cloud.wrapping_sub(start) as usize)
@@ -121,7 +121,7 @@ impl<'a> Listed<'a> {
 
     /// The entry of clouds `part` of its list, its first sprite `first`.
     fn entry(&self, part: std::ops::Range<usize>, eye_m: DVec3, first: u32) -> GpuDrawBlock {
-        let (fade_kind, fade_progress) = fade_code(self.r.motion.fade);
+        let (fade_kind, fade_progress) = fade_code(self.r.fade());
         GpuDrawBlock {
             origin_rel: (self.r.centre_m() - eye_m).as_vec3().to_array(),
             fade_kind: fade_kind | if self.r.distant { DISTANT_BLOCK } else { 0 },
@@ -209,12 +209,12 @@ impl Listed<'_> {
             return;
         };
         let start = self.r.place.as_ref().map_or(0, |p| p.1.start);
-        let at = self.r.motion.offset_m - eye_m;
+        let at = self.r.offset_m() - eye_m;
         let mut run = part.start..part.start;
         for k in part.clone() {
             let seen = self
                 .r
-                .clouds
+                .seen
                 .get(self.list[k].cloud.wrapping_sub(start) as usize)
                 .is_none_or(|c| {
                     sight.sees_cloud(

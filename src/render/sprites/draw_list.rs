@@ -436,7 +436,7 @@ pub(in crate::render) fn main_view(
             let here = inside_clouds(r, camera_m, settings, locks);
             // A forming or dissipating block's inside is as thick as it has formed: a new
             // report's deck around the camera thickens with its clouds, not in one frame.
-            let shown = fade_opacity(r.motion.fade);
+            let shown = fade_opacity(r.fade());
             inside.cloud = inside.cloud.max(here.cloud * shown);
             inside.rain = inside.rain.max(here.rain * shown);
         }
@@ -485,8 +485,8 @@ fn recheck(
     } else {
         settings.clouds.draw_distance_m as f64
     };
-    let offset = r.motion.offset_m;
-    let fading = r.motion.fade != Fade::Steady;
+    let offset = r.offset_m();
+    let fading = r.fade() != Fade::Steady;
     let slope = cache.move_fraction as f64;
     scratch.clear();
     // Slack before a cloud crosses the draw distance.
@@ -576,7 +576,7 @@ fn inside_clouds(
     let mut in_rain = 0.0f32;
     let lock_fraction = settings.clouds.lock_radius_fraction;
     for (state, cloud) in r.clouds.iter().zip(&r.block.clouds) {
-        let cam_local = (camera_m - (state.centre_m + r.motion.offset_m)).as_vec3();
+        let cam_local = (camera_m - (state.centre_m + r.offset_m())).as_vec3();
         if cam_local.length() >= state.radius_m {
             continue;
         }

@@ -24,6 +24,10 @@ use crate::render::stats::Spent;
 // Where a block's slots are found, packed and grown, and its records written: apart, as the
 // set's bookkeeping above does not need to read it.
 mod packing;
+// The drift bands' offsets, which every block reads at use.
+mod drift;
+
+pub(in crate::render) use drift::SharedDrift;
 
 /// Bytes of GPU memory each sprite slot costs: its record, its order entry and its Harris and
 /// Lastra light (a cloud's record and list entry come on top, about a twentieth of it for
@@ -58,6 +62,15 @@ pub(in crate::render) struct CloudState {
     pub ordered_at: Option<(DVec3, f64)>,
 }
 
+/// A cloud as a view's draw list looks at it ([`Resident::seen`]): a copy of its centre, its
+/// radius and its largest sprite's half side.
+#[derive(Debug, Clone, Copy)]
+pub(in crate::render) struct CloudSeen {
+    pub centre_m: DVec3,
+    pub radius_m: f32,
+    pub largest_half_side_m: f32,
+}
+
 /// When a block's cloud list and orders must be looked at again: the camera relative to the
 /// block then, how far it may move from there and until when, before any of its clouds passes
 /// its cache thresholds or the draw distance.
@@ -73,7 +86,12 @@ pub(in crate::render) struct BlockCheck {
 #[derive(Debug, Clone)]
 pub(in crate::render) struct Resident {
     pub block: SkyBlock,
-    pub motion: BlockMotion,
+    /// Its fade and drift band, and its own offset: the one it moves by while `own_since` is
+    /// the drift's count of settings (it was given after the bands were last set); else its
+    /// band's offset ([`Self::offset_m`]).
+    motion: BlockMotion,
+    drift: SharedDrift,
+    own_since: u64,
     /// Radius of a sphere around the block's centre holding all its clouds, metres.
     pub radius_m: f64,
     /// Its largest cloud's radius, metres: how far its sprites reach past the plane between
@@ -107,6 +125,11 @@ pub(in crate::render) struct Resident {
     /// field ([`crate::render::Sky::insert_distant_block`]).
     pub distant: bool,
     pub clouds: Vec<CloudState>,
+    /// What a view's draw list reads of each cloud of [`Self::clouds`], in its order, 32 bytes
+    /// a cloud: read in the order of the block's list, scattered, once a frame for every cloud
+    /// of a block across the view's edge (reading it from the clouds' states cost two or three
+    /// cache lines a cloud, most of the draw list's time over an overcast).
+    pub seen: Vec<CloudSeen>,
     /// Every sprite's offset from its cloud's centre, metres, cloud after cloud
     /// ([`CloudState::first_offset`]): what a sort of a cloud's sprites reads, 12 bytes a sprite
     /// together, not the 40 of a whole sprite (the Cb circle's frames re-sort 4,000 sprites, and
@@ -144,6 +167,13 @@ impl Resident {
                 state
             })
             .collect();
+        let seen = (clouds.iter())
+            .map(|c| CloudSeen {
+                centre_m: c.centre_m,
+                radius_m: c.radius_m,
+                largest_half_side_m: c.largest_half_side_m,
+            })
+            .collect();
         let offsets = block
             .clouds
             .iter()
@@ -170,6 +200,8 @@ impl Resident {
         Self {
             block,
             motion,
+            drift: SharedDrift::default(),
+            own_since: 0,
             radius_m,
             largest_cloud_m,
             largest_half_side_m,
@@ -185,6 +217,7 @@ impl Resident {
             light: BlockLight::default(),
             distant: false,
             clouds,
+            seen,
             offsets,
         }
     }
@@ -206,7 +239,41 @@ impl Resident {
 
     /// Its centre now (with the drift), metres.
     pub fn centre_m(&self) -> DVec3 {
-        self.block.centre_m + self.motion.offset_m
+        self.block.centre_m + self.offset_m()
+    }
+
+    /// Its drift now, metres: its own offset if it was given since the drift bands were last
+    /// set, else its band's.
+    pub fn offset_m(&self) -> DVec3 {
+        if self.own_since == self.drift.settings() {
+            self.motion.offset_m
+        } else {
+            self.drift.offset_m(self.motion.drift_band)
+        }
+    }
+
+    /// Where it is in its life.
+    pub fn fade(&self) -> crate::render::Fade {
+        self.motion.fade
+    }
+
+    /// Its motion now: its fade and band, and its drift ([`Self::offset_m`]).
+    pub fn motion(&self) -> BlockMotion {
+        BlockMotion {
+            offset_m: self.offset_m(),
+            ..self.motion
+        }
+    }
+
+    /// Gives it `motion`, its offset its own until the drift bands are next set.
+    pub fn set_motion(&mut self, motion: BlockMotion) {
+        self.motion = motion;
+        self.own_since = self.drift.settings();
+    }
+
+    /// Sets where it is in its life, keeping its drift.
+    pub fn set_fade(&mut self, fade: crate::render::Fade) {
+        self.motion.fade = fade;
     }
 
     /// Its centre moved up or down to the height within its clouds' span nearest `height_m`:
@@ -301,6 +368,8 @@ pub(in crate::render) struct ResidentSet {
     pub fades: u64,
     /// The drift [`crate::render::Sky::set_drift`] last moved every block to.
     pub drift_m: crate::render::scene::BandOffsets,
+    /// The same, as every block it holds reads it ([`Resident::offset_m`]).
+    drift: SharedDrift,
     /// Placings of blocks so far ([`Resident::place_serial`]).
     placings: u64,
     /// Sprites and clouds of blocks the caller will insert in the next frames
@@ -398,6 +467,7 @@ impl ResidentSet {
             changes: 0,
             fades: 0,
             drift_m: Default::default(),
+            drift: SharedDrift::default(),
             placings: 0,
             expected: (0, 0),
         }
@@ -433,7 +503,17 @@ impl ResidentSet {
         self.remove(block.id);
         self.waiting.insert(block.id);
         self.changes += 1;
-        self.blocks.insert(block.id, Resident::new(block, motion));
+        let mut r = Resident::new(block, motion);
+        r.drift = self.drift.clone();
+        r.own_since = self.drift.settings();
+        self.blocks.insert(r.block.id, r);
+    }
+
+    /// Moves every drift band to `offsets_m` (the blocks that follow their band with it): one
+    /// write whatever the blocks held.
+    pub fn set_drift(&mut self, offsets_m: &crate::render::scene::BandOffsets) {
+        self.drift_m = *offsets_m;
+        self.drift.set(offsets_m);
     }
 
     /// Retires a block and frees its slots; returns the sprite slots it had, if it was held.
