@@ -68,52 +68,102 @@ pub fn ring_band_rad(
     (low, high.max(low))
 }
 
-/// The rows of the screen the band of elevations `band_rad` crosses, as normalised device y
-/// (lowest first), under the camera whose camera-relative clip-to-world matrix is
-/// `inv_view_proj`; `None` when it crosses none. Searched on a grid: a cell is kept when the
-/// elevations of its corners, widened by half its diagonal (no ray in it is farther from a
-/// corner), meet the band.
+/// [`ScreenGrid::rows_ndc`] on a grid made for `inv_view_proj` alone (a ring keeps its grid
+/// from frame to frame).
+#[cfg(test)]
 pub fn screen_rows_ndc(band_rad: (f64, f64), inv_view_proj: Mat4) -> Option<(f32, f32)> {
-    let (rows, cols) = GRID;
-    let ray = |x: f32, y: f32| {
-        let far = inv_view_proj * Vec4::new(x, y, 0.5, 1.0);
-        (far.truncate() / far.w).as_dvec3().normalize_or_zero()
-    };
-    let ndc = |k: u32, n: u32| -1.0 + 2.0 * k as f32 / n as f32;
-    let side = cols as usize + 1;
-    // Each grid point's ray, row after row, and its elevation once a cell asks for it (four
-    // cells share a corner; a row of cells the band is far from asks none).
-    let rays: Vec<DVec3> = (0..=rows)
-        .flat_map(|j| (0..=cols).map(move |i| ray(ndc(i, cols), ndc(j, rows))))
-        .collect();
-    let mut elevations: Vec<Option<f64>> = vec![None; rays.len()];
-    let mut found: Option<(f32, f32)> = None;
-    for j in 0..rows as usize {
-        let points = &rays[j * side..(j + 2) * side];
-        if row_is_off(band_rad, points, side) {
-            continue;
+    let mut grid = ScreenGrid::default();
+    grid.aim(inv_view_proj);
+    grid.rows_ndc(band_rad)
+}
+
+/// The grid the rows of the screen a band crosses are searched on, for one camera-relative clip-to-world matrix: its rays,
+/// their elevations as cells ask for them, and what each row's shortcut reads. A camera that
+/// moves without turning keeps its matrix (it is relative to the eye), and a frame then only
+/// compares the band with each row's reach (the grid's 833 rays and their rows' chords were a
+/// tenth of the sky's update on the approach).
+#[derive(Debug, Clone, Default)]
+pub struct ScreenGrid {
+    /// The matrix's bits (none yet: empty).
+    key: Option<[u32; 16]>,
+    /// Each grid point's ray, row after row.
+    rays: Vec<DVec3>,
+    /// Each grid point's ray's elevation, once a cell asked for it.
+    elevations: Vec<Option<f64>>,
+    /// Per row of cells: the elevations no cell of it can reach below and above
+    /// ([`row_reach`]); `None` where that shortcut does not hold.
+    reach: Vec<Option<(f64, f64)>>,
+}
+
+impl ScreenGrid {
+    /// Points the grid along `inv_view_proj`: made again only if it differs from the last to
+    /// the bit.
+    pub fn aim(&mut self, inv_view_proj: Mat4) {
+        let key = inv_view_proj.to_cols_array().map(f32::to_bits);
+        if self.key == Some(key) {
+            return;
         }
-        let mut corner = |k: usize| -> Corner {
-            let r = rays[k];
-            (r, *elevations[k].get_or_insert_with(|| elevation(r.z)))
+        self.key = Some(key);
+        let (rows, cols) = GRID;
+        let ray = |x: f32, y: f32| {
+            let far = inv_view_proj * Vec4::new(x, y, 0.5, 1.0);
+            (far.truncate() / far.w).as_dvec3().normalize_or_zero()
         };
-        // One cell of a row that meets the band is enough: the row is in.
-        let meets = (0..side - 1).any(|i| {
-            let at = j * side + i;
-            let c = [
-                corner(at),
-                corner(at + 1),
-                corner(at + side),
-                corner(at + side + 1),
-            ];
-            cell_meets(band_rad, c)
-        });
-        if meets {
-            let (y0, y1) = (ndc(j as u32, rows), ndc(j as u32 + 1, rows));
-            found = Some(found.map_or((y0, y1), |(a, b)| (a.min(y0), b.max(y1))));
-        }
+        let side = cols as usize + 1;
+        self.rays.clear();
+        self.rays.extend(
+            (0..=rows).flat_map(|j| (0..=cols).map(move |i| ray(ndc(i, cols), ndc(j, rows)))),
+        );
+        self.elevations.clear();
+        self.elevations.resize(self.rays.len(), None);
+        self.reach.clear();
+        let rays = &self.rays;
+        (self.reach)
+            .extend((0..rows as usize).map(|j| row_reach(&rays[j * side..(j + 2) * side], side)));
     }
-    found
+
+    /// The rows of the screen the band of elevations `band_rad` crosses, as normalised device
+    /// y (lowest first), under the matrix last aimed at; `None` when it crosses none. A cell is
+    /// kept when the elevations of its corners, widened by half its diagonal (no ray in it is
+    /// farther from a corner), meet the band.
+    pub fn rows_ndc(&mut self, band_rad: (f64, f64)) -> Option<(f32, f32)> {
+        let (rows, cols) = GRID;
+        let side = cols as usize + 1;
+        let mut found: Option<(f32, f32)> = None;
+        for j in 0..rows as usize {
+            if let Some(Some((low, high))) = self.reach.get(j)
+                && (*low > band_rad.1 || *high < band_rad.0)
+            {
+                continue;
+            }
+            let (rays, elevations) = (&self.rays, &mut self.elevations);
+            let mut corner = |k: usize| -> Corner {
+                let r = rays[k];
+                (r, *elevations[k].get_or_insert_with(|| elevation(r.z)))
+            };
+            // One cell of a row that meets the band is enough: the row is in.
+            let meets = (0..side - 1).any(|i| {
+                let at = j * side + i;
+                let c = [
+                    corner(at),
+                    corner(at + 1),
+                    corner(at + side),
+                    corner(at + side + 1),
+                ];
+                cell_meets(band_rad, c)
+            });
+            if meets {
+                let (y0, y1) = (ndc(j as u32, rows), ndc(j as u32 + 1, rows));
+                found = Some(found.map_or((y0, y1), |(a, b)| (a.min(y0), b.max(y1))));
+            }
+        }
+        found
+    }
+}
+
+/// Grid line `k` of `n` as normalised device coordinates.
+fn ndc(k: u32, n: u32) -> f32 {
+    -1.0 + 2.0 * k as f32 / n as f32
 }
 
 /// The elevation of a unit ray whose up component is `z`, radians.
@@ -121,15 +171,16 @@ fn elevation(z: f64) -> f64 {
     z.clamp(-1.0, 1.0).asin()
 }
 
-/// Whether no cell of a row of [`screen_rows_ndc`]'s grid can meet the band, told from the
-/// row's lowest and highest ray and its longest diagonal chord alone (two arc sines a row, not
-/// one a point): then [`cell_meets`] is false for each of its cells, each of which lies within
-/// those elevations and has a diagonal within that bound (a billionth of a radian more against
-/// the arc sine's rounding). `points`: the row's two lines of `side` unit rays.
-fn row_is_off(band_rad: (f64, f64), points: &[DVec3], side: usize) -> bool {
+/// The elevations below and above which no cell of a row of [`ScreenGrid`]'s grid can
+/// meet a band, told from the row's lowest and highest ray and its longest diagonal chord alone
+/// (two arc sines a row, not one a point): a band wholly outside them fails [`cell_meets`] for
+/// each of the row's cells, each of which lies within those elevations and has a diagonal within
+/// that bound (a billionth of a radian more against the arc sine's rounding). `None` where a
+/// ray is not of unit length (no shortcut). `points`: the row's two lines of `side` unit rays.
+fn row_reach(points: &[DVec3], side: usize) -> Option<(f64, f64)> {
     let unit = |r: &DVec3| r.is_finite() && (r.length_squared() - 1.0).abs() < 1e-12;
     if !points.iter().all(unit) {
-        return false;
+        return None;
     }
     let lowest = elevation(points.iter().map(|r| r.z).fold(f64::MAX, f64::min));
     let highest = elevation(points.iter().map(|r| r.z).fold(f64::MIN, f64::max));
@@ -145,7 +196,7 @@ fn row_is_off(band_rad: (f64, f64), points: &[DVec3], side: usize) -> bool {
         })
         .fold(0.0, f64::max);
     let half = 0.5 * diagonal_bound(chord) + 1e-9;
-    lowest - half > band_rad.1 || highest + half < band_rad.0
+    Some((lowest - half, highest + half))
 }
 
 /// At least the angle between two unit rays `chord` apart (pi/2 times the chord), with a margin
@@ -154,10 +205,10 @@ fn diagonal_bound(chord: f64) -> f64 {
     chord * std::f64::consts::FRAC_PI_2 * (1.0 + 1e-9) + 1e-6
 }
 
-/// A grid point of [`screen_rows_ndc`]: its ray (unit, or zero) and the ray's elevation.
+/// A grid point of a [`ScreenGrid`]: its ray (unit, or zero) and the ray's elevation.
 type Corner = (DVec3, f64);
 
-/// Whether a cell of [`screen_rows_ndc`]'s grid, corners (south-west, south-east, north-west,
+/// Whether a cell of [`ScreenGrid`]'s grid, corners (south-west, south-east, north-west,
 /// north-east) `c`, meets the band: the elevations of its corners widened by half its diagonal
 /// (the larger angle between opposite corners) reach it. The diagonal (two arc cosines, most of
 /// the search's time) is asked only where the answer depends on it: the corners' elevations
@@ -344,6 +395,8 @@ mod tests {
     #[test]
     fn the_rows_are_those_of_widening_every_cell() {
         let mut checked = 0;
+        // One grid aimed at each camera in turn, as a ring keeps it: the same rows.
+        let mut kept = ScreenGrid::default();
         for pitch in [-89.0, -30.0, -3.0, 0.0, 2.5, 12.0, 45.0, 89.0] {
             for heading in [0.0, 37.0, 90.0, 211.0] {
                 for (fov, aspect) in [(60.0, 16.0 / 9.0), (30.0, 1.0), (90.0, 2.4)] {
@@ -357,15 +410,18 @@ mod tests {
                         far_m: 160_000.0,
                     };
                     let inv = camera.view_proj_relative().inverse();
+                    kept.aim(inv);
                     for k in 0..40 {
                         let lo = -0.8 + 0.04 * f64::from(k) + 0.0013 * f64::from(k % 7);
                         for width in [0.0, 0.001, 0.02, 0.1, 0.5] {
                             let band = (lo, lo + width);
+                            let expected = rows_every_cell(band, inv);
                             assert_eq!(
                                 screen_rows_ndc(band, inv),
-                                rows_every_cell(band, inv),
+                                expected,
                                 "pitch {pitch} heading {heading} fov {fov} band {band:?}"
                             );
+                            assert_eq!(kept.rows_ndc(band), expected, "kept grid");
                             checked += 1;
                         }
                     }

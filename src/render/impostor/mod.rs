@@ -121,6 +121,8 @@ pub struct ImpostorRing {
     /// the screen where it can show a cloud as normalised device y, lowest first), if any ring
     /// is shown and crosses the screen.
     quads: Option<(usize, usize, bool, (f32, f32))>,
+    /// The screen's grid of rays that finds those rows, kept while the camera does not turn.
+    screen: band::ScreenGrid,
     /// Whether the plan's pending renders went into a recorded frame (then the next plan
     /// starts afresh).
     recorded: Cell<bool>,
@@ -387,6 +389,7 @@ impl ImpostorRing {
             ring_uniform,
             plan: RingPlan::default(),
             quads: None,
+            screen: band::ScreenGrid::default(),
             recorded: Cell::new(false),
             reach_limit_m: None,
             bytes,
@@ -604,7 +607,8 @@ impl ImpostorRing {
                 band_of(old_state)
             };
             let inv_view_proj = glam::Mat4::from_cols_array_2d(&template.inv_view_proj);
-            let rows = band::screen_rows_ndc(band, inv_view_proj);
+            self.screen.aim(inv_view_proj);
+            let rows = self.screen.rows_ndc(band);
             let uniform = GpuRing {
                 old_centre_weight: (old_state.centre_m - camera_m)
                     .as_vec3()
