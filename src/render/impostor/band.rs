@@ -77,11 +77,12 @@ pub fn screen_rows_ndc(band_rad: (f64, f64), inv_view_proj: Mat4) -> Option<(f32
     grid.rows_ndc(band_rad)
 }
 
-/// The grid the rows of the screen a band crosses are searched on, for one camera-relative clip-to-world matrix: its rays,
-/// their elevations as cells ask for them, and what each row's shortcut reads. A camera that
-/// moves without turning keeps its matrix (it is relative to the eye), and a frame then only
-/// compares the band with each row's reach (the grid's 833 rays and their rows' chords were a
-/// tenth of the sky's update on the approach).
+/// The grid the rows of the screen a band crosses are searched on, for one camera-relative
+/// clip-to-world matrix: its rays, their elevations as cells ask for them, and what each row's
+/// shortcut reads. A camera that moves without turning keeps its matrix (it is relative to the
+/// eye), and a frame then only compares the band with each row's reach (the grid's 833 rays and
+/// their rows' chords took more of the ring's prepare than its sorting on the approach's
+/// profile).
 #[derive(Debug, Clone, Default)]
 pub struct ScreenGrid {
     /// The matrix's bits (none yet: empty).

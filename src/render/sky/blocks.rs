@@ -52,8 +52,8 @@ impl Sky {
     /// the next [`Self::prepare`]), those that went are retired, the fades and the drift set.
     /// Applying is counted in the next frame's [`crate::render::FrameStats::cpu_update_us`]
     /// when blocks come or go (timed once); a drift (one write for every block) and fades (one
-    /// a fading block) alone go untimed, as a clock read would cost more. `update.field_cpu` is the host's to count
-    /// ([`Self::add_field_cpu`], or the frame's stats).
+    /// a fading block) alone go untimed, as a clock read would cost more. `update.field_cpu` is
+    /// the host's to count ([`Self::add_field_cpu`], or the frame's stats).
     pub fn apply(&mut self, update: SkyUpdate) {
         let start = update.moves_blocks().then(Stopwatch::start);
         let SkyUpdate {
