@@ -126,8 +126,9 @@ impl ScreenGrid {
     /// The rows of the screen the band of elevations `band_rad` crosses, as normalised device
     /// y (lowest first), under the matrix last aimed at; `None` when it crosses none. A cell is
     /// kept when the elevations of its corners, widened by half its diagonal (no ray in it is
-    /// farther from a corner), meet the band.
+    /// farther from a corner), meet the band. A grid never aimed crosses no row.
     pub fn rows_ndc(&mut self, band_rad: (f64, f64)) -> Option<(f32, f32)> {
+        self.key?;
         let (rows, cols) = GRID;
         let side = cols as usize + 1;
         let mut found: Option<(f32, f32)> = None;
@@ -398,6 +399,7 @@ mod tests {
         let mut checked = 0;
         // One grid aimed at each camera in turn, as a ring keeps it: the same rows.
         let mut kept = ScreenGrid::default();
+        assert_eq!(kept.rows_ndc((-0.1, 0.1)), None, "a grid never aimed");
         for pitch in [-89.0, -30.0, -3.0, 0.0, 2.5, 12.0, 45.0, 89.0] {
             for heading in [0.0, 37.0, 90.0, 211.0] {
                 for (fov, aspect) in [(60.0, 16.0 / 9.0), (30.0, 1.0), (90.0, 2.4)] {
