@@ -79,7 +79,7 @@ impl ImpostorRing {
     ) {
         let s = self.reach_settings();
         let recorded = self.recorded.replace(false);
-        let blocks = (&resident.blocks, resident.changes, resident.drift_m);
+        let blocks = (&resident.blocks, resident.changes, resident.drift_m());
         if (self.plan).split(&s, blocks, (camera_m, sun, dt_s), recorded) {
             // The orders kept for blocks gone go with the build that starts.
             self.sorts.retain(&resident.blocks);

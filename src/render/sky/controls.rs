@@ -42,7 +42,7 @@ impl Sky {
     pub fn set_sprite_budget_bytes(&mut self, bytes: u64) {
         let mut old = ResidentSet::new(&self.device, bytes);
         std::mem::swap(&mut old, &mut self.sprites.resident);
-        self.sprites.resident.set_drift(&old.drift_m);
+        self.sprites.resident.set_drift(&old.drift_m());
         for (_, r) in old.blocks {
             let motion = r.motion();
             self.sprites.resident.insert(r.block, motion);

@@ -366,9 +366,8 @@ pub(in crate::render) struct ResidentSet {
     /// shadow map's cover check watches, which a sky of forming clouds would otherwise trip
     /// every frame.
     pub fades: u64,
-    /// The drift [`crate::render::Sky::set_drift`] last moved every block to.
-    pub drift_m: crate::render::scene::BandOffsets,
-    /// The same, as every block it holds reads it ([`Resident::offset_m`]).
+    /// The drift bands' offsets [`crate::render::Sky::set_band_drifts`] last moved every block
+    /// to, as every block it holds reads them ([`Resident::offset_m`]).
     drift: SharedDrift,
     /// Placings of blocks so far ([`Resident::place_serial`]).
     placings: u64,
@@ -466,7 +465,6 @@ impl ResidentSet {
             waiting: IdSet::default(),
             changes: 0,
             fades: 0,
-            drift_m: Default::default(),
             drift: SharedDrift::default(),
             placings: 0,
             expected: (0, 0),
@@ -512,8 +510,12 @@ impl ResidentSet {
     /// Moves every drift band to `offsets_m` (the blocks that follow their band with it): one
     /// write whatever the blocks held.
     pub fn set_drift(&mut self, offsets_m: &crate::render::scene::BandOffsets) {
-        self.drift_m = *offsets_m;
         self.drift.set(offsets_m);
+    }
+
+    /// The drift bands' offsets the blocks were last moved to (none yet: zero).
+    pub fn drift_m(&self) -> crate::render::scene::BandOffsets {
+        self.drift.offsets_m()
     }
 
     /// Retires a block and frees its slots; returns the sprite slots it had, if it was held.

@@ -42,12 +42,21 @@ impl SharedDrift {
     /// Band `band`'s offset (the last band's for a band past the last).
     pub fn offset_m(&self, band: u8) -> DVec3 {
         let bands = &self.0.offsets;
-        let b = &bands[usize::from(band).min(bands.len() - 1)];
-        let [x, y, z] = b
-            .each_ref()
-            .map(|bits| f64::from_bits(bits.load(Ordering::Relaxed)));
-        DVec3::new(x, y, z)
+        read(&bands[usize::from(band).min(bands.len() - 1)])
     }
+
+    /// Every band's offset.
+    pub fn offsets_m(&self) -> BandOffsets {
+        self.0.offsets.each_ref().map(read)
+    }
+}
+
+/// An offset from the bits of its three `f64`s.
+fn read(bits: &[AtomicU64; 3]) -> DVec3 {
+    let [x, y, z] = bits
+        .each_ref()
+        .map(|b| f64::from_bits(b.load(Ordering::Relaxed)));
+    DVec3::new(x, y, z)
 }
 
 #[cfg(test)]
@@ -67,5 +76,6 @@ mod tests {
         assert_eq!(held.settings(), 1);
         assert_eq!(held.offset_m(2), offsets[2]);
         assert_eq!(held.offset_m(200), offsets[offsets.len() - 1]);
+        assert_eq!(held.offsets_m(), offsets);
     }
 }
