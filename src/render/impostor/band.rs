@@ -5,7 +5,7 @@
 //! triangle (the same rays to the bit, so the same pixels) under a scissor of the rows that band
 //! crosses. Units: metres, radians above the level plane.
 
-use glam::{DVec3, Mat4, Vec4};
+use glam::{DVec2, DVec3, Mat4, Vec4};
 
 use super::layout::IMPOSTOR_FOV_Y_DEG;
 
@@ -27,12 +27,46 @@ const DROP_RADIUS_M: f64 = 6.0e6;
 /// The elevations from the ring centre (lowest first) of a cloud whose sprites lie within
 /// `radius_m` of `rel_m` (its centre relative to the ring centre), drawn on the round Earth.
 pub fn cloud_elevations_rad(rel_m: DVec3, radius_m: f64) -> (f64, f64) {
-    // A turned sprite's corner reaches past the sphere of its half side.
-    let r = radius_m * std::f64::consts::SQRT_2 + CLOUD_MARGIN_M;
+    let r = widened_m(radius_m);
     let d = rel_m.truncate().length();
     let (near, far) = ((d - r).max(0.0), d + r);
     let top = rel_m.z + r;
     let bottom = rel_m.z - r - far * far / (2.0 * DROP_RADIUS_M);
+    (
+        bottom.atan2(if bottom >= 0.0 { far } else { near }),
+        top.atan2(if top >= 0.0 { near } else { far }),
+    )
+}
+
+/// The radius [`cloud_elevations_rad`] takes a cloud of radius `radius_m` to reach: a turned
+/// sprite's corner reaches past the sphere of its half side, and the margin.
+pub fn widened_m(radius_m: f64) -> f64 {
+    radius_m * std::f64::consts::SQRT_2 + CLOUD_MARGIN_M
+}
+
+/// Elevations no cloud inside a box reaches beyond (lowest first): for every cloud whose
+/// sphere widened by [`widened_m`] lies within `lo_m..=hi_m` (relative to the ring centre), its
+/// [`cloud_elevations_rad`] lie within them. The box's top over its nearest reach across the
+/// ground, its bottom less the drop at its farthest reach over its nearest or its farthest (as
+/// the cloud's own are taken), each the extreme of every sphere inside it.
+pub fn box_elevations_rad(lo_m: DVec3, hi_m: DVec3) -> (f64, f64) {
+    let nearest = |lo: f64, hi: f64| {
+        if lo > 0.0 {
+            lo
+        } else if hi < 0.0 {
+            -hi
+        } else {
+            0.0
+        }
+    };
+    let near = DVec2::new(nearest(lo_m.x, hi_m.x), nearest(lo_m.y, hi_m.y)).length();
+    let far = DVec2::new(
+        lo_m.x.abs().max(hi_m.x.abs()),
+        lo_m.y.abs().max(hi_m.y.abs()),
+    )
+    .length();
+    let top = hi_m.z;
+    let bottom = lo_m.z - far * far / (2.0 * DROP_RADIUS_M);
     (
         bottom.atan2(if bottom >= 0.0 { far } else { near }),
         top.atan2(if top >= 0.0 { near } else { far }),

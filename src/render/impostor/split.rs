@@ -7,12 +7,13 @@
 
 use glam::{DVec3, Vec3};
 
+use super::band::{box_elevations_rad, cloud_elevations_rad, widened_m};
 use super::layout::{IMPOSTORS, ImpostorSettings, is_far, needs_rebuild, sectors_of};
 use super::{Build, ImpostorRing, RingState};
 use crate::render::id_hash::IdSet;
 use crate::render::scene::{BandOffsets, Fade};
 use crate::render::sprites::draw_list::Blocks;
-use crate::render::sprites::resident::ResidentSet;
+use crate::render::sprites::resident::{Resident, ResidentSet};
 
 /// The ring's CPU state from frame to frame: the rings shown, built and fading in, the renders
 /// planned and not recorded yet, and which blocks the view draws as sprites.
@@ -215,12 +216,12 @@ impl RingPlan {
         // Renders into that ring not recorded yet (frames prepared and never recorded) are of a
         // ring no longer shown: this build replaces them.
         self.pending.retain(|p| p.0 != ring);
-        let far: Vec<(u64, f64)> = blocks
+        let far: Vec<(u64, f64, &Resident)> = blocks
             .values()
             .filter(|r| {
                 !r.distant && is_far(r.nearest_height_m(camera_m.z), camera_m, camera_m, &s)
             })
-            .map(|r| (r.block.id, (r.centre_m() - camera_m).length()))
+            .map(|r| (r.block.id, (r.centre_m() - camera_m).length(), r))
             .collect();
         let far_mean_m = if far.is_empty() {
             s.ring_radius_m
@@ -228,17 +229,8 @@ impl RingPlan {
             far.iter().map(|f| f.1).sum::<f64>() / far.len() as f64
         };
         let far_ids: IdSet = far.iter().map(|f| f.0).collect();
-        let content_rad = blocks
-            .values()
-            .filter(|r| far_ids.contains(&r.block.id))
-            .flat_map(|r| {
-                r.clouds.iter().map(move |c| {
-                    let rel_m = c.centre_m + r.offset_m() - camera_m;
-                    super::band::cloud_elevations_rad(rel_m, f64::from(c.radius_m))
-                })
-            })
-            .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
-            .unwrap_or((0.0, 0.0));
+        let far_blocks: Vec<&Resident> = far.iter().map(|f| f.2).collect();
+        let content_rad = content_rad(&far_blocks, camera_m);
         let mut sectors: [Vec<u64>; IMPOSTORS] = Default::default();
         for r in blocks.values().filter(|r| far_ids.contains(&r.block.id)) {
             let bits = sectors_of(camera_m, r.centre_m());
@@ -274,6 +266,64 @@ impl RingPlan {
     }
 }
 
+/// Radians a block's bound is taken as wider than it is: far more than the rounding of its
+/// elevations (about 1e-16 of a radian), far less than any elevation two clouds differ by.
+const BOUND_SLACK_RAD: f64 = 1e-9;
+
+/// The elevations from `from_m` of every cloud of the `far` blocks: the lowest bottom and the
+/// highest top of [`cloud_elevations_rad`] over them, `(0, 0)` for none (the ring's content,
+/// where its pass is drawn). A block's box of cloud centres widened by its largest cloud
+/// ([`box_elevations_rad`]) bounds its clouds' elevations, so the blocks are read highest bound
+/// first for the top and lowest first for the bottom, and each walk stops at the first block
+/// that cannot reach past what it found: the same numbers as a walk over every cloud, which
+/// read the ring's tens of thousands of clouds once a rebuild started (the approach's slowest
+/// frames).
+fn content_rad(far: &[&Resident], from_m: DVec3) -> (f64, f64) {
+    let mut bounds: Vec<(f64, f64, usize)> = (far.iter().enumerate())
+        .map(|(k, r)| {
+            let (low, high) = block_bound_rad(r, from_m);
+            (low, high, k)
+        })
+        .collect();
+    let mut read = vec![false; far.len()];
+    let mut found: Option<(f64, f64)> = None;
+    let mut read_block = |k: usize, found: &mut Option<(f64, f64)>| {
+        if std::mem::replace(&mut read[k], true) {
+            return;
+        }
+        let r = far[k];
+        let offset_m = r.offset_m();
+        for c in &r.seen {
+            let (a, b) =
+                cloud_elevations_rad(c.centre_m + offset_m - from_m, f64::from(c.radius_m));
+            *found = Some(found.map_or((a, b), |f| (f.0.min(a), f.1.max(b))));
+        }
+    };
+    bounds.sort_by(|a, b| b.1.total_cmp(&a.1));
+    for &(_, high, k) in &bounds {
+        if found.is_some_and(|f| high < f.1 - BOUND_SLACK_RAD) {
+            break;
+        }
+        read_block(k, &mut found);
+    }
+    bounds.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for &(low, _, k) in &bounds {
+        if found.is_some_and(|f| low > f.0 + BOUND_SLACK_RAD) {
+            break;
+        }
+        read_block(k, &mut found);
+    }
+    found.unwrap_or((0.0, 0.0))
+}
+
+/// Elevations from `from_m` that no cloud of block `r` reaches beyond (lowest first): its box
+/// of cloud centres widened by its largest cloud, read without its clouds.
+fn block_bound_rad(r: &Resident, from_m: DVec3) -> (f64, f64) {
+    let (lo, hi) = r.centres_box_m;
+    let (at, reach) = (r.centre_m() - from_m, widened_m(r.largest_cloud_m));
+    box_elevations_rad(at + lo - reach, at + hi + reach)
+}
+
 /// How far the farthest-moved drift band has moved from `then` to `now`, metres.
 fn drift_moved_m(then: &BandOffsets, now: &BandOffsets) -> f64 {
     then.iter()
@@ -285,9 +335,9 @@ fn drift_moved_m(then: &BandOffsets, now: &BandOffsets) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::scene::BlockMotion;
     use crate::render::scene::{SkyBlock, SkyCloud};
     use crate::render::sprites::draw_list::tests::small_cloud;
-    use crate::render::sprites::resident::Resident;
 
     /// Blocks of one small cloud each at `centres`, ids 0, 1, ...
     fn blocks_at(centres: &[DVec3]) -> Blocks {
@@ -341,5 +391,174 @@ mod tests {
         assert!(!plan.split(&off, frame, (camera, Vec3::Z, 0.016), false));
         assert!(plan.build.is_none());
         assert_eq!(plan.near.len(), 4);
+    }
+
+    /// The ring's content band read block by block, from the highest and the lowest bound, is
+    /// the band of every cloud to the bit: blocks of clouds of many sizes spread around their
+    /// centres, near and far, above and below the ring centre, each with its own drift.
+    #[test]
+    fn the_content_band_read_by_block_bounds_is_the_band_of_every_cloud() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let from = DVec3::new(1_000.0, -2_000.0, 3_000.0);
+        for _ in 0..200 {
+            let blocks: Vec<Resident> = (0..30)
+                .map(|id| {
+                    let centre_m = DVec3::new(
+                        (next() - 0.5) * 100_000.0,
+                        (next() - 0.5) * 100_000.0,
+                        next() * 12_000.0,
+                    );
+                    let clouds = (0..1 + (next() * 8.0) as usize)
+                        .map(|_| {
+                            let scale = 0.2 + 10.0 * next() as f32;
+                            let mut cloud = small_cloud();
+                            for s in &mut cloud.sprites {
+                                s.offset_m *= scale;
+                                (s.width_m, s.height_m) = (s.width_m * scale, s.height_m * scale);
+                            }
+                            let spread = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+                            cloud.centre_m = centre_m + spread * DVec3::new(3e3, 3e3, 8e3);
+                            cloud
+                        })
+                        .collect();
+                    let motion = BlockMotion {
+                        offset_m: DVec3::new(next(), next(), 0.0) * 800.0,
+                        ..BlockMotion::default()
+                    };
+                    Resident::new(
+                        SkyBlock {
+                            id,
+                            centre_m,
+                            clouds,
+                        },
+                        motion,
+                    )
+                })
+                .collect();
+            let far: Vec<&Resident> = blocks.iter().collect();
+            let every = (far.iter())
+                .flat_map(|r| {
+                    let offset_m = r.offset_m();
+                    r.seen.iter().map(move |c| {
+                        let rel_m = c.centre_m + offset_m - from;
+                        cloud_elevations_rad(rel_m, f64::from(c.radius_m))
+                    })
+                })
+                .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+                .map(|(a, b)| (a.to_bits(), b.to_bits()));
+            let (low, high) = content_rad(&far, from);
+            assert_eq!(Some((low.to_bits(), high.to_bits())), every);
+        }
+        assert_eq!(content_rad(&[], from), (0.0, 0.0));
+    }
+
+    /// A block whose highest (lowest) cloud lies at the edge of its sphere is still read when a
+    /// block with a tighter bound was read first and came close: one small cloud swept past the
+    /// top cloud of a block reaching up (past the bottom cloud of one reaching down), beside a
+    /// block far below (above) that the other walk reads first.
+    #[test]
+    fn a_tall_block_is_read_past_a_near_miss() {
+        let block = |id: u64, heights: &[f64]| {
+            let at = |z: f64| DVec3::new(300.0 * id as f64, 40_000.0, z);
+            let clouds = (heights.iter())
+                .map(|&z| SkyCloud {
+                    centre_m: at(z),
+                    ..small_cloud()
+                })
+                .collect();
+            let block = SkyBlock {
+                id,
+                centre_m: at(heights[0]),
+                clouds,
+            };
+            Resident::new(block, BlockMotion::default())
+        };
+        let (up, down) = (block(0, &[2_000.0, 4_500.0]), block(0, &[2_000.0, -500.0]));
+        let (low, high) = (block(2, &[-6_000.0]), block(2, &[10_000.0]));
+        for k in 0..400 {
+            let rise = 1_500.0 + 2.5 * f64::from(k);
+            for (tall, far) in [(&up, &low), (&down, &high)] {
+                let z = if std::ptr::eq(tall, &up) {
+                    2_000.0 + rise
+                } else {
+                    2_000.0 - rise
+                };
+                let small = block(1, &[z]);
+                let blocks = [&small, tall, far];
+                let every = (blocks.iter())
+                    .flat_map(|r| r.seen.iter())
+                    .map(|c| cloud_elevations_rad(c.centre_m, f64::from(c.radius_m)))
+                    .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
+                assert_eq!(Some(content_rad(&blocks, DVec3::ZERO)), every, "at {z} m");
+            }
+        }
+    }
+
+    /// Every cloud's elevations lie within its block's bound, to a picoradian: clouds alone
+    /// straight ahead, behind and beside (where the bound is their own), above and below the
+    /// eye, near and far, and blocks of several clouds, each drifted.
+    #[test]
+    fn every_cloud_lies_within_its_blocks_bound() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let from = DVec3::new(-3_000.0, 500.0, 2_500.0);
+        let mut checked = 0;
+        for k in 0..400 {
+            let distance = 5_000.0 + 150_000.0 * next();
+            let height = (next() - 0.4) * 20_000.0;
+            let (sin, cos) = ((k % 4) as f64 * std::f64::consts::FRAC_PI_2).sin_cos();
+            let centre_m = from + DVec3::new(distance * sin, distance * cos, height);
+            let clouds = (0..if k % 2 == 0 {
+                1
+            } else {
+                1 + (next() * 6.0) as usize
+            })
+                .map(|_| {
+                    let scale = 0.2 + 20.0 * next() as f32;
+                    let mut cloud = small_cloud();
+                    for s in &mut cloud.sprites {
+                        s.offset_m *= scale;
+                        (s.width_m, s.height_m) = (s.width_m * scale, s.height_m * scale);
+                    }
+                    let spread = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+                    cloud.centre_m = centre_m + spread * DVec3::new(4e3, 4e3, 6e3) * (k % 2) as f64;
+                    cloud
+                })
+                .collect();
+            let motion = BlockMotion {
+                offset_m: DVec3::new(next() - 0.5, next() - 0.5, 0.0) * 3_000.0,
+                ..BlockMotion::default()
+            };
+            let r = Resident::new(
+                SkyBlock {
+                    id: k,
+                    centre_m,
+                    clouds,
+                },
+                motion,
+            );
+            let (low, high) = block_bound_rad(&r, from);
+            for c in &r.seen {
+                let rel_m = c.centre_m + r.offset_m() - from;
+                let (a, b) = cloud_elevations_rad(rel_m, f64::from(c.radius_m));
+                assert!(
+                    low <= a + 1e-12 && b <= high + 1e-12,
+                    "{a} {b} in {low} {high}"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 800);
     }
 }

@@ -98,6 +98,10 @@ pub(in crate::render) struct Resident {
     /// it and a neighbour (the draw list interleaves the clouds of two deck blocks whose order
     /// the camera is that close to deciding).
     pub largest_cloud_m: f64,
+    /// The lowest and highest corner of the box of its clouds' centres, from its centre,
+    /// metres: with [`Self::largest_cloud_m`], where its clouds can be without reading them
+    /// (the impostor ring's content band).
+    pub centres_box_m: (DVec3, DVec3),
     /// The largest half side of its sprites, metres: how far a quad's corner reaches past the
     /// cloud radius that counts only the half side (`sqrt(2) - 1` of it).
     pub largest_half_side_m: f32,
@@ -184,6 +188,12 @@ impl Resident {
             .map(|c| (c.centre_m - block.centre_m).length() + c.radius_m as f64)
             .fold(0.0, f64::max);
         let largest_cloud_m = clouds.iter().map(|c| c.radius_m as f64).fold(0.0, f64::max);
+        let centres_box_m = (clouds.iter())
+            .map(|c| c.centre_m - block.centre_m)
+            .fold(None, |b: Option<(DVec3, DVec3)>, c| {
+                Some(b.map_or((c, c), |(lo, hi)| (lo.min(c), hi.max(c))))
+            })
+            .unwrap_or_default();
         let largest_half_side_m = clouds
             .iter()
             .map(|c| c.largest_half_side_m)
@@ -204,6 +214,7 @@ impl Resident {
             own_since: 0,
             radius_m,
             largest_cloud_m,
+            centres_box_m,
             largest_half_side_m,
             deck,
             z_span_m,
