@@ -335,6 +335,7 @@ fn drift_moved_m(then: &BandOffsets, now: &BandOffsets) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::clouds::rng::SplitMix64;
     use crate::render::scene::BlockMotion;
     use crate::render::scene::{SkyBlock, SkyCloud};
     use crate::render::sprites::draw_list::tests::small_cloud;
@@ -398,13 +399,8 @@ mod tests {
     /// centres, near and far, above and below the ring centre, each with its own drift.
     #[test]
     fn the_content_band_read_by_block_bounds_is_the_band_of_every_cloud() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = SplitMix64::new(0x2545_f491_4f6c_dd1d);
+        let mut next = || rng.next_f64();
         let from = DVec3::new(1_000.0, -2_000.0, 3_000.0);
         for _ in 0..200 {
             let blocks: Vec<Resident> = (0..30)
@@ -505,13 +501,8 @@ mod tests {
     /// eye, near and far, and blocks of several clouds, each drifted.
     #[test]
     fn every_cloud_lies_within_its_blocks_bound() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = SplitMix64::new(0x9e37_79b9_7f4a_7c15);
+        let mut next = || rng.next_f64();
         let from = DVec3::new(-3_000.0, 500.0, 2_500.0);
         let mut checked = 0;
         for k in 0..400 {
